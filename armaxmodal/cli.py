@@ -1,0 +1,117 @@
+"""Command-line interface: a thin layer over the public API.
+
+armaxmodal info DATA [--input COL] [--fs HZ]
+armaxmodal modes --system supine|chapter2 [--json OUT]
+armaxmodal simulate --system supine --excitation random|sweep --out DATA.csv
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+
+import numpy as np
+
+from . import datasets
+from .exceptions import ArmaxModalError
+from .io import read_recording, write_json, write_recording_csv
+
+SYSTEMS = {"supine": datasets.supine_human, "chapter2": datasets.chapter2_system}
+
+
+def _add_data_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("data", help="recording: .csv[.gz], .mat or .uff")
+    p.add_argument(
+        "--input", default="base", help="input (base acceleration) column; default 'base'"
+    )
+    p.add_argument(
+        "--fs", type=float, default=None, help="sampling rate in Hz if the file has no time column"
+    )
+    p.add_argument(
+        "--outputs", default=None, help="comma-separated output columns to use (default: all)"
+    )
+
+
+def _load(args):
+    outputs = args.outputs.split(",") if args.outputs else None
+    return read_recording(args.data, input=args.input, fs=args.fs, outputs=outputs)
+
+
+def _cmd_info(args) -> int:
+    rec = _load(args)
+    print(f"{args.data}: {rec.n_samples} samples at {rec.fs:g} Hz ({rec.duration:.1f} s)")
+    print(f"input  {rec.input_name}: rms {np.sqrt(np.mean(rec.base**2)):.4g}")
+    for name, col in zip(rec.sensors, rec.response.T, strict=True):
+        print(f"output {name}: rms {np.sqrt(np.mean(col**2)):.4g}")
+    if rec.subject or rec.mass_kg:
+        print(f"subject: {rec.subject or '-'}  mass: {rec.mass_kg or '-'} kg")
+    return 0
+
+
+def _cmd_modes(args) -> int:
+    modes = SYSTEMS[args.system]().modes()
+    print(modes.to_frame().to_string(index=False, float_format=lambda v: f"{v:.4f}"))
+    if args.json:
+        write_json(modes.to_dict(), args.json)
+        if not args.quiet:
+            print(f"wrote {args.json}")
+    return 0
+
+
+def _cmd_simulate(args) -> int:
+    from .simulate import random_vibration, simulate_recording, sine_sweep
+
+    structure = SYSTEMS[args.system]()
+    if args.excitation == "random":
+        u = random_vibration(
+            args.fs, args.duration, (0.5, min(28.0, 0.47 * args.fs)), seed=args.seed
+        )
+    else:
+        u = sine_sweep(args.fs, args.duration)
+    rec = simulate_recording(
+        structure, u, args.fs, noise=args.noise, seed=args.seed, hold=args.hold
+    )
+    write_recording_csv(rec, args.out)
+    if not args.quiet:
+        print(f"wrote {args.out}: {rec.n_samples} samples, outputs {', '.join(rec.sensors)}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="armaxmodal", description="Time-domain modal analysis of base-excited systems."
+    )
+    parser.add_argument("--quiet", action="store_true", help="no progress or chatter")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("info", help="summarise a recording")
+    _add_data_args(p)
+    p.set_defaults(func=_cmd_info)
+
+    p = sub.add_parser("modes", help="exact modes of a reference structure from the thesis")
+    p.add_argument("--system", choices=sorted(SYSTEMS), default="supine")
+    p.add_argument("--json", default=None, help="write the modes as JSON")
+    p.set_defaults(func=_cmd_modes)
+
+    p = sub.add_parser("simulate", help="simulate a base-excitation ride of a reference structure")
+    p.add_argument("--system", choices=sorted(SYSTEMS), default="supine")
+    p.add_argument("--excitation", choices=["random", "sweep"], default="random")
+    p.add_argument("--fs", type=float, default=60.0)
+    p.add_argument("--duration", type=float, default=120.0)
+    p.add_argument("--noise", type=float, default=0.05, help="sensor noise, fraction of RMS")
+    p.add_argument("--hold", choices=["zoh", "bandlimited"], default="bandlimited")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--out", required=True, help="CSV file to write")
+    p.set_defaults(func=_cmd_simulate)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except (ArmaxModalError, FileNotFoundError) as exc:
+        print(f"armaxmodal: error: {exc}", file=sys.stderr)
+        return 2

@@ -1,0 +1,408 @@
+"""Read recordings from CSV, MAT and UFF (type 58) files; write CSV, UFF and JSON.
+
+Input files are never modified. Every output is written to a temporary file beside the
+target and renamed over it only when complete, so a failed write leaves nothing behind.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import struct
+import tempfile
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .exceptions import DataError
+from .recording import Recording
+
+__all__ = [
+    "read_recording",
+    "write_recording_csv",
+    "write_recording_uff",
+    "write_json",
+    "atomic_write",
+]
+
+_TIME_NAMES = ("time", "t", "time_s")
+# Relative jitter allowed in a time column before it counts as non-uniform (device clocks
+# quantise to a microsecond: 1e-4 of a 120 Hz step).
+_TIME_JITTER = 1e-3
+
+
+def read_recording(
+    path: str | os.PathLike,
+    *,
+    input: str = "base",
+    fs: float | None = None,
+    outputs: Sequence[str] | None = None,
+    format: str | None = None,
+    subject: str | None = None,
+    mass_kg: float | None = None,
+) -> Recording:
+    """Read a recording: one input column, the other numeric columns as outputs.
+
+    Parameters
+    ----------
+    path : path-like
+        ``.csv`` (optionally ``.gz``), ``.mat`` or ``.uff``/``.unv``.
+    input : str
+        Name of the input channel (CSV column, MAT variable, UFF ``id1``).
+    fs : float, optional
+        Sampling rate in Hz; required when the file has no time column / sample step.
+    outputs : sequence of str, optional
+        Output channels to keep, in this order (default: every other numeric channel).
+    format : {"csv", "mat", "uff"}, optional
+        Override the format guessed from the file name.
+    subject, mass_kg : optional
+        Who was measured and the total mass in kg; CSV files may also carry them as
+        ``# subject: ...`` and ``# mass_kg: ...`` lines before the header.
+
+    Returns
+    -------
+    Recording
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no such recording: {path}")
+    kind = format or _guess_format(path)
+    readers: dict[str, Callable] = {"csv": _read_csv, "mat": _read_mat, "uff": _read_uff}
+    if kind not in readers:
+        raise DataError(f"unknown format {kind!r} for {path.name}; use csv, mat or uff.")
+    channels, file_fs, info = readers[kind](path)
+    if not channels:
+        raise DataError(f"{path.name}: no numeric channels found.")
+    fs = _resolve_fs(file_fs, fs, path)
+    if input not in channels:
+        raise DataError(
+            f"{path.name}: input channel '{input}' not found; channels are {list(channels)}. "
+            "Name the input column with input=... (CLI: --input)."
+        )
+    names = list(outputs) if outputs is not None else [c for c in channels if c != input]
+    missing = [c for c in names if c not in channels]
+    if missing:
+        raise DataError(
+            f"{path.name}: unknown output channel(s) {missing}; channels are {list(channels)}."
+        )
+    if not names:
+        raise DataError(f"{path.name}: only the input channel '{input}' is present; no outputs.")
+    lengths = {c: channels[c].size for c in [input, *names]}
+    if len(set(lengths.values())) > 1:
+        raise DataError(
+            f"{path.name}: channels differ in length {lengths}; trim them to a common length."
+        )
+    meta = {"source": str(path), "format": kind}
+    return Recording(
+        fs,
+        channels[input],
+        np.column_stack([channels[c] for c in names]),
+        tuple(names),
+        input,
+        subject if subject is not None else info.get("subject"),
+        mass_kg if mass_kg is not None else info.get("mass_kg"),
+        meta,
+    )
+
+
+def _guess_format(path: Path) -> str:
+    suffixes = [s.lower() for s in path.suffixes]
+    if suffixes and suffixes[-1] == ".gz":
+        suffixes = suffixes[:-1]
+    ext = suffixes[-1] if suffixes else ""
+    return {".csv": "csv", ".txt": "csv", ".mat": "mat", ".uff": "uff", ".unv": "uff"}.get(ext, ext)
+
+
+def _resolve_fs(file_fs: float | None, user_fs: float | None, path: Path) -> float:
+    if file_fs is None and user_fs is None:
+        raise DataError(
+            f"{path.name}: no time column or sample step in the file; give the sampling rate "
+            "with fs=... (CLI: --fs)."
+        )
+    if file_fs is not None and user_fs is not None:
+        if abs(file_fs - user_fs) > _TIME_JITTER * user_fs:
+            raise DataError(
+                f"{path.name}: the file's time column gives fs = {file_fs:.6g} Hz but fs = "
+                f"{user_fs:.6g} Hz was passed; drop one of them."
+            )
+        return float(user_fs)
+    return float(user_fs if user_fs is not None else file_fs)
+
+
+def _fs_from_time(t: np.ndarray, path: Path) -> float:
+    if t.size < 2:
+        raise DataError(f"{path.name}: the time column needs at least two samples.")
+    steps = np.diff(t)
+    dt = float(np.median(steps))
+    if dt <= 0:
+        raise DataError(f"{path.name}: the time column does not increase.")
+    worst = int(np.argmax(np.abs(steps - dt)))
+    if abs(steps[worst] - dt) > _TIME_JITTER * dt:
+        raise DataError(
+            f"{path.name}: the time column is not uniformly spaced: the step after row "
+            f"{worst} is {steps[worst]:.6g} s against a median of {dt:.6g} s (a dropped or "
+            "repeated sample?). Resample the data to a uniform grid first."
+        )
+    # The mean step over the whole record is far less sensitive to printed rounding.
+    return (t.size - 1) / float(t[-1] - t[0])
+
+
+# -- CSV ------------------------------------------------------------------------------
+def _read_csv(path: Path):
+    info = _csv_comments(path)
+    try:
+        frame = pd.read_csv(
+            path, comment="#", skipinitialspace=True, dtype=str, keep_default_na=False
+        )
+    except pd.errors.EmptyDataError as exc:
+        raise DataError(f"{path.name}: the file is empty; expected a header row and data.") from exc
+    except (pd.errors.ParserError, UnicodeDecodeError, OSError, EOFError) as exc:
+        raise DataError(f"{path.name}: not a readable CSV file ({exc}).") from exc
+    if frame.shape[0] == 0:
+        raise DataError(f"{path.name}: header only, no data rows.")
+    frame.columns = [str(c).strip() for c in frame.columns]
+    channels: dict[str, np.ndarray] = {}
+    for col in frame.columns:
+        text = frame[col].str.strip()
+        values = pd.to_numeric(text, errors="coerce").to_numpy(dtype=float)
+        bad = np.isnan(values) & ~text.str.lower().isin(["nan"]).to_numpy()
+        if bad.all():
+            continue  # a text column (labels, comments): not a channel
+        if bad.any():
+            row = int(np.argmax(bad))
+            if text.iloc[row] == "":
+                raise DataError(
+                    f"{path.name}: column '{col}', data row {row + 1} is empty (a missing "
+                    "sample); fill or trim it before analysis."
+                )
+            raise DataError(
+                f"{path.name}: column '{col}', data row {row + 1}: {frame[col].iloc[row]!r} is "
+                "not a number; fix or remove that cell."
+            )
+        channels[col] = values
+    file_fs = None
+    time_col = next((c for c in channels if c.lower() in _TIME_NAMES), None)
+    if time_col is not None:
+        t = channels.pop(time_col)
+        if not np.all(np.isfinite(t)):
+            raise DataError(f"{path.name}: the time column contains NaN or empty cells.")
+        file_fs = _fs_from_time(t, path)
+    return channels, file_fs, info
+
+
+def _csv_comments(path: Path) -> dict:
+    """``# key: value`` lines before the header (subject, mass_kg)."""
+    import gzip
+
+    opener = gzip.open if path.suffix.lower() == ".gz" else open
+    info: dict = {}
+    try:
+        with opener(path, "rt", encoding="utf-8") as fh:
+            for line in fh:
+                if not line.startswith("#"):
+                    break
+                key, _, value = line[1:].partition(":")
+                key, value = key.strip().lower(), value.strip()
+                if key == "subject":
+                    info["subject"] = value
+                elif key == "mass_kg":
+                    try:
+                        info["mass_kg"] = float(value)
+                    except ValueError as exc:
+                        raise DataError(
+                            f"{path.name}: '# mass_kg: {value}' is not a number."
+                        ) from exc
+    except (UnicodeDecodeError, OSError, EOFError) as exc:
+        raise DataError(f"{path.name}: not a readable text file ({exc}).") from exc
+    return info
+
+
+# -- MAT ------------------------------------------------------------------------------
+def _read_mat(path: Path):
+    import scipy.io
+
+    try:
+        data = scipy.io.loadmat(path, squeeze_me=False)
+    except NotImplementedError as exc:
+        raise DataError(
+            f"{path.name}: MATLAB v7.3 (HDF5) files are not supported; save with "
+            "save(..., '-v7') or export to CSV."
+        ) from exc
+    except (ValueError, TypeError, IndexError, OSError, struct.error, EOFError) as exc:
+        raise DataError(f"{path.name}: not a readable MAT file ({exc}).") from exc
+    arrays = {k: v for k, v in data.items() if not k.startswith("__") and isinstance(v, np.ndarray)}
+    numeric = {k: np.squeeze(v) for k, v in arrays.items() if v.dtype.kind in "fiu" and v.size > 0}
+    file_fs = None
+    for key in ("fs", "Fs", "FS"):
+        if key in numeric and numeric[key].size == 1:
+            file_fs = float(numeric.pop(key))
+            break
+    time_key = next((k for k in numeric if k.lower() in _TIME_NAMES), None)
+    if time_key is not None:
+        t = numeric.pop(time_key).ravel().astype(float)
+        t_fs = _fs_from_time(t, path)
+        file_fs = file_fs if file_fs is not None else t_fs
+    sensor_names = None
+    if "sensors" in arrays and arrays["sensors"].dtype.kind in "OU":
+        sensor_names = [str(np.squeeze(s)) for s in np.ravel(arrays["sensors"])]
+    vectors = [v for v in numeric.values() if v.ndim == 1]
+    n = max(
+        (v.size for v in vectors), default=max((max(v.shape) for v in numeric.values()), default=0)
+    )
+    channels: dict[str, np.ndarray] = {}
+    for key, v in numeric.items():
+        v = v.astype(float)
+        if v.ndim == 1 and v.size == n:
+            channels[key] = v
+        elif v.ndim == 2 and n in v.shape:
+            cols = v if v.shape[0] == n else v.T
+            names = (
+                sensor_names
+                if key == "response" and sensor_names and len(sensor_names) == cols.shape[1]
+                else [f"{key}_{i + 1}" for i in range(cols.shape[1])]
+            )
+            channels.update({name: cols[:, i].copy() for i, name in enumerate(names)})
+    return channels, file_fs, {}
+
+
+# -- UFF ------------------------------------------------------------------------------
+def _read_uff(path: Path):
+    import pyuff
+
+    try:
+        sets = pyuff.UFF(str(path)).read_sets()
+    except (
+        ValueError,
+        IndexError,
+        KeyError,
+        TypeError,
+        UnicodeDecodeError,
+        struct.error,
+        OSError,
+        EOFError,
+        AttributeError,
+    ) as exc:
+        raise DataError(f"{path.name}: not a readable UFF file ({exc}).") from exc
+    sets = [sets] if isinstance(sets, dict) else list(sets)
+    series = [s for s in sets if s.get("type") == 58]
+    if not series:
+        raise DataError(f"{path.name}: no type-58 (function at node) data sets in this UFF file.")
+    channels: dict[str, np.ndarray] = {}
+    steps = set()
+    for s in series:
+        if int(s.get("func_type", 1)) != 1:
+            raise DataError(
+                f"{path.name}: data set '{s.get('id1', '')}' has function type "
+                f"{s.get('func_type')}, not a time response (1); armaxmodal needs time histories."
+            )
+        name = str(s.get("id1", "")).strip() or f"node{s.get('rsp_node')}:{s.get('rsp_dir')}"
+        if name in channels:
+            raise DataError(
+                f"{path.name}: two data sets are named '{name}'; give each channel its own id1."
+            )
+        data = np.asarray(s["data"])
+        if np.iscomplexobj(data):
+            raise DataError(
+                f"{path.name}: data set '{name}' is complex; expected a real time history."
+            )
+        channels[name] = data.astype(float)
+        steps.add(float(s.get("abscissa_inc", 0.0)))
+    steps.discard(0.0)
+    if len(steps) > 1:
+        raise DataError(f"{path.name}: channels have different sample steps {sorted(steps)}.")
+    file_fs = 1.0 / steps.pop() if steps else None
+    return channels, file_fs, {}
+
+
+# -- writers --------------------------------------------------------------------------
+def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
+    """Call ``write(tmp_path)`` and move the file into place only if it succeeds."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        write(tmp)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def write_recording_csv(
+    recording: Recording, path: str | os.PathLike, float_format: str = "%.9g"
+) -> Path:
+    """Write ``time``, the input and every sensor as CSV, with subject lines if known."""
+
+    def write(tmp: str) -> None:
+        with open(tmp, "w", encoding="utf-8", newline="") as fh:
+            if recording.subject is not None:
+                fh.write(f"# subject: {recording.subject}\n")
+            if recording.mass_kg is not None:
+                fh.write(f"# mass_kg: {recording.mass_kg:.6g}\n")
+            frame = recording.to_frame()
+            # Enough digits that the sampling rate read back from the times is exact.
+            frame["time"] = [f"{t:.12g}" for t in frame["time"]]
+            frame.to_csv(fh, index=False, float_format=float_format, lineterminator="\n")
+
+    return atomic_write(path, write)
+
+
+def write_recording_uff(recording: Recording, path: str | os.PathLike) -> Path:
+    """Write every channel (input first) as a type-58 time-response data set."""
+    import pyuff
+
+    names = [recording.input_name, *recording.sensors]
+    signals = [recording.base, *recording.response.T]
+
+    def write(tmp: str) -> None:
+        os.unlink(tmp)  # pyuff refuses to overwrite in 'add' mode; let it create the file
+        uff = pyuff.UFF(tmp)
+        for node, (name, x) in enumerate(zip(names, signals, strict=True), start=1):
+            uff.write_sets(
+                pyuff.prepare_58(
+                    id1=name,
+                    func_type=1,
+                    rsp_node=node,
+                    rsp_dir=3,
+                    ref_node=1,
+                    ref_dir=3,
+                    ord_data_type=4,
+                    abscissa_spacing=1,
+                    abscissa_min=0.0,
+                    abscissa_inc=1.0 / recording.fs,
+                    num_pts=x.size,
+                    data=np.asarray(x),
+                    x=recording.time,
+                    ordinate_spec_data_type=12,
+                    abscissa_spec_data_type=17,
+                    orddenom_spec_data_type=0,  # pyuff has no default for this one
+                ),
+                mode="add",
+            )
+
+    return atomic_write(path, write)
+
+
+def write_json(obj, path: str | os.PathLike) -> Path:
+    """Write ``obj`` as indented JSON (numpy scalars and arrays converted)."""
+
+    def default(o):
+        if isinstance(o, np.ndarray):
+            return o.tolist()
+        if isinstance(o, np.generic):
+            return o.item()
+        raise TypeError(f"cannot write {type(o).__name__} to JSON")
+
+    def write(tmp: str) -> None:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            json.dump(obj, fh, indent=2, default=default)
+            fh.write("\n")
+
+    return atomic_write(path, write)

@@ -1,0 +1,73 @@
+"""Poles to natural frequency and damping ratio (thesis Section 3.3.2, Eqs. 3.15-3.16).
+
+A discrete-time pole ``mu`` of an ARMAX model sampled every ``dt`` seconds maps to the
+continuous-time pole ``lambda = ln(mu) / dt``; the undamped natural frequency is
+``|lambda| / (2 pi)`` Hz and the damping ratio ``-Re(lambda) / |lambda|``. Eqs. (3.15)-(3.16)
+write the same numbers with ``ln(mu mu*)`` and ``arccos``; both forms are provided so the
+tests can show they agree.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "continuous_modal_parameters",
+    "discrete_to_continuous",
+    "discrete_modal_parameters",
+    "thesis_frequency_damping",
+]
+
+
+def continuous_modal_parameters(lam) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Undamped frequency, damping ratio and damped frequency of continuous poles.
+
+    Parameters
+    ----------
+    lam : array_like of complex
+        Continuous-time poles in rad/s.
+
+    Returns
+    -------
+    freq_hz, damping, damped_freq_hz : ndarray
+        ``|lam| / 2pi`` (Hz), ``-Re(lam) / |lam|`` (ratio), ``|Im(lam)| / 2pi`` (Hz).
+    """
+    lam = np.asarray(lam, dtype=np.complex128)
+    mag = np.abs(lam)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        damping = np.where(mag > 0, -lam.real / np.where(mag > 0, mag, 1.0), np.nan)
+    return mag / (2 * np.pi), damping, np.abs(lam.imag) / (2 * np.pi)
+
+
+def discrete_to_continuous(mu, fs: float) -> np.ndarray:
+    """Continuous poles ``lambda = ln(mu) * fs`` (rad/s) of discrete poles ``mu``."""
+    return np.log(np.asarray(mu, dtype=np.complex128)) * float(fs)
+
+
+def discrete_modal_parameters(mu, fs: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Undamped frequency (Hz), damping ratio and damped frequency (Hz) of discrete poles."""
+    return continuous_modal_parameters(discrete_to_continuous(mu, fs))
+
+
+def thesis_frequency_damping(mu, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """Eqs. (3.15)-(3.16) of the thesis, written as printed.
+
+    Parameters
+    ----------
+    mu : array_like of complex
+        Discrete-time poles (roots of A(z)).
+    dt : float
+        Sampling interval in seconds.
+
+    Returns
+    -------
+    freq_hz, damping : ndarray
+    """
+    mu = np.asarray(mu, dtype=np.complex128)
+    mm = (mu * np.conj(mu)).real
+    log_mm = np.log(mm)
+    cos_arg = np.clip(((mu + np.conj(mu)).real) / (2 * np.sqrt(mm)), -1.0, 1.0)
+    angle = np.arccos(cos_arg)
+    freq = np.sqrt((log_mm / 2) ** 2 + angle**2) / (2 * np.pi * dt)
+    damping = np.sqrt(log_mm**2 / (log_mm**2 + 4 * angle**2))
+    return freq, damping

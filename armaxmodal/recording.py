@@ -1,0 +1,124 @@
+"""A recording: one base-acceleration input and several body/structure sensors."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from ._validate import as_signal_matrix, as_signal_vector, check_fs, check_not_constant
+from .exceptions import DataError
+
+__all__ = ["Recording"]
+
+
+@dataclass(frozen=True)
+class Recording:
+    """Synchronously sampled input and outputs.
+
+    Parameters
+    ----------
+    fs : float
+        Sampling rate, Hz.
+    base : (n_samples,) array_like
+        The measured input (base acceleration, m/s^2, or a force).
+    response : (n_samples, n_sensors) array_like
+        The outputs, one column per sensor.
+    sensors : sequence of str, optional
+        Output names (default ``s1..sk``).
+    input_name : str
+        Name of the input channel (default ``"base"``).
+    subject : str, optional
+        Who or what was measured.
+    mass_kg : float, optional
+        Total mass of the subject, kg (used to scale physical models, Eq. 4.7).
+    meta : dict
+        Anything else worth keeping (source file, simulation truth, ...).
+    """
+
+    fs: float
+    base: np.ndarray
+    response: np.ndarray
+    sensors: tuple[str, ...] = ()
+    input_name: str = "base"
+    subject: str | None = None
+    mass_kg: float | None = None
+    meta: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        fs = check_fs(self.fs)
+        base = as_signal_vector(self.base, f"input '{self.input_name}'")
+        sensors = tuple(self.sensors) if self.sensors else ()
+        n_out = np.shape(self.response)[1] if np.ndim(self.response) == 2 else 1
+        if not sensors:
+            sensors = tuple(f"s{i + 1}" for i in range(n_out))
+        response = as_signal_matrix(self.response, "response", sensors)
+        if response.shape[0] != base.size:
+            raise DataError(
+                f"input has {base.size} samples but the outputs have {response.shape[0]}; "
+                "trim the channels to a common length (align them by time stamp first)."
+            )
+        if len(sensors) != response.shape[1] or len(set(sensors)) != len(sensors):
+            raise DataError(
+                f"sensors: expected {response.shape[1]} distinct names, got {list(sensors)}."
+            )
+        if self.input_name in sensors:
+            raise DataError(f"input '{self.input_name}' is also listed as an output sensor.")
+        check_not_constant(base, f"input '{self.input_name}'")
+        if self.mass_kg is not None and not (np.isfinite(self.mass_kg) and self.mass_kg > 0):
+            raise DataError(f"mass_kg: expected a positive mass in kg, got {self.mass_kg!r}.")
+        base.setflags(write=False)
+        response.setflags(write=False)
+        object.__setattr__(self, "fs", fs)
+        object.__setattr__(self, "base", base)
+        object.__setattr__(self, "response", response)
+        object.__setattr__(self, "sensors", sensors)
+
+    @property
+    def n_samples(self) -> int:
+        return self.base.size
+
+    @property
+    def n_sensors(self) -> int:
+        return self.response.shape[1]
+
+    @property
+    def duration(self) -> float:
+        """Record length in seconds."""
+        return self.n_samples / self.fs
+
+    @property
+    def time(self) -> np.ndarray:
+        """Sample times in seconds, starting at 0."""
+        return np.arange(self.n_samples) / self.fs
+
+    def channel(self, name: str) -> np.ndarray:
+        """One output by name."""
+        return self.response[:, self._sensor_index(name)]
+
+    def select(self, sensors: Sequence[str]) -> Recording:
+        """A recording with only the named outputs, in the given order."""
+        idx = [self._sensor_index(s) for s in sensors]
+        return Recording(
+            self.fs,
+            self.base,
+            self.response[:, idx],
+            tuple(sensors),
+            self.input_name,
+            self.subject,
+            self.mass_kg,
+            dict(self.meta),
+        )
+
+    def to_frame(self) -> pd.DataFrame:
+        """Columns ``time``, the input, then each sensor."""
+        data = {"time": self.time, self.input_name: self.base}
+        data.update({s: self.response[:, i] for i, s in enumerate(self.sensors)})
+        return pd.DataFrame(data)
+
+    def _sensor_index(self, name: str) -> int:
+        if name not in self.sensors:
+            raise DataError(f"unknown sensor '{name}'; the outputs are {list(self.sensors)}.")
+        return self.sensors.index(name)

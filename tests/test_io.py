@@ -1,0 +1,175 @@
+import gzip
+import hashlib
+
+import numpy as np
+import pytest
+import scipy.io
+
+import armaxmodal as am
+from armaxmodal.exceptions import DataError
+
+
+@pytest.fixture
+def rec():
+    s = am.supine_human()
+    u = am.random_vibration(60.0, 10.0, seed=1)
+    r = am.simulate_recording(s, u, 60.0, noise=0.02, seed=2)
+    return am.Recording(r.fs, r.base, r.response, r.sensors, subject="S3", mass_kg=76.96)
+
+
+def _write(tmp_path, name, text):
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+def test_csv_round_trip_with_subject(tmp_path, rec):
+    path = am.write_recording_csv(rec, tmp_path / "r.csv")
+    back = am.read_recording(path)
+    assert back.fs == pytest.approx(60.0, rel=1e-9)
+    assert back.sensors == rec.sensors and back.input_name == "base"
+    np.testing.assert_allclose(back.response, rec.response, rtol=1e-8)
+    np.testing.assert_allclose(back.base, rec.base, rtol=1e-8)
+    assert back.subject == "S3" and back.mass_kg == pytest.approx(76.96)
+
+
+def test_csv_gz_and_fs_without_time(tmp_path):
+    p = tmp_path / "r.csv.gz"
+    with gzip.open(p, "wt") as fh:
+        fh.write("plat,a,b\n1,2,3\n2,3,4\n0,1,1\n")
+    r = am.read_recording(p, input="plat", fs=100.0)
+    assert r.fs == 100.0 and r.sensors == ("a", "b")
+    np.testing.assert_array_equal(r.base, [1, 2, 0])
+
+
+def test_csv_output_selection(tmp_path):
+    p = _write(tmp_path, "r.csv", "time,base,a,b,c\n0,1,2,3,4\n0.5,2,3,4,5\n1.0,0,1,1,1\n")
+    r = am.read_recording(p, outputs=["c", "a"])
+    assert r.sensors == ("c", "a") and r.fs == 2.0
+    with pytest.raises(DataError, match="unknown output"):
+        am.read_recording(p, outputs=["z"])
+
+
+@pytest.mark.parametrize(
+    "text, kwargs, message",
+    [
+        ("time,plat,a\n0,1,2\n1,2,3\n2,0,1\n", {}, "input channel 'base' not found.*--input"),
+        ("base,a\n1,2\n2,3\n", {}, "fs=.*--fs"),
+        ("time,base,a\n0,1,2\n1,2,x3\n2,0,1\n", {}, "column 'a', data row 2: 'x3' is not a number"),
+        ("time,base,a\n0,1,2\n1,2,3\n3,0,1\n4,1,1\n", {}, "not uniformly spaced"),
+        ("time,base,a\n0,1,2\n1,2,\n2,0,1\n", {}, "data row 2 is empty"),
+        ("time,base,a\n0,1,2\n1,2,nan\n2,0,1\n", {}, "channel 'a' has 1 NaN"),
+        ("time,base,a\n0,1,2\n1,2,3\n2,0,1\n", {"fs": 50.0}, "fs = 1 Hz but fs = 50 Hz"),
+        ("time,base,a\n", {}, "no data rows"),
+        ("", {}, "empty"),
+        ("time,base,a\n0,1,2\n1,1,3\n2,1,1\n", {}, "constant"),
+        ("time,base\n0,1\n1,2\n2,0\n", {}, "no outputs"),
+    ],
+)
+def test_bad_csv_gets_a_clear_error(tmp_path, text, kwargs, message):
+    p = _write(tmp_path, "bad.csv", text)
+    with pytest.raises(DataError, match=message):
+        am.read_recording(p, **kwargs)
+
+
+def test_missing_file():
+    with pytest.raises(FileNotFoundError):
+        am.read_recording("/nonexistent/file.csv")
+
+
+def test_mismatched_lengths_in_arrays():
+    with pytest.raises(DataError, match="common length"):
+        am.Recording(60.0, np.arange(10.0), np.ones((9, 2)))
+
+
+def test_input_file_is_never_modified(tmp_path, rec):
+    path = am.write_recording_csv(rec, tmp_path / "r.csv")
+    before = hashlib.sha256(path.read_bytes()).hexdigest()
+    am.read_recording(path)
+    assert hashlib.sha256(path.read_bytes()).hexdigest() == before
+
+
+def test_failed_write_leaves_nothing(tmp_path, rec):
+    from armaxmodal.io import atomic_write
+
+    def broken(tmp):
+        with open(tmp, "w") as fh:
+            fh.write("partial")
+        raise RuntimeError("disk full")
+
+    with pytest.raises(RuntimeError):
+        atomic_write(tmp_path / "out.csv", broken)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_mat_round_trip_with_matrix_channels(tmp_path):
+    n = 500
+    rng = np.random.default_rng(0)
+    force = rng.standard_normal(n)
+    acc = rng.standard_normal((3, n))
+    p = tmp_path / "gvt.mat"
+    scipy.io.savemat(p, {"Fs": 400.0, "Force": force[None, :], "Acceleration": acc})
+    r = am.read_recording(p, input="Force")
+    assert r.fs == 400.0 and r.sensors == ("Acceleration_1", "Acceleration_2", "Acceleration_3")
+    np.testing.assert_array_equal(r.response, acc.T)
+
+
+def test_mat_with_named_response(tmp_path):
+    p = tmp_path / "r.mat"
+    rng = np.random.default_rng(1)
+    scipy.io.savemat(
+        p,
+        {
+            "time": np.arange(100) / 60.0,
+            "base": rng.standard_normal(100),
+            "response": rng.standard_normal((100, 2)),
+            "sensors": np.array(["head", "legs"], dtype=object),
+        },
+    )
+    r = am.read_recording(p)
+    assert r.sensors == ("head", "legs") and r.fs == pytest.approx(60.0)
+
+
+def test_corrupt_and_v73_mat_files(tmp_path):
+    p = tmp_path / "corrupt.mat"
+    p.write_bytes(b"MATLAB 5.0 MAT-file" + b"\x00" * 20)
+    with pytest.raises(DataError, match="not a readable MAT"):
+        am.read_recording(p, fs=1.0)
+    header = (
+        b"MATLAB 7.3 MAT-file, Platform: GLNXA64".ljust(116, b" ") + b"\x00" * 8 + b"\x00\x02IM"
+    )
+    p73 = tmp_path / "v73.mat"
+    p73.write_bytes(header + b"\x00" * 512)
+    with pytest.raises(DataError, match="v7.3"):
+        am.read_recording(p73, fs=1.0)
+
+
+def test_uff_round_trip(tmp_path, rec):
+    path = am.write_recording_uff(rec, tmp_path / "r.uff")
+    back = am.read_recording(path)
+    # UFF 58 stores the sample step as E13.5 (six significant digits).
+    assert back.fs == pytest.approx(60.0, rel=1e-5)
+    assert back.sensors == rec.sensors
+    np.testing.assert_allclose(back.response, rec.response, rtol=1e-6)
+
+
+def test_corrupt_uff(tmp_path):
+    p = tmp_path / "bad.uff"
+    p.write_text("    -1\n    58\nthis is not a data set\n")
+    with pytest.raises(DataError, match="UFF"):
+        am.read_recording(p, fs=1.0)
+
+
+def test_real_f16_mat_file(realdata_dir):
+    r = am.read_recording(
+        realdata_dir / "f16_gvt" / "F16Data_FullMSine_Level1.mat",
+        input="Force",
+        outputs=["Acceleration_1", "Acceleration_2", "Acceleration_3"],
+    )
+    assert r.fs == 400.0 and r.n_samples == 73728
+
+
+def test_real_shake_table_csv_needs_its_header_skipped(realdata_dir):
+    """Xsens exports carry 7 header lines; reading them raw must fail clearly, not crash."""
+    with pytest.raises(DataError):
+        am.read_recording(realdata_dir / "mini_shake_table_imu" / "flex3" / "northridge__g.csv.gz")
