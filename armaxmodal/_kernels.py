@@ -55,3 +55,129 @@ def _hold_recursion(phi, gam, u_pad, n_steps, stride):
             for i in range(ns):
                 out[row, i] = x[i]
     return out
+
+
+@njit(**_JIT)
+def _inverse_filter(x, c):
+    """``x_f = x / C(q)`` with zero initial state: ``x_f[t] = x[t] - sum_i c[i] x_f[t-i]``.
+
+    ``c`` is monic (``c[0] == 1``); shape (nc + 1,). ``x`` is (n_sig, n) and every row is
+    filtered.
+    """
+    n_sig, n = x.shape
+    nc = c.size - 1
+    out = np.empty_like(x)
+    for s in range(n_sig):
+        for t in range(n):
+            acc = x[s, t]
+            top = min(nc, t)
+            for i in range(1, top + 1):
+                acc -= c[i] * out[s, t - i]
+            out[s, t] = acc
+    return out
+
+
+@njit(**_JIT)
+def _armax_residual(y, u, a, b, nk, c):
+    """One-step prediction errors ``eps = (A y - q^-nk B u) / C`` with zero padding.
+
+    Parameters
+    ----------
+    y : (n,) output
+    u : (n_in, n) inputs
+    a : (na + 1,) monic A coefficients
+    b : (n_in, nb) B coefficients; ``b[m, j]`` multiplies ``u[m, t - nk - j]``
+    nk : int, input delay (negative: non-causal taps)
+    c : (nc + 1,) monic C coefficients
+
+    Returns
+    -------
+    (n,) prediction errors; samples outside [0, n) count as zero.
+    """
+    n = y.size
+    n_in, nb = b.shape
+    na = a.size - 1
+    nc = c.size - 1
+    eps = np.empty(n)
+    for t in range(n):
+        w = y[t]
+        for i in range(1, min(na, t) + 1):
+            w += a[i] * y[t - i]
+        for m in range(n_in):
+            for j in range(nb):
+                k = t - nk - j
+                if 0 <= k < n:
+                    w -= b[m, j] * u[m, k]
+        for i in range(1, min(nc, t) + 1):
+            w -= c[i] * eps[t - i]
+        eps[t] = w
+    return eps
+
+
+@njit(**_JIT)
+def _lagged_value(sig, s, k):
+    if k < 0 or k >= sig.shape[1]:
+        return 0.0
+    return sig[s, k]
+
+
+@njit(**_JIT)
+def _lagged_gram(sig, col_sig, col_lag, col_sign, t0, t1):
+    """Gram matrix of regressor columns that are lagged copies of a few signals.
+
+    Column ``c`` is ``col_sign[c] * sig[col_sig[c], t - col_lag[c]]`` for t in [t0, t1)
+    (zero outside the record). Within a run of columns on the same signal the lags must
+    increase by one; then each entry follows from its upper-left neighbour by adding the
+    sample entering at ``t0`` and removing the one leaving at ``t1`` -- O(n p) work instead
+    of O(n p^2). Returns the symmetric (p, p) matrix.
+    """
+    p = col_sig.size
+    g = np.zeros((p, p))
+    for c1 in range(p):
+        for c2 in range(c1, p):
+            s1, s2 = col_sig[c1], col_sig[c2]
+            l1, l2 = col_lag[c1], col_lag[c2]
+            chained = (
+                c1 > 0
+                and c2 > 0
+                and col_sig[c1 - 1] == s1
+                and col_sig[c2 - 1] == s2
+                and col_lag[c1 - 1] == l1 - 1
+                and col_lag[c2 - 1] == l2 - 1
+            )
+            if chained:
+                val = col_sign[c1 - 1] * col_sign[c2 - 1] * g[c1 - 1, c2 - 1]
+                val *= col_sign[c1] * col_sign[c2]
+                val += (
+                    col_sign[c1]
+                    * col_sign[c2]
+                    * (
+                        _lagged_value(sig, s1, t0 - l1) * _lagged_value(sig, s2, t0 - l2)
+                        - _lagged_value(sig, s1, t1 - l1) * _lagged_value(sig, s2, t1 - l2)
+                    )
+                )
+            else:
+                acc = 0.0
+                lo = max(t0, l1, l2)
+                hi = min(t1, sig.shape[1] + l1, sig.shape[1] + l2)
+                for t in range(lo, hi):
+                    acc += sig[s1, t - l1] * sig[s2, t - l2]
+                val = col_sign[c1] * col_sign[c2] * acc
+            g[c1, c2] = val
+            g[c2, c1] = val
+    return g
+
+
+@njit(**_JIT)
+def _lagged_cross(sig, col_sig, col_lag, col_sign, target, t0, t1):
+    """``sum_t column_c(t) * target(t)`` for t in [t0, t1), for every column; shape (p,)."""
+    p = col_sig.size
+    out = np.zeros(p)
+    n = sig.shape[1]
+    for c in range(p):
+        s, lag = col_sig[c], col_lag[c]
+        acc = 0.0
+        for t in range(max(t0, lag), min(t1, n + lag)):
+            acc += sig[s, t - lag] * target[t]
+        out[c] = col_sign[c] * acc
+    return out

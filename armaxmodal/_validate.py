@@ -18,15 +18,11 @@ def as_signal_matrix(x, name: str, channel_names: Sequence[str] | None = None) -
     try:
         arr = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError) as exc:
-        raise DataError(
-            f"{name}: expected numeric samples, got {type(x).__name__} ({exc})."
-        ) from exc
+        raise DataError(f"{name}: expected numeric samples, got {type(x).__name__} ({exc}).") from exc
     if arr.ndim == 1:
         arr = arr[:, None]
     if arr.ndim != 2:
-        raise DataError(
-            f"{name}: expected shape (n_samples,) or (n_samples, n_channels), got {arr.shape}."
-        )
+        raise DataError(f"{name}: expected shape (n_samples,) or (n_samples, n_channels), got {arr.shape}.")
     if arr.shape[0] == 0 or arr.shape[1] == 0:
         raise DataError(f"{name}: the signal is empty (shape {arr.shape}).")
     bad = ~np.isfinite(arr)

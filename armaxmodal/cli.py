@@ -22,15 +22,9 @@ SYSTEMS = {"supine": datasets.supine_human, "chapter2": datasets.chapter2_system
 
 def _add_data_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("data", help="recording: .csv[.gz], .mat or .uff")
-    p.add_argument(
-        "--input", default="base", help="input (base acceleration) column; default 'base'"
-    )
-    p.add_argument(
-        "--fs", type=float, default=None, help="sampling rate in Hz if the file has no time column"
-    )
-    p.add_argument(
-        "--outputs", default=None, help="comma-separated output columns to use (default: all)"
-    )
+    p.add_argument("--input", default="base", help="input (base acceleration) column; default 'base'")
+    p.add_argument("--fs", type=float, default=None, help="sampling rate in Hz if the file has no time column")
+    p.add_argument("--outputs", default=None, help="comma-separated output columns to use (default: all)")
 
 
 def _load(args):
@@ -64,14 +58,10 @@ def _cmd_simulate(args) -> int:
 
     structure = SYSTEMS[args.system]()
     if args.excitation == "random":
-        u = random_vibration(
-            args.fs, args.duration, (0.5, min(28.0, 0.47 * args.fs)), seed=args.seed
-        )
+        u = random_vibration(args.fs, args.duration, (0.5, min(28.0, 0.47 * args.fs)), seed=args.seed)
     else:
         u = sine_sweep(args.fs, args.duration)
-    rec = simulate_recording(
-        structure, u, args.fs, noise=args.noise, seed=args.seed, hold=args.hold
-    )
+    rec = simulate_recording(structure, u, args.fs, noise=args.noise, seed=args.seed, hold=args.hold)
     write_recording_csv(rec, args.out)
     if not args.quiet:
         print(f"wrote {args.out}: {rec.n_samples} samples, outputs {', '.join(rec.sensors)}")

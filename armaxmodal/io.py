@@ -84,16 +84,12 @@ def read_recording(
     names = list(outputs) if outputs is not None else [c for c in channels if c != input]
     missing = [c for c in names if c not in channels]
     if missing:
-        raise DataError(
-            f"{path.name}: unknown output channel(s) {missing}; channels are {list(channels)}."
-        )
+        raise DataError(f"{path.name}: unknown output channel(s) {missing}; channels are {list(channels)}.")
     if not names:
         raise DataError(f"{path.name}: only the input channel '{input}' is present; no outputs.")
     lengths = {c: channels[c].size for c in [input, *names]}
     if len(set(lengths.values())) > 1:
-        raise DataError(
-            f"{path.name}: channels differ in length {lengths}; trim them to a common length."
-        )
+        raise DataError(f"{path.name}: channels differ in length {lengths}; trim them to a common length.")
     meta = {"source": str(path), "format": kind}
     return Recording(
         fs,
@@ -118,8 +114,7 @@ def _guess_format(path: Path) -> str:
 def _resolve_fs(file_fs: float | None, user_fs: float | None, path: Path) -> float:
     if file_fs is None and user_fs is None:
         raise DataError(
-            f"{path.name}: no time column or sample step in the file; give the sampling rate "
-            "with fs=... (CLI: --fs)."
+            f"{path.name}: no time column or sample step in the file; give the sampling rate with fs=... (CLI: --fs)."
         )
     if file_fs is not None and user_fs is not None:
         if abs(file_fs - user_fs) > _TIME_JITTER * user_fs:
@@ -153,9 +148,7 @@ def _fs_from_time(t: np.ndarray, path: Path) -> float:
 def _read_csv(path: Path):
     info = _csv_comments(path)
     try:
-        frame = pd.read_csv(
-            path, comment="#", skipinitialspace=True, dtype=str, keep_default_na=False
-        )
+        frame = pd.read_csv(path, comment="#", skipinitialspace=True, dtype=str, keep_default_na=False)
     except pd.errors.EmptyDataError as exc:
         raise DataError(f"{path.name}: the file is empty; expected a header row and data.") from exc
     except (pd.errors.ParserError, UnicodeDecodeError, OSError, EOFError) as exc:
@@ -211,9 +204,7 @@ def _csv_comments(path: Path) -> dict:
                     try:
                         info["mass_kg"] = float(value)
                     except ValueError as exc:
-                        raise DataError(
-                            f"{path.name}: '# mass_kg: {value}' is not a number."
-                        ) from exc
+                        raise DataError(f"{path.name}: '# mass_kg: {value}' is not a number.") from exc
     except (UnicodeDecodeError, OSError, EOFError) as exc:
         raise DataError(f"{path.name}: not a readable text file ({exc}).") from exc
     return info
@@ -227,8 +218,7 @@ def _read_mat(path: Path):
         data = scipy.io.loadmat(path, squeeze_me=False)
     except NotImplementedError as exc:
         raise DataError(
-            f"{path.name}: MATLAB v7.3 (HDF5) files are not supported; save with "
-            "save(..., '-v7') or export to CSV."
+            f"{path.name}: MATLAB v7.3 (HDF5) files are not supported; save with save(..., '-v7') or export to CSV."
         ) from exc
     except (ValueError, TypeError, IndexError, OSError, struct.error, EOFError) as exc:
         raise DataError(f"{path.name}: not a readable MAT file ({exc}).") from exc
@@ -248,9 +238,7 @@ def _read_mat(path: Path):
     if "sensors" in arrays and arrays["sensors"].dtype.kind in "OU":
         sensor_names = [str(np.squeeze(s)) for s in np.ravel(arrays["sensors"])]
     vectors = [v for v in numeric.values() if v.ndim == 1]
-    n = max(
-        (v.size for v in vectors), default=max((max(v.shape) for v in numeric.values()), default=0)
-    )
+    n = max((v.size for v in vectors), default=max((max(v.shape) for v in numeric.values()), default=0))
     channels: dict[str, np.ndarray] = {}
     for key, v in numeric.items():
         v = v.astype(float)
@@ -299,14 +287,10 @@ def _read_uff(path: Path):
             )
         name = str(s.get("id1", "")).strip() or f"node{s.get('rsp_node')}:{s.get('rsp_dir')}"
         if name in channels:
-            raise DataError(
-                f"{path.name}: two data sets are named '{name}'; give each channel its own id1."
-            )
+            raise DataError(f"{path.name}: two data sets are named '{name}'; give each channel its own id1.")
         data = np.asarray(s["data"])
         if np.iscomplexobj(data):
-            raise DataError(
-                f"{path.name}: data set '{name}' is complex; expected a real time history."
-            )
+            raise DataError(f"{path.name}: data set '{name}' is complex; expected a real time history.")
         channels[name] = data.astype(float)
         steps.add(float(s.get("abscissa_inc", 0.0)))
     steps.discard(0.0)
@@ -335,9 +319,7 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
     return path
 
 
-def write_recording_csv(
-    recording: Recording, path: str | os.PathLike, float_format: str = "%.9g"
-) -> Path:
+def write_recording_csv(recording: Recording, path: str | os.PathLike, float_format: str = "%.9g") -> Path:
     """Write ``time``, the input and every sensor as CSV, with subject lines if known."""
 
     def write(tmp: str) -> None:

@@ -16,6 +16,7 @@ __all__ = [
     "discrete_to_continuous",
     "discrete_modal_parameters",
     "thesis_frequency_damping",
+    "pole_uncertainty",
 ]
 
 
@@ -71,3 +72,38 @@ def thesis_frequency_damping(mu, dt: float) -> tuple[np.ndarray, np.ndarray]:
     freq = np.sqrt((log_mm / 2) ** 2 + angle**2) / (2 * np.pi * dt)
     damping = np.sqrt(log_mm**2 / (log_mm**2 + 4 * angle**2))
     return freq, damping
+
+
+def pole_uncertainty(a, mu, cov_a, fs: float) -> tuple[np.ndarray, np.ndarray]:
+    """Standard deviations of frequency (Hz) and damping of poles ``mu`` of ``A(z)``.
+
+    Delta method: a root of ``z^na + a_1 z^(na-1) + ... + a_na`` moves by
+    ``dmu/da_i = -mu^(na-i) / A'(mu)``; then ``lambda = fs ln(mu)``, ``f = |lambda|/2pi`` and
+    ``xi = -Re(lambda)/|lambda|``.
+
+    Parameters
+    ----------
+    a : (na + 1,) monic A coefficients
+    mu : (k,) complex poles of A
+    cov_a : (na, na) covariance of ``a_1..a_na``
+    fs : sampling rate, Hz
+
+    Returns
+    -------
+    sd_freq_hz, sd_damping : (k,) ndarray
+    """
+    a = np.asarray(a, dtype=float)
+    mu = np.atleast_1d(np.asarray(mu, dtype=complex))
+    na = a.size - 1
+    deriv = np.polyval(np.polyder(a), mu)
+    powers = mu[:, None] ** (na - np.arange(1, na + 1))[None, :]
+    dmu = -powers / deriv[:, None]  # (k, na) complex
+    lam = np.log(mu) * fs
+    dlam = dmu * (fs / mu)[:, None]
+    mag = np.abs(lam)
+    lr, li = lam.real, lam.imag
+    df = (lr[:, None] * dlam.real + li[:, None] * dlam.imag) / (2 * np.pi * mag[:, None])
+    dxi = (-(li**2)[:, None] * dlam.real + (lr * li)[:, None] * dlam.imag) / (mag**3)[:, None]
+    var_f = np.einsum("ki,ij,kj->k", df, cov_a, df)
+    var_xi = np.einsum("ki,ij,kj->k", dxi, cov_a, dxi)
+    return np.sqrt(np.maximum(var_f, 0)), np.sqrt(np.maximum(var_xi, 0))

@@ -61,9 +61,7 @@ class Recording:
                 "trim the channels to a common length (align them by time stamp first)."
             )
         if len(sensors) != response.shape[1] or len(set(sensors)) != len(sensors):
-            raise DataError(
-                f"sensors: expected {response.shape[1]} distinct names, got {list(sensors)}."
-            )
+            raise DataError(f"sensors: expected {response.shape[1]} distinct names, got {list(sensors)}.")
         if self.input_name in sensors:
             raise DataError(f"input '{self.input_name}' is also listed as an output sensor.")
         check_not_constant(base, f"input '{self.input_name}'")

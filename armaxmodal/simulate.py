@@ -29,10 +29,12 @@ import scipy.signal
 
 from ._kernels import _hold_recursion
 from ._validate import as_signal_vector, check_fs
+from .armax import ArmaxModel
 from .recording import Recording
 from .structure import FRAMES, QUANTITIES, Structure
 
 __all__ = [
+    "exact_armax",
     "simulate",
     "simulate_recording",
     "sine_sweep",
@@ -109,9 +111,7 @@ def simulate(
     if hold not in HOLDS:
         raise ValueError(f"hold: expected one of {HOLDS}, got {hold!r}.")
     if quantity not in QUANTITIES or frame not in FRAMES:
-        raise ValueError(
-            f"quantity/frame: expected {QUANTITIES} and {FRAMES}, got {quantity!r}, {frame!r}."
-        )
+        raise ValueError(f"quantity/frame: expected {QUANTITIES} and {FRAMES}, got {quantity!r}, {frame!r}.")
     fs = check_fs(fs)
     u = as_signal_vector(base_acceleration, "base_acceleration")
     r = _DEFAULT_OVERSAMPLE[hold] if oversample is None else int(oversample)
@@ -130,6 +130,50 @@ def simulate(
         np.ascontiguousarray(phi), np.ascontiguousarray(gam), np.ascontiguousarray(u_pad), n * r, r
     )[:n]
     return states @ c.T + u[:, None] * d[:, 0][None, :]
+
+
+def exact_armax(
+    structure: Structure,
+    fs: float,
+    *,
+    quantity: str = "acceleration",
+    frame: str = "absolute",
+    noise_std=None,
+) -> list[ArmaxModel]:
+    """The exact discrete models of a structure under a zero-order-hold base input.
+
+    One ARMAX model per DOF with ``na = n_states``, ``nb = na + 1`` (lags 0..na: b0 is the
+    feed-through), ``nk = 0`` and ``C = A``: white sensor noise ``v`` on the output gives
+    ``A y = B u + A v``, so these are the true parameters of the ``zoh`` simulation with
+    sensor noise, and the point at which to evaluate the Cramer-Rao bound.
+
+    Parameters
+    ----------
+    structure : Structure
+    fs : float
+        Sampling rate, Hz.
+    quantity, frame : str
+        As in :func:`simulate`.
+    noise_std : float or (n_dof,) array_like, optional
+        Sensor noise standard deviations (the innovation variance of each model).
+
+    Returns
+    -------
+    list of ArmaxModel
+    """
+    fs = check_fs(fs)
+    a, b, c, d = structure.state_space(quantity, frame)
+    ns = a.shape[0]
+    phi, gam = _hold_gains(a, b, 1.0 / fs, "zoh")
+    den = np.real(np.poly(np.linalg.eigvals(phi)))
+    std = np.broadcast_to(np.nan if noise_std is None else np.asarray(noise_std, float), (structure.n_dof,))
+    models = []
+    for k, name in enumerate(structure.names):
+        num, _ = scipy.signal.ss2tf(phi, gam, c[k : k + 1], d[k : k + 1])
+        num = np.real(num[0])
+        num = np.concatenate([np.zeros(ns + 1 - num.size), num])
+        models.append(ArmaxModel(den.copy(), num[None, :], den.copy(), 0, fs, float(std[k]) ** 2, name, ("base",)))
+    return models
 
 
 def simulate_recording(

@@ -184,9 +184,7 @@ class Structure:
         C = as_square_matrix(self.C, "C", n)
         K = as_square_matrix(self.K, "K", n)
         if np.any(np.abs(M - np.diag(np.diag(M))) > 0):
-            raise StructureError(
-                "M must be diagonal (lumped masses, Eq. 3.21); got off-diagonal terms."
-            )
+            raise StructureError("M must be diagonal (lumped masses, Eq. 3.21); got off-diagonal terms.")
         if np.any(np.diag(M) <= 0):
             raise StructureError(f"M must have positive masses on its diagonal; got {np.diag(M)}.")
         for label, mat in (("C", C), ("K", K)):
@@ -206,9 +204,7 @@ class Structure:
             )
         c_eig = np.linalg.eigvalsh(C)
         if c_eig.min() < -1e-9 * max(abs(c_eig).max(), 1e-300):
-            raise StructureError(
-                f"C must be positive semi-definite; its smallest eigenvalue is {c_eig.min():.6g}."
-            )
+            raise StructureError(f"C must be positive semi-definite; its smallest eigenvalue is {c_eig.min():.6g}.")
         names = tuple(self.names) if self.names else tuple(f"dof{i + 1}" for i in range(n))
         if len(names) != n or len(set(names)) != n:
             raise StructureError(f"names: expected {n} distinct names, got {list(names)}.")
@@ -234,14 +230,10 @@ class Structure:
         n = masses.size
         for label, v, size in (("k", k, n), ("c", c, n), ("k_s", k_s, n - 1), ("c_s", c_s, n - 1)):
             if np.size(v) != size:
-                raise StructureError(
-                    f"{label}: expected {size} values for {n} masses, got {np.size(v)}."
-                )
+                raise StructureError(f"{label}: expected {size} values for {n} masses, got {np.size(v)}.")
             if np.any(np.asarray(v, dtype=float) < 0):
                 raise StructureError(f"{label}: springs and dampers must be non-negative, got {v}.")
-        return cls(
-            np.diag(masses), _chain_matrix(c, c_s), _chain_matrix(k, k_s), tuple(names or ())
-        )
+        return cls(np.diag(masses), _chain_matrix(c, c_s), _chain_matrix(k, k_s), tuple(names or ()))
 
     @property
     def n_dof(self) -> int:
@@ -263,9 +255,7 @@ class Structure:
         """Complex modes from the first-order (state-space) eigenproblem."""
         n = self.n_dof
         m_inv = 1.0 / np.diag(self.M)
-        a = np.block(
-            [[np.zeros((n, n)), np.eye(n)], [-m_inv[:, None] * self.K, -m_inv[:, None] * self.C]]
-        )
+        a = np.block([[np.zeros((n, n)), np.eye(n)], [-m_inv[:, None] * self.K, -m_inv[:, None] * self.C]])
         lam, vec = np.linalg.eig(a)
         real = np.abs(lam.imag) <= 1e-9 * np.abs(lam)
         upper = (lam.imag > 0) & ~real
@@ -276,9 +266,7 @@ class Structure:
         psi = psi / np.linalg.norm(psi, axis=0)
         big = psi[np.argmax(np.abs(psi), axis=0), np.arange(psi.shape[1])]
         psi = psi * (np.abs(big) / big)
-        modal_a = np.array(
-            [psi[:, i] @ (2 * lam_u[i] * self.M + self.C) @ psi[:, i] for i in range(lam_u.size)]
-        )
+        modal_a = np.array([psi[:, i] @ (2 * lam_u[i] * self.M + self.C) @ psi[:, i] for i in range(lam_u.size)])
         constants = psi * (psi.T @ self.masses)[None, :] / modal_a[None, :]
         freq, damping, damped = continuous_modal_parameters(lam_u)
         return ExactModes(
@@ -297,11 +285,7 @@ class Structure:
     def frf(self, freq_hz) -> np.ndarray:
         """Receptance ``H(w) = (K + iwC - w^2 M)^-1`` (Eq. 2.19), shape (n_freq, n, n), m/N."""
         w = 2 * np.pi * np.atleast_1d(np.asarray(freq_hz, dtype=float))
-        dyn = (
-            self.K[None]
-            + 1j * w[:, None, None] * self.C[None]
-            - (w**2)[:, None, None] * self.M[None]
-        )
+        dyn = self.K[None] + 1j * w[:, None, None] * self.C[None] - (w**2)[:, None, None] * self.M[None]
         return np.linalg.inv(dyn)
 
     def epfrf(self, freq_hz) -> np.ndarray:

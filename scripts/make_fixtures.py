@@ -79,9 +79,7 @@ def make(out: Path) -> list[Path]:
     for name, (factory, fs, kind, hold, noise, input_noise, seed) in FIXTURES.items():
         structure = factory()
         u = excitation(kind, fs, seed)
-        rec = am.simulate_recording(
-            structure, u, fs, noise=noise, input_noise=input_noise, seed=seed + 1000, hold=hold
-        )
+        rec = am.simulate_recording(structure, u, fs, noise=noise, input_noise=input_noise, seed=seed + 1000, hold=hold)
         rec = am.Recording(
             rec.fs,
             rec.base,
@@ -103,9 +101,7 @@ def make(out: Path) -> list[Path]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument(
-        "--out", type=Path, default=Path(__file__).resolve().parents[1] / "fixtures"
-    )
+    parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "fixtures")
     args = parser.parse_args()
     for path in make(args.out):
         print(path)

@@ -15,3 +15,39 @@ def hold_recursion(phi, gam, u_pad, n_steps, stride):
         if (k + 1) % stride == 0:
             kept.append(x.copy())
     return np.array(kept)
+
+
+def armax_residual(y, u, a, b, nk, c):
+    """``(A y - q^-nk B u) / C`` with scipy.signal.lfilter and zero padding."""
+    import scipy.signal
+
+    n = y.size
+    w = scipy.signal.lfilter(a, [1.0], y)
+    for m in range(u.shape[0]):
+        for j in range(b.shape[1]):
+            lag = nk + j
+            shifted = np.zeros(n)
+            if lag >= 0:
+                shifted[lag:] = u[m, : n - lag]
+            else:
+                shifted[: n + lag] = u[m, -lag:]
+            w -= b[m, j] * shifted
+    return scipy.signal.lfilter([1.0], c, w)
+
+
+def inverse_filter(x, c):
+    """Each row of x filtered by 1/C with scipy.signal.lfilter."""
+    import scipy.signal
+
+    return np.array([scipy.signal.lfilter([1.0], c, row) for row in x])
+
+
+def lagged_design(sig, col_sig, col_lag, col_sign, t0, t1):
+    """The explicit regressor matrix whose Gram the kernel computes, shape (t1 - t0, p)."""
+    n = sig.shape[1]
+    out = np.zeros((t1 - t0, col_sig.size))
+    for c, (s, lag, sign) in enumerate(zip(col_sig, col_lag, col_sign, strict=True)):
+        for t in range(t0, t1):
+            k = t - lag
+            out[t - t0, c] = sign * sig[s, k] if 0 <= k < n else 0.0
+    return out

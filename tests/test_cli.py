@@ -16,9 +16,7 @@ def test_modes_json(tmp_path, capsys):
     out = tmp_path / "modes.json"
     assert main(["--quiet", "modes", "--system", "supine", "--json", str(out)]) == 0
     data = json.loads(out.read_text())
-    np.testing.assert_allclose(
-        [m["freq_hz"] for m in data["modes"]], am.supine_human().modes().freq_hz
-    )
+    np.testing.assert_allclose([m["freq_hz"] for m in data["modes"]], am.supine_human().modes().freq_hz)
 
 
 def test_simulate_writes_a_readable_recording(tmp_path):

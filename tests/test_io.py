@@ -135,9 +135,7 @@ def test_corrupt_and_v73_mat_files(tmp_path):
     p.write_bytes(b"MATLAB 5.0 MAT-file" + b"\x00" * 20)
     with pytest.raises(DataError, match="not a readable MAT"):
         am.read_recording(p, fs=1.0)
-    header = (
-        b"MATLAB 7.3 MAT-file, Platform: GLNXA64".ljust(116, b" ") + b"\x00" * 8 + b"\x00\x02IM"
-    )
+    header = b"MATLAB 7.3 MAT-file, Platform: GLNXA64".ljust(116, b" ") + b"\x00" * 8 + b"\x00\x02IM"
     p73 = tmp_path / "v73.mat"
     p73.write_bytes(header + b"\x00" * 512)
     with pytest.raises(DataError, match="v7.3"):

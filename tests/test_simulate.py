@@ -104,9 +104,7 @@ def test_relative_plus_base_is_absolute_acceleration():
     for hold in ("zoh", "bandlimited"):
         absolute = am.simulate(s, u, 100.0, hold=hold)
         relative = am.simulate(s, u, 100.0, hold=hold, frame="relative")
-        np.testing.assert_allclose(
-            relative + u[:, None], absolute, atol=1e-10 * np.abs(absolute).max()
-        )
+        np.testing.assert_allclose(relative + u[:, None], absolute, atol=1e-10 * np.abs(absolute).max())
 
 
 def test_random_vibration_band_rms_and_seed():

@@ -20,23 +20,15 @@ TABLE_4_4_C_ATOL = 0.06
 
 def test_chapter2_reproduces_table_2_1():
     modes = am.chapter2_system().modes()
-    np.testing.assert_array_equal(
-        np.round(modes.freq_hz, TABLE_2_1_DECIMALS), datasets.TABLE_2_1["freq_hz"]
-    )
-    np.testing.assert_array_equal(
-        np.round(modes.damping, TABLE_2_1_DECIMALS), datasets.TABLE_2_1["damping"]
-    )
+    np.testing.assert_array_equal(np.round(modes.freq_hz, TABLE_2_1_DECIMALS), datasets.TABLE_2_1["freq_hz"])
+    np.testing.assert_array_equal(np.round(modes.damping, TABLE_2_1_DECIMALS), datasets.TABLE_2_1["damping"])
 
 
 def test_supine_reproduces_table_4_3():
     modes = am.supine_human().modes()
     for key in ("freq_hz", "damped_freq_hz"):
-        np.testing.assert_allclose(
-            getattr(modes, key), datasets.TABLE_4_3[key], atol=TABLE_4_3_FREQ_ATOL
-        )
-    np.testing.assert_allclose(
-        modes.damping, datasets.TABLE_4_3["damping"], atol=TABLE_4_3_DAMPING_ATOL
-    )
+        np.testing.assert_allclose(getattr(modes, key), datasets.TABLE_4_3[key], atol=TABLE_4_3_FREQ_ATOL)
+    np.testing.assert_allclose(modes.damping, datasets.TABLE_4_3["damping"], atol=TABLE_4_3_DAMPING_ATOL)
 
 
 def test_supine_components_match_table_4_4():
@@ -54,9 +46,7 @@ def test_supine_components_match_table_4_4():
 def test_table_4_4_chain_gives_table_4_3():
     t = datasets.TABLE_4_4
     s = am.Structure.from_chain(np.diag(am.supine_human().M), t["k"], t["c"], t["k_s"], t["c_s"])
-    np.testing.assert_allclose(
-        s.modes().freq_hz, datasets.TABLE_4_3["freq_hz"], atol=TABLE_4_3_FREQ_ATOL
-    )
+    np.testing.assert_allclose(s.modes().freq_hz, datasets.TABLE_4_3["freq_hz"], atol=TABLE_4_3_FREQ_ATOL)
 
 
 def test_chain_round_trip():
@@ -140,9 +130,7 @@ def test_transmissibility_limits():
 
 def test_transmissibility_between_outputs_tends_to_mode_shape_ratio():
     """Eqs. 3.32-3.33 on a lightly damped chain with separated modes."""
-    s = am.Structure.from_chain(
-        [2.0, 1.0, 1.5], [4e4, 1e3, 2e4], [1.0, 0.3, 0.5], [1e4, 3e4], [0.3, 1.0]
-    )
+    s = am.Structure.from_chain([2.0, 1.0, 1.5], [4e4, 1e3, 2e4], [1.0, 0.3, 0.5], [1e4, 3e4], [0.3, 1.0])
     m = s.modes()
     assert m.damping.max() < 0.01
     for r in range(3):

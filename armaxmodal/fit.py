@@ -1,0 +1,719 @@
+"""Prediction-error method (PEM) for ARMAX models (thesis Section 3.3.2).
+
+Minimises the sum of squared one-step prediction errors ``eps = (A y - q^-nk B u) / C``
+over the record. Start: a high-order ARX fit estimates the innovations, then a
+Hannan-Rissanen least-squares step gives A, B and C. Then Levenberg-Marquardt with the
+exact gradient (regressors filtered through 1/C), keeping C stable by reflecting its roots
+into the unit circle.
+
+Two forms:
+
+* per sensor (``shared_poles=False``): one model per output, all driven by the same
+  base input -- the thesis's diagonal A (Eqs. 3.11-3.13). Use it to see what each sensor
+  shows on its own (the thesis's Table 3.2 with its gaps).
+* shared poles (``shared_poles=True``): one A(q) for every sensor, B and C per sensor,
+  fitted jointly by maximum likelihood with each channel weighted by its own noise variance
+  (the concentrated Gaussian likelihood ``sum_k log V_k``). Physically every sensor sees the
+  same poles; pooling them finds heavily damped modes that single sensors miss and gives
+  far tighter frequency and damping estimates. Use it for the modal parameters.
+
+Initial conditions are zero (samples before the record count as zero); the loss sums the
+errors from the first sample whose regressors all lie inside the record.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+import scipy.linalg
+
+from ._kernels import _armax_residual, _inverse_filter, _lagged_cross, _lagged_gram
+from ._validate import as_signal_matrix, check_fs, check_not_constant
+from .armax import ArmaxModel
+from .exceptions import ConvergenceWarning, DataError, OrderError
+from .modal import pole_uncertainty
+from .recording import Recording
+
+__all__ = ["fit_armax", "ArmaxFit", "covariance_at"]
+
+# At least this many samples per estimated parameter in the fit window.
+_MIN_SAMPLES_PER_PARAMETER = 5
+# Largest root radius allowed for C (keeps 1/C filtering stable and well conditioned).
+_MAX_C_RADIUS = 0.995
+_Z95 = 1.959963984540054
+
+
+@dataclass(frozen=True)
+class ArmaxFit:
+    """Result of :func:`fit_armax`.
+
+    Attributes
+    ----------
+    models : tuple of ArmaxModel
+        One per output sensor (identical A when ``shared_poles``).
+    shared_poles : bool
+    orders : (na, nb, nc, nk)
+    loss : (n_sensors,) ndarray
+        Mean squared one-step prediction error over the fit window.
+    noise_variance : (n_sensors,) ndarray
+        Innovation variance estimate ``V / (N - p)``.
+    fit_percent : (n_sensors,) ndarray
+        Simulation fit, ``100 (1 - |y - y_sim| / |y - mean y|)`` (NRMSE).
+    iterations : (n_sensors,) ndarray of int
+        Levenberg-Marquardt iterations (the same number for every sensor when shared).
+    converged : (n_sensors,) ndarray of bool
+    covariance : tuple of ndarray
+        Per sensor, the covariance of ``[a_1..a_na, b (row-major), c_1..c_nc]``.
+    joint_covariance : ndarray or None
+        Shared form: covariance of ``[a, b_1, c_1, b_2, c_2, ...]``.
+    n_samples : int
+        Samples in the fit window.
+    """
+
+    models: tuple[ArmaxModel, ...]
+    shared_poles: bool
+    orders: tuple[int, int, int, int]
+    loss: np.ndarray
+    noise_variance: np.ndarray
+    fit_percent: np.ndarray
+    iterations: np.ndarray
+    converged: np.ndarray
+    covariance: tuple[np.ndarray, ...]
+    joint_covariance: np.ndarray | None = None
+    n_samples: int = 0
+    fs: float = field(default=float("nan"))
+
+    @property
+    def sensors(self) -> tuple[str, ...]:
+        return tuple(m.output for m in self.models)
+
+    def modes(self, band: tuple[float, float] | None = None) -> pd.DataFrame:
+        """One row per sensor and oscillatory pole.
+
+        Columns: sensor, freq_hz, damping, damped_freq_hz, freq_ci95_lo/hi, damping_ci95_lo/hi
+        (delta method on the A covariance), residue (complex, first input), residue_mag,
+        residue_phase_deg. ``band`` keeps poles whose frequency lies in it (Hz).
+        """
+        rows = []
+        na = self.orders[0]
+        for model, cov in zip(self.models, self.covariance, strict=True):
+            mu, f, xi, fd = model.modal_parameters()
+            sd_f, sd_xi = pole_uncertainty(model.a, mu, cov[:na, :na], model.fs)
+            res = model.residues(mu)[0]
+            for i in range(mu.size):
+                rows.append(
+                    {
+                        "sensor": model.output,
+                        "freq_hz": f[i],
+                        "damping": xi[i],
+                        "damped_freq_hz": fd[i],
+                        "freq_ci95_lo": f[i] - _Z95 * sd_f[i],
+                        "freq_ci95_hi": f[i] + _Z95 * sd_f[i],
+                        "damping_ci95_lo": xi[i] - _Z95 * sd_xi[i],
+                        "damping_ci95_hi": xi[i] + _Z95 * sd_xi[i],
+                        "freq_sd": sd_f[i],
+                        "damping_sd": sd_xi[i],
+                        "pole": mu[i],
+                        "residue": res[i],
+                        "residue_mag": abs(res[i]),
+                        "residue_phase_deg": np.degrees(np.angle(res[i])),
+                    }
+                )
+        frame = pd.DataFrame(rows)
+        if band is not None and len(frame):
+            frame = frame[(frame.freq_hz >= band[0]) & (frame.freq_hz <= band[1])]
+        return frame.reset_index(drop=True)
+
+    def to_frame(self) -> pd.DataFrame:
+        """One row per sensor: orders, loss, noise variance, fit %, iterations, convergence."""
+        na, nb, nc, nk = self.orders
+        return pd.DataFrame(
+            {
+                "sensor": self.sensors,
+                "na": na,
+                "nb": nb,
+                "nc": nc,
+                "nk": nk,
+                "shared_poles": self.shared_poles,
+                "loss": self.loss,
+                "noise_variance": self.noise_variance,
+                "fit_percent": self.fit_percent,
+                "iterations": self.iterations,
+                "converged": self.converged,
+            }
+        )
+
+
+# -- public entry point -----------------------------------------------------------------
+def fit_armax(
+    data: Recording | tuple,
+    na: int,
+    nb: int,
+    nc: int,
+    nk: int = 0,
+    *,
+    fs: float | None = None,
+    shared_poles: bool = False,
+    max_iter: int = 100,
+    tol: float = 1e-6,
+    warn: bool = True,
+) -> ArmaxFit:
+    """Fit ARMAX models by the prediction-error method.
+
+    Parameters
+    ----------
+    data : Recording or (u, y)
+        A recording, or arrays ``u`` (n_samples,) / (n_samples, n_inputs) and ``y``
+        (n_samples,) / (n_samples, n_sensors); then ``fs`` is required.
+    na, nb, nc : int
+        Orders of A (poles), B (coefficients per input) and C.
+    nk : int
+        Input delay; 0 for a biproper model with a b0 term, negative for non-causal taps.
+    fs : float, optional
+        Sampling rate in Hz when arrays are given.
+    shared_poles : bool
+        One A(q) for all sensors (see the module docstring for when to use which).
+    max_iter : int
+        Levenberg-Marquardt iteration cap.
+    tol : float
+        Stop when an iteration lowers the loss by less than this fraction (shared form: the
+        sum over sensors of the relative decreases). The default sits far below the
+        statistical resolution of the loss (about 1/N), so stopping there moves no
+        estimate by a meaningful fraction of its standard error.
+    warn : bool
+        Emit :class:`ConvergenceWarning` when the cap is hit.
+
+    Returns
+    -------
+    ArmaxFit
+    """
+    u, y, fs, sensors, inputs = _unpack(data, fs)
+    na, nb, nc, nk = _check_orders(na, nb, nc, nk)
+    # Non-causal taps (nk < 0): y[t] depends on u[t + lead - j]. Pairing y[:n-lead] with
+    # u[lead:] gives the equivalent causal model (delay 0) on a window of the record.
+    # Filtering by 1/C from rest commutes with delays, not with advances, so this keeps the
+    # prediction errors and their gradient exact.
+    lead = max(0, -nk)
+    y_fit, u_fit, nk_fit = y[: y.shape[0] - lead], u[lead:], nk + lead
+    n = y_fit.shape[0]
+    t0 = max(na, nc, nk_fit + nb - 1, 0)
+    t1 = n
+    n_in = u.shape[1]
+    p_single = na + n_in * nb + nc
+    p_needed = p_single if not shared_poles else na + y.shape[1] * (n_in * nb + nc)
+    n_eff = t1 - t0
+    if n_eff * (y.shape[1] if shared_poles else 1) < _MIN_SAMPLES_PER_PARAMETER * p_needed or n_eff < 2 * p_single:
+        raise OrderError(
+            f"orders na={na}, nb={nb}, nc={nc}, nk={nk} give {p_needed} parameters; the record has "
+            f"{n} samples ({n_eff} usable), too few (need about "
+            f"{_MIN_SAMPLES_PER_PARAMETER * p_single} per sensor). Lower the orders or use a longer record."
+        )
+    uT = np.ascontiguousarray(u_fit.T)
+    if shared_poles:
+        thetas, info = _fit_shared(y_fit, uT, na, nb, nc, nk_fit, t0, t1, max_iter, tol)
+    else:
+        thetas, info = [], []
+        for k in range(y.shape[1]):
+            th, inf = _fit_single(np.ascontiguousarray(y_fit[:, k]), uT, na, nb, nc, nk_fit, t0, t1, max_iter, tol)
+            thetas.append(th)
+            info.append(inf)
+        info = _merge_single_info(info)
+    models = []
+    for k, theta in enumerate(thetas):
+        a, b, c = _unpack_theta(theta, na, nb, nc, n_in)
+        models.append(ArmaxModel(a, b, c, nk, fs, float(info["noise_variance"][k]), sensors[k], inputs))
+    fit_pct = np.array([_nrmse_fit(y[:, k], m.simulate(u), t0, y.shape[0] - lead) for k, m in enumerate(models)])
+    result = ArmaxFit(
+        models=tuple(models),
+        shared_poles=shared_poles,
+        orders=(na, nb, nc, nk),
+        loss=info["loss"],
+        noise_variance=info["noise_variance"],
+        fit_percent=fit_pct,
+        iterations=info["iterations"],
+        converged=info["converged"],
+        covariance=tuple(info["covariance"]),
+        joint_covariance=info.get("joint_covariance"),
+        n_samples=n_eff,
+        fs=fs,
+    )
+    if warn and not np.all(result.converged):
+        bad = [s for s, ok in zip(sensors, result.converged, strict=True) if not ok]
+        warnings.warn(
+            f"PEM did not converge in {max_iter} iterations for {bad} (orders {na},{nb},{nc},{nk}); "
+            "the estimate is flagged converged=False. Try a larger max_iter, lower orders, or check "
+            "the data for drift and outliers.",
+            ConvergenceWarning,
+            stacklevel=2,
+        )
+    return result
+
+
+# -- input handling ----------------------------------------------------------------------
+def _unpack(data, fs):
+    if isinstance(data, Recording):
+        return (
+            data.base[:, None].copy(),
+            np.array(data.response),
+            data.fs,
+            data.sensors,
+            (data.input_name,),
+        )
+    try:
+        u_raw, y_raw = data
+    except (TypeError, ValueError) as exc:
+        raise DataError("data: expected a Recording or a (u, y) pair of arrays.") from exc
+    if fs is None:
+        raise DataError("fs: give the sampling rate in Hz when passing arrays (u, y).")
+    fs = check_fs(fs)
+    u = as_signal_matrix(u_raw, "u", [f"u{m + 1}" for m in range(np.shape(u_raw)[1] if np.ndim(u_raw) == 2 else 1)])
+    y = as_signal_matrix(y_raw, "y", [f"y{k + 1}" for k in range(np.shape(y_raw)[1] if np.ndim(y_raw) == 2 else 1)])
+    if u.shape[0] != y.shape[0]:
+        raise DataError(f"u has {u.shape[0]} samples but y has {y.shape[0]}; trim them to a common length.")
+    check_not_constant(u, "input u")
+    sensors = tuple(f"y{k + 1}" for k in range(y.shape[1]))
+    inputs = tuple(f"u{m + 1}" for m in range(u.shape[1]))
+    return u, y, fs, sensors, inputs
+
+
+def _check_orders(na, nb, nc, nk):
+    vals = {}
+    for name, v, lo in (("na", na, 1), ("nb", nb, 1), ("nc", nc, 0), ("nk", nk, None)):
+        if isinstance(v, bool) or not float(v).is_integer():
+            raise OrderError(f"{name}: expected an integer, got {v!r}.")
+        v = int(v)
+        if lo is not None and v < lo:
+            raise OrderError(f"{name}: expected an integer >= {lo}, got {v}.")
+        vals[name] = v
+    return vals["na"], vals["nb"], vals["nc"], vals["nk"]
+
+
+# -- parameter layout ----------------------------------------------------------------------
+def _columns(na, nb, nc, nk, n_in):
+    """Regressor columns as (signal, lag, sign) over the rows of :func:`_signals`."""
+    sig = [0] * na + [1 + m for m in range(n_in) for _ in range(nb)] + [n_in + 1] * nc
+    lag = list(range(1, na + 1)) + [nk + j for _ in range(n_in) for j in range(nb)] + list(range(1, nc + 1))
+    sign = [-1.0] * na + [1.0] * (n_in * nb) + [1.0] * nc
+    return np.array(sig, np.int64), np.array(lag, np.int64), np.array(sign)
+
+
+def _signals(y, uT, e):
+    """Rows [y, u_1 .. u_m, e] for the lagged-regressor kernels."""
+    return np.ascontiguousarray(np.vstack([y[None, :], uT, e[None, :]]))
+
+
+def _unpack_theta(theta, na, nb, nc, n_in):
+    a = np.concatenate([[1.0], theta[:na]])
+    b = theta[na : na + n_in * nb].reshape(n_in, nb).copy()
+    c = np.concatenate([[1.0], theta[na + n_in * nb :]])
+    return a, b, c
+
+
+def _stable_c(c):
+    """Reflect roots of C outside the unit circle inside and cap their radius."""
+    if c.size <= 1:
+        return c
+    r = np.roots(c)
+    mag = np.abs(r)
+    if np.all(mag <= _MAX_C_RADIUS):
+        return c
+    r = np.where(mag > 1, 1 / np.conj(r), r)
+    mag = np.abs(r)
+    r = np.where(mag > _MAX_C_RADIUS, r * (_MAX_C_RADIUS / np.maximum(mag, 1e-300)), r)
+    return np.real(np.poly(r))
+
+
+def _solve(g_mat, g_vec, damping=0.0):
+    d = np.diag(g_mat).copy()
+    d[d <= 0] = 1.0
+    lhs = g_mat + np.diag(damping * d + 1e-13 * d)
+    try:
+        return scipy.linalg.cho_solve(scipy.linalg.cho_factor(lhs), g_vec)
+    except (np.linalg.LinAlgError, scipy.linalg.LinAlgError):
+        return np.linalg.lstsq(lhs, g_vec, rcond=None)[0]
+
+
+# -- initial estimate ------------------------------------------------------------------------
+def _arx_residual(y, uT, n_h, nb_h, nk, t1):
+    """High-order ARX by least squares; returns its residuals (innovation estimates)."""
+    n_in = uT.shape[0]
+    t0 = max(n_h, nk + nb_h - 1, 0)
+    sig = _signals(y, uT, np.zeros(y.size))
+    cols = _columns(n_h, nb_h, 0, nk, n_in)
+    g_mat = _lagged_gram(sig, *cols, t0, t1)
+    g_vec = _lagged_cross(sig, *cols, y, t0, t1)
+    theta = _solve(g_mat, g_vec)
+    a, b, c = _unpack_theta(theta, n_h, nb_h, 0, n_in)
+    return _armax_residual(y, uT, a, b, nk, c)
+
+
+def _initial_columns_and_signals(y, uT, na, nb, nc, nk, t1):
+    n = y.size
+    n_h = int(min(max(2 * (na + nc), 20), max(na + nc + 1, (t1 - nk) // 20)))
+    e_hat = _arx_residual(y, uT, n_h, nb + n_h // 2, nk, t1) if nc > 0 else np.zeros(n)
+    return _signals(y, uT, e_hat), _columns(na, nb, nc, nk, uT.shape[0])
+
+
+def _hannan_rissanen(y, uT, na, nb, nc, nk, t0, t1):
+    sig, cols = _initial_columns_and_signals(y, uT, na, nb, nc, nk, t1)
+    theta = _solve(_lagged_gram(sig, *cols, t0, t1), _lagged_cross(sig, *cols, y, t0, t1))
+    return _project(theta, na, nb, nc, uT.shape[0])
+
+
+def _project(theta, na, nb, nc, n_in):
+    """Keep C stable inside a parameter vector [a, b, c]."""
+    if nc == 0:
+        return theta
+    theta = theta.copy()
+    start = na + n_in * nb
+    theta[start:] = _stable_c(np.concatenate([[1.0], theta[start:]]))[1:]
+    return theta
+
+
+def _stable_a(a):
+    """Reflect roots of A outside the unit circle inside (filtering by 1/A must be stable)."""
+    r = np.roots(a)
+    if np.all(np.abs(r) < 1):
+        return a
+    r = np.where(np.abs(r) > 1, 1 / np.conj(r), r)
+    r = np.where(np.abs(r) >= 0.999, r * (0.999 / np.abs(r)), r)
+    return np.real(np.poly(r))
+
+
+def _steiglitz_mcbride(ys, uT, a0, na, nb, nk, t0, t1, iterations=20):
+    """Output-error start: shared A and per-sensor B by iterated prefiltering with 1/A.
+
+    Each pass solves ``min sum_k w_k |A (y_k / A_prev) - B_k (u / A_prev)|^2`` by linear least
+    squares; at the fixed point this is the output-error estimate, the maximum-likelihood
+    fit for white sensor noise. Returns ``(a, [b_k])``.
+    """
+    n_in = uT.shape[0]
+    n_out = len(ys)
+    cols = _columns(na, nb, 0, nk, n_in)
+    p_k = n_in * nb
+    a = _stable_a(a0)
+    weights = np.ones(n_out)
+    bs = [np.zeros(p_k)] * n_out
+    for _ in range(iterations):
+        g_mat = np.zeros((na + n_out * p_k,) * 2)
+        g_vec = np.zeros(na + n_out * p_k)
+        for k, yk in enumerate(ys):
+            sig = _inverse_filter(_signals(yk, uT, np.zeros(yk.size)), a)
+            idx = np.concatenate([np.arange(na), na + k * p_k + np.arange(p_k)])
+            g_mat[np.ix_(idx, idx)] += weights[k] * _lagged_gram(sig, *cols, t0, t1)
+            g_vec[idx] += weights[k] * _lagged_cross(sig, *cols, sig[0], t0, t1)
+        theta = _solve(g_mat, g_vec)
+        a_new = _stable_a(np.concatenate([[1.0], theta[:na]]))
+        bs = [theta[na + k * p_k : na + (k + 1) * p_k] for k in range(n_out)]
+        # reweight by each sensor's output-error residual variance
+        for k, yk in enumerate(ys):
+            e = _armax_residual(yk, uT, a_new, bs[k].reshape(n_in, -1), nk, a_new)
+            weights[k] = 1.0 / max(float(np.var(e[t0:t1])), 1e-300)
+        done = np.max(np.abs(a_new - a)) < 1e-10
+        a = a_new
+        if done:
+            break
+    return a, bs
+
+
+def _subspace_a(ys, uT, na):
+    """Monic A(z) of order na from PO-MOESP on all outputs at once (shared poles).
+
+    Past inputs and outputs instrument the future outputs; the column space of the
+    projected block Hankel matrix is the extended observability matrix, whose shift
+    invariance gives the state matrix. Non-iterative, so it cannot crawl.
+    """
+    u = uT.T
+    y = np.column_stack(ys)
+    m, n_out = u.shape[1], y.shape[1]
+    i = max(-(-na // n_out) + 2, 2 * -(-na // n_out), 6)
+    n_cols = u.shape[0] - 2 * i + 1
+
+    def hankel(x, start):
+        return np.vstack([x[start + j : start + j + n_cols].T for j in range(i)])
+
+    data = np.vstack([hankel(u, i), hankel(u, 0), hankel(y, 0), hankel(y, i)]) / np.sqrt(n_cols)
+    low = scipy.linalg.qr(data.T, mode="r")[0].T
+    mi, li = m * i, n_out * i
+    l42 = low[2 * mi + li :, mi : 2 * mi + li]
+    left, sv, _ = np.linalg.svd(l42, full_matrices=False)
+    gamma = left[:, :na] * np.sqrt(sv[:na])
+    a_ss = np.linalg.lstsq(gamma[:-n_out], gamma[n_out:], rcond=None)[0]
+    return _stable_a(np.real(np.poly(np.linalg.eigvals(a_ss))))
+
+
+def _output_error_start(ys, uT, theta_hr, na, nb, nc, nk, t0, t1):
+    """Parameter vector [a, b_1, c_1, ...]: subspace poles refined by Steiglitz-McBride,
+    with C = A where the orders allow (white sensor noise)."""
+    n_in = uT.shape[0]
+    p_k = n_in * nb + nc
+    a, bs = _steiglitz_mcbride(ys, uT, _subspace_a(ys, uT, na), na, nb, nk, t0, t1)
+    c = _stable_c(a[: nc + 1] if nc <= na else np.concatenate([a, np.zeros(nc - na)]))[1:]
+    parts = [a[1:]]
+    for k in range(len(ys)):
+        hr_c = theta_hr[na + k * p_k + n_in * nb : na + (k + 1) * p_k]
+        parts += [bs[k], c if nc == na else hr_c]
+    return np.concatenate(parts)
+
+
+# -- single-output PEM ------------------------------------------------------------------------
+def _residual_and_loss(y, uT, theta, na, nb, nc, nk, t0, t1):
+    a, b, c = _unpack_theta(theta, na, nb, nc, uT.shape[0])
+    eps = _armax_residual(y, uT, a, b, nk, c)
+    with np.errstate(over="ignore", invalid="ignore"):  # an unstable trial step is rejected
+        loss = float(eps[t0:t1] @ eps[t0:t1])
+    return eps, (loss if np.isfinite(loss) else np.inf), c
+
+
+def _normal_equations(y, uT, eps, c, cols, t0, t1):
+    filtered = _inverse_filter(_signals(y, uT, eps), c)
+    return _lagged_gram(filtered, *cols, t0, t1), _lagged_cross(filtered, *cols, eps, t0, t1)
+
+
+def _fit_single(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol):
+    n_in = uT.shape[0]
+    cols = _columns(na, nb, nc, nk, n_in)
+    theta = _hannan_rissanen(y, uT, na, nb, nc, nk, t0, t1)
+    eps, loss, c = _residual_and_loss(y, uT, theta, na, nb, nc, nk, t0, t1)
+    alt = _project(_output_error_start([y], uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in)
+    eps_alt, loss_alt, c_alt = _residual_and_loss(y, uT, alt, na, nb, nc, nk, t0, t1)
+    if loss_alt < loss:
+        theta, eps, loss, c = alt, eps_alt, loss_alt, c_alt
+    lm = 1e-4
+    converged = False
+    it = 0
+    for it in range(1, max_iter + 1):  # noqa: B007 - the count is reported
+        g_mat, g_vec = _normal_equations(y, uT, eps, c, cols, t0, t1)
+        improved = False
+        while lm < 1e10:
+            step = _solve(g_mat, g_vec, lm)
+            trial = _project(theta + step, na, nb, nc, n_in)
+            eps_t, loss_t, c_t = _residual_and_loss(y, uT, trial, na, nb, nc, nk, t0, t1)
+            if loss_t < loss:
+                improved = True
+                break
+            lm *= 10
+        if not improved:
+            # Not even a vanishing gradient step lowers the loss: a minimum to numerical
+            # precision, or on the stability boundary kept for C.
+            converged = True
+            break
+        rel = (loss - loss_t) / loss
+        theta, eps, loss, c = trial, eps_t, loss_t, c_t
+        lm = max(lm / 10, 1e-8)
+        if rel < tol:
+            converged = True
+            break
+    g_mat, _ = _normal_equations(y, uT, eps, c, cols, t0, t1)
+    n_eff = t1 - t0
+    p = theta.size
+    lam = loss / max(n_eff - p, 1)
+    cov = lam * _inverse(g_mat)
+    return theta, {
+        "loss": loss / n_eff,
+        "noise_variance": lam,
+        "iterations": it,
+        "converged": converged,
+        "covariance": cov,
+    }
+
+
+def _inverse(g_mat):
+    try:
+        return scipy.linalg.cho_solve(scipy.linalg.cho_factor(g_mat), np.eye(g_mat.shape[0]))
+    except (np.linalg.LinAlgError, scipy.linalg.LinAlgError):
+        return np.linalg.pinv(g_mat)
+
+
+def _merge_single_info(info):
+    return {
+        "loss": np.array([i["loss"] for i in info]),
+        "noise_variance": np.array([i["noise_variance"] for i in info]),
+        "iterations": np.array([i["iterations"] for i in info]),
+        "converged": np.array([i["converged"] for i in info]),
+        "covariance": [i["covariance"] for i in info],
+    }
+
+
+# -- shared-pole PEM -------------------------------------------------------------------------
+def _shared_index(k, na, p_k):
+    """Global indices of sensor k's local parameters [a, b_k, c_k]."""
+    return np.concatenate([np.arange(na), na + k * p_k + np.arange(p_k)])
+
+
+def _local(theta, k, na, p_k):
+    return theta[_shared_index(k, na, p_k)]
+
+
+def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol):
+    """Joint maximum likelihood with per-sensor noise variances.
+
+    Alternates a weighted least-squares Levenberg-Marquardt solve at fixed variances
+    (a true Gauss-Newton problem, so it converges fast) with the variance update
+    ``lambda_k = V_k / N``; at the fixed point this maximises the concentrated likelihood
+    ``-N/2 sum_k log V_k``. Gauss-Newton on ``sum_k log V_k`` directly would drop a Hessian
+    term that does not vanish at the optimum and crawl.
+    """
+    n_out = y.shape[1]
+    n_in = uT.shape[0]
+    p_k = n_in * nb + nc
+    cols = _columns(na, nb, nc, nk, n_in)
+    ys = [np.ascontiguousarray(y[:, k]) for k in range(n_out)]
+    n_eff = t1 - t0
+
+    # Joint Hannan-Rissanen start, each sensor weighted by its ARX innovation variance.
+    p = na + n_out * p_k
+    g_mat = np.zeros((p, p))
+    g_vec = np.zeros(p)
+    for k in range(n_out):
+        sig, _ = _initial_columns_and_signals(ys[k], uT, na, nb, nc, nk, t1)
+        w = 1.0 / max(float(np.var(sig[-1, t0:t1])) if nc else float(np.var(ys[k][t0:t1])), 1e-300)
+        idx = _shared_index(k, na, p_k)
+        g_mat[np.ix_(idx, idx)] += w * _lagged_gram(sig, *cols, t0, t1)
+        g_vec[idx] += w * _lagged_cross(sig, *cols, ys[k], t0, t1)
+    theta = _project_shared(_solve(g_mat, g_vec), na, nb, nc, n_in, n_out)
+
+    def evaluate(th):
+        out = [_residual_and_loss(ys[k], uT, _local(th, k, na, p_k), na, nb, nc, nk, t0, t1) for k in range(n_out)]
+        return out, np.array([o[1] for o in out])
+
+    state, losses = evaluate(theta)
+    # Second start: output error by Steiglitz-McBride; keep whichever is more likely.
+    alt = _project_shared(_output_error_start(ys, uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in, n_out)
+    state_alt, losses_alt = evaluate(alt)
+    if np.sum(np.log(losses_alt)) < np.sum(np.log(losses)):
+        theta, state, losses = alt, state_alt, losses_alt
+    variances = losses / n_eff
+    total_iterations = 0
+    converged = False
+    while total_iterations < max_iter:
+        weights = 1.0 / variances
+        objective = float(weights @ losses)
+        lm = 1e-4
+        inner_converged = False
+        while total_iterations < max_iter:
+            total_iterations += 1
+            g_mat, g_vec = _shared_normal_equations(ys, uT, state, variances, cols, na, p_k, t0, t1)
+            improved = False
+            while lm < 1e10:
+                step = _solve(g_mat, g_vec, lm)
+                trial = _project_shared(theta + step, na, nb, nc, n_in, n_out)
+                state_t, losses_t = evaluate(trial)
+                objective_t = float(weights @ losses_t)
+                if objective_t < objective:
+                    improved = True
+                    break
+                lm *= 10
+            if not improved:
+                inner_converged = True  # as in _fit_single
+                break
+            rel = (objective - objective_t) / objective
+            theta, state, losses, objective = trial, state_t, losses_t, objective_t
+            lm = max(lm / 10, 1e-8)
+            if rel < tol:
+                inner_converged = True
+                break
+        new_variances = losses / n_eff
+        settled = np.max(np.abs(new_variances / variances - 1.0)) < 1e-3
+        variances = new_variances
+        if inner_converged and settled:
+            converged = True
+            break
+    lam = losses / max(n_eff - (na / n_out + p_k), 1)
+    g_mat, _ = _shared_normal_equations(ys, uT, state, lam, cols, na, p_k, t0, t1)
+    joint = _inverse(g_mat)
+    covs = [joint[np.ix_(_shared_index(k, na, p_k), _shared_index(k, na, p_k))] for k in range(n_out)]
+    thetas = [_local(theta, k, na, p_k) for k in range(n_out)]
+    info = {
+        "loss": losses / n_eff,
+        "noise_variance": lam,
+        "iterations": np.full(n_out, total_iterations),
+        "converged": np.full(n_out, converged),
+        "covariance": covs,
+        "joint_covariance": joint,
+    }
+    return thetas, info
+
+
+def _shared_normal_equations(ys, uT, state, variances, cols, na, p_k, t0, t1):
+    p = na + len(ys) * p_k
+    g_mat = np.zeros((p, p))
+    g_vec = np.zeros(p)
+    for k, (eps, _, c) in enumerate(state):
+        gk, vk = _normal_equations(ys[k], uT, eps, c, cols, t0, t1)
+        idx = _shared_index(k, na, p_k)
+        g_mat[np.ix_(idx, idx)] += gk / variances[k]
+        g_vec[idx] += vk / variances[k]
+    return g_mat, g_vec
+
+
+def _project_shared(theta, na, nb, nc, n_in, n_out):
+    if nc == 0:
+        return theta
+    theta = theta.copy()
+    p_k = n_in * nb + nc
+    for k in range(n_out):
+        start = na + k * p_k + n_in * nb
+        theta[start : start + nc] = _stable_c(np.concatenate([[1.0], theta[start : start + nc]]))[1:]
+    return theta
+
+
+def _nrmse_fit(y, y_sim, t0, t1):
+    """NRMSE fit in percent; NaN when the model is unstable and its simulation diverges."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        err = np.sqrt(np.sum((y[t0:t1] - y_sim[t0:t1]) ** 2))
+    if not np.isfinite(err):
+        return float("nan")
+    ref = np.linalg.norm(y[t0:t1] - y[t0:t1].mean())
+    return 100.0 * (1.0 - err / ref) if ref > 0 else float("nan")
+
+
+def covariance_at(
+    models, data: Recording | tuple, *, fs: float | None = None, shared_poles: bool = False
+) -> list[np.ndarray]:
+    """Asymptotic covariance of the PEM estimate evaluated at given models.
+
+    At the true system with Gaussian innovations this is the Cramer-Rao bound: the
+    smallest covariance any unbiased estimator can reach on this record.
+
+    Parameters
+    ----------
+    models : sequence of ArmaxModel
+        One per sensor, with ``noise_variance`` set (identical A when ``shared_poles``).
+    data : Recording or (u, y)
+        The input and outputs that drive the gradient (use noise-free or measured data).
+    shared_poles : bool
+        Pool the A parameters over sensors as :func:`fit_armax` does.
+
+    Returns
+    -------
+    list of ndarray
+        Per sensor, the covariance of ``[a_1..a_na, b (row-major), c_1..c_nc]``.
+    """
+    u, y, _, _, _ = _unpack(data, fs)
+    na, nb, nc, nk = models[0].orders
+    lead = max(0, -nk)
+    y_fit, u_fit, nk_fit = y[: y.shape[0] - lead], u[lead:], nk + lead
+    n = y_fit.shape[0]
+    t0, t1 = max(na, nc, nk_fit + nb - 1, 0), n
+    uT = np.ascontiguousarray(u_fit.T)
+    n_in = uT.shape[0]
+    cols = _columns(na, nb, nc, nk_fit, n_in)
+    blocks = []
+    for k, m in enumerate(models):
+        yk = np.ascontiguousarray(y_fit[:, k])
+        theta = np.concatenate([m.a[1:], m.b.ravel(), m.c[1:]])
+        eps, _, c = _residual_and_loss(yk, uT, theta, na, nb, nc, nk_fit, t0, t1)
+        blocks.append(_normal_equations(yk, uT, eps, c, cols, t0, t1)[0] / m.noise_variance)
+    if not shared_poles:
+        return [_inverse(g) for g in blocks]
+    p_k = n_in * nb + nc
+    g_mat = np.zeros((na + len(models) * p_k,) * 2)
+    for k, g in enumerate(blocks):
+        idx = _shared_index(k, na, p_k)
+        g_mat[np.ix_(idx, idx)] += g
+    joint = _inverse(g_mat)
+    return [joint[np.ix_(_shared_index(k, na, p_k), _shared_index(k, na, p_k))] for k in range(len(models))]
