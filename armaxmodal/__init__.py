@@ -14,7 +14,10 @@ from .exceptions import (
     OrderError,
     StructureError,
 )
+from .fit import ArmaxFit, fit_armax
+from .identify import Identification, identify
 from .io import read_recording, write_recording_csv, write_recording_uff
+from .orders import choose_orders
 from .recording import Recording
 from .simulate import add_noise, random_vibration, simulate, simulate_recording, sine_sweep
 from .structure import ChainComponents, ExactModes, Structure
@@ -22,7 +25,12 @@ from .structure import ChainComponents, ExactModes, Structure
 __version__ = "0.1.0"
 
 __all__ = [
+    "ArmaxFit",
     "ArmaxModalError",
+    "Identification",
+    "choose_orders",
+    "fit_armax",
+    "identify",
     "ChainComponents",
     "ConvergenceWarning",
     "DataError",

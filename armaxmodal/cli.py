@@ -14,8 +14,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from . import datasets
-from .exceptions import ArmaxModalError
-from .io import read_recording, write_json, write_recording_csv
+from .exceptions import ArmaxModalError, DataError, OrderError
+from .io import atomic_write, read_recording, write_json, write_recording_csv
 
 SYSTEMS = {"supine": datasets.supine_human, "chapter2": datasets.chapter2_system}
 
@@ -40,6 +40,45 @@ def _cmd_info(args) -> int:
         print(f"output {name}: rms {np.sqrt(np.mean(col**2)):.4g}")
     if rec.subject or rec.mass_kg:
         print(f"subject: {rec.subject or '-'}  mass: {rec.mass_kg or '-'} kg")
+    return 0
+
+
+def _parse_pair(text: str, what: str) -> tuple[float, float]:
+    try:
+        lo, hi = (float(v) for v in text.split(":"))
+    except ValueError as exc:
+        raise DataError(f"{what}: expected LO:HI in Hz, got {text!r}.") from exc
+    return lo, hi
+
+
+def _cmd_identify(args) -> int:
+    from .identify import identify
+
+    rec = _load(args)
+    orders = None
+    if args.orders != "auto":
+        try:
+            orders = tuple(int(v) for v in args.orders.split(","))
+        except ValueError as exc:
+            raise OrderError(f"--orders: expected 'auto' or na,nb,nc,nk, got {args.orders!r}.") from exc
+        if len(orders) != 4:
+            raise OrderError(f"--orders: expected four integers na,nb,nc,nk, got {args.orders!r}.")
+    band = _parse_pair(args.band, "--band") if args.band else None
+    result = identify(rec, orders, band=band)
+    na, nb, nc, nk = result.fit.orders
+    print(
+        f"{args.data}: shared-pole ARMAX na={na} nb={nb} nc={nc} nk={nk}, "
+        f"converged={bool(result.fit.converged.all())}, fit {np.round(result.fit.fit_percent, 1).tolist()} %"
+    )
+    table = result.modes[
+        ["freq_hz", "damping", "damped_freq_hz", "freq_ci95_lo", "freq_ci95_hi", "damping_ci95_lo", "damping_ci95_hi"]
+    ]
+    print(table.to_string(float_format=lambda v: f"{v:.4f}"))
+    if args.json:
+        write_json(result.to_dict(), args.json)
+    if args.csv:
+        poles = result.fit.modes().drop(columns=["pole", "residue"])
+        atomic_write(args.csv, lambda tmp: poles.to_csv(tmp, index=False))
     return 0
 
 
@@ -74,6 +113,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--quiet", action="store_true", help="no progress or chatter")
     sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("identify", help="fit a shared-pole ARMAX model and print the modes")
+    _add_data_args(p)
+    p.add_argument("--orders", default="auto", help="'auto' (BIC) or na,nb,nc,nk; default auto")
+    p.add_argument("--band", default=None, help="frequency band LO:HI in Hz")
+    p.add_argument("--json", default=None, help="write modes as JSON")
+    p.add_argument("--csv", default=None, help="write every pole of every sensor as CSV")
+    p.set_defaults(func=_cmd_identify)
 
     p = sub.add_parser("info", help="summarise a recording")
     _add_data_args(p)

@@ -140,8 +140,9 @@ def _fs_from_time(t: np.ndarray, path: Path) -> float:
             f"{worst} is {steps[worst]:.6g} s against a median of {dt:.6g} s (a dropped or "
             "repeated sample?). Resample the data to a uniform grid first."
         )
-    # The mean step over the whole record is far less sensitive to printed rounding.
-    return (t.size - 1) / float(t[-1] - t[0])
+    # The mean step over the whole record is far less sensitive to printed rounding; ten
+    # significant digits is more than any printed time column carries.
+    return float(f"{(t.size - 1) / float(t[-1] - t[0]):.10g}")
 
 
 # -- CSV ------------------------------------------------------------------------------

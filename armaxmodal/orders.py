@@ -12,8 +12,12 @@ Rules (documented defaults, all overridable):
 
 from __future__ import annotations
 
+import multiprocessing
+import os
 from collections.abc import Iterable
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 import pandas as pd
@@ -59,6 +63,30 @@ def information_criterion(fit: ArmaxFit, kind: str = "bic") -> float:
     return fit_term + penalty
 
 
+def _fit_or_none(recording, orders, *, shared_poles, max_iter):
+    try:
+        return fit_armax(recording, *orders, shared_poles=shared_poles, max_iter=max_iter, warn=False)
+    except OrderError:
+        return None
+
+
+def _single_blas_thread() -> None:
+    # Every matrix here is small; BLAS threads in several worker processes only contend.
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=1, user_api="blas")
+
+
+def _map(func, items, n_jobs):
+    """``map`` over forked worker processes when it pays, else in this process."""
+    n_jobs = n_jobs or os.cpu_count() or 1
+    if n_jobs <= 1 or len(items) < 4 or "fork" not in multiprocessing.get_all_start_methods():
+        return [func(item) for item in items]
+    ctx = multiprocessing.get_context("fork")
+    with ProcessPoolExecutor(n_jobs, mp_context=ctx, initializer=_single_blas_thread) as pool:
+        return list(pool.map(func, items))
+
+
 def choose_orders(
     recording: Recording,
     na_values: Iterable[int] = range(4, 21, 2),
@@ -67,6 +95,7 @@ def choose_orders(
     shared_poles: bool = True,
     criterion: str = "bic",
     max_iter: int = 100,
+    n_jobs: int | None = None,
 ) -> OrderChoice:
     """Fit every (na, nk) candidate with the default nb and nc and keep the best by BIC/AIC.
 
@@ -78,6 +107,9 @@ def choose_orders(
     shared_poles : bool
         Choose for the shared-pole form (default) or the per-sensor form.
     criterion : {"bic", "aic"}
+    n_jobs : int, optional
+        Worker processes (default: all cores; 1 runs in this process). Workers are forked,
+        so they reuse the compiled kernels.
 
     Returns
     -------
@@ -85,36 +117,19 @@ def choose_orders(
     """
     if criterion not in ("bic", "aic"):
         raise ValueError(f"criterion: expected 'bic' or 'aic', got {criterion!r}.")
+    candidates = [(na, default_nb(na, nk), default_nc(na), nk) for na in na_values for nk in nk_values]
+    run = partial(_fit_or_none, recording, shared_poles=shared_poles, max_iter=max_iter)
+    fits = _map(run, candidates, n_jobs)
     rows, best, best_value = [], None, np.inf
-    for na in na_values:
-        for nk in nk_values:
-            nb, nc = default_nb(na, nk), default_nc(na)
-            try:
-                fit = fit_armax(
-                    recording,
-                    na,
-                    nb,
-                    nc,
-                    nk,
-                    shared_poles=shared_poles,
-                    max_iter=max_iter,
-                    warn=False,
-                )
-            except OrderError:
-                continue
-            value = information_criterion(fit, criterion)
-            rows.append(
-                {
-                    "na": na,
-                    "nb": nb,
-                    "nc": nc,
-                    "nk": nk,
-                    criterion: value,
-                    "converged": bool(np.all(fit.converged)),
-                }
-            )
-            if value < best_value:
-                best, best_value = fit, value
+    for (na, nb, nc, nk), fit in zip(candidates, fits, strict=True):
+        if fit is None:
+            continue
+        value = information_criterion(fit, criterion)
+        rows.append(
+            {"na": na, "nb": nb, "nc": nc, "nk": nk, criterion: value, "converged": bool(np.all(fit.converged))}
+        )
+        if value < best_value:
+            best, best_value = fit, value
     if best is None:
         raise OrderError("no candidate order fits this record; give smaller na_values.")
     return OrderChoice(best, pd.DataFrame(rows).sort_values(criterion).reset_index(drop=True))

@@ -49,3 +49,36 @@ def test_errors_exit_2_with_a_message(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "input channel 'base' not found" in err and "--input" in err
     assert main(["info", str(p), "--input", "plat"]) == 0
+
+
+def test_identify_fixed_orders_writes_the_json_contract(fixtures_dir, tmp_path, capsys):
+    out, poles = tmp_path / "modes.json", tmp_path / "poles.csv"
+    code = main(
+        [
+            "identify",
+            str(fixtures_dir / "supine_random_zoh.csv"),
+            "--orders",
+            "8,9,8,0",
+            "--json",
+            str(out),
+            "--csv",
+            str(poles),
+        ]
+    )
+    assert code == 0
+    data = json.loads(out.read_text())
+    assert data["fs"] == 60.0 and data["input"] == "base" and data["outputs"] == ["head", "chest", "pelvis", "legs"]
+    freqs = [m["freq_hz"] for m in data["modes"]]
+    assert freqs == sorted(freqs) and len(freqs) == 4
+    np.testing.assert_allclose(freqs, am.supine_human().modes().freq_hz, rtol=0.01)
+    mode = data["modes"][0]
+    assert mode["freq_ci95"][0] < mode["freq_hz"] < mode["freq_ci95"][1]
+    assert set(mode["shape"]) == {"head", "chest", "pelvis", "legs"}
+    assert max(v["mag"] for v in mode["shape"].values()) == 1.0
+    assert {"sensor", "mode", "freq_hz", "damping", "residue_mag"} <= set(data["per_sensor"][0])
+    assert poles.read_text().startswith("sensor,freq_hz")
+
+
+def test_identify_rejects_bad_orders(fixtures_dir, capsys):
+    assert main(["identify", str(fixtures_dir / "supine_random_zoh.csv"), "--orders", "8,9"]) == 2
+    assert "na,nb,nc,nk" in capsys.readouterr().err
