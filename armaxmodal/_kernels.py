@@ -67,10 +67,12 @@ def _inverse_filter(x, c):
     n_sig, n = x.shape
     nc = c.size - 1
     out = np.empty_like(x)
-    for s in range(n_sig):
-        for t in range(n):
+    # Time outermost: the signals' recursions are independent, so interleaving them keeps
+    # the pipeline busy where one recursion alone waits on its previous output.
+    for t in range(n):
+        top = min(nc, t)
+        for s in range(n_sig):
             acc = x[s, t]
-            top = min(nc, t)
             for i in range(1, top + 1):
                 acc -= c[i] * out[s, t - i]
             out[s, t] = acc
@@ -99,17 +101,29 @@ def _armax_residual(y, u, a, b, nk, c):
     na = a.size - 1
     nc = c.size - 1
     eps = np.empty(n)
+    # Interior samples have every regressor inside the record: no bounds checks there.
+    lo = max(na, nc, nk + nb - 1, 0)
+    hi = n - max(0, -nk)
     for t in range(n):
         w = y[t]
-        for i in range(1, min(na, t) + 1):
-            w += a[i] * y[t - i]
-        for m in range(n_in):
-            for j in range(nb):
-                k = t - nk - j
-                if 0 <= k < n:
-                    w -= b[m, j] * u[m, k]
-        for i in range(1, min(nc, t) + 1):
-            w -= c[i] * eps[t - i]
+        if lo <= t < hi:
+            for i in range(1, na + 1):
+                w += a[i] * y[t - i]
+            for m in range(n_in):
+                for j in range(nb):
+                    w -= b[m, j] * u[m, t - nk - j]
+            for i in range(1, nc + 1):
+                w -= c[i] * eps[t - i]
+        else:
+            for i in range(1, min(na, t) + 1):
+                w += a[i] * y[t - i]
+            for m in range(n_in):
+                for j in range(nb):
+                    k = t - nk - j
+                    if 0 <= k < n:
+                        w -= b[m, j] * u[m, k]
+            for i in range(1, min(nc, t) + 1):
+                w -= c[i] * eps[t - i]
         eps[t] = w
     return eps
 
@@ -157,11 +171,11 @@ def _lagged_gram(sig, col_sig, col_lag, col_sign, t0, t1):
                     )
                 )
             else:
-                acc = 0.0
                 lo = max(t0, l1, l2)
                 hi = min(t1, sig.shape[1] + l1, sig.shape[1] + l2)
-                for t in range(lo, hi):
-                    acc += sig[s1, t - l1] * sig[s2, t - l2]
+                acc = 0.0
+                if hi > lo:
+                    acc = np.dot(sig[s1, lo - l1 : hi - l1], sig[s2, lo - l2 : hi - l2])
                 val = col_sign[c1] * col_sign[c2] * acc
             g[c1, c2] = val
             g[c2, c1] = val
@@ -176,8 +190,9 @@ def _lagged_cross(sig, col_sig, col_lag, col_sign, target, t0, t1):
     n = sig.shape[1]
     for c in range(p):
         s, lag = col_sig[c], col_lag[c]
+        lo, hi = max(t0, lag), min(t1, n + lag)
         acc = 0.0
-        for t in range(max(t0, lag), min(t1, n + lag)):
-            acc += sig[s, t - lag] * target[t]
+        if hi > lo:
+            acc = np.dot(sig[s, lo - lag : hi - lag], target[lo:hi])
         out[c] = col_sign[c] * acc
     return out

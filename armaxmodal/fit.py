@@ -66,7 +66,8 @@ class ArmaxFit:
         Levenberg-Marquardt iterations (the same number for every sensor when shared).
     converged : (n_sensors,) ndarray of bool
     covariance : tuple of ndarray
-        Per sensor, the covariance of ``[a_1..a_na, b (row-major), c_1..c_nc]``.
+        Per sensor, the covariance of ``[a_1..a_na, b (row-major), c_1..c_nc]`` (no c for an
+        output-error fit).
     joint_covariance : ndarray or None
         Shared form: covariance of ``[a, b_1, c_1, b_2, c_2, ...]``.
     n_samples : int
@@ -157,6 +158,7 @@ def fit_armax(
     *,
     fs: float | None = None,
     shared_poles: bool = False,
+    output_error: bool = False,
     max_iter: int = 100,
     tol: float = 1e-6,
     warn: bool = True,
@@ -176,6 +178,10 @@ def fit_armax(
         Sampling rate in Hz when arrays are given.
     shared_poles : bool
         One A(q) for all sensors (see the module docstring for when to use which).
+    output_error : bool
+        Fix ``C = A`` (``nc`` is ignored): ``y = (B/A) u + white noise``, the model of white
+        sensor noise. Fewer parameters than ARMAX, so tighter estimates when that noise model
+        holds (simulated rides, good sensors); ARMAX when the disturbance is coloured.
     max_iter : int
         Levenberg-Marquardt iteration cap.
     tol : float
@@ -191,7 +197,7 @@ def fit_armax(
     ArmaxFit
     """
     u, y, fs, sensors, inputs = _unpack(data, fs)
-    na, nb, nc, nk = _check_orders(na, nb, nc, nk)
+    na, nb, nc, nk = _check_orders(na, nb, 0 if output_error else nc, nk)
     # Non-causal taps (nk < 0): y[t] depends on u[t + lead - j]. Pairing y[:n-lead] with
     # u[lead:] gives the equivalent causal model (delay 0) on a window of the record.
     # Filtering by 1/C from rest commutes with delays, not with advances, so this keeps the
@@ -213,17 +219,20 @@ def fit_armax(
         )
     uT = np.ascontiguousarray(u_fit.T)
     if shared_poles:
-        thetas, info = _fit_shared(y_fit, uT, na, nb, nc, nk_fit, t0, t1, max_iter, tol)
+        thetas, info = _fit_shared(y_fit, uT, na, nb, nc, nk_fit, t0, t1, max_iter, tol, output_error)
     else:
         thetas, info = [], []
         for k in range(y.shape[1]):
-            th, inf = _fit_single(np.ascontiguousarray(y_fit[:, k]), uT, na, nb, nc, nk_fit, t0, t1, max_iter, tol)
+            th, inf = _fit_single(
+                np.ascontiguousarray(y_fit[:, k]), uT, na, nb, nc, nk_fit, t0, t1, max_iter, tol, output_error
+            )
             thetas.append(th)
             info.append(inf)
         info = _merge_single_info(info)
     models = []
     for k, theta in enumerate(thetas):
         a, b, c = _unpack_theta(theta, na, nb, nc, n_in)
+        c = a.copy() if output_error else c
         models.append(ArmaxModel(a, b, c, nk, fs, float(info["noise_variance"][k]), sensors[k], inputs))
     fit_pct = np.array([_nrmse_fit(y[:, k], m.simulate(u), t0, y.shape[0] - lead) for k, m in enumerate(models)])
     result = ArmaxFit(
@@ -363,8 +372,12 @@ def _hannan_rissanen(y, uT, na, nb, nc, nk, t0, t1):
     return _project(theta, na, nb, nc, uT.shape[0])
 
 
-def _project(theta, na, nb, nc, n_in):
-    """Keep C stable inside a parameter vector [a, b, c]."""
+def _project(theta, na, nb, nc, n_in, oe=False):
+    """Keep C (output error: A) stable inside a parameter vector [a, b, c]."""
+    if oe:
+        theta = theta.copy()
+        theta[:na] = _stable_a(np.concatenate([[1.0], theta[:na]]))[1:]
+        return theta
     if nc == 0:
         return theta
     theta = theta.copy()
@@ -379,11 +392,11 @@ def _stable_a(a):
     if np.all(np.abs(r) < 1):
         return a
     r = np.where(np.abs(r) > 1, 1 / np.conj(r), r)
-    r = np.where(np.abs(r) >= 0.999, r * (0.999 / np.abs(r)), r)
+    r = np.where(np.abs(r) >= 0.9999, r * (0.9999 / np.abs(r)), r)
     return np.real(np.poly(r))
 
 
-def _steiglitz_mcbride(ys, uT, a0, na, nb, nk, t0, t1, iterations=10):
+def _steiglitz_mcbride(ys, uT, a0, na, nb, nk, t0, t1, iterations=6):
     """Output-error start: shared A and per-sensor B by iterated prefiltering with 1/A.
 
     Each pass solves ``min sum_k w_k |A (y_k / A_prev) - B_k (u / A_prev)|^2`` by linear least
@@ -412,7 +425,7 @@ def _steiglitz_mcbride(ys, uT, a0, na, nb, nk, t0, t1, iterations=10):
         for k, yk in enumerate(ys):
             e = _armax_residual(yk, uT, a_new, bs[k].reshape(n_in, -1), nk, a_new)
             weights[k] = 1.0 / max(float(np.var(e[t0:t1])), 1e-300)
-        done = np.max(np.abs(a_new - a)) < 1e-6  # a start only: PEM does the rest
+        done = np.max(np.abs(a_new - a)) < 1e-4  # a start only: PEM does the rest
         a = a_new
         if done:
             break
@@ -424,20 +437,28 @@ def _subspace_a(ys, uT, na):
 
     Past inputs and outputs instrument the future outputs; the column space of the
     projected block Hankel matrix is the extended observability matrix, whose shift
-    invariance gives the state matrix. Non-iterative, so it cannot crawl.
+    invariance gives the state matrix. Non-iterative, so it cannot crawl. The block-Hankel
+    rows are lagged copies of u and y, so the LQ factor is computed as the Cholesky factor
+    of their lagged Gram matrix: O(N p) time and O(p^2) memory instead of a tall QR.
     """
-    u = uT.T
-    y = np.column_stack(ys)
-    m, n_out = u.shape[1], y.shape[1]
+    n_in, n_out = uT.shape[0], len(ys)
     i = max(-(-na // n_out) + 2, 2 * -(-na // n_out), 6)
-    n_cols = u.shape[0] - 2 * i + 1
+    sig = np.ascontiguousarray(np.vstack([uT, np.vstack(ys)]))
+    n_sig = n_in + n_out
+    # kernel column order: each signal with lags 0..2i-1
+    col_sig = np.repeat(np.arange(n_sig), 2 * i).astype(np.int64)
+    col_lag = np.tile(np.arange(2 * i), n_sig).astype(np.int64)
+    gram = _lagged_gram(sig, col_sig, col_lag, np.ones(col_sig.size), 2 * i - 1, sig.shape[1])
 
-    def hankel(x, start):
-        return np.vstack([x[start + j : start + j + n_cols].T for j in range(i)])
+    def rows(signals, lags):  # Hankel block j of signal s sits at lag 2i-1-j
+        return [s * 2 * i + lag for lag in lags for s in signals]
 
-    data = np.vstack([hankel(u, i), hankel(u, 0), hankel(y, 0), hankel(y, i)]) / np.sqrt(n_cols)
-    low = scipy.linalg.qr(data.T, mode="r")[0].T
-    mi, li = m * i, n_out * i
+    inputs, outputs = range(n_in), range(n_in, n_sig)
+    future, past = [i - 1 - j for j in range(i)], [2 * i - 1 - j for j in range(i)]
+    order = rows(inputs, future) + rows(inputs, past) + rows(outputs, past) + rows(outputs, future)
+    g = gram[np.ix_(order, order)] / (sig.shape[1] - 2 * i + 1)
+    low = np.linalg.cholesky(g + 1e-12 * np.trace(g) / g.shape[0] * np.eye(g.shape[0]))
+    mi, li = n_in * i, n_out * i
     l42 = low[2 * mi + li :, mi : 2 * mi + li]
     left, sv, _ = np.linalg.svd(l42, full_matrices=False)
     gamma = left[:, :na] * np.sqrt(sv[:na])
@@ -460,38 +481,39 @@ def _output_error_start(ys, uT, theta_hr, na, nb, nc, nk, t0, t1):
 
 
 # -- single-output PEM ------------------------------------------------------------------------
-def _residual_and_loss(y, uT, theta, na, nb, nc, nk, t0, t1):
+def _residual_and_loss(y, uT, theta, na, nb, nc, nk, t0, t1, oe=False):
     a, b, c = _unpack_theta(theta, na, nb, nc, uT.shape[0])
+    if oe:  # output error: C = A, so eps = y - (B / A) u
+        c = a
     eps = _armax_residual(y, uT, a, b, nk, c)
     with np.errstate(over="ignore", invalid="ignore"):  # an unstable trial step is rejected
         loss = float(eps[t0:t1] @ eps[t0:t1])
     return eps, (loss if np.isfinite(loss) else np.inf), c
 
 
-def _normal_equations(y, uT, eps, c, cols, t0, t1):
-    filtered = _inverse_filter(_signals(y, uT, eps), c)
+def _normal_equations(y, uT, eps, c, cols, t0, t1, oe=False):
+    # Output error: d eps / d a_i is the simulated output y - eps, filtered by 1/A, lagged.
+    filtered = _inverse_filter(_signals(y - eps if oe else y, uT, eps), c)
     return _lagged_gram(filtered, *cols, t0, t1), _lagged_cross(filtered, *cols, eps, t0, t1)
 
 
-def _fit_single(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol):
+def _fit_single(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
     n_in = uT.shape[0]
     cols = _columns(na, nb, nc, nk, n_in)
     theta = _hannan_rissanen(y, uT, na, nb, nc, nk, t0, t1)
-    eps, loss, c = _residual_and_loss(y, uT, theta, na, nb, nc, nk, t0, t1)
-    alt = _project(_output_error_start([y], uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in)
-    eps_alt, loss_alt, c_alt = _residual_and_loss(y, uT, alt, na, nb, nc, nk, t0, t1)
-    if loss_alt < loss:
-        theta, eps, loss, c = alt, eps_alt, loss_alt, c_alt
+    if oe:
+        theta = _project(_output_error_start([y], uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in, oe=True)
+    eps, loss, c = _residual_and_loss(y, uT, theta, na, nb, nc, nk, t0, t1, oe)
     lm = 1e-4
     converged = False
     it = 0
     for it in range(1, max_iter + 1):  # noqa: B007 - the count is reported
-        g_mat, g_vec = _normal_equations(y, uT, eps, c, cols, t0, t1)
+        g_mat, g_vec = _normal_equations(y, uT, eps, c, cols, t0, t1, oe)
         improved = False
         while lm < 1e10:
             step = _solve(g_mat, g_vec, lm)
-            trial = _project(theta + step, na, nb, nc, n_in)
-            eps_t, loss_t, c_t = _residual_and_loss(y, uT, trial, na, nb, nc, nk, t0, t1)
+            trial = _project(theta + step, na, nb, nc, n_in, oe)
+            eps_t, loss_t, c_t = _residual_and_loss(y, uT, trial, na, nb, nc, nk, t0, t1, oe)
             if loss_t < loss:
                 improved = True
                 break
@@ -507,7 +529,7 @@ def _fit_single(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol):
         if rel < tol:
             converged = True
             break
-    g_mat, _ = _normal_equations(y, uT, eps, c, cols, t0, t1)
+    g_mat, _ = _normal_equations(y, uT, eps, c, cols, t0, t1, oe)
     n_eff = t1 - t0
     p = theta.size
     lam = loss / max(n_eff - p, 1)
@@ -548,7 +570,7 @@ def _local(theta, k, na, p_k):
     return theta[_shared_index(k, na, p_k)]
 
 
-def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol):
+def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
     """Joint maximum likelihood with per-sensor noise variances.
 
     Alternates a weighted least-squares Levenberg-Marquardt solve at fixed variances
@@ -574,15 +596,15 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol):
         idx = _shared_index(k, na, p_k)
         g_mat[np.ix_(idx, idx)] += w * _lagged_gram(sig, *cols, t0, t1)
         g_vec[idx] += w * _lagged_cross(sig, *cols, ys[k], t0, t1)
-    theta = _project_shared(_solve(g_mat, g_vec), na, nb, nc, n_in, n_out)
+    theta = _project_shared(_solve(g_mat, g_vec), na, nb, nc, n_in, n_out, oe)
 
     def evaluate(th):
-        out = [_residual_and_loss(ys[k], uT, _local(th, k, na, p_k), na, nb, nc, nk, t0, t1) for k in range(n_out)]
+        out = [_residual_and_loss(ys[k], uT, _local(th, k, na, p_k), na, nb, nc, nk, t0, t1, oe) for k in range(n_out)]
         return out, np.array([o[1] for o in out])
 
     state, losses = evaluate(theta)
     # Second start: output error by Steiglitz-McBride; keep whichever is more likely.
-    alt = _project_shared(_output_error_start(ys, uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in, n_out)
+    alt = _project_shared(_output_error_start(ys, uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in, n_out, oe)
     state_alt, losses_alt = evaluate(alt)
     if np.sum(np.log(losses_alt)) < np.sum(np.log(losses)):
         theta, state, losses = alt, state_alt, losses_alt
@@ -596,11 +618,11 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol):
         inner_converged = False
         while total_iterations < max_iter:
             total_iterations += 1
-            g_mat, g_vec = _shared_normal_equations(ys, uT, state, variances, cols, na, p_k, t0, t1)
+            g_mat, g_vec = _shared_normal_equations(ys, uT, state, variances, cols, na, p_k, t0, t1, oe)
             improved = False
             while lm < 1e10:
                 step = _solve(g_mat, g_vec, lm)
-                trial = _project_shared(theta + step, na, nb, nc, n_in, n_out)
+                trial = _project_shared(theta + step, na, nb, nc, n_in, n_out, oe)
                 state_t, losses_t = evaluate(trial)
                 objective_t = float(weights @ losses_t)
                 if objective_t < objective:
@@ -623,7 +645,7 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol):
             converged = True
             break
     lam = losses / max(n_eff - (na / n_out + p_k), 1)
-    g_mat, _ = _shared_normal_equations(ys, uT, state, lam, cols, na, p_k, t0, t1)
+    g_mat, _ = _shared_normal_equations(ys, uT, state, lam, cols, na, p_k, t0, t1, oe)
     joint = _inverse(g_mat)
     covs = [joint[np.ix_(_shared_index(k, na, p_k), _shared_index(k, na, p_k))] for k in range(n_out)]
     thetas = [_local(theta, k, na, p_k) for k in range(n_out)]
@@ -638,19 +660,21 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol):
     return thetas, info
 
 
-def _shared_normal_equations(ys, uT, state, variances, cols, na, p_k, t0, t1):
+def _shared_normal_equations(ys, uT, state, variances, cols, na, p_k, t0, t1, oe=False):
     p = na + len(ys) * p_k
     g_mat = np.zeros((p, p))
     g_vec = np.zeros(p)
     for k, (eps, _, c) in enumerate(state):
-        gk, vk = _normal_equations(ys[k], uT, eps, c, cols, t0, t1)
+        gk, vk = _normal_equations(ys[k], uT, eps, c, cols, t0, t1, oe)
         idx = _shared_index(k, na, p_k)
         g_mat[np.ix_(idx, idx)] += gk / variances[k]
         g_vec[idx] += vk / variances[k]
     return g_mat, g_vec
 
 
-def _project_shared(theta, na, nb, nc, n_in, n_out):
+def _project_shared(theta, na, nb, nc, n_in, n_out, oe=False):
+    if oe:
+        return _project(theta, na, nb, nc, n_in, oe=True)
     if nc == 0:
         return theta
     theta = theta.copy()
@@ -672,7 +696,12 @@ def _nrmse_fit(y, y_sim, t0, t1):
 
 
 def covariance_at(
-    models, data: Recording | tuple, *, fs: float | None = None, shared_poles: bool = False
+    models,
+    data: Recording | tuple,
+    *,
+    fs: float | None = None,
+    shared_poles: bool = False,
+    output_error: bool = False,
 ) -> list[np.ndarray]:
     """Asymptotic covariance of the PEM estimate evaluated at given models.
 
@@ -687,6 +716,8 @@ def covariance_at(
         The input and outputs that drive the gradient (use noise-free or measured data).
     shared_poles : bool
         Pool the A parameters over sensors as :func:`fit_armax` does.
+    output_error : bool
+        The output-error parametrisation ``[a, b]`` with ``C = A`` fixed.
 
     Returns
     -------
@@ -695,6 +726,7 @@ def covariance_at(
     """
     u, y, _, _, _ = _unpack(data, fs)
     na, nb, nc, nk = models[0].orders
+    nc = 0 if output_error else nc
     lead = max(0, -nk)
     y_fit, u_fit, nk_fit = y[: y.shape[0] - lead], u[lead:], nk + lead
     n = y_fit.shape[0]
@@ -705,9 +737,9 @@ def covariance_at(
     blocks = []
     for k, m in enumerate(models):
         yk = np.ascontiguousarray(y_fit[:, k])
-        theta = np.concatenate([m.a[1:], m.b.ravel(), m.c[1:]])
-        eps, _, c = _residual_and_loss(yk, uT, theta, na, nb, nc, nk_fit, t0, t1)
-        blocks.append(_normal_equations(yk, uT, eps, c, cols, t0, t1)[0] / m.noise_variance)
+        theta = np.concatenate([m.a[1:], m.b.ravel(), m.c[1 : nc + 1]])
+        eps, _, c = _residual_and_loss(yk, uT, theta, na, nb, nc, nk_fit, t0, t1, output_error)
+        blocks.append(_normal_equations(yk, uT, eps, c, cols, t0, t1, output_error)[0] / m.noise_variance)
     if not shared_poles:
         return [_inverse(g) for g in blocks]
     p_k = n_in * nb + nc

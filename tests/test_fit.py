@@ -324,3 +324,17 @@ def test_thesis_equations_3_15_3_16_agree_with_the_log_form():
     np.testing.assert_allclose(f_thesis, f, rtol=1e-12)
     np.testing.assert_allclose(xi_thesis, xi, rtol=1e-12)
     np.testing.assert_allclose(f, am.supine_human().modes().freq_hz, rtol=1e-12)
+
+
+def test_output_error_form(supine_zoh):
+    """C = A fixed: same modes, and never a lower loss than the ARMAX model that contains it."""
+    oe = fit_armax(supine_zoh, 8, 9, 0, 0, shared_poles=True, output_error=True)
+    armax = fit_armax(supine_zoh, 8, 9, 8, 0, shared_poles=True)
+    assert oe.converged.all()
+    assert np.allclose(oe.models[0].c, oe.models[0].a)
+    assert np.all(armax.loss <= oe.loss * (1 + 1e-9))
+    modes = oe.modes().query("sensor == 'head'")
+    err = _match(modes.freq_hz.values, modes.damping.values, am.supine_human().modes())
+    assert np.all(np.abs(err[:, 0]) < ZOH_FREQ_RTOL) and np.all(np.abs(err[:, 1]) < ZOH_DAMPING_RTOL), err
+    single = fit_armax(supine_zoh.select(["legs"]), 8, 9, 0, 0, output_error=True)
+    assert single.converged.all() and single.covariance[0].shape == (8 + 9,) * 2
