@@ -85,18 +85,22 @@ class ArmaxModel:
             out[:, k] = (self.b @ powers) / denom
         return out
 
-    def modal_constants(self, poles: np.ndarray | None = None) -> np.ndarray:
+    def modal_constants(self, poles: np.ndarray | None = None, hold: str = "bandlimited") -> np.ndarray:
         """EPFRF modal constants ``M_in`` (Eq. 3.24) from the residues, (n_inputs, n_poles).
 
-        Assumes the output is absolute acceleration per unit base acceleration and a
-        zero-order-hold input, for which the discrete residue is
-        ``R = r (mu - 1) / (lambda mu)`` with the continuous residue ``r = -lambda^2 M``.
-        The conversion factor is common to every sensor for a given mode, so mode-shape
-        ratios are the same under any input assumption.
+        The output is absolute acceleration per unit base acceleration, whose continuous
+        residue is ``r = -lambda^2 M``. How a discrete residue ``R`` maps to ``r`` depends on
+        how the input was sampled: ``"bandlimited"`` (anti-aliased sensors, measured data) is
+        impulse invariance, ``R = r / fs``; ``"zoh"`` (input held between samples) is
+        ``R = r (mu - 1) / (lambda mu)``. The factor is common to every sensor of a mode, so
+        mode-shape ratios are the same either way; magnitudes (FRF synthesis) are not.
         """
+        if hold not in ("bandlimited", "zoh"):
+            raise ValueError(f"hold: expected 'bandlimited' or 'zoh', got {hold!r}.")
         mu = self.poles() if poles is None else np.asarray(poles, dtype=complex)
         lam = np.log(mu) * self.fs
-        return -self.residues(mu) * mu / ((mu - 1.0) * lam)
+        r = self.residues(mu) * (self.fs if hold == "bandlimited" else mu * lam / (mu - 1.0))
+        return -r / lam**2
 
     def modal_parameters(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Poles with positive imaginary part and their (freq_hz, damping, damped_freq_hz).

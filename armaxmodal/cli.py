@@ -82,6 +82,58 @@ def _cmd_identify(args) -> int:
     return 0
 
 
+def _cmd_stabilise(args) -> int:
+    from .stabilisation import select_modes, stabilisation_diagram
+
+    rec = _load(args)
+    try:
+        lo, hi = (int(v) for v in args.orders.split(":"))
+    except ValueError as exc:
+        raise OrderError(f"--orders: expected LO:HI model orders such as 2:40, got {args.orders!r}.") from exc
+    if not 1 <= lo <= hi:
+        raise OrderError(f"--orders: expected 1 <= LO <= HI, got {args.orders!r}.")
+    band = _parse_pair(args.band, "--band") if args.band else None
+    diagram = stabilisation_diagram(rec, range(lo, hi + 1, 2), progress=not args.quiet)
+    selection = select_modes(diagram, args.modes, band)
+    if not args.quiet:
+        print(
+            selection.modes[
+                [
+                    "freq_hz",
+                    "damping",
+                    "damped_freq_hz",
+                    "freq_ci95_lo",
+                    "freq_ci95_hi",
+                    "damping_ci95_lo",
+                    "damping_ci95_hi",
+                    "count",
+                ]
+            ].to_string(float_format=lambda v: f"{v:.4f}")
+        )
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        ax, _ = diagram.plot(selection)
+        atomic_write(args.plot, lambda tmp: ax.figure.savefig(tmp, dpi=150, format=_format(args.plot)))
+        plt.close(ax.figure)
+    if args.json:
+        write_json(selection.to_dict(), args.json)
+    if args.csv:
+        table = diagram.to_frame()
+        atomic_write(args.csv, lambda tmp: table.to_csv(tmp, index=False))
+    return 0
+
+
+def _format(path: str) -> str:
+    ext = path.rsplit(".", 1)[-1].lower()
+    if ext not in ("png", "svg", "pdf"):
+        raise DataError(f"--plot: expected a .png, .svg or .pdf file name, got {path!r}.")
+    return ext
+
+
 def _cmd_modes(args) -> int:
     modes = SYSTEMS[args.system]().modes()
     print(modes.to_frame().to_string(index=False, float_format=lambda v: f"{v:.4f}"))
@@ -113,6 +165,16 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--quiet", action="store_true", help="no progress or chatter")
     sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("stabilise", help="order sweep, stabilisation plot and automatic mode selection")
+    _add_data_args(p)
+    p.add_argument("--orders", default="2:40", help="range of na, LO:HI (even steps); default 2:40")
+    p.add_argument("--modes", type=int, default=None, help="number of modes to keep (default: automatic)")
+    p.add_argument("--band", default=None, help="frequency band LO:HI in Hz")
+    p.add_argument("--plot", default=None, help="stabilisation plot (.png, .svg or .pdf)")
+    p.add_argument("--json", default=None, help="selected modes as JSON")
+    p.add_argument("--csv", default=None, help="every pole of the sweep as CSV")
+    p.set_defaults(func=_cmd_stabilise)
 
     p = sub.add_parser("identify", help="fit a shared-pole ARMAX model and print the modes")
     _add_data_args(p)

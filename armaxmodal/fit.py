@@ -44,6 +44,10 @@ _MIN_SAMPLES_PER_PARAMETER = 5
 # Largest root radius allowed for C (keeps 1/C filtering stable and well conditioned).
 _MAX_C_RADIUS = 0.995
 _Z95 = 1.959963984540054
+_MODE_COLUMNS = [
+    "sensor", "freq_hz", "damping", "damped_freq_hz", "freq_ci95_lo", "freq_ci95_hi", "damping_ci95_lo",
+    "damping_ci95_hi", "freq_sd", "damping_sd", "pole", "residue", "residue_mag", "residue_phase_deg",
+]  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -123,7 +127,7 @@ class ArmaxFit:
                         "residue_phase_deg": np.degrees(np.angle(res[i])),
                     }
                 )
-        frame = pd.DataFrame(rows)
+        frame = pd.DataFrame(rows, columns=_MODE_COLUMNS)
         if band is not None and len(frame):
             frame = frame[(frame.freq_hz >= band[0]) & (frame.freq_hz <= band[1])]
         return frame.reset_index(drop=True)

@@ -77,14 +77,26 @@ def _single_blas_thread() -> None:
     threadpool_limits(limits=1, user_api="blas")
 
 
-def _map(func, items, n_jobs):
-    """``map`` over forked worker processes when it pays, else in this process."""
+def _map(func, items, n_jobs, bar=None):
+    """``map`` over forked worker processes when it pays, else in this process.
+
+    ``bar`` (a tqdm bar) is advanced as results arrive.
+    """
     n_jobs = n_jobs or os.cpu_count() or 1
+    out = []
     if n_jobs <= 1 or len(items) < 4 or "fork" not in multiprocessing.get_all_start_methods():
-        return [func(item) for item in items]
+        for item in items:
+            out.append(func(item))
+            if bar is not None:
+                bar.update()
+        return out
     ctx = multiprocessing.get_context("fork")
     with ProcessPoolExecutor(n_jobs, mp_context=ctx, initializer=_single_blas_thread) as pool:
-        return list(pool.map(func, items))
+        for result in pool.map(func, items):
+            out.append(result)
+            if bar is not None:
+                bar.update()
+    return out
 
 
 def choose_orders(

@@ -226,7 +226,7 @@ def test_residue_shapes_match_true_modal_constants(supine_zoh):
     fit = fit_armax(supine_zoh, 8, 9, 8, 0, shared_poles=True)
     truth = am.supine_human().modes()
     mu, f, _, _ = fit.models[0].modal_parameters()
-    est = np.array([m.modal_constants(mu)[0] for m in fit.models])  # (sensor, mode)
+    est = np.array([m.modal_constants(mu, hold="zoh")[0] for m in fit.models])  # (sensor, mode)
     for r in (0, 1):  # the two best-determined modes
         i = int(np.argmin(np.abs(f - truth.freq_hz[r])))
         mac = abs(np.vdot(est[:, i], truth.modal_constants[:, r])) ** 2 / (

@@ -1,0 +1,157 @@
+"""Figures (the only module that imports matplotlib). Functions take ``ax=None`` and return axes."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.signal
+
+__all__ = ["plot_stabilisation", "measured_frf", "modal_frf"]
+
+# class -> (marker, colour, label); distinct in shape and colour
+_STYLE = {
+    "new": ("o", "#9e9e9e", "new"),
+    "f": ("^", "#1f77b4", "stable f"),
+    "f+d": ("s", "#ff7f0e", "stable f, ξ"),
+    "f+d+v": ("*", "#d62728", "stable f, ξ, shape"),
+}
+
+
+def measured_frf(recording, nperseg: int | None = None):
+    """H1 estimate of each output over the input and the coherence.
+
+    Returns ``(freq_hz, H (n_freq, n_sensors) complex, coherence (n_freq, n_sensors))``.
+    """
+    n = nperseg or int(min(recording.n_samples // 8, 2 ** int(np.log2(recording.fs * 10))))
+    u = recording.base
+    f, puu = scipy.signal.welch(u, recording.fs, nperseg=n)
+    h, coh = [], []
+    for y in recording.response.T:
+        _, puy = scipy.signal.csd(u, y, recording.fs, nperseg=n)
+        _, pyy = scipy.signal.welch(y, recording.fs, nperseg=n)
+        h.append(puy / puu)
+        coh.append(np.abs(puy) ** 2 / (puu * pyy))
+    return f, np.array(h).T, np.array(coh).T
+
+
+def modal_frf(freq_hz, freqs, dampings, shapes):
+    """Absolute-acceleration transmissibility synthesised from modes: ``sum r/(iw - lambda) + c.c.``
+    with ``r = -lambda^2 M`` (M: EPFRF modal constants). Shape (n_freq, n_sensors)."""
+    w = 2j * np.pi * np.asarray(freq_hz)[:, None, None]
+    wn = 2 * np.pi * np.asarray(freqs)
+    lam = -np.asarray(dampings) * wn + 1j * wn * np.sqrt(1 - np.asarray(dampings) ** 2)
+    r = -(lam**2)[None, :] * shapes  # (n_sensors, n_modes)
+    out = r[None] / (w - lam[None, None]) + np.conj(r)[None] / (w - np.conj(lam)[None, None])
+    return out.sum(axis=2)
+
+
+def plot_stabilisation(diagram, selection=None, ax=None):
+    """Stabilisation diagram over the measured FRF, with a damping panel below.
+
+    Frequency on x, model order on y, one marker per shared-pole pole by stability class
+    (rejected poles faint), the selected modes as labelled vertical lines, the measured H1
+    magnitude of every sensor and the FRF rebuilt from the selected modes on a log axis,
+    low-coherence bands shaded. Returns ``(ax_top, ax_damping)``.
+    """
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig, (ax, ax_d) = plt.subplots(
+            2, 1, sharex=True, figsize=(9, 7.5), height_ratios=(3, 1.3), constrained_layout=True
+        )
+    else:
+        fig = ax.figure
+        ax_d = ax.inset_axes([0, -0.45, 1, 0.35], sharex=ax)
+    poles = diagram.poles[diagram.poles.source == "shared"]
+    rec = diagram.recording
+    tol = diagram.tolerances
+    f_hi = tol.max_freq_fraction * rec.fs
+    rejected = poles[poles.rejected != ""]
+    ax.scatter(
+        rejected.freq_hz,
+        rejected.na,
+        marker="x",
+        s=12,
+        color="#bdbdbd",
+        alpha=0.5,
+        label=f"rejected ({len(rejected)})",
+        zorder=2,
+    )
+    for cls, (marker, colour, label) in _STYLE.items():
+        sel = poles[(poles.rejected == "") & (poles.cls == cls)]
+        ax_d.scatter(sel.freq_hz, sel.damping, marker=marker, s=18, color=colour, alpha=0.8)
+        ax.scatter(sel.freq_hz, sel.na, marker=marker, s=28, color=colour, label=f"{label} ({len(sel)})", zorder=3)
+    ax.set_ylabel("model order na")
+    ax.set_xlim(0, f_hi)
+    ax.set_title(
+        f"Stabilisation: tolerances f {100 * tol.freq:g} %, ξ {100 * tol.damping:g} %, "
+        f"shape 1-MAC {tol.shape:g}; nk = {diagram.orders[0][3]}",
+        fontsize=10,
+        pad=28,
+    )
+
+    f, h, coh = measured_frf(rec)
+    ax_f = ax.twinx()
+    for k, s in enumerate(rec.sensors):
+        ax_f.semilogy(f, np.abs(h[:, k]), lw=1.0, alpha=0.7, label=f"|H1| {s}")
+    low = np.min(coh, axis=1) < 0.8
+    for lo, hi in _runs(f, low):
+        ax.axvspan(lo, hi, color="#fff3b0", alpha=0.5, zorder=0, lw=0)
+    if selection is not None:
+        rebuilt = modal_frf(f, selection.modes.freq_hz, selection.modes.damping, selection.shapes)
+        for k in range(len(rec.sensors)):
+            ax_f.semilogy(
+                f,
+                np.abs(rebuilt[:, k]),
+                lw=1.0,
+                ls="--",
+                color="k",
+                alpha=0.6,
+                label="from selected modes" if k == 0 else None,
+            )
+        top = max(o[0] for o in diagram.orders)
+        for i, m in enumerate(selection.modes.itertuples(index=False)):
+            ax.axvline(m.freq_hz, color="k", lw=0.8, ls=":")
+            ax_d.axvline(m.freq_hz, color="k", lw=0.8, ls=":")
+            # labels sit above the axes, alternating in height so neighbours never overlap
+            ax.annotate(
+                f"{m.freq_hz:.2f} Hz, ξ {m.damping:.3f}",
+                (m.freq_hz, 1.0),
+                xycoords=("data", "axes fraction"),
+                xytext=(0, 3 + 11 * (i % 2)),
+                textcoords="offset points",
+                ha="center",
+                va="bottom",
+                fontsize=8,
+            )
+        ax.set_ylim(0, top * 1.05)
+        err = selection.reconstruction_error
+        ax.text(
+            0.01,
+            0.01,
+            f"FRF from selected modes vs H1: {100 * err:.1f} % error where coherence ≥ 0.8",
+            transform=ax.transAxes,
+            fontsize=8,
+            va="bottom",
+        )
+    ax_f.set_ylabel("|FRF| (output / base acceleration)")
+    h1, l1 = ax.get_legend_handles_labels()
+    h2, l2 = ax_f.get_legend_handles_labels()
+    fig.legend(h1 + h2, l1 + l2, fontsize=7, loc="outside lower center", ncol=5, frameon=False)
+    ax_d.set_ylabel("damping ratio")
+    ax_d.set_xlabel("frequency (Hz)")
+    ax_d.set_ylim(0, tol.max_damping)
+    return ax, ax_d
+
+
+def _runs(f, mask):
+    """Contiguous frequency intervals where ``mask`` is true."""
+    out, start = [], None
+    for x, m in zip(f, mask, strict=True):
+        if m and start is None:
+            start = x
+        if not m and start is not None:
+            out.append((start, x))
+            start = None
+    if start is not None:
+        out.append((start, f[-1]))
+    return out

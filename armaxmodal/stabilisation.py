@@ -1,0 +1,471 @@
+"""Stabilisation diagram and automatic mode selection (thesis Sections 3.3.2 and 3.4).
+
+The model order is unknown: too low misses modes, too high adds spurious poles. The sweep
+fits the shared-pole model (the default source of modes) and every sensor alone for
+``na`` over a range, with the documented rules ``nb = na + 1 - nk`` and ``nc = na``, and one
+input delay ``nk`` chosen by BIC at a middle order. Physical poles stay put as the order
+grows; each pole is classed against the nearest pole of the previous order of the same
+source: ``new``, ``f`` (frequency within ``tol_freq``), ``f+d`` (and damping within
+``tol_damping``), ``f+d+v`` (and the mode-shape vector or residue within ``tol_shape``).
+
+:func:`select_modes` then clusters the stable shared-pole estimates across orders, keeps the
+clusters supported by a good share of the orders, and takes each cluster's medoid. It is
+deterministic: the same data gives the same modes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import partial
+
+import numpy as np
+import pandas as pd
+
+from .exceptions import OrderError
+from .fit import ArmaxFit, fit_armax
+from .orders import _map, default_nb, default_nc, information_criterion
+from .recording import Recording
+
+__all__ = ["stabilisation_diagram", "StabilisationDiagram", "select_modes", "ModeSelection", "Tolerances"]
+
+SHARED = "shared"
+CLASSES = ("new", "f", "f+d", "f+d+v")
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Stability tolerances between consecutive orders and the pole-rejection rules."""
+
+    freq: float = 0.01  #: relative frequency change
+    damping: float = 0.05  #: relative damping change
+    shape: float = 0.02  #: 1 - MAC for shared shapes; relative residue change per sensor
+    max_damping: float = 0.6  #: heavier damping is not a vibration mode here
+    min_freq_hz: float | None = None  #: default: 3 / record length
+    max_freq_fraction: float = 0.45  #: of fs; poles near Nyquist are filter artefacts
+    min_energy: float = 0.01  #: residue energy relative to the largest pole at that order
+    min_input_db: float = -30.0  #: input PSD below this (dB re its peak): no excitation there
+
+
+@dataclass(frozen=True)
+class StabilisationDiagram:
+    """Poles of every order and source.
+
+    Attributes
+    ----------
+    poles : DataFrame
+        One row per pole: source (``shared`` or a sensor), na, freq_hz, damping,
+        damped_freq_hz, freq_sd, damping_sd, energy (residue energy), cls (stability class),
+        rejected (reason, empty when kept), pole (complex), vector (complex shape over
+        sensors for shared poles; the residue for a sensor's own pole).
+    orders : list of (na, nb, nc, nk)
+    tolerances : Tolerances
+    recording : Recording
+    """
+
+    poles: pd.DataFrame
+    orders: list
+    tolerances: Tolerances
+    recording: Recording
+    fits: dict = field(repr=False, default_factory=dict)
+
+    def to_frame(self) -> pd.DataFrame:
+        """The tidy pole table without the complex columns (for CSV)."""
+        return self.poles.drop(columns=["pole", "vector"])
+
+    def plot(self, selection=None, ax=None):
+        from .plot import plot_stabilisation
+
+        return plot_stabilisation(self, selection, ax=ax)
+
+
+def _mac(a: np.ndarray, b: np.ndarray) -> float:
+    den = np.vdot(a, a).real * np.vdot(b, b).real
+    return float(abs(np.vdot(a, b)) ** 2 / den) if den > 0 else 0.0
+
+
+def _poles_of(fit: ArmaxFit, source: str) -> list[dict]:
+    """Rows for one fit: shared fit -> one source with shapes over sensors."""
+    rows = []
+    if source == SHARED:
+        frame = fit.modes().query(f"sensor == '{fit.sensors[0]}'")
+        mu = frame.pole.to_numpy()
+        shapes = np.array([m.modal_constants(mu)[0] for m in fit.models]) if mu.size else np.zeros((0, 0))
+        for i, r in enumerate(frame.itertuples(index=False)):
+            rows.append(_row(source, fit, r, shapes[:, i], float(np.linalg.norm(shapes[:, i] * r.freq_hz))))
+        return rows
+    frame = fit.modes()
+    mu = frame.pole.to_numpy()
+    consts = fit.models[0].modal_constants(mu)[0] if mu.size else np.zeros(0)
+    for i, r in enumerate(frame.itertuples(index=False)):
+        rows.append(_row(source, fit, r, np.array([consts[i]]), float(abs(consts[i]) * r.freq_hz)))
+    return rows
+
+
+def _row(source, fit, r, shape, energy):
+    return {
+        "source": source,
+        "na": fit.orders[0],
+        "freq_hz": r.freq_hz,
+        "damping": r.damping,
+        "damped_freq_hz": r.damped_freq_hz,
+        "freq_sd": r.freq_sd,
+        "damping_sd": r.damping_sd,
+        "freq_ci95_lo": r.freq_ci95_lo,
+        "freq_ci95_hi": r.freq_ci95_hi,
+        "damping_ci95_lo": r.damping_ci95_lo,
+        "damping_ci95_hi": r.damping_ci95_hi,
+        "energy": energy,
+        "pole": r.pole,
+        "vector": shape,
+    }
+
+
+def _fit_job(recording: Recording, job, max_iter: int):
+    source, orders = job
+    rec = recording if source == SHARED else recording.select([source])
+    try:
+        return fit_armax(rec, *orders, shared_poles=source == SHARED, max_iter=max_iter, warn=False)
+    except OrderError:
+        return None
+
+
+def choose_nk(recording: Recording, nk_values=range(0, -7, -1), na_values=(8, 10, 12), n_jobs=None) -> int:
+    """The input delay of the lowest-BIC shared-pole model over a few middle orders.
+
+    The delay and the order interact (band-limited data trade non-causal taps for poles), so
+    they are chosen jointly; one order alone can pick a delay that biases heavily damped modes.
+    """
+    jobs = [(SHARED, (na, default_nb(na, nk), default_nc(na), nk)) for na in na_values for nk in nk_values]
+    fits = _map(partial(_fit_job, recording, max_iter=50), jobs, n_jobs)
+    scores = [information_criterion(f) if f is not None else np.inf for f in fits]
+    return int(jobs[int(np.argmin(scores))][1][3])
+
+
+def stabilisation_diagram(
+    recording: Recording,
+    orders=range(2, 41, 2),
+    *,
+    nk: int | None = None,
+    per_sensor: bool = True,
+    tolerances: Tolerances | None = None,
+    max_iter: int = 50,
+    n_jobs: int | None = None,
+    progress: bool = False,
+) -> StabilisationDiagram:
+    """Sweep the model order and class every pole.
+
+    Parameters
+    ----------
+    recording : Recording
+    orders : iterable of int
+        The ``na`` values; ``nb`` and ``nc`` follow the module's rules.
+    nk : int, optional
+        Input delay; by default chosen by BIC (:func:`choose_nk`).
+    per_sensor : bool
+        Also sweep every sensor alone (the thesis's per-sensor view, Table 3.2).
+    tolerances : Tolerances, optional
+    max_iter : int
+        Levenberg-Marquardt cap per fit (a sweep needs positions, not the last digit).
+    n_jobs : int, optional
+        Worker processes (default: all cores).
+    progress : bool
+        Show a progress bar.
+    """
+    tol = tolerances or Tolerances()
+    if nk is None:
+        nk = choose_nk(recording, n_jobs=n_jobs)
+    sources = [SHARED] + (list(recording.sensors) if per_sensor else [])
+    order_list = [(na, default_nb(na, nk), default_nc(na), nk) for na in orders]
+    jobs = [(s, o) for o in order_list for s in sources]
+    from tqdm import tqdm
+
+    with tqdm(total=len(jobs), desc="stabilisation sweep", unit="fit", disable=not progress) as bar:
+        fits = _map(partial(_fit_job, recording, max_iter=max_iter), jobs, n_jobs, bar)
+    rows, kept = [], {}
+    for (source, o), fit in zip(jobs, fits, strict=True):
+        if fit is None:
+            continue
+        kept[(source, o[0])] = fit
+        rows += _poles_of(fit, source)
+    if not rows:
+        raise OrderError("no order in the sweep could be fitted; use lower orders or a longer record.")
+    poles = pd.DataFrame(rows)
+    poles["cls"] = _classify(poles, tol)
+    poles["rejected"] = _reject(poles, tol, recording)
+    return StabilisationDiagram(poles, order_list, tol, recording, kept)
+
+
+def _classify(poles: pd.DataFrame, tol: Tolerances) -> list[str]:
+    cls = ["new"] * len(poles)
+    for _source, group in poles.groupby("source", sort=False):
+        by_order = {na: g for na, g in group.groupby("na")}
+        nas = sorted(by_order)
+        for prev, cur in zip(nas[:-1], nas[1:], strict=True):
+            p = by_order[prev]
+            for idx, row in by_order[cur].iterrows():
+                rel = np.abs(p.freq_hz.values - row.freq_hz) / row.freq_hz
+                j = int(np.argmin(rel))
+                if rel[j] > tol.freq:
+                    continue
+                label = "f"
+                prev_row = p.iloc[j]
+                if abs(prev_row.damping - row.damping) <= tol.damping * max(abs(row.damping), 1e-3):
+                    label = "f+d"
+                    if row.vector.size > 1:
+                        same_shape = 1 - _mac(row.vector, prev_row.vector) <= tol.shape
+                    else:
+                        same_shape = abs(abs(row.vector[0]) / max(abs(prev_row.vector[0]), 1e-300) - 1) <= 5 * tol.shape
+                    if same_shape:
+                        label = "f+d+v"
+                cls[poles.index.get_loc(idx)] = label
+    return cls
+
+
+def excited_band(recording: Recording, min_db: float = -30.0) -> tuple[float, float]:
+    """Lowest and highest frequency (Hz) where the input PSD is within ``min_db`` of its peak."""
+    import scipy.signal
+
+    f, pxx = scipy.signal.welch(recording.base, recording.fs, nperseg=min(recording.n_samples, 1024))
+    live = f[pxx >= pxx.max() * 10 ** (min_db / 10)]
+    return float(live.min()), float(live.max())
+
+
+def _reject(poles: pd.DataFrame, tol: Tolerances, recording: Recording) -> list[str]:
+    f_min = tol.min_freq_hz if tol.min_freq_hz is not None else 3.0 / recording.duration
+    f_max = tol.max_freq_fraction * recording.fs
+    band_lo, band_hi = excited_band(recording, tol.min_input_db)
+    top = poles.groupby(["source", "na"]).energy.transform("max")
+    reasons = []
+    for row, e_max in zip(poles.itertuples(index=False), top, strict=True):
+        if row.damping <= 0:
+            reasons.append("negative damping")
+        elif row.damping > tol.max_damping:
+            reasons.append("over-damped")
+        elif row.freq_hz < f_min:
+            reasons.append("near 0 Hz")
+        elif row.freq_hz > f_max:
+            reasons.append("near Nyquist")
+        elif row.freq_hz > band_hi * (1 + row.damping) or row.freq_hz < band_lo * (1 - row.damping):
+            reasons.append("no input energy")
+        elif row.energy < tol.min_energy * e_max:
+            reasons.append("negligible residue")
+        else:
+            reasons.append("")
+    return reasons
+
+
+# -- automatic selection -----------------------------------------------------------------------
+@dataclass(frozen=True)
+class ModeSelection:
+    """Physical modes picked from a stabilisation diagram.
+
+    Attributes
+    ----------
+    modes : DataFrame
+        One row per mode, by frequency: freq_hz, damping, damped_freq_hz and 95 % intervals
+        (from the representative fit), na of that fit, count and support of the cluster,
+        its spread (standard deviation over orders) and medoid.
+    shapes : (n_sensors, n_modes) complex ndarray
+        EPFRF modal constants per sensor (Eq. 3.24) from the representative fit.
+    per_sensor : DataFrame
+        Table 3.2 form: one row per sensor and mode with the sensor's own frequency, damping
+        and residue magnitude, NaN where the sensor does not show the mode (the thesis's X).
+    weighted : DataFrame
+        Eqs. 3.35-3.36: per mode, the |M_ij|-weighted mean of the per-sensor values.
+    diagram : StabilisationDiagram
+    """
+
+    modes: pd.DataFrame
+    shapes: np.ndarray
+    per_sensor: pd.DataFrame
+    weighted: pd.DataFrame
+    diagram: StabilisationDiagram
+
+    @property
+    def reconstruction_error(self) -> float:
+        """Relative RMS difference between the FRF rebuilt from the selected modes and the
+        measured H1 FRF, over frequencies where every sensor's coherence is at least 0.8."""
+        from .plot import measured_frf, modal_frf
+
+        f, h, coh = measured_frf(self.diagram.recording)
+        good = (np.min(coh, axis=1) >= 0.8) & (f > 0)
+        if not good.any():
+            return float("nan")
+        rebuilt = modal_frf(f[good], self.modes.freq_hz, self.modes.damping, self.shapes)
+        return float(np.linalg.norm(rebuilt - h[good]) / np.linalg.norm(h[good]))
+
+    def to_dict(self) -> dict:
+        """The JSON contract of the ``stabilise`` command."""
+        rec = self.diagram.recording
+        modes = []
+        for i, row in enumerate(self.modes.itertuples(index=False)):
+            v = self.shapes[:, i]
+            v = v / v[np.argmax(np.abs(v))]
+            modes.append(
+                {
+                    "freq_hz": float(row.freq_hz),
+                    "damping": float(row.damping),
+                    "damped_freq_hz": float(row.damped_freq_hz),
+                    "freq_ci95": [float(row.freq_ci95_lo), float(row.freq_ci95_hi)],
+                    "damping_ci95": [float(row.damping_ci95_lo), float(row.damping_ci95_hi)],
+                    "orders_supporting": int(row.count),
+                    "freq_spread_hz": float(row.freq_spread),
+                    "damping_spread": float(row.damping_spread),
+                    "shape": {
+                        s: {"mag": float(abs(c)), "phase_deg": float(np.degrees(np.angle(c))), "supplemented": False}
+                        for s, c in zip(rec.sensors, v, strict=True)
+                    },
+                }
+            )
+        per_sensor = [
+            {k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in r.items()}
+            for r in self.per_sensor.to_dict("records")
+        ]
+        t = self.diagram.tolerances
+        return {
+            "fs": rec.fs,
+            "input": rec.input_name,
+            "outputs": list(rec.sensors),
+            "nk": self.diagram.orders[0][3],
+            "orders_na": [o[0] for o in self.diagram.orders],
+            "tolerances": {"freq": t.freq, "damping": t.damping, "shape": t.shape, "max_damping": t.max_damping},
+            "reconstruction_error": self.reconstruction_error,
+            "modes": modes,
+            "per_sensor": per_sensor,
+        }
+
+
+def select_modes(
+    diagram: StabilisationDiagram,
+    n_modes: int | None = None,
+    band: tuple[float, float] | None = None,
+    *,
+    min_support: float = 0.4,
+    cluster_freq: float = 0.05,
+    cluster_damping: float = 0.5,
+) -> ModeSelection:
+    """Pick the physical modes from the shared-pole poles of a diagram.
+
+    Kept, non-rejected poles are clustered across orders (greedy, in order of increasing
+    ``na``; a pole joins the nearest cluster whose median lies within ``cluster_freq``
+    relative frequency and ``cluster_damping`` relative damping and which has no pole of that
+    order yet). A cluster is a mode when it holds poles of at least ``min_support`` of the
+    swept orders. Each mode is reported from the
+    fit of lowest BIC among the orders in its cluster -- the most parsimonious adequate model;
+    over-parameterised orders scatter heavily damped modes -- with the cluster's medoid,
+    spread and count alongside.
+
+    Parameters
+    ----------
+    diagram : StabilisationDiagram
+    n_modes : int, optional
+        Keep the ``n_modes`` best-supported modes.
+    band : (lo, hi), optional
+        Frequency band in Hz.
+    """
+    poles = diagram.poles
+    cand = poles[(poles.source == SHARED) & (poles.rejected == "")]
+    if band is not None:
+        cand = cand[(cand.freq_hz >= band[0]) & (cand.freq_hz <= band[1])]
+    nas = sorted({o[0] for o in diagram.orders})
+    clusters: list[list[int]] = []
+    for na in nas:
+        group = cand[cand.na == na].sort_values("energy", ascending=False)
+        for idx, row in group.iterrows():
+            best, best_d = None, np.inf
+            for ci, members in enumerate(clusters):
+                if any(cand.at[m, "na"] == na for m in members):
+                    continue
+                f_c = float(np.median(cand.loc[members, "freq_hz"]))
+                x_c = float(np.median(cand.loc[members, "damping"]))
+                df, dx = abs(row.freq_hz - f_c) / f_c, abs(row.damping - x_c) / x_c
+                if df <= cluster_freq and dx <= cluster_damping and df + 0.1 * dx < best_d:
+                    best, best_d = ci, df + 0.1 * dx
+            if best is None:
+                clusters.append([idx])
+            else:
+                clusters[best].append(idx)
+    bic = {na: information_criterion(fit) for (src, na), fit in diagram.fits.items() if src == SHARED}
+    rows, vectors = [], []
+    for members in clusters:
+        sub = cand.loc[members]
+        support = len(members) / len(nas)
+        if len(members) < 3 or support < min_support:
+            continue
+        f, x = sub.freq_hz.to_numpy(), sub.damping.to_numpy()
+        dist = np.abs(f[:, None] - f[None]) / f.mean() + np.abs(x[:, None] - x[None]) / x.mean()
+        medoid = sub.iloc[int(np.argmin(dist.sum(axis=1)))]
+        rep = sub.loc[min(members, key=lambda m: (bic.get(int(cand.at[m, "na"]), np.inf), cand.at[m, "na"]))]
+        rows.append(
+            {
+                "freq_hz": rep.freq_hz,
+                "damping": rep.damping,
+                "damped_freq_hz": rep.damped_freq_hz,
+                "freq_ci95_lo": rep.freq_ci95_lo,
+                "freq_ci95_hi": rep.freq_ci95_hi,
+                "damping_ci95_lo": rep.damping_ci95_lo,
+                "damping_ci95_hi": rep.damping_ci95_hi,
+                "na": int(rep.na),
+                "count": len(members),
+                "support": support,
+                "freq_spread": float(np.std(f, ddof=1)),
+                "damping_spread": float(np.std(x, ddof=1)),
+                "medoid_freq_hz": medoid.freq_hz,
+                "medoid_damping": medoid.damping,
+                "energy": float(sub.energy.median()),
+            }
+        )
+        vectors.append(rep.vector)
+    modes = pd.DataFrame(rows)
+    if modes.empty:
+        raise OrderError(
+            "no stable mode found"
+            + (f" in {band[0]:g}-{band[1]:g} Hz" if band else "")
+            + "; widen the band, extend the order range, or check that the input excites the structure."
+        )
+    order = modes.sort_values(["support", "count", "energy"], ascending=False).index
+    if n_modes is not None:
+        order = order[:n_modes]
+    order = modes.loc[order].sort_values("freq_hz").index
+    modes = modes.loc[order].reset_index(drop=True)
+    shapes = np.column_stack([vectors[i] for i in order])
+    per_sensor, weighted = _per_sensor_table(diagram, modes, shapes, cluster_freq)
+    return ModeSelection(modes, shapes, per_sensor, weighted, diagram)
+
+
+def _per_sensor_table(diagram, modes, shapes, cluster_freq):
+    """Table 3.2 (per sensor, gaps as NaN) and the Eq. 3.35-3.36 weighted averages."""
+    poles = diagram.poles
+    sensors = diagram.recording.sensors
+    nas = sorted({o[0] for o in diagram.orders})
+    rows = []
+    for i, mode in enumerate(modes.itertuples(index=False)):
+        for k, s in enumerate(sensors):
+            own = poles[(poles.source == s) & (poles.rejected == "")]
+            near = own[np.abs(own.freq_hz - mode.freq_hz) <= cluster_freq * mode.freq_hz]
+            near = near.loc[near.groupby("na").energy.idxmax()] if len(near) else near
+            shown = len(near) >= 0.5 * sum(1 for na in nas if na >= mode.na)
+            rows.append(
+                {
+                    "sensor": s,
+                    "mode": i + 1,
+                    "freq_hz": float(near.freq_hz.median()) if shown else np.nan,
+                    "damping": float(near.damping.median()) if shown else np.nan,
+                    "damped_freq_hz": float(near.damped_freq_hz.median()) if shown else np.nan,
+                    "residue_mag": float(abs(shapes[k, i])),
+                }
+            )
+    table = pd.DataFrame(rows)
+    weighted = []
+    for i, g in table.groupby("mode"):
+        ok = g.dropna(subset=["freq_hz"])
+        w = ok.residue_mag.to_numpy()
+        weighted.append(
+            {
+                "mode": i,
+                "freq_hz": float(np.sum(w * ok.freq_hz) / w.sum()) if len(ok) else np.nan,
+                "damping": float(np.sum(w * ok.damping) / w.sum()) if len(ok) else np.nan,
+                "sensors": len(ok),
+            }
+        )
+    return table, pd.DataFrame(weighted)
