@@ -85,6 +85,7 @@ def _cmd_identify(args) -> int:
 def _cmd_stabilise(args) -> int:
     from .stabilisation import select_modes, stabilisation_diagram
 
+    plot_format = _format(args.plot) if args.plot else None
     rec = _load(args)
     try:
         lo, hi = (int(v) for v in args.orders.split(":"))
@@ -117,7 +118,7 @@ def _cmd_stabilise(args) -> int:
         import matplotlib.pyplot as plt
 
         ax, _ = diagram.plot(selection)
-        atomic_write(args.plot, lambda tmp: ax.figure.savefig(tmp, dpi=150, format=_format(args.plot)))
+        atomic_write(args.plot, lambda tmp: ax.figure.savefig(tmp, dpi=150, format=plot_format))
         plt.close(ax.figure)
     if args.json:
         write_json(selection.to_dict(), args.json)

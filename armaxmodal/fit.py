@@ -202,6 +202,9 @@ def fit_armax(
     """
     u, y, fs, sensors, inputs = _unpack(data, fs)
     na, nb, nc, nk = _check_orders(na, nb, 0 if output_error else nc, nk)
+    flat = [s for s, col in zip(sensors, y.T, strict=True) if np.ptp(col) <= 1e-12 * max(np.abs(col).max(), 1e-300)]
+    if flat:
+        raise DataError(f"sensor(s) {flat} carry no signal (constant); check the cable or drop them with outputs=.")
     # Non-causal taps (nk < 0): y[t] depends on u[t + lead - j]. Pairing y[:n-lead] with
     # u[lead:] gives the equivalent causal model (delay 0) on a window of the record.
     # Filtering by 1/C from rest commutes with delays, not with advances, so this keeps the

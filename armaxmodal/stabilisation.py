@@ -343,6 +343,7 @@ def select_modes(
     min_support: float = 0.4,
     cluster_freq: float = 0.05,
     cluster_damping: float = 0.5,
+    merge_mac: float = 0.8,
 ) -> ModeSelection:
     """Pick the physical modes from the shared-pole poles of a diagram.
 
@@ -353,7 +354,9 @@ def select_modes(
     swept orders. Each mode is reported from the
     fit of lowest BIC among the orders in its cluster -- the most parsimonious adequate model;
     over-parameterised orders scatter heavily damped modes -- with the cluster's medoid,
-    spread and count alongside.
+    spread and count alongside. Two modes closer than the half-power bandwidth of the
+    better-supported one (``2 xi f``) whose shapes agree (MAC >= ``merge_mac``) are one mode
+    split by over-modelling; the weaker is dropped.
 
     Parameters
     ----------
@@ -417,6 +420,9 @@ def select_modes(
         )
         vectors.append(rep.vector)
     modes = pd.DataFrame(rows)
+    if not modes.empty:
+        keep = _merge_duplicates(modes, vectors, merge_mac)
+        modes, vectors = modes.loc[keep].reset_index(drop=True), [vectors[i] for i in keep]
     if modes.empty:
         raise OrderError(
             "no stable mode found"
@@ -431,6 +437,22 @@ def select_modes(
     shapes = np.column_stack([vectors[i] for i in order])
     per_sensor, weighted = _per_sensor_table(diagram, modes, shapes, cluster_freq)
     return ModeSelection(modes, shapes, per_sensor, weighted, diagram)
+
+
+def _merge_duplicates(modes: pd.DataFrame, vectors: list, merge_mac: float) -> list[int]:
+    """Indices of the modes to keep after merging split (near-duplicate) modes."""
+    ranked = modes.sort_values(["support", "count", "energy"], ascending=False).index
+    kept: list[int] = []
+    for i in ranked:
+        f = modes.at[i, "freq_hz"]
+        duplicate = any(
+            abs(f - modes.at[j, "freq_hz"]) <= 2 * modes.at[j, "damping"] * modes.at[j, "freq_hz"]
+            and _mac(vectors[i], vectors[j]) >= merge_mac
+            for j in kept
+        )
+        if not duplicate:
+            kept.append(i)
+    return sorted(kept)
 
 
 def _per_sensor_table(diagram, modes, shapes, cluster_freq):

@@ -1,0 +1,133 @@
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import armaxmodal as am
+from armaxmodal.cli import main
+from armaxmodal.exceptions import DataError, OrderError
+from armaxmodal.stabilisation import select_modes, stabilisation_diagram
+
+# Issue targets for automatic selection with nothing told but the data.
+FREQ_RTOL, DAMPING_RTOL = 0.02, 0.10
+LIGHT_FREQ_RTOL, LIGHT_DAMPING_RTOL = 0.005, 0.20
+REAL_PERIOD_RTOL = 0.05
+
+
+def _errors(selection, structure):
+    truth = structure.modes()
+    assert len(selection.modes) == len(truth.freq_hz)
+    f = selection.modes.freq_hz.to_numpy()
+    x = selection.modes.damping.to_numpy()
+    return f / truth.freq_hz - 1, x / truth.damping - 1
+
+
+@pytest.fixture(scope="module")
+def supine_selection(fixtures_dir):
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    return select_modes(stabilisation_diagram(rec))
+
+
+def test_supine_random_ride_gives_exactly_four_modes(supine_selection):
+    df, dx = _errors(supine_selection, am.supine_human())
+    assert np.all(np.abs(df) < FREQ_RTOL), df
+    assert np.all(np.abs(dx) < DAMPING_RTOL), dx
+    # the FRF rebuilt from the four modes explains the measured one
+    assert supine_selection.reconstruction_error < 0.05
+
+
+def test_chapter2_system(fixtures_dir):
+    rec = am.read_recording(fixtures_dir / "chapter2_random_zoh.csv")
+    selection = select_modes(stabilisation_diagram(rec, per_sensor=False))
+    df, dx = _errors(selection, am.chapter2_system())
+    assert np.all(np.abs(df) < FREQ_RTOL) and np.all(np.abs(dx) < DAMPING_RTOL), (df, dx)
+
+
+def test_lightly_damped_structure():
+    structure = am.Structure.from_chain([1.0, 1.5, 2.0], [2e4, 1e4, 3e4], [2.0, 1.5, 3.0], [1.5e4, 1e4], [1.0, 1.0])
+    assert structure.modes().damping.max() < 0.02
+    u = am.random_vibration(100.0, 120.0, (0.5, 45.0), seed=7)
+    rec = am.simulate_recording(structure, u, 100.0, noise=0.05, input_noise=0.01, seed=8, hold="bandlimited")
+    selection = select_modes(stabilisation_diagram(rec, per_sensor=False))
+    df, dx = _errors(selection, structure)
+    assert np.all(np.abs(df) < LIGHT_FREQ_RTOL) and np.all(np.abs(dx) < LIGHT_DAMPING_RTOL), (df, dx)
+
+
+def _xsens(path):
+    frame = pd.read_csv(path, skiprows=7).iloc[1:]  # 7 header lines; first row is all zeros
+    return frame["SampleTimeFine"].to_numpy(np.int64), frame["Acc_X"].to_numpy(float)
+
+
+@pytest.mark.parametrize("model, period_s", [("flex3", 0.274), ("stiff3", 0.127)])
+def test_real_shake_table_fundamental(realdata_dir, model, period_s):
+    """Published fundamental periods of the 3-storey models (mdof solution notebook)."""
+    folder = realdata_dir / "mini_shake_table_imu" / model
+    stamps, u = _xsens(folder / "northridge__g.csv.gz")
+    ys = [_xsens(folder / f"northridge__{s}.csv.gz")[1] for s in ("f1", "f2", "f3")]
+    n = min(len(u), *map(len, ys))
+    y = np.column_stack([v[:n] - v[:n].mean() for v in ys])
+    rec = am.Recording(1e6 / np.median(np.diff(stamps)), u[:n] - u[:n].mean(), y, ("f1", "f2", "f3"))
+    selection = select_modes(stabilisation_diagram(rec, per_sensor=False))
+    assert len(selection.modes) == 3  # a three-storey model
+    fundamental = selection.modes.freq_hz.iloc[0]
+    assert abs(fundamental * period_s - 1) < REAL_PERIOD_RTOL, fundamental
+
+
+def test_selection_is_deterministic_and_tables_follow_the_thesis(supine_selection):
+    again = select_modes(supine_selection.diagram)
+    pd.testing.assert_frame_equal(again.modes, supine_selection.modes)
+    table = supine_selection.per_sensor
+    assert set(table.columns) >= {"sensor", "mode", "freq_hz", "damping", "residue_mag"}
+    assert len(table) == 4 * 4
+    # Eq. 3.35: |M|-weighted mean over the sensors that show the mode
+    for mode, group in table.dropna(subset=["freq_hz"]).groupby("mode"):
+        w = group.residue_mag.to_numpy()
+        expected = np.sum(w * group.freq_hz) / w.sum()
+        got = supine_selection.weighted.set_index("mode").at[mode, "freq_hz"]
+        assert got == pytest.approx(expected)
+    classes = set(supine_selection.diagram.poles.cls)
+    assert classes <= {"new", "f", "f+d", "f+d+v"} and "f+d+v" in classes
+
+
+def test_band_with_no_modes_and_bad_data(supine_selection, fixtures_dir):
+    with pytest.raises(OrderError, match="no stable mode found in 22-26 Hz"):
+        select_modes(supine_selection.diagram, band=(22.0, 26.0))
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    dead = am.Recording(
+        rec.fs, rec.base, np.column_stack([rec.response[:, 0], np.zeros(rec.n_samples)]), ("head", "dead")
+    )
+    with pytest.raises(DataError, match="no signal"):
+        stabilisation_diagram(dead, range(2, 9, 2))
+    short = am.Recording(rec.fs, rec.base[:40], rec.response[:40], rec.sensors)
+    with pytest.raises(OrderError):
+        stabilisation_diagram(short, range(30, 41, 2), nk=0)
+
+
+def test_stabilise_cli(fixtures_dir, tmp_path):
+    plot, js, csv = tmp_path / "stab.png", tmp_path / "modes.json", tmp_path / "poles.csv"
+    code = main(
+        [
+            "--quiet",
+            "stabilise",
+            str(fixtures_dir / "supine_random.csv"),
+            "--orders",
+            "2:24",
+            "--plot",
+            str(plot),
+            "--json",
+            str(js),
+            "--csv",
+            str(csv),
+        ]
+    )
+    assert code == 0
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and plot.stat().st_size > 50_000
+    data = json.loads(js.read_text())
+    assert {"fs", "input", "outputs", "modes", "per_sensor"} <= set(data)
+    freqs = [m["freq_hz"] for m in data["modes"]]
+    assert freqs == sorted(freqs) and len(freqs) == 4
+    assert set(data["modes"][0]["shape"]["head"]) == {"mag", "phase_deg", "supplemented"}
+    poles = pd.read_csv(csv)
+    assert {"source", "na", "freq_hz", "damping", "cls", "rejected"} <= set(poles.columns)
+    assert main(["stabilise", str(fixtures_dir / "supine_random.csv"), "--plot", str(tmp_path / "x.gif")]) == 2
