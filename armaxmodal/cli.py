@@ -121,7 +121,7 @@ def _cmd_stabilise(args) -> int:
         atomic_write(args.plot, lambda tmp: ax.figure.savefig(tmp, dpi=150, format=plot_format))
         plt.close(ax.figure)
     if args.json:
-        write_json(selection.to_dict(), args.json)
+        write_json(selection.to_dict(args.shapes.replace("-", "_")), args.json)
     if args.csv:
         table = diagram.to_frame()
         atomic_write(args.csv, lambda tmp: table.to_csv(tmp, index=False))
@@ -175,6 +175,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", default=None, help="stabilisation plot (.png, .svg or .pdf)")
     p.add_argument("--json", default=None, help="selected modes as JSON")
     p.add_argument("--csv", default=None, help="every pole of the sweep as CSV")
+    p.add_argument(
+        "--shapes",
+        choices=["shared", "per-sensor"],
+        default="shared",
+        help="mode shapes from the shared-pole fit, or per sensor with gaps filled by Eq. 3.34",
+    )
     p.set_defaults(func=_cmd_stabilise)
 
     p = sub.add_parser("identify", help="fit a shared-pole ARMAX model and print the modes")

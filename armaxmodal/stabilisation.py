@@ -294,12 +294,25 @@ class ModeSelection:
         rebuilt = modal_frf(f[good], self.modes.freq_hz, self.modes.damping, self.shapes)
         return float(np.linalg.norm(rebuilt - h[good]) / np.linalg.norm(h[good]))
 
-    def to_dict(self) -> dict:
-        """The JSON contract of the ``stabilise`` command."""
+    def to_dict(self, shapes: str = "shared") -> dict:
+        """The JSON contract of the ``stabilise`` command.
+
+        ``shapes="shared"`` reports the shared-pole residues (complete by construction);
+        ``"per_sensor"`` each sensor's own residue, with gaps filled by Eq. (3.34) and
+        flagged ``supplemented``.
+        """
+        if shapes not in ("shared", "per_sensor"):
+            raise ValueError(f"shapes: expected 'shared' or 'per_sensor', got {shapes!r}.")
         rec = self.diagram.recording
+        if shapes == "shared":
+            matrix, flags = self.shapes, np.zeros(self.shapes.shape, dtype=bool)
+        else:
+            from .merge import supplement_shapes
+
+            matrix, flags = supplement_shapes(self)
         modes = []
         for i, row in enumerate(self.modes.itertuples(index=False)):
-            v = self.shapes[:, i]
+            v = matrix[:, i]
             v = v / v[np.argmax(np.abs(v))]
             modes.append(
                 {
@@ -312,14 +325,18 @@ class ModeSelection:
                     "freq_spread_hz": float(row.freq_spread),
                     "damping_spread": float(row.damping_spread),
                     "shape": {
-                        s: {"mag": float(abs(c)), "phase_deg": float(np.degrees(np.angle(c))), "supplemented": False}
-                        for s, c in zip(rec.sensors, v, strict=True)
+                        s: {
+                            "mag": float(abs(c)),
+                            "phase_deg": float(np.degrees(np.angle(c))),
+                            "supplemented": bool(sup),
+                        }
+                        for s, c, sup in zip(rec.sensors, v, flags[:, i], strict=True)
                     },
                 }
             )
         per_sensor = [
             {k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in r.items()}
-            for r in self.per_sensor.to_dict("records")
+            for r in self.per_sensor.drop(columns=["own_modal_constant"]).to_dict("records")
         ]
         t = self.diagram.tolerances
         return {
@@ -467,6 +484,10 @@ def _per_sensor_table(diagram, modes, shapes, cluster_freq):
             near = own[np.abs(own.freq_hz - mode.freq_hz) <= cluster_freq * mode.freq_hz]
             near = near.loc[near.groupby("na").energy.idxmax()] if len(near) else near
             shown = len(near) >= 0.5 * sum(1 for na in nas if na >= mode.na)
+            own_const = np.nan + 0j
+            if shown:
+                at = near.iloc[int(np.argmin(np.abs(near.na.to_numpy() - mode.na)))]
+                own_const = complex(at.vector[0])
             rows.append(
                 {
                     "sensor": s,
@@ -475,6 +496,7 @@ def _per_sensor_table(diagram, modes, shapes, cluster_freq):
                     "damping": float(near.damping.median()) if shown else np.nan,
                     "damped_freq_hz": float(near.damped_freq_hz.median()) if shown else np.nan,
                     "residue_mag": float(abs(shapes[k, i])),
+                    "own_modal_constant": own_const,
                 }
             )
     table = pd.DataFrame(rows)
