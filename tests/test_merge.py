@@ -16,10 +16,10 @@ TABLE_ATOL = 0.6e-4
 # here at up to 4.7 %.
 EQ_3_34_RTOL = 0.06
 # Against the true shape: Eq. 3.33 is a near-resonance approximation; on this lightly damped
-# chain the exact transmissibility ratio is 0.1 % off in magnitude but up to 8 degrees off in
-# phase from the true shape ratio (the neighbouring modes' tails), hence these bounds.
+# chain the exact transmissibility ratio is within 3 % of the true shape ratio in magnitude but
+# up to 13.5 degrees off in phase (mode 3: the neighbouring modes' tails), hence these bounds.
 SUPPLEMENT_RTOL = 0.10
-SUPPLEMENT_PHASE_DEG = 15.0
+SUPPLEMENT_PHASE_DEG = 20.0
 
 
 def test_summary_reproduces_table_3_3():
