@@ -196,3 +196,27 @@ def _lagged_cross(sig, col_sig, col_lag, col_sign, target, t0, t1):
             acc = np.dot(sig[s, lo - lag : hi - lag], target[lo:hi])
         out[c] = col_sign[c] * acc
     return out
+
+
+@njit(**_JIT)
+def _max_root_radius_below(p, radius):
+    """True when every root of the monic polynomial ``p`` lies strictly inside ``radius``.
+
+    Schur-Cohn step-down recursion on the polynomial scaled to the unit circle: the roots
+    are inside iff every reflection coefficient has magnitude below one. O(n^2), no
+    eigenvalue problem.
+    """
+    n = p.size - 1
+    a = np.empty(n + 1)
+    for i in range(n + 1):
+        a[i] = p[i] * radius ** (-i)  # roots z of p -> z / radius
+    for m in range(n, 0, -1):
+        k = a[m] / a[0]
+        if abs(k) >= 1.0:
+            return False
+        denom = 1.0 - k * k
+        b = np.empty(m)
+        for i in range(m):
+            b[i] = (a[i] - k * a[m - i]) / denom
+        a = b
+    return True

@@ -169,7 +169,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("stabilise", help="order sweep, stabilisation plot and automatic mode selection")
     _add_data_args(p)
-    p.add_argument("--orders", default="2:40", help="range of na, LO:HI (even steps); default 2:40")
+    p.add_argument("--orders", default="2:30", help="range of na, LO:HI (even steps); default 2:30")
     p.add_argument("--modes", type=int, default=None, help="number of modes to keep (default: automatic)")
     p.add_argument("--band", default=None, help="frequency band LO:HI in Hz")
     p.add_argument("--plot", default=None, help="stabilisation plot (.png, .svg or .pdf)")

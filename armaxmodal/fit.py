@@ -30,7 +30,7 @@ import numpy as np
 import pandas as pd
 import scipy.linalg
 
-from ._kernels import _armax_residual, _inverse_filter, _lagged_cross, _lagged_gram
+from ._kernels import _armax_residual, _inverse_filter, _lagged_cross, _lagged_gram, _max_root_radius_below
 from ._validate import as_signal_matrix, check_fs, check_not_constant
 from .armax import ArmaxModel
 from .exceptions import ConvergenceWarning, DataError, OrderError
@@ -330,12 +330,10 @@ def _unpack_theta(theta, na, nb, nc, n_in):
 
 def _stable_c(c):
     """Reflect roots of C outside the unit circle inside and cap their radius."""
-    if c.size <= 1:
+    if c.size <= 1 or _max_root_radius_below(c, _MAX_C_RADIUS):
         return c
     r = np.roots(c)
     mag = np.abs(r)
-    if np.all(mag <= _MAX_C_RADIUS):
-        return c
     r = np.where(mag > 1, 1 / np.conj(r), r)
     mag = np.abs(r)
     r = np.where(mag > _MAX_C_RADIUS, r * (_MAX_C_RADIUS / np.maximum(mag, 1e-300)), r)
@@ -395,9 +393,9 @@ def _project(theta, na, nb, nc, n_in, oe=False):
 
 def _stable_a(a):
     """Reflect roots of A outside the unit circle inside (filtering by 1/A must be stable)."""
-    r = np.roots(a)
-    if np.all(np.abs(r) < 1):
+    if _max_root_radius_below(a, 1.0):
         return a
+    r = np.roots(a)
     r = np.where(np.abs(r) > 1, 1 / np.conj(r), r)
     r = np.where(np.abs(r) >= 0.9999, r * (0.9999 / np.abs(r)), r)
     return np.real(np.poly(r))
@@ -625,10 +623,10 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
         inner_converged = False
         while total_iterations < max_iter:
             total_iterations += 1
-            g_mat, g_vec = _shared_normal_equations(ys, uT, state, variances, cols, na, p_k, t0, t1, oe)
+            arrow = _shared_normal_equations(ys, uT, state, variances, cols, na, p_k, t0, t1, oe)
             improved = False
             while lm < 1e10:
-                step = _solve(g_mat, g_vec, lm)
+                step = arrow.solve(lm)
                 trial = _project_shared(theta + step, na, nb, nc, n_in, n_out, oe)
                 state_t, losses_t = evaluate(trial)
                 objective_t = float(weights @ losses_t)
@@ -652,8 +650,7 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
             converged = True
             break
     lam = losses / max(n_eff - (na / n_out + p_k), 1)
-    g_mat, _ = _shared_normal_equations(ys, uT, state, lam, cols, na, p_k, t0, t1, oe)
-    joint = _inverse(g_mat)
+    joint = _inverse(_shared_normal_equations(ys, uT, state, lam, cols, na, p_k, t0, t1, oe).full())
     covs = [joint[np.ix_(_shared_index(k, na, p_k), _shared_index(k, na, p_k))] for k in range(n_out)]
     thetas = [_local(theta, k, na, p_k) for k in range(n_out)]
     info = {
@@ -667,16 +664,63 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
     return thetas, info
 
 
+@dataclass
+class _Arrow:
+    """Block-arrow normal equations of the shared-pole fit: the A block couples to every
+    sensor's (B, C) block; sensors do not couple to each other."""
+
+    aa: np.ndarray
+    ab: list
+    bb: list
+    ga: np.ndarray
+    gb: list
+
+    def solve(self, damping: float = 0.0) -> np.ndarray:
+        """LM step by the Schur complement on the A block: K small factorisations instead
+        of one of the full size (20x fewer flops at high orders)."""
+
+        def damped(m):
+            d = np.diag(m).copy()
+            d[d <= 0] = 1.0
+            return m + np.diag(damping * d + 1e-13 * d)
+
+        schur = damped(self.aa)
+        rhs = self.ga.copy()
+        parts = []
+        for ab, bb, gb in zip(self.ab, self.bb, self.gb, strict=True):
+            try:
+                factor = scipy.linalg.cho_factor(damped(bb))
+                x, y = scipy.linalg.cho_solve(factor, ab.T), scipy.linalg.cho_solve(factor, gb)
+            except (np.linalg.LinAlgError, scipy.linalg.LinAlgError):
+                x, y = np.linalg.lstsq(damped(bb), ab.T, rcond=None)[0], np.linalg.lstsq(damped(bb), gb, rcond=None)[0]
+            schur -= ab @ x
+            rhs -= ab @ y
+            parts.append((x, y))
+        step_a = _solve(schur, rhs)
+        return np.concatenate([step_a] + [y - x @ step_a for x, y in parts])
+
+    def full(self) -> np.ndarray:
+        na, p_k = self.aa.shape[0], self.bb[0].shape[0]
+        out = np.zeros((na + len(self.bb) * p_k,) * 2)
+        out[:na, :na] = self.aa
+        for k, (ab, bb) in enumerate(zip(self.ab, self.bb, strict=True)):
+            sl = slice(na + k * p_k, na + (k + 1) * p_k)
+            out[:na, sl], out[sl, :na], out[sl, sl] = ab, ab.T, bb
+        return out
+
+
 def _shared_normal_equations(ys, uT, state, variances, cols, na, p_k, t0, t1, oe=False):
-    p = na + len(ys) * p_k
-    g_mat = np.zeros((p, p))
-    g_vec = np.zeros(p)
+    aa, ga = np.zeros((na, na)), np.zeros(na)
+    ab, bb, gb = [], [], []
     for k, (eps, _, c) in enumerate(state):
         gk, vk = _normal_equations(ys[k], uT, eps, c, cols, t0, t1, oe)
-        idx = _shared_index(k, na, p_k)
-        g_mat[np.ix_(idx, idx)] += gk / variances[k]
-        g_vec[idx] += vk / variances[k]
-    return g_mat, g_vec
+        gk, vk = gk / variances[k], vk / variances[k]
+        aa += gk[:na, :na]
+        ga += vk[:na]
+        ab.append(gk[:na, na:])
+        bb.append(gk[na:, na:])
+        gb.append(vk[na:])
+    return _Arrow(aa, ab, bb, ga, gb)
 
 
 def _project_shared(theta, na, nb, nc, n_in, n_out, oe=False):

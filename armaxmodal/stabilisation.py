@@ -143,12 +143,12 @@ def choose_nk(recording: Recording, nk_values=range(0, -7, -1), na_values=(8, 10
 
 def stabilisation_diagram(
     recording: Recording,
-    orders=range(2, 41, 2),
+    orders=range(2, 31, 2),
     *,
     nk: int | None = None,
     per_sensor: bool = True,
     tolerances: Tolerances | None = None,
-    max_iter: int = 50,
+    max_iter: int = 30,
     n_jobs: int | None = None,
     progress: bool = False,
 ) -> StabilisationDiagram:

@@ -51,3 +51,8 @@ def lagged_design(sig, col_sig, col_lag, col_sign, t0, t1):
             k = t - lag
             out[t - t0, c] = sign * sig[s, k] if 0 <= k < n else 0.0
     return out
+
+
+def max_root_radius_below(p, radius):
+    """All roots of p strictly inside ``radius``, from numpy's companion-matrix roots."""
+    return bool(np.all(np.abs(np.roots(p)) < radius))

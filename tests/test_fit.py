@@ -338,3 +338,14 @@ def test_output_error_form(supine_zoh):
     assert np.all(np.abs(err[:, 0]) < ZOH_FREQ_RTOL) and np.all(np.abs(err[:, 1]) < ZOH_DAMPING_RTOL), err
     single = fit_armax(supine_zoh.select(["legs"]), 8, 9, 0, 0, output_error=True)
     assert single.converged.all() and single.covariance[0].shape == (8 + 9,) * 2
+
+
+def test_stability_kernel_matches_roots():
+    from armaxmodal._kernels import _max_root_radius_below
+
+    rng = np.random.default_rng(5)
+    for _ in range(300):
+        roots = rng.uniform(0.2, 1.2, 6) * np.exp(1j * rng.uniform(0, np.pi, 6))
+        p = np.real(np.poly(np.r_[roots, np.conj(roots)]))
+        for radius in (0.9, 0.995, 1.0):
+            assert _max_root_radius_below(p, radius) == naive.max_root_radius_below(p, radius)
