@@ -112,8 +112,13 @@ def one_fit(rec, quick):
 
 
 def sweep(rec, quick):
+    from armaxmodal.stabilisation import stabilisation_diagram
+
     orders = range(2, 21 if quick else 41)
-    print(f"\nOrder sweep: na {orders.start}..{orders.stop - 1}, nb = na + 1, nc = na, nk = 0, 7200 samples")
+    print(
+        f"\nOrder sweep: na {orders.start}..{orders.stop - 1} (every order), nb = na + 1, nc = na, nk = 0, "
+        "7200 samples, one process"
+    )
     for shared in (False, True):
         t = time.perf_counter()
         iters = 0
@@ -122,6 +127,30 @@ def sweep(rec, quick):
             iters += int(fit.iterations.sum())
         label = "shared poles, 4 sensors jointly" if shared else "per sensor, 4 sensors"
         print(f"  {label:32s} {time.perf_counter() - t:8.2f} s  ({iters} LM iterations)")
+    print("Stabilisation sweep as `stabilise` runs it (even na, shared + 4 sensors, 2 worker processes):")
+    for top in (30, 40):
+        t = time.perf_counter()
+        diagram = stabilisation_diagram(rec, range(2, top + 1, 2), nk=-5)
+        print(f"  na 2..{top}: {len(diagram.fits)} fits in {time.perf_counter() - t:.2f} s")
+    t = time.perf_counter()
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "armaxmodal",
+            "--quiet",
+            "stabilise",
+            "fixtures/supine_random.csv",
+            "--plot",
+            str(Path(tempfile.gettempdir()) / "_bench_stab.png"),
+        ],
+        cwd=ROOT,
+        check=True,
+    )
+    print(
+        f"  whole `armaxmodal stabilise` command (process start, nk choice, sweep, selection, plot): "
+        f"{time.perf_counter() - t:.2f} s"
+    )
 
 
 def scaling(quick):
