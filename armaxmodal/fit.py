@@ -485,6 +485,35 @@ def _output_error_start(ys, uT, theta_hr, na, nb, nc, nk, t0, t1):
     return np.concatenate(parts)
 
 
+def _levenberg_marquardt(theta, state, evaluate, linearise, project, max_iter, tol):
+    """Levenberg-Marquardt on a Gauss-Newton model, shared by every fit.
+
+    ``evaluate(theta) -> (state, objective)``; ``linearise(state) -> solve(damping)`` gives
+    the damped Gauss-Newton step; ``project`` keeps the parameters admissible. Stops when an
+    accepted step lowers the objective by less than ``tol`` (relative), or when no step at
+    any damping lowers it: a minimum to numerical precision, or on the stability boundary
+    kept for C. Returns ``(theta, state, iterations, converged)``.
+    """
+    objective = evaluate(theta)[1]
+    lm = 1e-4
+    for it in range(1, max_iter + 1):
+        solve = linearise(state)
+        while lm < 1e10:
+            trial = project(theta + solve(lm))
+            state_t, objective_t = evaluate(trial)
+            if objective_t < objective:
+                break
+            lm *= 10
+        else:
+            return theta, state, it, True
+        rel = (objective - objective_t) / objective
+        theta, state, objective = trial, state_t, objective_t
+        lm = max(lm / 10, 1e-8)
+        if rel < tol:
+            return theta, state, it, True
+    return theta, state, max_iter, False
+
+
 # -- single-output PEM ------------------------------------------------------------------------
 def _residual_and_loss(y, uT, theta, na, nb, nc, nk, t0, t1, oe=False):
     a, b, c = _unpack_theta(theta, na, nb, nc, uT.shape[0])
@@ -508,32 +537,20 @@ def _fit_single(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
     theta = _hannan_rissanen(y, uT, na, nb, nc, nk, t0, t1)
     if oe:
         theta = _project(_output_error_start([y], uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in, oe=True)
-    eps, loss, c = _residual_and_loss(y, uT, theta, na, nb, nc, nk, t0, t1, oe)
-    lm = 1e-4
-    converged = False
-    it = 0
-    for it in range(1, max_iter + 1):  # noqa: B007 - the count is reported
-        g_mat, g_vec = _normal_equations(y, uT, eps, c, cols, t0, t1, oe)
-        improved = False
-        while lm < 1e10:
-            step = _solve(g_mat, g_vec, lm)
-            trial = _project(theta + step, na, nb, nc, n_in, oe)
-            eps_t, loss_t, c_t = _residual_and_loss(y, uT, trial, na, nb, nc, nk, t0, t1, oe)
-            if loss_t < loss:
-                improved = True
-                break
-            lm *= 10
-        if not improved:
-            # Not even a vanishing gradient step lowers the loss: a minimum to numerical
-            # precision, or on the stability boundary kept for C.
-            converged = True
-            break
-        rel = (loss - loss_t) / loss
-        theta, eps, loss, c = trial, eps_t, loss_t, c_t
-        lm = max(lm / 10, 1e-8)
-        if rel < tol:
-            converged = True
-            break
+
+    def evaluate(th):
+        state = _residual_and_loss(y, uT, th, na, nb, nc, nk, t0, t1, oe)
+        return state, state[1]
+
+    def linearise(state):
+        g_mat, g_vec = _normal_equations(y, uT, state[0], state[2], cols, t0, t1, oe)
+        return lambda damping: _solve(g_mat, g_vec, damping)
+
+    state, _ = evaluate(theta)
+    theta, state, it, converged = _levenberg_marquardt(
+        theta, state, evaluate, linearise, lambda th: _project(th, na, nb, nc, n_in, oe), max_iter, tol
+    )
+    eps, loss, c = state
     g_mat, _ = _normal_equations(y, uT, eps, c, cols, t0, t1, oe)
     n_eff = t1 - t0
     p = theta.size
@@ -618,31 +635,24 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
     converged = False
     while total_iterations < max_iter:
         weights = 1.0 / variances
-        objective = float(weights @ losses)
-        lm = 1e-4
-        inner_converged = False
-        while total_iterations < max_iter:
-            total_iterations += 1
-            arrow = _shared_normal_equations(ys, uT, state, variances, cols, na, p_k, t0, t1, oe)
-            improved = False
-            while lm < 1e10:
-                step = arrow.solve(lm)
-                trial = _project_shared(theta + step, na, nb, nc, n_in, n_out, oe)
-                state_t, losses_t = evaluate(trial)
-                objective_t = float(weights @ losses_t)
-                if objective_t < objective:
-                    improved = True
-                    break
-                lm *= 10
-            if not improved:
-                inner_converged = True  # as in _fit_single
-                break
-            rel = (objective - objective_t) / objective
-            theta, state, losses, objective = trial, state_t, losses_t, objective_t
-            lm = max(lm / 10, 1e-8)
-            if rel < tol:
-                inner_converged = True
-                break
+
+        def weighted(th, weights=weights):
+            per_sensor, losses_t = evaluate(th)
+            return (per_sensor, losses_t), float(weights @ losses_t)
+
+        def linearise(st, variances=variances):
+            return _shared_normal_equations(ys, uT, st[0], variances, cols, na, p_k, t0, t1, oe).solve
+
+        theta, (state, losses), used, inner_converged = _levenberg_marquardt(
+            theta,
+            (state, losses),
+            weighted,
+            linearise,
+            lambda th: _project_shared(th, na, nb, nc, n_in, n_out, oe),
+            max_iter - total_iterations,
+            tol,
+        )
+        total_iterations += used
         new_variances = losses / n_eff
         settled = np.max(np.abs(new_variances / variances - 1.0)) < 1e-3
         variances = new_variances

@@ -48,22 +48,7 @@ class Identification:
     def to_dict(self) -> dict:
         """The JSON contract: fs, input, outputs, modes (with shapes) and per_sensor rows."""
         rec = self.recording
-        modes = []
-        for i, row in enumerate(self.modes.itertuples(index=False)):
-            shape = _normalise(self.shapes[:, i])
-            modes.append(
-                {
-                    "freq_hz": float(row.freq_hz),
-                    "damping": float(row.damping),
-                    "damped_freq_hz": float(row.damped_freq_hz),
-                    "freq_ci95": [float(row.freq_ci95_lo), float(row.freq_ci95_hi)],
-                    "damping_ci95": [float(row.damping_ci95_lo), float(row.damping_ci95_hi)],
-                    "shape": {
-                        s: {"mag": float(abs(v)), "phase_deg": float(np.degrees(np.angle(v))), "supplemented": False}
-                        for s, v in zip(rec.sensors, shape, strict=True)
-                    },
-                }
-            )
+        modes = [mode_record(row, self.shapes[:, i], rec.sensors) for i, row in enumerate(self.modes.itertuples())]
         per_sensor = [
             {
                 "sensor": s,
@@ -88,10 +73,23 @@ class Identification:
         }
 
 
-def _normalise(v: np.ndarray) -> np.ndarray:
-    """Unit largest component on the positive real axis."""
-    big = v[np.argmax(np.abs(v))]
-    return v / big if abs(big) > 0 else v
+def mode_record(row, shape: np.ndarray, sensors, supplemented=None) -> dict:
+    """One mode of the JSON contract: frequency, damping, 95 % intervals and the shape
+    (normalised to a unit largest component on the positive real axis) per sensor."""
+    big = shape[np.argmax(np.abs(shape))]
+    shape = shape / big if abs(big) > 0 else shape
+    flags = np.zeros(len(sensors), dtype=bool) if supplemented is None else supplemented
+    return {
+        "freq_hz": float(row.freq_hz),
+        "damping": float(row.damping),
+        "damped_freq_hz": float(row.damped_freq_hz),
+        "freq_ci95": [float(row.freq_ci95_lo), float(row.freq_ci95_hi)],
+        "damping_ci95": [float(row.damping_ci95_lo), float(row.damping_ci95_hi)],
+        "shape": {
+            s: {"mag": float(abs(v)), "phase_deg": float(np.degrees(np.angle(v))), "supplemented": bool(f)}
+            for s, v, f in zip(sensors, shape, flags, strict=True)
+        },
+    }
 
 
 def identify(

@@ -23,6 +23,7 @@ import pandas as pd
 
 from .exceptions import OrderError
 from .fit import ArmaxFit, fit_armax
+from .identify import mode_record
 from .orders import _map, default_nb, default_nc, information_criterion
 from .recording import Recording
 
@@ -312,28 +313,13 @@ class ModeSelection:
             matrix, flags = supplement_shapes(self)
         modes = []
         for i, row in enumerate(self.modes.itertuples(index=False)):
-            v = matrix[:, i]
-            v = v / v[np.argmax(np.abs(v))]
-            modes.append(
-                {
-                    "freq_hz": float(row.freq_hz),
-                    "damping": float(row.damping),
-                    "damped_freq_hz": float(row.damped_freq_hz),
-                    "freq_ci95": [float(row.freq_ci95_lo), float(row.freq_ci95_hi)],
-                    "damping_ci95": [float(row.damping_ci95_lo), float(row.damping_ci95_hi)],
-                    "orders_supporting": int(row.count),
-                    "freq_spread_hz": float(row.freq_spread),
-                    "damping_spread": float(row.damping_spread),
-                    "shape": {
-                        s: {
-                            "mag": float(abs(c)),
-                            "phase_deg": float(np.degrees(np.angle(c))),
-                            "supplemented": bool(sup),
-                        }
-                        for s, c, sup in zip(rec.sensors, v, flags[:, i], strict=True)
-                    },
-                }
+            record = mode_record(row, matrix[:, i], rec.sensors, flags[:, i])
+            record.update(
+                orders_supporting=int(row.count),
+                freq_spread_hz=float(row.freq_spread),
+                damping_spread=float(row.damping_spread),
             )
+            modes.append(record)
         per_sensor = [
             {k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in r.items()}
             for r in self.per_sensor.drop(columns=["own_modal_constant"]).to_dict("records")
