@@ -1,0 +1,41 @@
+"""Validation of modal data handed to the inverse methods."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..exceptions import StructureError
+
+
+def check_modes(eigenvalues, shapes, n_dof: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Return (lambda (n_modes,), psi (n_dof, n_modes)) as complex arrays, or raise.
+
+    Eigenvalues are continuous poles in rad/s with positive imaginary part (under-damped);
+    shapes have one column per mode and no missing components.
+    """
+    lam = np.atleast_1d(np.asarray(eigenvalues, dtype=complex))
+    psi = np.asarray(shapes, dtype=complex)
+    if psi.ndim != 2 or psi.shape[1] != lam.size:
+        raise StructureError(f"shapes: expected shape (n_dof, {lam.size}) for {lam.size} modes, got {psi.shape}.")
+    if n_dof is not None and psi.shape[0] != n_dof:
+        raise StructureError(f"shapes: expected {n_dof} components per mode, got {psi.shape[0]}.")
+    if not (np.all(np.isfinite(lam)) and np.all(np.isfinite(psi))):
+        raise StructureError(
+            "modal data contain NaN or inf (a missing shape component?); fill gaps first "
+            "(armaxmodal.merge.supplement_shapes) or drop that sensor."
+        )
+    if np.any(lam.imag <= 1e-9 * np.abs(lam)):
+        raise StructureError(
+            "a real or lower-half-plane eigenvalue was given: over-damped modes carry no oscillation "
+            "and the chain model here needs under-damped poles (positive imaginary part)."
+        )
+    return lam, psi
+
+
+def to_eigenvalues(freq_hz, damping) -> np.ndarray:
+    """Continuous poles from undamped frequency (Hz) and damping ratio."""
+    wn = 2 * np.pi * np.asarray(freq_hz, dtype=float)
+    x = np.asarray(damping, dtype=float)
+    if np.any(x >= 1) or np.any(x < 0):
+        raise StructureError(f"damping ratios must lie in [0, 1) for under-damped modes, got {x}.")
+    return -x * wn + 1j * wn * np.sqrt(1 - x**2)
