@@ -135,6 +135,69 @@ def _format(path: str) -> str:
     return ext
 
 
+def _cmd_invert(args) -> int:
+    import json
+
+    from .inverse import evphc, inner_solve, model_update, pia
+    from .inverse._modal_data import body_mass_bounds, modes_from_json
+
+    try:
+        data = json.loads(open(args.modes, encoding="utf-8").read())
+    except (OSError, json.JSONDecodeError) as exc:
+        raise DataError(f"{args.modes}: not a readable modes JSON ({exc}).") from exc
+    lam, shapes, sensors = modes_from_json(data)
+    bounds = None
+    if set(sensors) <= set(datasets.TABLE_4_2_MASS_FRACTION):
+        bounds = body_mass_bounds(sensors, datasets.TABLE_4_2_MASS_FRACTION)
+    frf = None
+    if args.recording:
+        from .plot import measured_frf
+
+        rec = read_recording(args.recording, input=args.input, fs=args.fs)
+        f, h, coh = measured_frf(rec)
+        keep = (f > 0.5) & (np.min(coh, axis=1) >= 0.8)
+        frf = (f[keep], h[keep])
+    total = args.total_mass
+    if args.method == "pia":
+        if total is None or bounds is None:
+            raise DataError("pia needs the masses: give --total-mass for body segments of Table 4.2.")
+        fr = datasets.TABLE_4_2_MASS_FRACTION
+        sol = pia(lam, shapes, [total * fr[s] / sum(fr[x] for x in sensors) for s in sensors], names=sensors)
+    elif args.method == "inner":
+        sol = inner_solve(lam, shapes, mass_ratio_bounds=bounds, total_mass=total, names=sensors)
+    elif args.method == "evphc":
+        if frf is None:
+            raise DataError("evphc needs the measured transmissibility: give --recording DATA.")
+        sol = evphc(lam, shapes, frf, mass_ratio_bounds=bounds, total_mass=total, names=sensors)
+    else:
+        sol = model_update(lam, shapes, frf=frf, mass_ratio_bounds=bounds, total_mass=total, names=sensors)
+    if not args.quiet:
+        print(sol.to_frame().to_string(float_format=lambda v: f"{v:.4g}"))
+        for flag in sol.flags:
+            print(f"note: {flag}")
+    if args.json:
+        comps = sol.components
+        write_json(
+            {
+                "method": sol.method,
+                "M": sol.structure.M,
+                "C": sol.structure.C,
+                "K": sol.structure.K,
+                "names": list(sol.structure.names),
+                "components": None
+                if comps is None
+                else {"masses": comps.masses, "k": comps.k, "c": comps.c, "k_s": comps.k_s, "c_s": comps.c_s},
+                "modes": sol.modes.to_dict()["modes"],
+                "misfits": sol.misfits,
+                "flags": sol.flags,
+                "converged": sol.converged,
+                "time_s": sol.time_s,
+            },
+            args.json,
+        )
+    return 0
+
+
 def _cmd_modes(args) -> int:
     modes = SYSTEMS[args.system]().modes()
     print(modes.to_frame().to_string(index=False, float_format=lambda v: f"{v:.4f}"))
@@ -182,6 +245,16 @@ def build_parser() -> argparse.ArgumentParser:
         help="mode shapes from the shared-pole fit, or per sensor with gaps filled by Eq. 3.34",
     )
     p.set_defaults(func=_cmd_stabilise)
+
+    p = sub.add_parser("invert", help="physical chain model (M, C, K) from identified modes")
+    p.add_argument("modes", help="modes JSON written by 'stabilise --json'")
+    p.add_argument("--recording", default=None, help="the recording, for the measured transmissibility")
+    p.add_argument("--input", default="base")
+    p.add_argument("--fs", type=float, default=None)
+    p.add_argument("--method", choices=["model_update", "evphc", "pia", "inner"], default="model_update")
+    p.add_argument("--total-mass", type=float, default=None, help="subject mass in kg (sets the scale)")
+    p.add_argument("--json", default=None, help="write M, C, K, components and modes as JSON")
+    p.set_defaults(func=_cmd_invert)
 
     p = sub.add_parser("identify", help="fit a shared-pole ARMAX model and print the modes")
     _add_data_args(p)

@@ -91,3 +91,36 @@ def test_bad_modal_data_is_refused():
         inner_solve(m.eigenvalues, m.shapes, mass_ratio_bounds=[(3.0, 2.0), (3.0, 5.0), (1.0, 2.0)])
     with pytest.raises(StructureError, match="too few equations"):
         inner_solve(m.eigenvalues[:1], m.shapes[:, :1])
+
+
+def test_model_update_honours_mass_ratio_bounds_in_physical_units():
+    s = am.chapter2_system()
+    m = s.modes()
+    f = np.linspace(0.5, 30.0, 40)
+    bounds = [(1.0, 2.5), (3.0, 5.0), (1.0, 2.0)]
+    sol = model_update(m.eigenvalues, m.shapes, frf=(f, s.transmissibility(f)), mass_ratio_bounds=bounds, m1=6.0)
+    assert _rel(sol.structure.K, s.K) < 1e-6
+    ratios = sol.structure.masses[1:] / sol.structure.masses[0]
+    assert np.all(ratios >= np.array(bounds)[:, 0] - 1e-12) and np.all(ratios <= np.array(bounds)[:, 1] + 1e-12)
+
+
+def test_evphc_exact_data_and_noisy_eigenvectors():
+    from armaxmodal.inverse import evphc
+
+    s = am.chapter2_system()
+    m = s.modes()
+    f = np.linspace(0.5, 30.0, 60)
+    exact = evphc(m.eigenvalues, m.shapes, (f, s.transmissibility(f)), m1=6.0, starts=1)
+    assert _rel(exact.structure.K, s.K) < EXACT_RTOL and exact.method == "evphc"
+    # P1 at 10 %: phase correction pulls the modes back towards the exact FRF
+    rng = np.random.default_rng(1)
+    z = (rng.standard_normal(m.shapes.shape) + 1j * rng.standard_normal(m.shapes.shape)) / np.sqrt(2)
+    noisy = m.shapes * (1 + 0.1 * z)
+    plain = inner_solve(m.eigenvalues, noisy, m1=6.0)
+    corrected = evphc(m.eigenvalues, noisy, (f, s.transmissibility(f)), m1=6.0, starts=2)
+    cost = corrected.misfits["cost"]
+    plain_cost = float(np.mean(np.sum(np.abs(plain.structure.transmissibility(f) - s.transmissibility(f)), axis=1)))
+    assert cost < plain_cost
+    assert np.max(np.abs(corrected.modes.damping / m.damping - 1)) < 0.06  # the EVPHC target at P1 10 %
+    with pytest.raises(ValueError, match="cost"):
+        evphc(m.eigenvalues, m.shapes, (f, s.transmissibility(f)), cost="phase")

@@ -2,6 +2,7 @@
 
 * :func:`inner_solve` -- the well-posed convex inner problem of EVPHC (Eq. 2.14 residual,
   chain topology and signs, mass-ratio bounds of Eq. 2.18, scale fixed by a mass).
+* :func:`evphc` -- the thesis's outer optimisation over eigenvector phases.
 * :func:`pia` -- the Pilkey-Inman iterative algorithm (PIA), the baseline: M given.
 * :func:`model_update` -- weighted nonlinear least squares of the chain's physical values
   on frequencies, damping, mode shapes and transmissibility together.
@@ -10,9 +11,10 @@ Acronyms: EVPHC, eigenvector phase correction (the thesis's method); PIA, Pilkey
 algorithm; EPFRF, equivalent point frequency response function.
 """
 
+from .evphc import evphc
 from .inner import inner_solve
 from .pia import pia
 from .result import InverseSolution
 from .update import model_update
 
-__all__ = ["InverseSolution", "inner_solve", "model_update", "pia"]
+__all__ = ["InverseSolution", "evphc", "inner_solve", "model_update", "pia"]

@@ -88,12 +88,13 @@ def model_update(
     # each parameter in units of its start value (or of its kind's mean where the start is 0)
     floor = np.array([x0[kinds == k].mean() for k in kinds])
     scale = np.where(x0 > 1e-9 * floor, x0, floor)
-    lo = np.full(x0.size, 0.0)
+    lo = np.full(x0.size, 0.0)  # physical units (first mass = 1) ...
     hi = np.full(x0.size, np.inf)
     if mass_ratio_bounds is not None:
         b = np.asarray(mass_ratio_bounds, dtype=float)
         lo[: n - 1], hi[: n - 1] = b[:, 0], b[:, 1]
     lo[kinds == 2] = 1e-9 * scale[kinds == 2]  # a spring must keep K positive definite
+    lo, hi = lo / scale, hi / scale  # ... and in the optimiser's units (start values)
 
     def build(z):
         v = z * scale
@@ -148,8 +149,16 @@ def model_update(
         names,
     )
     flags = [] if res.success else [f"model updating stopped: {res.message}"]
-    if np.any(res.active_mask != 0):
-        flags.append("a bound is active (a component at zero or a mass ratio at its limit)")
+    labels = (
+        [f"m{i + 2}/m1" for i in range(n - 1)]
+        + [f"c{i + 1}" for i in range(n)]
+        + [f"c_s{i + 1}" for i in range(n - 1)]
+        + [f"k{i + 1}" for i in range(n)]
+        + [f"k_s{i + 1}" for i in range(n - 1)]
+    )
+    at_bound = [lab for lab, a in zip(labels, res.active_mask, strict=True) if a != 0]
+    if at_bound:
+        flags.append(f"at a bound: {', '.join(at_bound)} (a component at zero or a mass ratio at its limit)")
     return InverseSolution(
         s,
         s.chain_components(),
