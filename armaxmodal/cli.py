@@ -145,6 +145,7 @@ def _cmd_invert(args) -> int:
         data = json.loads(open(args.modes, encoding="utf-8").read())
     except (OSError, json.JSONDecodeError) as exc:
         raise DataError(f"{args.modes}: not a readable modes JSON ({exc}).") from exc
+    plot_format = _format(args.plot) if args.plot else None
     lam, shapes, sensors = modes_from_json(data)
     bounds = None
     if set(sensors) <= set(datasets.TABLE_4_2_MASS_FRACTION):
@@ -171,10 +172,30 @@ def _cmd_invert(args) -> int:
         sol = evphc(lam, shapes, frf, mass_ratio_bounds=bounds, total_mass=total, names=sensors)
     else:
         sol = model_update(lam, shapes, frf=frf, mass_ratio_bounds=bounds, total_mass=total, names=sensors)
+    prediction = None
+    if args.recording:
+        from .inverse import predict_recording
+
+        prediction = predict_recording(sol.structure, rec)
     if not args.quiet:
         print(sol.to_frame().to_string(float_format=lambda v: f"{v:.4g}"))
         for flag in sol.flags:
             print(f"note: {flag}")
+        if prediction is not None:
+            print(prediction.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+    if args.plot:
+        if prediction is None:
+            raise DataError("--plot shows the predicted against the measured motion: give --recording DATA.")
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        from .plot import plot_prediction
+
+        axes = plot_prediction(rec, prediction.attrs["prediction"], prediction.fit_percent.to_numpy())
+        atomic_write(args.plot, lambda tmp: axes[0].figure.savefig(tmp, dpi=150, format=plot_format))
+        plt.close(axes[0].figure)
     if args.json:
         comps = sol.components
         write_json(
@@ -192,6 +213,9 @@ def _cmd_invert(args) -> int:
                 "flags": sol.flags,
                 "converged": sol.converged,
                 "time_s": sol.time_s,
+                "prediction_fit_percent": None
+                if prediction is None
+                else dict(zip(prediction.sensor, map(float, prediction.fit_percent), strict=True)),
             },
             args.json,
         )
@@ -254,6 +278,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--method", choices=["model_update", "evphc", "pia", "inner"], default="model_update")
     p.add_argument("--total-mass", type=float, default=None, help="subject mass in kg (sets the scale)")
     p.add_argument("--json", default=None, help="write M, C, K, components and modes as JSON")
+    p.add_argument("--plot", default=None, help="predicted vs measured acceleration per sensor (.png/.svg/.pdf)")
     p.set_defaults(func=_cmd_invert)
 
     p = sub.add_parser("identify", help="fit a shared-pole ARMAX model and print the modes")

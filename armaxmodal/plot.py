@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.signal
 
-__all__ = ["plot_stabilisation", "measured_frf", "modal_frf"]
+__all__ = ["plot_stabilisation", "plot_prediction", "measured_frf", "modal_frf"]
 
 # class -> (marker, colour, label); distinct in shape and colour
 _STYLE = {
@@ -155,3 +155,28 @@ def _runs(f, mask):
     if start is not None:
         out.append((start, f[-1]))
     return out
+
+
+def plot_prediction(recording, prediction, fits=None, ax=None, window_s: float | None = 5.0):
+    """Measured (solid) and predicted (dashed) acceleration per sensor (Figs. 4.8-4.9).
+
+    ``prediction`` is (n_samples, n_sensors); ``fits`` the NRMSE fit per sensor for the
+    titles; ``window_s`` shows the last seconds only (None: whole record). Returns the axes.
+    """
+    import matplotlib.pyplot as plt
+
+    n = recording.n_sensors
+    if ax is None:
+        _, ax = plt.subplots(n, 1, sharex=True, figsize=(9, 1.9 * n + 0.6), layout="constrained")
+    axes = np.atleast_1d(ax)
+    t = recording.time
+    sel = slice(None) if window_s is None else t >= t[-1] - window_s
+    for k, a in enumerate(axes):
+        a.plot(t[sel], recording.response[sel, k], lw=0.8, color="tab:blue", label="measured")
+        a.plot(t[sel], prediction[sel, k], lw=0.8, ls="--", color="tab:red", label="predicted")
+        title = recording.sensors[k] + ("" if fits is None else f"  (fit {fits[k]:.1f} %)")
+        a.set_title(title, fontsize=9, loc="left")
+        a.set_ylabel("m/s²")
+    axes[0].legend(fontsize=8, loc="upper right")
+    axes[-1].set_xlabel("time (s)")
+    return axes

@@ -90,9 +90,26 @@ def test_invert_from_stabilise_json(fixtures_dir, tmp_path, capsys):
     rec = str(fixtures_dir / "supine_random.csv")
     assert main(["--quiet", "stabilise", rec, "--orders", "2:20", "--json", str(modes)]) == 0
     assert (
-        main(["--quiet", "invert", str(modes), "--recording", rec, "--total-mass", "77.5663", "--json", str(phys)]) == 0
+        main(
+            [
+                "--quiet",
+                "invert",
+                str(modes),
+                "--recording",
+                rec,
+                "--total-mass",
+                "77.5663",
+                "--json",
+                str(phys),
+                "--plot",
+                str(tmp_path / "fit.png"),
+            ]
+        )
+        == 0
     )
     data = json.loads(phys.read_text())
+    assert (tmp_path / "fit.png").stat().st_size > 20_000
+    assert min(data["prediction_fit_percent"].values()) > 90.0
     truth = am.supine_human()
     k = np.array(data["components"]["k"])
     np.testing.assert_allclose(k[:3], truth.chain_components().k[:3], rtol=0.05)  # k4 is small and weakly seen

@@ -2,6 +2,8 @@
 
 * :func:`inner_solve` -- the well-posed convex inner problem of EVPHC (Eq. 2.14 residual,
   chain topology and signs, mass-ratio bounds of Eq. 2.18, scale fixed by a mass).
+* :func:`inner_solve_sdp` -- the same for any coupling pattern, as a semi-definite program
+  (cvxpy + Clarabel), and the thesis's printed form for comparison.
 * :func:`evphc` -- the thesis's outer optimisation over eigenvector phases.
 * :func:`pia` -- the Pilkey-Inman iterative algorithm (PIA), the baseline: M given.
 * :func:`model_update` -- weighted nonlinear least squares of the chain's physical values
@@ -15,6 +17,18 @@ from .evphc import evphc
 from .inner import inner_solve
 from .pia import pia
 from .result import InverseSolution
-from .update import model_update
+from .sdp import inner_solve_sdp
+from .update import model_update, weight_sweep
+from .validate import predict_recording, scale_to_subject
 
-__all__ = ["InverseSolution", "evphc", "inner_solve", "model_update", "pia"]
+__all__ = [
+    "InverseSolution",
+    "evphc",
+    "inner_solve",
+    "inner_solve_sdp",
+    "model_update",
+    "pia",
+    "predict_recording",
+    "scale_to_subject",
+    "weight_sweep",
+]
