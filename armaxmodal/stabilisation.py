@@ -43,7 +43,8 @@ class Tolerances:
     max_damping: float = 0.6  #: heavier damping is not a vibration mode here
     min_freq_hz: float | None = None  #: default: 3 / record length
     max_freq_fraction: float = 0.45  #: of fs; poles near Nyquist are filter artefacts
-    min_energy: float = 0.01  #: residue energy relative to the largest pole at that order
+    min_energy: float = 0.01  #: residue energy relative to the largest pole at that order (lower it
+    #: to keep weakly excited modes; 0.1 % admits weak extra poles on real and band-limited data)
     min_input_db: float = -30.0  #: input PSD below this (dB re its peak): no excitation there
 
 
