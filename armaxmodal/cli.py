@@ -152,7 +152,7 @@ def _cmd_invert(args) -> int:
         bounds = body_mass_bounds(sensors, datasets.TABLE_4_2_MASS_FRACTION)
     frf = None
     if args.recording:
-        from .plot import measured_frf
+        from .frf import measured_frf
 
         rec = read_recording(args.recording, input=args.input, fs=args.fs)
         f, h, coh = measured_frf(rec)

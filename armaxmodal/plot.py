@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import numpy as np
-import scipy.signal
 
-__all__ = ["plot_stabilisation", "plot_prediction", "measured_frf", "modal_frf"]
+from .frf import measured_frf, modal_frf
+
+__all__ = ["plot_stabilisation", "plot_prediction"]
 
 # class -> (marker, colour, label); distinct in shape and colour
 _STYLE = {
@@ -14,34 +15,6 @@ _STYLE = {
     "f+d": ("s", "#ff7f0e", "stable f, ξ"),
     "f+d+v": ("*", "#d62728", "stable f, ξ, shape"),
 }
-
-
-def measured_frf(recording, nperseg: int | None = None):
-    """H1 estimate of each output over the input and the coherence.
-
-    Returns ``(freq_hz, H (n_freq, n_sensors) complex, coherence (n_freq, n_sensors))``.
-    """
-    n = nperseg or int(min(recording.n_samples // 8, 2 ** int(np.log2(recording.fs * 10))))
-    u = recording.base
-    f, puu = scipy.signal.welch(u, recording.fs, nperseg=n)
-    h, coh = [], []
-    for y in recording.response.T:
-        _, puy = scipy.signal.csd(u, y, recording.fs, nperseg=n)
-        _, pyy = scipy.signal.welch(y, recording.fs, nperseg=n)
-        h.append(puy / puu)
-        coh.append(np.abs(puy) ** 2 / (puu * pyy))
-    return f, np.array(h).T, np.array(coh).T
-
-
-def modal_frf(freq_hz, freqs, dampings, shapes):
-    """Absolute-acceleration transmissibility synthesised from modes: ``sum r/(iw - lambda) + c.c.``
-    with ``r = -lambda^2 M`` (M: EPFRF modal constants). Shape (n_freq, n_sensors)."""
-    w = 2j * np.pi * np.asarray(freq_hz)[:, None, None]
-    wn = 2 * np.pi * np.asarray(freqs)
-    lam = -np.asarray(dampings) * wn + 1j * wn * np.sqrt(1 - np.asarray(dampings) ** 2)
-    r = -(lam**2)[None, :] * shapes  # (n_sensors, n_modes)
-    out = r[None] / (w - lam[None, None]) + np.conj(r)[None] / (w - np.conj(lam)[None, None])
-    return out.sum(axis=2)
 
 
 def plot_stabilisation(diagram, selection=None, ax=None):

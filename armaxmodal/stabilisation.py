@@ -301,7 +301,7 @@ class ModeSelection:
     def reconstruction_error(self) -> float:
         """Relative RMS difference between the FRF rebuilt from the selected modes and the
         measured H1 FRF, over frequencies where every sensor's coherence is at least 0.8."""
-        from .plot import measured_frf, modal_frf
+        from .frf import measured_frf, modal_frf
 
         f, h, coh = measured_frf(self.diagram.recording)
         good = (np.min(coh, axis=1) >= 0.8) & (f > 0)
