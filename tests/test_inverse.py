@@ -180,3 +180,18 @@ def test_weight_sweep_shows_the_chapter_4_trade_off():
     np.testing.assert_allclose(freqs[0], datasets.TABLE_4_1["freq_hz"], rtol=0.01)
     np.testing.assert_allclose(freqs[-1], datasets.TABLE_4_3["freq_hz"], rtol=1e-3)
     assert np.all(np.diff(sweep.frf_rms) < 0) and np.all(np.diff(sweep.modal_rms) > 0)  # a Pareto front
+
+
+def test_evphc_magnitude_offsets_fix_a_scaled_component():
+    """A shape component whose magnitude is wrong by 30 % cannot be fixed by phases alone."""
+    from armaxmodal.inverse import evphc
+
+    s = am.chapter2_system()
+    m = s.modes()
+    f = np.linspace(0.5, 30.0, 60)
+    shapes = np.array(m.shapes)
+    shapes[1, 0] *= 1.3
+    phases = evphc(m.eigenvalues, shapes, (f, s.transmissibility(f)), m1=6.0, starts=1)
+    both = evphc(m.eigenvalues, shapes, (f, s.transmissibility(f)), m1=6.0, starts=1, magnitude_offsets=True)
+    assert both.misfits["cost"] < phases.misfits["cost"]
+    assert _rel(both.structure.K, s.K) < _rel(phases.structure.K, s.K)

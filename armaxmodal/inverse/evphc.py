@@ -32,6 +32,7 @@ def evphc(
     *,
     cost: str = "complex",
     reference: str = "largest",
+    magnitude_offsets: bool = False,
     starts: int = 4,
     max_iter: int = 50,
     cost_tol: float = 0.05,
@@ -54,6 +55,9 @@ def evphc(
         of the sum over DOFs of the absolute difference.
     reference : {"largest", "last"}
         Component whose phase stays fixed in each mode ("last" as the thesis).
+    magnitude_offsets : bool
+        Also let every free component's magnitude move by up to a factor 2 either way (log
+        offsets): the thesis keeps norms, but identified magnitudes are noisy too.
     starts : int
         The measured phases plus ``starts - 1`` random offsets.
     max_iter, cost_tol : as the thesis (50 iterations or cost <= 0.05).
@@ -69,10 +73,13 @@ def evphc(
     free = [(i, r) for r in range(n_modes) for i in range(n) if i != ref[r]]
     kw = {"mass_ratio_bounds": mass_ratio_bounds, "m1": 1.0, "names": names}
 
+    n_free = len(free)
+
     def shapes_for(offsets):
         out = psi.copy()
-        for (i, r), d in zip(free, offsets, strict=True):
-            out[i, r] = psi[i, r] * np.exp(1j * d)
+        log_mag = offsets[n_free:] if magnitude_offsets else np.zeros(n_free)
+        for (i, r), d, g in zip(free, offsets[:n_free], log_mag, strict=True):
+            out[i, r] = psi[i, r] * np.exp(g + 1j * d)
         return out
 
     def objective(offsets):
@@ -85,10 +92,12 @@ def evphc(
         return float(np.mean(np.sum(np.abs(diff), axis=1)))
 
     rng = np.random.default_rng(seed)
-    bounds = [(-np.pi, np.pi)] * len(free)
+    bounds = [(-np.pi, np.pi)] * n_free + ([(-np.log(2), np.log(2))] * n_free if magnitude_offsets else [])
     results = []
     for k in range(starts):
-        x0 = np.zeros(len(free)) if k == 0 else rng.uniform(-np.pi / 2, np.pi / 2, len(free))
+        x0 = np.zeros(len(bounds))
+        if k > 0:
+            x0[:n_free] = rng.uniform(-np.pi / 2, np.pi / 2, n_free)
         res = scipy.optimize.minimize(
             objective, x0, method="L-BFGS-B", bounds=bounds, options={"maxiter": max_iter, "ftol": 1e-12}
         )
