@@ -536,7 +536,10 @@ def _fit_single(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
     cols = _columns(na, nb, nc, nk, n_in)
     theta = _hannan_rissanen(y, uT, na, nb, nc, nk, t0, t1)
     if oe:
-        theta = _project(_output_error_start([y], uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in, oe=True)
+        try:
+            theta = _project(_output_error_start([y], uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in, oe=True)
+        except np.linalg.LinAlgError:  # degenerate input: keep the Hannan-Rissanen start
+            theta = _project(theta, na, nb, nc, n_in, oe=True)
 
     def evaluate(th):
         state = _residual_and_loss(y, uT, th, na, nb, nc, nk, t0, t1, oe)
@@ -625,11 +628,17 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
         return out, np.array([o[1] for o in out])
 
     state, losses = evaluate(theta)
-    # Second start: output error by Steiglitz-McBride; keep whichever is more likely.
-    alt = _project_shared(_output_error_start(ys, uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in, n_out, oe)
-    state_alt, losses_alt = evaluate(alt)
-    if np.sum(np.log(losses_alt)) < np.sum(np.log(losses)):
-        theta, state, losses = alt, state_alt, losses_alt
+    # Second start: output error by Steiglitz-McBride; keep whichever is more likely. A
+    # degenerate input (one sinusoid) can leave the subspace step without a Cholesky factor:
+    # then the first start stands alone.
+    try:
+        alt = _project_shared(_output_error_start(ys, uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in, n_out, oe)
+    except np.linalg.LinAlgError:
+        alt = None
+    if alt is not None:
+        state_alt, losses_alt = evaluate(alt)
+        if np.sum(np.log(losses_alt)) < np.sum(np.log(losses)):
+            theta, state, losses = alt, state_alt, losses_alt
     variances = losses / n_eff
     total_iterations = 0
     converged = False

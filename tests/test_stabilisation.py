@@ -131,3 +131,14 @@ def test_stabilise_cli(fixtures_dir, tmp_path):
     poles = pd.read_csv(csv)
     assert {"source", "na", "freq_hz", "damping", "cls", "rejected"} <= set(poles.columns)
     assert main(["stabilise", str(fixtures_dir / "supine_random.csv"), "--plot", str(tmp_path / "x.gif")]) == 2
+
+
+def test_a_single_sinusoid_input_gets_a_clear_answer():
+    """One excitation frequency identifies no mode: say so, do not crash or invent modes."""
+    s = am.supine_human()
+    t = np.arange(3600) / 60.0
+    rec = am.simulate_recording(s, np.sin(2 * np.pi * 3.0 * t), 60.0, noise=0.05, seed=1)
+    fit = am.fit_armax(rec, 8, 9, 8, 0, shared_poles=True, output_error=True)
+    assert fit.converged.all()
+    with pytest.raises(OrderError, match="check that the input excites the structure"):
+        select_modes(stabilisation_diagram(rec, range(2, 13, 2), per_sensor=False))
