@@ -159,6 +159,7 @@ def stabilisation_diagram(
     *,
     nk: int | None = None,
     per_sensor: bool = True,
+    per_sensor_max_order: int = 20,
     tolerances: Tolerances | None = None,
     max_iter: int = 30,
     n_jobs: int | None = None,
@@ -175,6 +176,8 @@ def stabilisation_diagram(
         Input delay; by default chosen by BIC (:func:`choose_nk`).
     per_sensor : bool
         Also sweep every sensor alone (the thesis's per-sensor view, Table 3.2).
+    per_sensor_max_order : int
+        Highest ``na`` of the single-sensor sweeps.
     tolerances : Tolerances, optional
     max_iter : int
         Levenberg-Marquardt cap per fit (a sweep needs positions, not the last digit).
@@ -189,7 +192,8 @@ def stabilisation_diagram(
         nk, known = _choose_nk(recording, range(0, -7, -1), (8, 10, 12), n_jobs)
     sources = [SHARED] + (list(recording.sensors) if per_sensor else [])
     order_list = [(na, default_nb(na, nk), default_nc(na), nk) for na in orders]
-    jobs = [(s, o) for o in order_list for s in sources]
+    # single sensors cannot support high orders (their bounds are wide): stop them earlier
+    jobs = [(s, o) for o in order_list for s in sources if s == SHARED or o[0] <= per_sensor_max_order]
     todo = [job for job in jobs if job not in known]
     from tqdm import tqdm
 
@@ -477,14 +481,15 @@ def _per_sensor_table(diagram, modes, shapes, cluster_freq):
     """Table 3.2 (per sensor, gaps as NaN) and the Eq. 3.35-3.36 weighted averages."""
     poles = diagram.poles
     sensors = diagram.recording.sensors
-    nas = sorted({o[0] for o in diagram.orders})
     rows = []
     for i, mode in enumerate(modes.itertuples(index=False)):
         for k, s in enumerate(sensors):
+            nas = sorted(na for src, na in diagram.fits if src == s)
             own = poles[(poles.source == s) & (poles.rejected == "")]
             near = own[np.abs(own.freq_hz - mode.freq_hz) <= cluster_freq * mode.freq_hz]
             near = near.loc[near.groupby("na").energy.idxmax()] if len(near) else near
-            shown = len(near) >= 0.5 * sum(1 for na in nas if na >= mode.na)
+            relevant = [na for na in nas if na >= min(mode.na, nas[-1])] if nas else []
+            shown = len(near) > 0 and len(near) >= 0.5 * len(relevant)
             own_const = np.nan + 0j
             if shown:
                 at = near.iloc[int(np.argmin(np.abs(near.na.to_numpy() - mode.na)))]
