@@ -195,3 +195,18 @@ def test_evphc_magnitude_offsets_fix_a_scaled_component():
     both = evphc(m.eigenvalues, shapes, (f, s.transmissibility(f)), m1=6.0, starts=1, magnitude_offsets=True)
     assert both.misfits["cost"] < phases.misfits["cost"]
     assert _rel(both.structure.K, s.K) < _rel(phases.structure.K, s.K)
+
+
+def test_modes_of_a_non_chain_are_flagged_not_silently_fitted():
+    s = am.chapter2_system()
+    k, c = np.array(s.K), np.array(s.C)
+    k[0, 2] = k[2, 0] = -20000.0
+    k[0, 0] += 20000.0
+    k[2, 2] += 20000.0
+    c[0, 3] = c[3, 0] = -100.0
+    c[0, 0] += 100.0
+    c[3, 3] += 100.0
+    m = am.Structure(s.M, c, k).modes()
+    sol = inner_solve(m.eigenvalues, m.shapes, m1=6.0)
+    assert any("fit a chain poorly" in f for f in sol.flags)
+    assert not any("poorly" in f for f in inner_solve(*_modes_of(s), m1=6.0).flags)
