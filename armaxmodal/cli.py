@@ -64,7 +64,7 @@ def _cmd_identify(args) -> int:
         if len(orders) != 4:
             raise OrderError(f"--orders: expected four integers na,nb,nc,nk, got {args.orders!r}.")
     band = _parse_pair(args.band, "--band") if args.band else None
-    result = identify(rec, orders, band=band)
+    result = identify(rec, orders, band=band, progress=not args.quiet)
     na, nb, nc, nk = result.fit.orders
     print(
         f"{args.data}: shared-pole ARMAX na={na} nb={nb} nc={nc} nk={nk}, "

@@ -98,6 +98,7 @@ def identify(
     *,
     band: tuple[float, float] | None = None,
     max_damping: float = DEFAULT_MAX_DAMPING,
+    progress: bool = False,
 ) -> Identification:
     """Fit the shared-pole ARMAX model and report its physical modes.
 
@@ -110,10 +111,12 @@ def identify(
         Frequency band of interest, Hz (default: 0 to 0.45 fs).
     max_damping : float
         Poles damped more than this are not reported as modes.
+    progress : bool
+        Show a progress bar during the automatic order search.
     """
     choice: OrderChoice | None = None
     if orders is None:
-        choice = choose_orders(recording)
+        choice = choose_orders(recording, progress=progress)
         fit = choice.fit
     else:
         fit = fit_armax(recording, *orders, shared_poles=True)

@@ -108,6 +108,7 @@ def choose_orders(
     criterion: str = "bic",
     max_iter: int = 100,
     n_jobs: int | None = None,
+    progress: bool = False,
 ) -> OrderChoice:
     """Fit every (na, nk) candidate with the default nb and nc and keep the best by BIC/AIC.
 
@@ -122,6 +123,8 @@ def choose_orders(
     n_jobs : int, optional
         Worker processes (default: all cores; 1 runs in this process). Workers are forked,
         so they reuse the compiled kernels.
+    progress : bool
+        Show a progress bar.
 
     Returns
     -------
@@ -131,7 +134,10 @@ def choose_orders(
         raise ValueError(f"criterion: expected 'bic' or 'aic', got {criterion!r}.")
     candidates = [(na, default_nb(na, nk), default_nc(na), nk) for na in na_values for nk in nk_values]
     run = partial(_fit_or_none, recording, shared_poles=shared_poles, max_iter=max_iter)
-    fits = _map(run, candidates, n_jobs)
+    from tqdm import tqdm
+
+    with tqdm(total=len(candidates), desc="order search", unit="fit", disable=not progress) as bar:
+        fits = _map(run, candidates, n_jobs, bar)
     rows, best, best_value = [], None, np.inf
     for (na, nb, nc, nk), fit in zip(candidates, fits, strict=True):
         if fit is None:
