@@ -340,10 +340,15 @@ def _stable_c(c):
     return np.real(np.poly(r))
 
 
-def _solve(g_mat, g_vec, damping=0.0):
+def _damped(g_mat, damping):
+    """Levenberg-Marquardt damping scaled by the diagonal, plus a tiny ridge for round-off."""
     d = np.diag(g_mat).copy()
     d[d <= 0] = 1.0
-    lhs = g_mat + np.diag(damping * d + 1e-13 * d)
+    return g_mat + np.diag(damping * d + 1e-13 * d)
+
+
+def _solve(g_mat, g_vec, damping=0.0):
+    lhs = _damped(g_mat, damping)
     try:
         return scipy.linalg.cho_solve(scipy.linalg.cho_factor(lhs), g_vec)
     except (np.linalg.LinAlgError, scipy.linalg.LinAlgError):
@@ -698,20 +703,16 @@ class _Arrow:
         """LM step by the Schur complement on the A block: K small factorisations instead
         of one of the full size (20x fewer flops at high orders)."""
 
-        def damped(m):
-            d = np.diag(m).copy()
-            d[d <= 0] = 1.0
-            return m + np.diag(damping * d + 1e-13 * d)
-
-        schur = damped(self.aa)
+        schur = _damped(self.aa, damping)
         rhs = self.ga.copy()
         parts = []
         for ab, bb, gb in zip(self.ab, self.bb, self.gb, strict=True):
             try:
-                factor = scipy.linalg.cho_factor(damped(bb))
+                factor = scipy.linalg.cho_factor(_damped(bb, damping))
                 x, y = scipy.linalg.cho_solve(factor, ab.T), scipy.linalg.cho_solve(factor, gb)
             except (np.linalg.LinAlgError, scipy.linalg.LinAlgError):
-                x, y = np.linalg.lstsq(damped(bb), ab.T, rcond=None)[0], np.linalg.lstsq(damped(bb), gb, rcond=None)[0]
+                x = np.linalg.lstsq(_damped(bb, damping), ab.T, rcond=None)[0]
+                y = np.linalg.lstsq(_damped(bb, damping), gb, rcond=None)[0]
             schur -= ab @ x
             rhs -= ab @ y
             parts.append((x, y))
