@@ -2,8 +2,9 @@
 
 The modes come from the shared-pole fit (every sensor sees the same poles); the per-sensor
 table lists, for each mode, how strongly each sensor shows it (the residue magnitude).
-Physical poles are those with damping in (0, ``max_damping``] inside ``band``; the full
-stabilisation-based selection lives in the stabilisation module.
+Physical poles are those the stabilisation diagram's rejection rules keep (positive damping
+up to ``max_damping``, away from 0 Hz and Nyquist, inside the excited band, non-negligible
+residue), within ``band``; selection across orders lives in the stabilisation module.
 """
 
 from __future__ import annotations
@@ -14,8 +15,10 @@ import numpy as np
 import pandas as pd
 
 from .fit import ArmaxFit, fit_armax
+from .modal import mode_record
 from .orders import OrderChoice, choose_orders
 from .recording import Recording
+from .stabilisation import _POLE_COLUMNS, SHARED, Tolerances, _poles_of, _reject
 
 __all__ = ["identify", "Identification", "DEFAULT_MAX_DAMPING"]
 
@@ -73,25 +76,6 @@ class Identification:
         }
 
 
-def mode_record(row, shape: np.ndarray, sensors, supplemented=None) -> dict:
-    """One mode of the JSON contract: frequency, damping, 95 % intervals and the shape
-    (normalised to a unit largest component on the positive real axis) per sensor."""
-    big = shape[np.argmax(np.abs(shape))]
-    shape = shape / big if abs(big) > 0 else shape
-    flags = np.zeros(len(sensors), dtype=bool) if supplemented is None else supplemented
-    return {
-        "freq_hz": float(row.freq_hz),
-        "damping": float(row.damping),
-        "damped_freq_hz": float(row.damped_freq_hz),
-        "freq_ci95": [float(row.freq_ci95_lo), float(row.freq_ci95_hi)],
-        "damping_ci95": [float(row.damping_ci95_lo), float(row.damping_ci95_hi)],
-        "shape": {
-            s: {"mag": float(abs(v)), "phase_deg": float(np.degrees(np.angle(v))), "supplemented": bool(f)}
-            for s, v, f in zip(sensors, shape, flags, strict=True)
-        },
-    }
-
-
 def identify(
     recording: Recording,
     orders: tuple[int, int, int, int] | None = None,
@@ -120,10 +104,13 @@ def identify(
         fit = choice.fit
     else:
         fit = fit_armax(recording, *orders, shared_poles=True)
-    lo, hi = band if band is not None else (0.0, 0.45 * recording.fs)
-    first = fit.modes().query(f"sensor == '{fit.sensors[0]}'")
-    keep = (first.damping > 0) & (first.damping <= max_damping) & (first.freq_hz >= lo) & (first.freq_hz <= hi)
-    modes = first[keep].drop(columns=["sensor", "residue", "residue_mag", "residue_phase_deg"]).reset_index(drop=True)
-    mu = modes.pole.to_numpy()
-    shapes = np.array([m.modal_constants(mu)[0] for m in fit.models]) if mu.size else np.zeros((len(fit.models), 0))
+    # the same rejection rules as the stabilisation diagram (damping ceiling, 0 Hz and Nyquist,
+    # the excited band, negligible residue), applied to this one order
+    poles = pd.DataFrame(_poles_of(fit, SHARED), columns=_POLE_COLUMNS)
+    poles = poles[np.array(_reject(poles, Tolerances(max_damping=max_damping), recording)) == ""]
+    if band is not None:
+        poles = poles[(poles.freq_hz >= band[0]) & (poles.freq_hz <= band[1])]
+    poles = poles.sort_values("freq_hz")
+    shapes = np.column_stack(poles.vector.to_list()) if len(poles) else np.zeros((len(fit.models), 0))
+    modes = poles.drop(columns=["source", "na", "energy", "vector"]).reset_index(drop=True)
     return Identification(fit, modes, shapes, recording, None if choice is None else choice.table)

@@ -17,6 +17,7 @@ __all__ = [
     "discrete_modal_parameters",
     "thesis_frequency_damping",
     "pole_uncertainty",
+    "mode_record",
 ]
 
 
@@ -107,3 +108,22 @@ def pole_uncertainty(a, mu, cov_a, fs: float) -> tuple[np.ndarray, np.ndarray]:
     var_f = np.einsum("ki,ij,kj->k", df, cov_a, df)
     var_xi = np.einsum("ki,ij,kj->k", dxi, cov_a, dxi)
     return np.sqrt(np.maximum(var_f, 0)), np.sqrt(np.maximum(var_xi, 0))
+
+
+def mode_record(row, shape: np.ndarray, sensors, supplemented=None) -> dict:
+    """One mode of the JSON contract: frequency, damping, 95 % intervals and the shape
+    (normalised to a unit largest component on the positive real axis) per sensor."""
+    big = shape[np.argmax(np.abs(shape))]
+    shape = shape / big if abs(big) > 0 else shape
+    flags = np.zeros(len(sensors), dtype=bool) if supplemented is None else supplemented
+    return {
+        "freq_hz": float(row.freq_hz),
+        "damping": float(row.damping),
+        "damped_freq_hz": float(row.damped_freq_hz),
+        "freq_ci95": [float(row.freq_ci95_lo), float(row.freq_ci95_hi)],
+        "damping_ci95": [float(row.damping_ci95_lo), float(row.damping_ci95_hi)],
+        "shape": {
+            s: {"mag": float(abs(v)), "phase_deg": float(np.degrees(np.angle(v))), "supplemented": bool(f)}
+            for s, v, f in zip(sensors, shape, flags, strict=True)
+        },
+    }

@@ -23,7 +23,7 @@ import pandas as pd
 
 from .exceptions import OrderError
 from .fit import ArmaxFit, fit_armax
-from .identify import mode_record
+from .modal import mode_record
 from .orders import _map, default_nb, default_nc, information_criterion
 from .recording import Recording
 
@@ -83,6 +83,12 @@ class StabilisationDiagram:
 def _mac(a: np.ndarray, b: np.ndarray) -> float:
     den = np.vdot(a, a).real * np.vdot(b, b).real
     return float(abs(np.vdot(a, b)) ** 2 / den) if den > 0 else 0.0
+
+
+_POLE_COLUMNS = [
+    "source", "na", "freq_hz", "damping", "damped_freq_hz", "freq_sd", "damping_sd", "freq_ci95_lo",
+    "freq_ci95_hi", "damping_ci95_lo", "damping_ci95_hi", "energy", "pole", "vector",
+]  # fmt: skip
 
 
 def _poles_of(fit: ArmaxFit, source: str) -> list[dict]:
