@@ -135,6 +135,20 @@ def _format(path: str) -> str:
     return ext
 
 
+def _modal_noise_levels(data: dict) -> dict:
+    """Relative standard deviations of each mode's frequency and damping from the 95 %
+    intervals in a stabilise JSON (model updating weighs each mode by them)."""
+    sigma = {}
+    for key, value, interval in (("freq", "freq_hz", "freq_ci95"), ("damping", "damping", "damping_ci95")):
+        try:
+            sd = [(m[interval][1] - m[interval][0]) / (2 * 1.96 * m[value]) for m in data["modes"]]
+        except (KeyError, TypeError, IndexError, ZeroDivisionError):
+            continue  # no intervals given: the documented defaults apply
+        if all(np.isfinite(sd)) and min(sd) > 0:
+            sigma[key] = np.asarray(sd)
+    return sigma
+
+
 def _cmd_invert(args) -> int:
     import json
 
@@ -150,14 +164,15 @@ def _cmd_invert(args) -> int:
     bounds = None
     if set(sensors) <= set(datasets.TABLE_4_2_MASS_FRACTION):
         bounds = body_mass_bounds(sensors, datasets.TABLE_4_2_MASS_FRACTION)
-    frf = None
+    frf, sigma = None, _modal_noise_levels(data)
     if args.recording:
-        from .frf import measured_frf
+        from .frf import default_nperseg, h1_relative_error, measured_frf
 
         rec = read_recording(args.recording, input=args.input, fs=args.fs)
         f, h, coh = measured_frf(rec)
         keep = (f > 0.5) & (np.min(coh, axis=1) >= 0.8)
         frf = (f[keep], h[keep])
+        sigma["frf"] = h1_relative_error(coh[keep], rec.n_samples, default_nperseg(rec))
     total = args.total_mass
     if args.method == "pia":
         if total is None or bounds is None:
@@ -171,7 +186,9 @@ def _cmd_invert(args) -> int:
             raise DataError("evphc needs the measured transmissibility: give --recording DATA.")
         sol = evphc(lam, shapes, frf, mass_ratio_bounds=bounds, total_mass=total, names=sensors)
     else:
-        sol = model_update(lam, shapes, frf=frf, mass_ratio_bounds=bounds, total_mass=total, names=sensors)
+        sol = model_update(
+            lam, shapes, frf=frf, sigma=sigma, mass_ratio_bounds=bounds, total_mass=total, names=sensors
+        )
     prediction = None
     if args.recording:
         from .inverse import predict_recording
@@ -205,9 +222,8 @@ def _cmd_invert(args) -> int:
                 "C": sol.structure.C,
                 "K": sol.structure.K,
                 "names": list(sol.structure.names),
-                "components": None
-                if comps is None
-                else {"masses": comps.masses, "k": comps.k, "c": comps.c, "k_s": comps.k_s, "c_s": comps.c_s},
+                "components": None if comps is None else _components_dict(comps),
+                "components_std": None if sol.std is None else _components_dict(sol.std),
                 "modes": sol.modes.to_dict()["modes"],
                 "misfits": sol.misfits,
                 "flags": sol.flags,
@@ -220,6 +236,10 @@ def _cmd_invert(args) -> int:
             args.json,
         )
     return 0
+
+
+def _components_dict(comps) -> dict:
+    return {"masses": comps.masses, "k": comps.k, "c": comps.c, "k_s": comps.k_s, "c_s": comps.c_s}
 
 
 def _cmd_modes(args) -> int:

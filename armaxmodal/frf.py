@@ -14,12 +14,18 @@ import scipy.signal
 __all__ = ["measured_frf", "modal_frf"]
 
 
+def default_nperseg(recording) -> int:
+    """Welch segment length of :func:`measured_frf`: about 10 s (a power of two), at most an
+    eighth of the record."""
+    return int(min(recording.n_samples // 8, 2 ** int(np.log2(recording.fs * 10))))
+
+
 def measured_frf(recording, nperseg: int | None = None):
     """H1 estimate of each output over the input and the coherence.
 
     Returns ``(freq_hz, H (n_freq, n_sensors) complex, coherence (n_freq, n_sensors))``.
     """
-    n = nperseg or int(min(recording.n_samples // 8, 2 ** int(np.log2(recording.fs * 10))))
+    n = default_nperseg(recording) if nperseg is None else nperseg
     u = recording.base
     f, puu = scipy.signal.welch(u, recording.fs, nperseg=n)
     h, coh = [], []
@@ -29,6 +35,16 @@ def measured_frf(recording, nperseg: int | None = None):
         h.append(puy / puu)
         coh.append(np.abs(puy) ** 2 / (puu * pyy))
     return f, np.array(h).T, np.array(coh).T
+
+
+def h1_relative_error(coherence: np.ndarray, n_samples: int, nperseg: int) -> np.ndarray:
+    """Relative random error (complex rms) of an H1 estimate: ``sqrt((1 - g^2) / (g^2 n_d))``
+    (Bendat & Piersol, Random Data, Sec. 9.2.4: sqrt(1 - g^2) / (|g| sqrt(2 n_d)) for the
+    magnitude and for the phase in radians), with n_d the number of Welch segments
+    (50 % overlap, as :func:`measured_frf`). Shape of ``coherence``."""
+    n_segments = max(1, (n_samples - nperseg) // (nperseg // 2) + 1)
+    g2 = np.clip(np.asarray(coherence, dtype=float), 1e-6, 1.0 - 1e-12)
+    return np.sqrt((1.0 - g2) / (g2 * n_segments))
 
 
 def modal_frf(freq_hz, freqs, dampings, shapes):

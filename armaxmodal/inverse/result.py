@@ -31,6 +31,10 @@ class InverseSolution:
     flags : list of str
         Conditions the user must know about (non-convergence, over-damped modes, bounds
         active, not identifiable...).
+    std : ChainComponents or None
+        Standard errors of the chain components from the stated noise levels (Gauss-Newton
+        covariance at the solution; model updating only). A component held at a bound, or
+        fixed by the scale, has 0.
     """
 
     structure: Structure
@@ -42,11 +46,14 @@ class InverseSolution:
     time_s: float = 0.0
     converged: bool = True
     flags: list = field(default_factory=list)
+    std: ChainComponents | None = None
 
     def to_frame(self) -> pd.DataFrame:
         """Chain components (or matrix diagonals) and the recovered modes, one row each."""
         if self.components is not None:
             comp = self.components.to_frame()
+            if self.std is not None:
+                comp.insert(3, "std", self.std.to_frame()["value"].to_numpy())
         else:
             s = self.structure
             rows = [("M", n, s.M[i, i]) for i, n in enumerate(s.names)]
