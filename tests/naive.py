@@ -56,3 +56,33 @@ def lagged_design(sig, col_sig, col_lag, col_sign, t0, t1):
 def max_root_radius_below(p, radius):
     """All roots of p strictly inside ``radius``, from numpy's companion-matrix roots."""
     return bool(np.all(np.abs(np.roots(p)) < radius))
+
+
+def sdp_inner_cvxpy(lam, psi, allowed, mass_ratio_bounds=None):
+    """The SDP inner problem stated in cvxpy (the modelling layer does the conic form).
+    Returns (m, C, K) with m1 = 1, in the units of ``lam`` (not non-dimensionalised)."""
+    import cvxpy as cp
+
+    n = psi.shape[0]
+    psi = psi / np.linalg.norm(psi, axis=0)
+    w_ref = float(np.exp(np.mean(np.log(np.abs(lam)))))
+    lam_s = lam / w_ref
+    m = cp.Variable(n)
+    c = cp.Variable((n, n), symmetric=True)
+    k = cp.Variable((n, n), symmetric=True)
+    cons = [m[0] == 1, m >= 0, c >> 0, k >> 1e-9 * np.eye(n)]
+    if mass_ratio_bounds is not None:
+        b = np.asarray(mass_ratio_bounds, dtype=float)
+        cons += [m[1:] >= b[:, 0], m[1:] <= b[:, 1]]
+    for i in range(n):
+        for j in range(i + 1, n):
+            cons += [c[i, j] <= 0, k[i, j] <= 0] if allowed[i, j] else [c[i, j] == 0, k[i, j] == 0]
+    parts = []
+    for r in range(lam.size):
+        a2, a1, a0 = lam_s[r] ** 2 * psi[:, r], lam_s[r] * psi[:, r], psi[:, r]
+        parts += [
+            cp.multiply(m, a2.real) + c @ a1.real + k @ a0.real,
+            cp.multiply(m, a2.imag) + c @ a1.imag + k @ a0.imag,
+        ]
+    cp.Problem(cp.Minimize(cp.sum_squares(cp.hstack(parts))), cons).solve(solver=cp.CLARABEL)
+    return np.asarray(m.value), np.asarray(c.value) * w_ref, np.asarray(k.value) * w_ref**2

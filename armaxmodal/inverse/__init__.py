@@ -3,7 +3,7 @@
 * :func:`inner_solve` -- the well-posed convex inner problem of EVPHC (Eq. 2.14 residual,
   chain topology and signs, mass-ratio bounds of Eq. 2.18, scale fixed by a mass).
 * :func:`inner_solve_sdp` -- the same for any coupling pattern, as a semi-definite program
-  (cvxpy + Clarabel), and the thesis's printed form for comparison.
+  (Clarabel, conic form built directly), and the thesis's printed form for comparison.
 * :func:`evphc` -- the thesis's outer optimisation over eigenvector phases.
 * :func:`pia` -- the Pilkey-Inman iterative algorithm (PIA), the baseline: M given.
 * :func:`model_update` -- weighted nonlinear least squares of the chain's physical values
