@@ -26,6 +26,7 @@ from .fit import ArmaxFit, fit_armax
 from .modal import mode_record
 from .orders import _map, default_nb, default_nc, information_criterion
 from .recording import Recording
+from .refine import ModalRefinement, refine_modes
 
 __all__ = ["stabilisation_diagram", "StabilisationDiagram", "select_modes", "ModeSelection", "Tolerances"]
 
@@ -299,6 +300,11 @@ class ModeSelection:
     weighted : DataFrame
         Eqs. 3.35-3.36: per mode, the |M_ij|-weighted mean of the per-sensor values.
     diagram : StabilisationDiagram
+    refinement : ModalRefinement or None
+        The frequency-domain refit (:mod:`armaxmodal.refine`); its ``hold`` is the
+        inter-sample behaviour the data chose. ``modes.estimator`` says which values are
+        reported: the refit for a band-limited recording, the ARMAX fit (the exact model
+        class) for a held input.
     """
 
     modes: pd.DataFrame
@@ -306,6 +312,7 @@ class ModeSelection:
     per_sensor: pd.DataFrame
     weighted: pd.DataFrame
     diagram: StabilisationDiagram
+    refinement: ModalRefinement | None = None
 
     @property
     def reconstruction_error(self) -> float:
@@ -358,6 +365,8 @@ class ModeSelection:
             "orders_na": [o[0] for o in self.diagram.orders],
             "tolerances": {"freq": t.freq, "damping": t.damping, "shape": t.shape, "max_damping": t.max_damping},
             "reconstruction_error": self.reconstruction_error,
+            "intersample_hold": None if self.refinement is None else self.refinement.hold,
+            "estimator": sorted(set(self.modes.estimator)),
             "modes": modes,
             "per_sensor": per_sensor,
         }
@@ -372,6 +381,7 @@ def select_modes(
     cluster_freq: float = 0.05,
     cluster_damping: float = 0.5,
     merge_mac: float = 0.8,
+    refine: bool = True,
 ) -> ModeSelection:
     """Pick the physical modes from the shared-pole poles of a diagram.
 
@@ -393,6 +403,10 @@ def select_modes(
         Keep the ``n_modes`` best-supported modes.
     band : (lo, hi), optional
         Frequency band in Hz.
+    refine : bool
+        Refit the selected modes to the recording's DFT under the inter-sample behaviour the
+        data choose (:func:`armaxmodal.refine.refine_modes`) and report the refit when the
+        recording is band-limited, where the discrete ARMAX class is biased.
     """
     poles = diagram.poles
     cand = poles[(poles.source == SHARED) & (poles.rejected == "")]
@@ -463,8 +477,39 @@ def select_modes(
     order = modes.loc[order].sort_values("freq_hz").index
     modes = modes.loc[order].reset_index(drop=True)
     shapes = np.column_stack([vectors[i] for i in order])
+    modes["estimator"] = "armax"
+    refinement = None
+    if refine:
+        refinement = refine_modes(
+            diagram.recording, modes.freq_hz, modes.damping, band_hz=excited_band(diagram.recording)
+        )
+        if refinement.hold == "bandlimited":
+            modes, shapes = _apply_refinement(modes, shapes, refinement, cluster_freq, cluster_damping)
     per_sensor, weighted = _per_sensor_table(diagram, modes, shapes, cluster_freq)
-    return ModeSelection(modes, shapes, per_sensor, weighted, diagram)
+    return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement)
+
+
+def _apply_refinement(modes, shapes, ref, max_freq_change, max_damping_change):
+    """Report the band-limited refit of each mode unless it left the mode's neighbourhood
+    (then the ARMAX value stays and ``estimator`` says so)."""
+    modes, shapes = modes.copy(), shapes.copy()
+    for i in range(len(modes)):
+        df = abs(ref.freq_hz[i] / modes.at[i, "freq_hz"] - 1)
+        dx = abs(ref.damping[i] / modes.at[i, "damping"] - 1)
+        if df > max_freq_change or dx > max_damping_change:
+            modes.at[i, "estimator"] = "armax (refit moved too far)"
+            continue
+        f, x = ref.freq_hz[i], ref.damping[i]
+        modes.loc[i, ["freq_hz", "damping", "damped_freq_hz", "estimator"]] = [
+            f, x, f * np.sqrt(1 - x**2), "fd-bandlimited"
+        ]
+        modes.loc[i, ["freq_ci95_lo", "freq_ci95_hi"]] = [f - 1.96 * ref.freq_sd[i], f + 1.96 * ref.freq_sd[i]]
+        modes.loc[i, ["damping_ci95_lo", "damping_ci95_hi"]] = [
+            x - 1.96 * ref.damping_sd[i],
+            x + 1.96 * ref.damping_sd[i],
+        ]
+        shapes[:, i] = ref.shapes[:, i]
+    return modes, shapes
 
 
 def _merge_duplicates(modes: pd.DataFrame, vectors: list, merge_mac: float) -> list[int]:

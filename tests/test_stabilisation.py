@@ -37,11 +37,24 @@ def test_supine_random_ride_gives_exactly_four_modes(supine_selection):
     assert supine_selection.reconstruction_error < 0.05
 
 
+def test_supine_sweep_ride_gives_exactly_four_modes(fixtures_dir):
+    """The 0.5-20 Hz sweep stops inside mode 4's half-power band: the ARMAX poles alone are
+    biased for this band-limited ride (mode 4 -2.9 %, mode 3 damping +12 %); the refit under
+    the inter-sample behaviour the data choose meets the targets."""
+    rec = am.read_recording(fixtures_dir / "supine_sweep.csv")
+    selection = select_modes(stabilisation_diagram(rec, per_sensor=False))
+    assert selection.refinement.hold == "bandlimited"
+    df, dx = _errors(selection, am.supine_human())
+    assert np.all(np.abs(df) < FREQ_RTOL) and np.all(np.abs(dx) < DAMPING_RTOL), (df, dx)
+
+
 def test_chapter2_system(fixtures_dir):
     rec = am.read_recording(fixtures_dir / "chapter2_random_zoh.csv")
     selection = select_modes(stabilisation_diagram(rec, per_sensor=False))
     df, dx = _errors(selection, am.chapter2_system())
     assert np.all(np.abs(df) < FREQ_RTOL) and np.all(np.abs(dx) < DAMPING_RTOL), (df, dx)
+    # a held input: the data choose the zero-order hold and the exact ARMAX values stay
+    assert selection.refinement.hold == "zoh" and set(selection.modes.estimator) == {"armax"}
 
 
 def test_lightly_damped_structure():

@@ -1,0 +1,56 @@
+"""Frequency-domain refit of selected modes under the inter-sample behaviour."""
+
+import json
+
+import numpy as np
+import pytest
+
+import armaxmodal as am
+from armaxmodal.refine import refine_modes
+from armaxmodal.stabilisation import excited_band
+
+
+def _start(fixtures_dir, name):
+    """Truth perturbed by 3 % in frequency and 15 % in damping: a start the selection could give."""
+    truth = json.loads((fixtures_dir / f"{name}.truth.json").read_text())["modes"]
+    f = np.array([m["freq_hz"] for m in truth])
+    x = np.array([m["damping"] for m in truth])
+    signs = np.array([1, -1, 1, -1])
+    return f, x, f * (1 + 0.03 * signs), x * (1 - 0.15 * signs)
+
+
+@pytest.mark.parametrize(
+    "name, hold", [("supine_sweep", "bandlimited"), ("supine_random", "bandlimited"), ("supine_random_zoh", "zoh")]
+)
+def test_the_data_choose_the_hold_and_the_refit_finds_the_modes(fixtures_dir, name, hold):
+    rec = am.read_recording(fixtures_dir / f"{name}.csv")
+    f, x, f0, x0 = _start(fixtures_dir, name)
+    ref = refine_modes(rec, f0, x0, band_hz=excited_band(rec))
+    assert ref.hold == hold
+    assert ref.cost[hold] < ref.cost[{"zoh": "bandlimited", "bandlimited": "zoh"}[hold]]
+    # within the issue's targets, and the errors consistent with the reported uncertainty
+    assert np.all(np.abs(ref.freq_hz / f - 1) < 0.02) and np.all(np.abs(ref.damping / x - 1) < 0.10)
+    assert np.all(np.abs(ref.freq_hz - f) < 4 * ref.freq_sd) and np.all(np.abs(ref.damping - x) < 4 * ref.damping_sd)
+
+
+def test_refit_shapes_match_the_exact_modal_constants(fixtures_dir):
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    f, x, f0, x0 = _start(fixtures_dir, "supine_random")
+    ref = refine_modes(rec, f0, x0, band_hz=excited_band(rec), hold="bandlimited")
+    # EPFRF modal constants -r / lambda^2, compared with magnitude and phase (unit largest component)
+    truth = json.loads((fixtures_dir / "supine_random.truth.json").read_text())["modes"]
+    want = np.array(
+        [
+            [m["shape"][s]["mag"] * np.exp(1j * np.radians(m["shape"][s]["phase_deg"])) for m in truth]
+            for s in rec.sensors
+        ]
+    )
+    got = ref.shapes / ref.shapes[np.argmax(np.abs(ref.shapes), axis=0), np.arange(4)]
+    want = want / want[np.argmax(np.abs(want), axis=0), np.arange(4)]
+    assert np.max(np.abs(got - want)) < 0.06
+
+
+def test_bad_hold_is_refused(fixtures_dir):
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    with pytest.raises(ValueError, match="hold"):
+        refine_modes(rec, [5.8], [0.25], band_hz=(0.5, 28.0), hold="foh")
