@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.optimize
 
+from .exceptions import OrderError
 from .recording import Recording
 
 HOLDS = ("bandlimited", "zoh")
@@ -116,6 +117,12 @@ def refine_modes(
     lines = (freq >= band_hz[0]) & (freq <= band_hz[1]) & (freq > 0)
     u = np.fft.rfft(recording.base)[lines]
     y = np.fft.rfft(recording.response, axis=0)[lines]
+    n_columns = 4 * f0.size + 2  # plant and transient pairs, direct and constant terms
+    if 2 * lines.sum() < 3 * n_columns:
+        raise OrderError(
+            f"{lines.sum()} DFT lines in {band_hz[0]:g}-{band_hz[1]:g} Hz cannot refit {f0.size} modes; "
+            "record longer or widen the band."
+        )
     w = 2 * np.pi * freq[lines]
     s, z_inv = 1j * w, np.exp(-1j * w * dt)
     start = np.ravel(np.column_stack([np.log(2 * np.pi * f0), x0]))

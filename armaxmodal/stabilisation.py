@@ -480,10 +480,14 @@ def select_modes(
     modes["estimator"] = "armax"
     refinement = None
     if refine:
-        refinement = refine_modes(
-            diagram.recording, modes.freq_hz, modes.damping, band_hz=excited_band(diagram.recording)
-        )
-        if refinement.hold == "bandlimited":
+        lo, hi = excited_band(diagram.recording)
+        if band is not None:  # modes outside the user's band are not in the refit: fit only inside it
+            lo, hi = max(lo, band[0]), min(hi, band[1])
+        try:
+            refinement = refine_modes(diagram.recording, modes.freq_hz, modes.damping, band_hz=(lo, hi))
+        except (OrderError, np.linalg.LinAlgError):
+            refinement = None  # too few lines or a degenerate basis: the ARMAX values stand
+        if refinement is not None and refinement.hold == "bandlimited":
             modes, shapes = _apply_refinement(modes, shapes, refinement, cluster_freq, cluster_damping)
     per_sensor, weighted = _per_sensor_table(diagram, modes, shapes, cluster_freq)
     return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement)

@@ -54,3 +54,11 @@ def test_bad_hold_is_refused(fixtures_dir):
     rec = am.read_recording(fixtures_dir / "supine_random.csv")
     with pytest.raises(ValueError, match="hold"):
         refine_modes(rec, [5.8], [0.25], band_hz=(0.5, 28.0), hold="foh")
+
+
+def test_too_few_lines_for_the_modes_is_a_clear_error(fixtures_dir):
+    from armaxmodal.exceptions import OrderError
+
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    with pytest.raises(OrderError, match="DFT lines"):
+        refine_modes(rec, [5.8, 8.3, 13.5, 16.2], [0.25, 0.35, 0.3, 0.27], band_hz=(5.0, 5.1))
