@@ -30,3 +30,18 @@ def test_h1_estimate_matches_the_exact_transmissibility():
     g2 = coh[band]
     bound = SIGMAS * np.sqrt(1 - g2) / (np.sqrt(g2) * np.sqrt(2 * n_segments / 2)) + BIAS
     assert np.all(np.abs(h[band] - exact) / np.abs(exact) < bound)
+
+
+def test_h1_relative_error_matches_the_scatter_around_the_true_transmissibility(fixtures_dir):
+    """Bendat & Piersol's random error of H1, from the coherence, against the actual scatter
+    of the H1 estimate around the exact transmissibility of the simulated ride."""
+    from armaxmodal.frf import default_nperseg, h1_relative_error, measured_frf
+
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    f, h, coh = measured_frf(rec)
+    keep = (f > 0.5) & (np.min(coh, axis=1) >= 0.8)
+    sigma = h1_relative_error(coh[keep], rec.n_samples, default_nperseg(rec))
+    ratio = h[keep] / am.supine_human().transmissibility(f[keep])
+    part_sd = np.tile(sigma.ravel() / np.sqrt(2), 2)  # log magnitude and phase, each
+    z = np.concatenate([np.log(np.abs(ratio)).ravel(), np.angle(ratio).ravel()]) / part_sd
+    assert 0.8 < np.sqrt(np.mean(z**2)) < 1.25
