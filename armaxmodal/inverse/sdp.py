@@ -23,6 +23,7 @@ import scipy.sparse
 from ..exceptions import StructureError
 from ..structure import Structure
 from ._modal_data import check_modes
+from .inner import _mass_bounds
 from .result import InverseSolution
 
 
@@ -114,13 +115,14 @@ def inner_solve_sdp(
     nonneg_rows, nonneg_b = [], []
     nonneg_rows += [-eye[i] for i in range(n)]  # masses >= 0
     nonneg_b += [0.0] * n
-    if mass_ratio_bounds is not None:
-        b = np.asarray(mass_ratio_bounds, dtype=float)
-        if b.shape != (n - 1, 2):
-            raise StructureError(f"mass_ratio_bounds: expected {n - 1} (low, high) pairs, got {b.shape}.")
-        for i in range(1, n):
-            nonneg_rows += [-eye[i], eye[i]]
-            nonneg_b += [-b[i - 1, 0], b[i - 1, 1]]
+    lo, hi = _mass_bounds(n, mass_ratio_bounds)  # validated as for the chain solve
+    for i in range(1, n):
+        if lo[i] > 0:
+            nonneg_rows.append(-eye[i])
+            nonneg_b.append(-lo[i])
+        if np.isfinite(hi[i]):
+            nonneg_rows.append(eye[i])
+            nonneg_b.append(hi[i])
     for v, (i, j) in enumerate(entries):
         if i != j:  # off-diagonal damping and stiffness couplings are non-positive
             nonneg_rows += [eye[n + v], eye[n + n_e + v]]
