@@ -186,9 +186,7 @@ def _cmd_invert(args) -> int:
             raise DataError("evphc needs the measured transmissibility: give --recording DATA.")
         sol = evphc(lam, shapes, frf, mass_ratio_bounds=bounds, total_mass=total, names=sensors)
     else:
-        sol = model_update(
-            lam, shapes, frf=frf, sigma=sigma, mass_ratio_bounds=bounds, total_mass=total, names=sensors
-        )
+        sol = model_update(lam, shapes, frf=frf, sigma=sigma, mass_ratio_bounds=bounds, total_mass=total, names=sensors)
     prediction = None
     if args.recording:
         from .inverse import predict_recording
@@ -272,9 +270,15 @@ def build_parser() -> argparse.ArgumentParser:
         prog="armaxmodal", description="Time-domain modal analysis of base-excited systems."
     )
     parser.add_argument("--quiet", action="store_true", help="no progress or chatter")
+    # --quiet is accepted after the command too; SUPPRESS keeps a subcommand's unset default
+    # from overwriting the top-level flag
+    quiet = argparse.ArgumentParser(add_help=False)
+    quiet.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS, help="no progress or chatter")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    p = sub.add_parser("stabilise", help="order sweep, stabilisation plot and automatic mode selection")
+    p = sub.add_parser(
+        "stabilise", parents=[quiet], help="order sweep, stabilisation plot and automatic mode selection"
+    )
     _add_data_args(p)
     p.add_argument("--orders", default="2:30", help="range of na, LO:HI (even steps); default 2:30")
     p.add_argument("--modes", type=int, default=None, help="number of modes to keep (default: automatic)")
@@ -290,7 +294,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=_cmd_stabilise)
 
-    p = sub.add_parser("invert", help="physical chain model (M, C, K) from identified modes")
+    p = sub.add_parser("invert", parents=[quiet], help="physical chain model (M, C, K) from identified modes")
     p.add_argument("modes", help="modes JSON written by 'stabilise --json'")
     p.add_argument("--recording", default=None, help="the recording, for the measured transmissibility")
     p.add_argument("--input", default="base")
@@ -301,7 +305,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", default=None, help="predicted vs measured acceleration per sensor (.png/.svg/.pdf)")
     p.set_defaults(func=_cmd_invert)
 
-    p = sub.add_parser("identify", help="fit a shared-pole ARMAX model and print the modes")
+    p = sub.add_parser("identify", parents=[quiet], help="fit a shared-pole ARMAX model and print the modes")
     _add_data_args(p)
     p.add_argument("--orders", default="auto", help="'auto' (BIC) or na,nb,nc,nk; default auto")
     p.add_argument("--band", default=None, help="frequency band LO:HI in Hz")
@@ -309,16 +313,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--csv", default=None, help="write every pole of every sensor as CSV")
     p.set_defaults(func=_cmd_identify)
 
-    p = sub.add_parser("info", help="summarise a recording")
+    p = sub.add_parser("info", parents=[quiet], help="summarise a recording")
     _add_data_args(p)
     p.set_defaults(func=_cmd_info)
 
-    p = sub.add_parser("modes", help="exact modes of a reference structure from the thesis")
+    p = sub.add_parser("modes", parents=[quiet], help="exact modes of a reference structure from the thesis")
     p.add_argument("--system", choices=sorted(SYSTEMS), default="supine")
     p.add_argument("--json", default=None, help="write the modes as JSON")
     p.set_defaults(func=_cmd_modes)
 
-    p = sub.add_parser("simulate", help="simulate a base-excitation ride of a reference structure")
+    p = sub.add_parser("simulate", parents=[quiet], help="simulate a base-excitation ride of a reference structure")
     p.add_argument("--system", choices=sorted(SYSTEMS), default="supine")
     p.add_argument("--excitation", choices=["random", "sweep"], default="random")
     p.add_argument("--fs", type=float, default=60.0)

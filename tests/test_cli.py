@@ -19,6 +19,15 @@ def test_modes_json(tmp_path, capsys):
     np.testing.assert_allclose([m["freq_hz"] for m in data["modes"]], am.supine_human().modes().freq_hz)
 
 
+def test_quiet_is_accepted_before_or_after_the_command(tmp_path, capsys):
+    out = tmp_path / "modes.json"
+    assert main(["modes", "--system", "supine", "--json", str(out)]) == 0
+    assert "wrote" in capsys.readouterr().out
+    for argv in (["--quiet", "modes"], ["modes", "--quiet"]):
+        assert main([*argv, "--system", "supine", "--json", str(out)]) == 0
+        assert "wrote" not in capsys.readouterr().out
+
+
 def test_simulate_writes_a_readable_recording(tmp_path):
     out = tmp_path / "sim.csv"
     assert (
