@@ -63,26 +63,99 @@ def _poles(x: np.ndarray) -> np.ndarray:
     return -xi * wn + 1j * wn * np.sqrt(1.0 - xi**2)
 
 
-def _pair_columns(h: np.ndarray, h_conj: np.ndarray) -> list[np.ndarray]:
+def _pole_derivatives(x: np.ndarray) -> np.ndarray:
+    """``d lambda / d x``: (n_modes, 2) for x = (log wn, xi) per mode."""
+    wn, xi = np.exp(x[0::2]), x[1::2]
+    return np.column_stack([_poles(x), -wn - 1j * wn * xi / np.sqrt(1.0 - xi**2)])
+
+
+def _pair(h: np.ndarray, h_conj: np.ndarray) -> np.ndarray:
     """Real-coefficient columns a, b such that ``(a + i b)`` times ``h`` plus its conjugate
-    partner is ``alpha a + beta b`` for a complex coefficient ``alpha + i beta``."""
-    return [h + h_conj, 1j * (h - h_conj)]
+    partner is ``alpha a + beta b`` for a complex coefficient ``alpha + i beta``; (L, 2)."""
+    return np.column_stack([h + h_conj, 1j * (h - h_conj)])
 
 
-def _basis(lam: np.ndarray, s: np.ndarray, z_inv: np.ndarray, u: np.ndarray, dt: float, hold: str) -> np.ndarray:
-    cols = []
-    for pole in lam:
-        if hold == "bandlimited":
-            cols += [c * u for c in _pair_columns(1 / (s - pole), 1 / (s - np.conj(pole)))]
-        else:
-            mu = np.exp(pole * dt)
-            cols += [c * u for c in _pair_columns(1 / (1 - mu * z_inv), 1 / (1 - np.conj(mu) * z_inv))]
-    cols.append(u)  # direct feed-through
-    for pole in lam:  # transient / leakage: same poles, in z
-        mu = np.exp(pole * dt)
-        cols += _pair_columns(1 / (1 - mu * z_inv), 1 / (1 - np.conj(mu) * z_inv))
-    cols.append(np.ones_like(s))
-    return np.array(cols).T
+class _SeparableModel:
+    """``Y = Phi(x) coef`` over DFT lines, with ``coef`` (residues, direct and transient terms)
+    projected out: residual and Golub-Pereyra Jacobian in the frequencies and dampings only.
+
+    Columns of ``Phi``: a plant pair per mode (``1 / (s - lambda)`` times U, or its held form
+    in ``z``), the direct term U, a transient pair per mode (``1 / (1 - mu z^-1)``), a constant.
+    Rows are the real parts of the lines stacked over the imaginary parts; the sensors are
+    right-hand sides sharing one basis.
+    """
+
+    def __init__(self, s, z_inv, u, y_weighted, dt, hold):
+        self.s, self.z_inv, self.u, self.dt, self.hold = s, z_inv, u, dt, hold
+        self.b = np.vstack([y_weighted.real, y_weighted.imag])
+        self._x = None
+
+    def _plant(self, lam, order):
+        """Plant response to a unit residue at pole ``lam`` (order 0) or its lam-derivative."""
+        if self.hold == "bandlimited":
+            return self.u / (self.s - lam) ** (order + 1)
+        return self.u * self._held(lam, order)
+
+    def _held(self, lam, order):
+        mu = np.exp(lam * self.dt)
+        den = 1 - mu * self.z_inv
+        return 1 / den if order == 0 else self.dt * mu * self.z_inv / den**2
+
+    def _columns(self, lam):
+        """(L, 2, n_modes) plant pairs and (L, 2, n_modes) transient pairs."""
+        plant = np.stack([_pair(self._plant(p, 0), self._plant(np.conj(p), 0)) for p in lam], axis=2)
+        trans = np.stack([_pair(self._held(p, 0), self._held(np.conj(p), 0)) for p in lam], axis=2)
+        return plant, trans
+
+    def _solve(self, x):
+        if self._x is not None and np.array_equal(x, self._x):
+            return
+        lam = _poles(x)
+        plant, trans = self._columns(lam)
+        n = lam.size
+        phi = np.column_stack(
+            [plant.transpose(0, 2, 1).reshape(-1, 2 * n), self.u, trans.transpose(0, 2, 1).reshape(-1, 2 * n)]
+            + [np.ones_like(self.s)]
+        )
+        a = np.vstack([phi.real, phi.imag])
+        q, r = np.linalg.qr(a)
+        qtb = q.T @ self.b
+        self._x, self.lam, self.q, self.r = x.copy(), lam, q, r
+        self.coef = np.linalg.solve(r, qtb)
+        self.resid = self.b - q @ qtb
+
+    def residual(self, x):
+        self._solve(x)
+        return self.resid.ravel()
+
+    def jacobian(self, x):
+        """``d resid / d x`` = ``-P_perp dA coef - A^+' dA' resid`` (Golub & Pereyra, 1973)."""
+        self._solve(x)
+        n = self.lam.size
+        d_lam = _pole_derivatives(x)
+        jac = np.empty((self.resid.size, x.size))
+        for j, p in enumerate(self.lam):
+            cols = [2 * j, 2 * j + 1, 2 * n + 1 + 2 * j, 2 * n + 2 + 2 * j]
+            for k, g in enumerate(d_lam[j]):
+                # the conjugate partner's column moves with conj(d lambda)
+                d_phi = np.hstack(
+                    [
+                        _pair(self._plant(p, 1) * g, self._plant(np.conj(p), 1) * np.conj(g)),
+                        _pair(self._held(p, 1) * g, self._held(np.conj(p), 1) * np.conj(g)),
+                    ]
+                )
+                d_a = np.vstack([d_phi.real, d_phi.imag])
+                moved = d_a @ self.coef[cols]
+                term = moved - self.q @ (self.q.T @ moved)
+                term += self.q @ np.linalg.solve(self.r.T, _scatter(d_a.T @ self.resid, cols, self.coef.shape[0]))
+                jac[:, 2 * j + k] = -term.ravel()
+        return jac
+
+
+def _scatter(rows: np.ndarray, at: list[int], n_rows: int) -> np.ndarray:
+    out = np.zeros((n_rows, rows.shape[1]))
+    out[at] = rows
+    return out
 
 
 def refine_modes(
@@ -130,23 +203,20 @@ def refine_modes(
     hi = np.ravel(np.column_stack([np.full(f0.size, np.log(np.pi * recording.fs)), np.full(f0.size, 0.95)]))
     start = np.clip(start, lo, hi)
 
-    def projection(x, hold_, weights):
-        phi = _basis(_poles(x), s, z_inv, u, dt, hold_)
-        a = np.vstack([phi.real, phi.imag])
-        b = np.vstack([y.real, y.imag]) * weights
-        # one basis for every sensor: a QR solve with the sensors as right-hand sides
-        q, r = np.linalg.qr(a)
-        qtb = q.T @ b
-        return np.linalg.solve(r, qtb), b - q @ qtb
+    def model(hold_, weights):
+        return _SeparableModel(s, z_inv, u, y * weights, dt, hold_)
 
     # each sensor weighted by its own noise level, estimated at the start
-    weights = np.ones(y.shape[1])
-    sd = np.sqrt(np.mean(projection(start, "zoh", weights)[1] ** 2, axis=0))
+    start_model = model("zoh", np.ones(y.shape[1]))
+    start_model.residual(start)
+    sd = np.sqrt(np.mean(start_model.resid**2, axis=0))
     weights = 1.0 / np.where(sd > 0, sd, 1.0)
+    models = {h: model(h, weights) for h in HOLDS}
 
     def fit(hold_, x, n_eval):
+        m = models[hold_]
         return scipy.optimize.least_squares(
-            lambda v: projection(v, hold_, weights)[1].ravel(), x, bounds=(lo, hi), x_scale="jac", max_nfev=n_eval
+            m.residual, x, jac=m.jacobian, bounds=(lo, hi), x_scale="jac", max_nfev=n_eval
         )
 
     # a few steps of each assumption tell them apart (the wrong one stays well above); the
@@ -155,7 +225,8 @@ def refine_modes(
     best = min(fits, key=lambda h: fits[h].cost)
     res = fits[best] if hold != "auto" else fit(best, fits[best].x, max_nfev)
     lam = _poles(res.x)
-    coef, resid = projection(res.x, best, weights)
+    models[best].residual(res.x)
+    coef, resid = models[best].coef, models[best].resid
     n_par = coef.shape[0] * coef.shape[1] + res.x.size
     variance = float(np.sum(resid**2)) / max(resid.size - n_par, 1)
     cov = variance * np.linalg.pinv(res.jac.T @ res.jac)

@@ -62,3 +62,22 @@ def test_too_few_lines_for_the_modes_is_a_clear_error(fixtures_dir):
     rec = am.read_recording(fixtures_dir / "supine_random.csv")
     with pytest.raises(OrderError, match="DFT lines"):
         refine_modes(rec, [5.8, 8.3, 13.5, 16.2], [0.25, 0.35, 0.3, 0.27], band_hz=(5.0, 5.1))
+
+
+@pytest.mark.parametrize("hold", ["bandlimited", "zoh"])
+def test_variable_projection_jacobian_matches_finite_differences(fixtures_dir, hold):
+    from scipy.optimize._numdiff import approx_derivative
+
+    from armaxmodal.refine import _SeparableModel
+
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    dt = 1 / rec.fs
+    freq = np.fft.rfftfreq(rec.n_samples, dt)
+    lines = (freq >= 0.5) & (freq <= 28)
+    w = 2 * np.pi * freq[lines]
+    y = np.fft.rfft(rec.response, axis=0)[lines]
+    model = _SeparableModel(1j * w, np.exp(-1j * w * dt), np.fft.rfft(rec.base)[lines], y / np.abs(y).mean(0), dt, hold)
+    x = np.ravel(np.column_stack([np.log(2 * np.pi * np.array([5.8, 8.3, 13.5, 16.2])), [0.25, 0.33, 0.3, 0.27]]))
+    analytic = model.jacobian(x)
+    numeric = approx_derivative(model.residual, x, method="3-point")
+    assert np.max(np.abs(analytic - numeric)) < 1e-6 * np.max(np.abs(numeric))
