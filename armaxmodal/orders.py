@@ -77,10 +77,12 @@ def _single_blas_thread() -> None:
     threadpool_limits(limits=1, user_api="blas")
 
 
-def _map(func, items, n_jobs, bar=None):
+def _map(func, items, n_jobs, bar=None, cost=None):
     """``map`` over forked worker processes when it pays, else in this process.
 
-    ``bar`` (a tqdm bar) is advanced as results arrive.
+    ``bar`` (a tqdm bar) is advanced as results arrive. ``cost(item)``, if given, estimates
+    an item's run time: the workers then take the longest first, so no long job starts last
+    and leaves a core idle. Results come back in the order of ``items``.
     """
     n_jobs = n_jobs or os.cpu_count() or 1
     out = []
@@ -90,10 +92,12 @@ def _map(func, items, n_jobs, bar=None):
             if bar is not None:
                 bar.update()
         return out
+    order = sorted(range(len(items)), key=lambda i: -cost(items[i])) if cost else list(range(len(items)))
+    out = [None] * len(items)
     ctx = multiprocessing.get_context("fork")
     with ProcessPoolExecutor(n_jobs, mp_context=ctx, initializer=_single_blas_thread) as pool:
-        for result in pool.map(func, items):
-            out.append(result)
+        for i, result in zip(order, pool.map(func, [items[i] for i in order]), strict=True):
+            out[i] = result
             if bar is not None:
                 bar.update()
     return out

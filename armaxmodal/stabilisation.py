@@ -138,6 +138,12 @@ def _fit_job(recording: Recording, job, max_iter: int):
         return None
 
 
+def _job_cost(job, n_sensors: int) -> float:
+    """Relative run time of a sweep fit: about linear in na and in the number of sensors."""
+    source, orders = job
+    return orders[0] * (n_sensors if source == SHARED else 1)
+
+
 def choose_nk(recording: Recording, nk_values=range(0, -7, -1), na_values=(8, 10, 12), n_jobs=None) -> int:
     """The input delay of the lowest-BIC shared-pole model over a few middle orders.
 
@@ -152,7 +158,12 @@ def _choose_nk(recording, nk_values, na_values, n_jobs):
     jobs = [(SHARED, (na, default_nb(na, nk), default_nc(na), nk)) for na in na_values for nk in nk_values]
     # BIC differences between delays are large; 20 iterations settle the choice (checked on
     # every fixture and the real recordings against 50)
-    fits = _map(partial(_fit_job, recording, max_iter=20), jobs, n_jobs)
+    fits = _map(
+        partial(_fit_job, recording, max_iter=20),
+        jobs,
+        n_jobs,
+        cost=partial(_job_cost, n_sensors=len(recording.sensors)),
+    )
     scores = [information_criterion(f) if f is not None else np.inf for f in fits]
     nk = int(jobs[int(np.argmin(scores))][1][3])
     # only converged fits may stand in the sweep: its estimates can be the reported ones
@@ -206,7 +217,14 @@ def stabilisation_diagram(
 
     with tqdm(total=len(jobs), desc="stabilisation sweep", unit="fit", disable=not progress) as bar:
         bar.update(len(jobs) - len(todo))
-        done = dict(zip(todo, _map(partial(_fit_job, recording, max_iter=max_iter), todo, n_jobs, bar), strict=True))
+        fitted = _map(
+            partial(_fit_job, recording, max_iter=max_iter),
+            todo,
+            n_jobs,
+            bar,
+            cost=partial(_job_cost, n_sensors=len(recording.sensors)),
+        )
+        done = dict(zip(todo, fitted, strict=True))
     fits = [known.get(job, done.get(job)) for job in jobs]
     rows, kept = [], {}
     for (source, o), fit in zip(jobs, fits, strict=True):
@@ -505,7 +523,10 @@ def _apply_refinement(modes, shapes, ref, max_freq_change, max_damping_change):
             continue
         f, x = ref.freq_hz[i], ref.damping[i]
         modes.loc[i, ["freq_hz", "damping", "damped_freq_hz", "estimator"]] = [
-            f, x, f * np.sqrt(1 - x**2), "fd-bandlimited"
+            f,
+            x,
+            f * np.sqrt(1 - x**2),
+            "fd-bandlimited",
         ]
         modes.loc[i, ["freq_ci95_lo", "freq_ci95_hi"]] = [f - 1.96 * ref.freq_sd[i], f + 1.96 * ref.freq_sd[i]]
         modes.loc[i, ["damping_ci95_lo", "damping_ci95_hi"]] = [
