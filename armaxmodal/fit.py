@@ -23,6 +23,7 @@ errors from the first sample whose regressors all lie inside the record.
 
 from __future__ import annotations
 
+import functools
 import warnings
 from dataclasses import dataclass, field
 
@@ -165,7 +166,9 @@ def fit_armax(
     output_error: bool = False,
     max_iter: int = 100,
     tol: float = 1e-6,
+    stop: str = "expected",
     warn: bool = True,
+    start: ArmaxFit | None = None,
 ) -> ArmaxFit:
     """Fit ARMAX models by the prediction-error method.
 
@@ -189,17 +192,28 @@ def fit_armax(
     max_iter : int
         Levenberg-Marquardt iteration cap.
     tol : float
-        Stop when an iteration lowers the loss by less than this fraction (shared form: the
-        sum over sensors of the relative decreases). The default sits far below the
-        statistical resolution of the loss (about 1/N), so stopping there moves no
-        estimate by a meaningful fraction of its standard error.
+        Converged when a full Gauss-Newton step would lower the loss by less than this
+        fraction (shared form: the noise-weighted sum over sensors). The default sits far
+        below the statistical resolution of the loss (about 1/N), so the estimate is within
+        a small fraction of its standard error of the optimum.
+    stop : {"expected", "decrease"}
+        "expected" applies ``tol`` to the Gauss-Newton step's expected improvement (as
+        MATLAB's pem does). "decrease" applies it to the last accepted step's actual decrease:
+        cheaper, but a damped step on a flat valley can stop it early -- for sweeps that
+        only place poles.
     warn : bool
         Emit :class:`ConvergenceWarning` when the cap is hit.
+    start : ArmaxFit, optional
+        Continue from this fit of the same data, orders and form instead of computing a
+        start: a sweep's fit stopped at a loose ``tol`` is finished for the price of its
+        last iterations. ``iterations`` then counts the new ones only.
 
     Returns
     -------
     ArmaxFit
     """
+    if stop not in ("expected", "decrease"):
+        raise ValueError(f"stop: expected 'expected' or 'decrease', got {stop!r}.")
     u, y, fs, sensors, inputs = _unpack(data, fs)
     na, nb, nc, nk = _check_orders(na, nb, 0 if output_error else nc, nk)
     flat = [s for s, col in zip(sensors, y.T, strict=True) if np.ptp(col) <= 1e-12 * max(np.abs(col).max(), 1e-300)]
@@ -225,13 +239,27 @@ def fit_armax(
             f"{_MIN_SAMPLES_PER_PARAMETER * p_single} per sensor). Lower the orders or use a longer record."
         )
     uT = np.ascontiguousarray(u_fit.T)
+    thetas0 = None if start is None else _start_parameters(start, (na, nb, nc, nk), shared_poles, sensors)
     if shared_poles:
-        thetas, info = _fit_shared(y_fit, uT, na, nb, nc, nk_fit, t0, t1, max_iter, tol, output_error)
+        theta0 = None if thetas0 is None else np.concatenate([thetas0[0][:na]] + [th[na:] for th in thetas0])
+        thetas, info = _fit_shared(y_fit, uT, na, nb, nc, nk_fit, t0, t1, max_iter, tol, output_error, theta0, stop)
     else:
         thetas, info = [], []
         for k in range(y.shape[1]):
             th, inf = _fit_single(
-                np.ascontiguousarray(y_fit[:, k]), uT, na, nb, nc, nk_fit, t0, t1, max_iter, tol, output_error
+                np.ascontiguousarray(y_fit[:, k]),
+                uT,
+                na,
+                nb,
+                nc,
+                nk_fit,
+                t0,
+                t1,
+                max_iter,
+                tol,
+                output_error,
+                None if thetas0 is None else thetas0[k],
+                stop,
             )
             thetas.append(th)
             info.append(inf)
@@ -268,6 +296,20 @@ def fit_armax(
     return result
 
 
+@functools.cache
+def load_kernels() -> None:
+    """Load the compiled kernels into this process with one tiny fit.
+
+    Numba reads them from its on-disk cache at first use, about 0.3 s per process. Called
+    before worker processes are forked, so that they inherit the kernels instead of each
+    loading them again.
+    """
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(400)
+    y = np.column_stack([np.convolve(u, [1.0, 0.5, 0.2])[:400] + 0.1 * rng.standard_normal(400) for _ in range(2)])
+    fit_armax((u, y), 2, 3, 2, -1, fs=100.0, shared_poles=True, max_iter=2, warn=False)
+
+
 # -- input handling ----------------------------------------------------------------------
 def _unpack(data, fs):
     if isinstance(data, Recording):
@@ -293,6 +335,20 @@ def _unpack(data, fs):
     sensors = tuple(f"y{k + 1}" for k in range(y.shape[1]))
     inputs = tuple(f"u{m + 1}" for m in range(u.shape[1]))
     return u, y, fs, sensors, inputs
+
+
+def _start_parameters(start, orders, shared_poles, sensors) -> list[np.ndarray]:
+    """Per-sensor parameter vectors ``[a, b (row-major), c]`` of a fit to continue from."""
+    if not isinstance(start, ArmaxFit):
+        raise TypeError(f"start: expected an ArmaxFit, got {type(start).__name__}.")
+    if tuple(start.orders) != tuple(orders) or start.shared_poles != shared_poles or start.sensors != tuple(sensors):
+        raise OrderError(
+            f"start: a fit with orders {tuple(start.orders)}, shared_poles={start.shared_poles} and sensors "
+            f"{start.sensors} cannot start one with orders {tuple(orders)}, shared_poles={shared_poles} and "
+            f"sensors {tuple(sensors)}; fit again without start."
+        )
+    nc = orders[2]
+    return [np.concatenate([m.a[1:], m.b.ravel(), m.c[1 : nc + 1]]) for m in start.models]
 
 
 def _check_orders(na, nb, nc, nk):
@@ -490,31 +546,44 @@ def _output_error_start(ys, uT, theta_hr, na, nb, nc, nk, t0, t1):
     return np.concatenate(parts)
 
 
-def _levenberg_marquardt(theta, state, evaluate, linearise, project, max_iter, tol):
+def _levenberg_marquardt(theta, state, evaluate, linearise, project, max_iter, tol, stop="expected"):
     """Levenberg-Marquardt on a Gauss-Newton model, shared by every fit.
 
-    ``evaluate(theta) -> (state, objective)``; ``linearise(state) -> solve(damping)`` gives
-    the damped Gauss-Newton step; ``project`` keeps the parameters admissible. Stops when an
-    accepted step lowers the objective by less than ``tol`` (relative), or when no step at
-    any damping lowers it: a minimum to numerical precision, or on the stability boundary
-    kept for C. Returns ``(theta, state, iterations, converged)``.
+    ``evaluate(theta) -> (state, objective)``; ``linearise(state)`` gives the normal
+    equations: ``solve(damping)`` the damped Gauss-Newton step, ``gradient`` and
+    ``curvature(step)``; ``project`` keeps the parameters admissible. The damping follows
+    the gain ratio (Nielsen, 1999): where the Gauss-Newton model overshoots along a curved
+    valley, as over-parameterised ARMAX models do, it grows instead of crawling at its floor.
+
+    ``stop="expected"``: converged when the undamped Gauss-Newton step would lower the
+    objective by less than ``tol`` (relative) -- the expected improvement, as MATLAB's pem.
+    ``stop="decrease"``: when an accepted step lowered it by less than ``tol``; cheaper, but
+    a damped step on a flat valley can stop it early (fine for placing poles in a sweep).
+    Both also stop when no step at any damping lowers the objective: a minimum to numerical
+    precision, or on the stability boundary kept for C. Returns
+    ``(theta, state, iterations, converged)``.
     """
     objective = evaluate(theta)[1]
-    lm = 1e-4
+    lm, grow = 1e-4, 2.0
     for it in range(1, max_iter + 1):
-        solve = linearise(state)
+        normal = linearise(state)
+        if stop == "expected" and normal.solve(0.0) @ normal.gradient < tol * objective:
+            return theta, state, it, True
         while lm < 1e10:
-            trial = project(theta + solve(lm))
+            step = normal.solve(lm)
+            trial = project(theta + step)
             state_t, objective_t = evaluate(trial)
             if objective_t < objective:
                 break
-            lm *= 10
+            lm, grow = lm * grow, grow * 2.0
         else:
             return theta, state, it, True
-        rel = (objective - objective_t) / objective
+        predicted = 2.0 * step @ normal.gradient - normal.curvature(step)
+        gain = (objective - objective_t) / predicted if predicted > 0 else 0.0
+        lm, grow = max(lm * max(1 / 3, 1 - (2 * gain - 1) ** 3), 1e-10), 2.0
+        decrease = (objective - objective_t) / objective
         theta, state, objective = trial, state_t, objective_t
-        lm = max(lm / 10, 1e-8)
-        if rel < tol:
+        if stop == "decrease" and decrease < tol:
             return theta, state, it, True
     return theta, state, max_iter, False
 
@@ -536,11 +605,14 @@ def _normal_equations(y, uT, eps, c, cols, t0, t1, oe=False):
     return _lagged_gram(filtered, *cols, t0, t1), _lagged_cross(filtered, *cols, eps, t0, t1)
 
 
-def _fit_single(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
+def _fit_single(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=None, stop="expected"):
     n_in = uT.shape[0]
     cols = _columns(na, nb, nc, nk, n_in)
-    theta = _hannan_rissanen(y, uT, na, nb, nc, nk, t0, t1)
-    if oe:
+    if theta0 is not None:
+        theta = _project(theta0, na, nb, nc, n_in, oe)
+    else:
+        theta = _hannan_rissanen(y, uT, na, nb, nc, nk, t0, t1)
+    if oe and theta0 is None:
         try:
             theta = _project(_output_error_start([y], uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in, oe=True)
         except np.linalg.LinAlgError:  # degenerate input: keep the Hannan-Rissanen start
@@ -551,12 +623,11 @@ def _fit_single(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
         return state, state[1]
 
     def linearise(state):
-        g_mat, g_vec = _normal_equations(y, uT, state[0], state[2], cols, t0, t1, oe)
-        return lambda damping: _solve(g_mat, g_vec, damping)
+        return _Dense(*_normal_equations(y, uT, state[0], state[2], cols, t0, t1, oe))
 
     state, _ = evaluate(theta)
     theta, state, it, converged = _levenberg_marquardt(
-        theta, state, evaluate, linearise, lambda th: _project(th, na, nb, nc, n_in, oe), max_iter, tol
+        theta, state, evaluate, linearise, lambda th: _project(th, na, nb, nc, n_in, oe), max_iter, tol, stop
     )
     eps, loss, c = state
     g_mat, _ = _normal_equations(y, uT, eps, c, cols, t0, t1, oe)
@@ -600,7 +671,40 @@ def _local(theta, k, na, p_k):
     return theta[_shared_index(k, na, p_k)]
 
 
-def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
+def _shared_start(ys, uT, na, nb, nc, nk, t0, t1, oe, evaluate):
+    """The more likely of a joint Hannan-Rissanen and a subspace/Steiglitz-McBride start:
+    ``(theta, state, losses)``."""
+    n_out, n_in = len(ys), uT.shape[0]
+    p_k = n_in * nb + nc
+    cols = _columns(na, nb, nc, nk, n_in)
+    # Joint Hannan-Rissanen start, each sensor weighted by its ARX innovation variance.
+    p = na + n_out * p_k
+    g_mat = np.zeros((p, p))
+    g_vec = np.zeros(p)
+    for k in range(n_out):
+        sig, _ = _initial_columns_and_signals(ys[k], uT, na, nb, nc, nk, t1)
+        w = 1.0 / max(float(np.var(sig[-1, t0:t1])) if nc else float(np.var(ys[k][t0:t1])), 1e-300)
+        idx = _shared_index(k, na, p_k)
+        g_mat[np.ix_(idx, idx)] += w * _lagged_gram(sig, *cols, t0, t1)
+        g_vec[idx] += w * _lagged_cross(sig, *cols, ys[k], t0, t1)
+    theta = _project_shared(_solve(g_mat, g_vec), na, nb, nc, n_in, n_out, oe)
+
+    state, losses = evaluate(theta)
+    # Second start: output error by Steiglitz-McBride; keep whichever is more likely. A
+    # degenerate input (one sinusoid) can leave the subspace step without a Cholesky factor:
+    # then the first start stands alone.
+    try:
+        alt = _project_shared(_output_error_start(ys, uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in, n_out, oe)
+    except np.linalg.LinAlgError:
+        alt = None
+    if alt is not None:
+        state_alt, losses_alt = evaluate(alt)
+        if np.sum(np.log(losses_alt)) < np.sum(np.log(losses)):
+            theta, state, losses = alt, state_alt, losses_alt
+    return theta, state, losses
+
+
+def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=None, stop="expected"):
     """Joint maximum likelihood with per-sensor noise variances.
 
     Alternates a weighted least-squares Levenberg-Marquardt solve at fixed variances
@@ -616,34 +720,15 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
     ys = [np.ascontiguousarray(y[:, k]) for k in range(n_out)]
     n_eff = t1 - t0
 
-    # Joint Hannan-Rissanen start, each sensor weighted by its ARX innovation variance.
-    p = na + n_out * p_k
-    g_mat = np.zeros((p, p))
-    g_vec = np.zeros(p)
-    for k in range(n_out):
-        sig, _ = _initial_columns_and_signals(ys[k], uT, na, nb, nc, nk, t1)
-        w = 1.0 / max(float(np.var(sig[-1, t0:t1])) if nc else float(np.var(ys[k][t0:t1])), 1e-300)
-        idx = _shared_index(k, na, p_k)
-        g_mat[np.ix_(idx, idx)] += w * _lagged_gram(sig, *cols, t0, t1)
-        g_vec[idx] += w * _lagged_cross(sig, *cols, ys[k], t0, t1)
-    theta = _project_shared(_solve(g_mat, g_vec), na, nb, nc, n_in, n_out, oe)
-
     def evaluate(th):
         out = [_residual_and_loss(ys[k], uT, _local(th, k, na, p_k), na, nb, nc, nk, t0, t1, oe) for k in range(n_out)]
         return out, np.array([o[1] for o in out])
 
-    state, losses = evaluate(theta)
-    # Second start: output error by Steiglitz-McBride; keep whichever is more likely. A
-    # degenerate input (one sinusoid) can leave the subspace step without a Cholesky factor:
-    # then the first start stands alone.
-    try:
-        alt = _project_shared(_output_error_start(ys, uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in, n_out, oe)
-    except np.linalg.LinAlgError:
-        alt = None
-    if alt is not None:
-        state_alt, losses_alt = evaluate(alt)
-        if np.sum(np.log(losses_alt)) < np.sum(np.log(losses)):
-            theta, state, losses = alt, state_alt, losses_alt
+    if theta0 is not None:
+        theta = _project_shared(theta0, na, nb, nc, n_in, n_out, oe)
+        state, losses = evaluate(theta)
+    else:
+        theta, state, losses = _shared_start(ys, uT, na, nb, nc, nk, t0, t1, oe, evaluate)
     variances = losses / n_eff
     total_iterations = 0
     converged = False
@@ -655,7 +740,7 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
             return (per_sensor, losses_t), float(weights @ losses_t)
 
         def linearise(st, variances=variances):
-            return _shared_normal_equations(ys, uT, st[0], variances, cols, na, p_k, t0, t1, oe).solve
+            return _shared_normal_equations(ys, uT, st[0], variances, cols, na, p_k, t0, t1, oe)
 
         theta, (state, losses), used, inner_converged = _levenberg_marquardt(
             theta,
@@ -665,6 +750,7 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
             lambda th: _project_shared(th, na, nb, nc, n_in, n_out, oe),
             max_iter - total_iterations,
             tol,
+            stop,
         )
         total_iterations += used
         new_variances = losses / n_eff
@@ -686,6 +772,21 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False):
         "joint_covariance": joint,
     }
     return thetas, info
+
+
+@dataclass
+class _Dense:
+    """Normal equations ``H step = gradient`` of a single-output fit."""
+
+    hessian: np.ndarray
+    gradient: np.ndarray
+
+    def solve(self, damping: float = 0.0) -> np.ndarray:
+        return _solve(self.hessian, self.gradient, damping)
+
+    def curvature(self, step: np.ndarray) -> float:
+        """``step' H step``."""
+        return float(step @ self.hessian @ step)
 
 
 @dataclass
@@ -718,6 +819,20 @@ class _Arrow:
             parts.append((x, y))
         step_a = _solve(schur, rhs)
         return np.concatenate([step_a] + [y - x @ step_a for x, y in parts])
+
+    @property
+    def gradient(self) -> np.ndarray:
+        return np.concatenate([self.ga, *self.gb])
+
+    def curvature(self, step: np.ndarray) -> float:
+        """``step' H step`` without forming H."""
+        na, p_k = self.aa.shape[0], self.bb[0].shape[0]
+        sa = step[:na]
+        total = sa @ self.aa @ sa
+        for k, (ab, bb) in enumerate(zip(self.ab, self.bb, strict=True)):
+            sb = step[na + k * p_k : na + (k + 1) * p_k]
+            total += 2.0 * sa @ ab @ sb + sb @ bb @ sb
+        return float(total)
 
     def full(self) -> np.ndarray:
         na, p_k = self.aa.shape[0], self.bb[0].shape[0]

@@ -267,6 +267,33 @@ def test_non_convergence_is_flagged_and_warned(supine_zoh):
         fit_armax(supine_zoh, 8, 9, 8, 0, max_iter=1, warn=False)
 
 
+def test_a_stopped_fit_continued_with_start_reaches_the_full_fit(supine_zoh):
+    full = fit_armax(supine_zoh, 8, 9, 8, 0, shared_poles=True)
+    stopped = fit_armax(supine_zoh, 8, 9, 8, 0, shared_poles=True, max_iter=2, warn=False)
+    assert not stopped.converged.all()  # stopped early
+    done = fit_armax(supine_zoh, 8, 9, 8, 0, shared_poles=True, start=stopped)
+    assert done.converged.all() and done.iterations[0] < full.iterations[0] + 2
+    np.testing.assert_allclose(done.loss, full.loss, rtol=1e-6)
+    a, b = full.modes(), done.modes()
+    assert np.all(np.abs(a.freq_hz - b.freq_hz) < 0.01 * a.freq_sd)
+    assert np.all(np.abs(a.damping - b.damping) < 0.01 * a.damping_sd)
+    # per sensor: a continued fit descends from where the stopped one was, to convergence
+    # (one sensor's surface has several minima, so not necessarily to the same one)
+    stopped = fit_armax(supine_zoh, 8, 9, 8, 0, max_iter=2, warn=False)
+    resumed = fit_armax(supine_zoh, 8, 9, 8, 0, start=stopped)
+    assert resumed.converged.all() and np.all(resumed.loss < stopped.loss)
+
+
+def test_start_must_match_the_fit(supine_zoh):
+    fit = fit_armax(supine_zoh, 6, 7, 6, 0, shared_poles=True, max_iter=3, warn=False)
+    with pytest.raises(OrderError, match="cannot start"):
+        fit_armax(supine_zoh, 8, 9, 8, 0, shared_poles=True, start=fit)
+    with pytest.raises(OrderError, match="cannot start"):
+        fit_armax(supine_zoh, 6, 7, 6, 0, start=fit)
+    with pytest.raises(TypeError, match="ArmaxFit"):
+        fit_armax(supine_zoh, 6, 7, 6, 0, start=np.zeros(3))
+
+
 # -- against an established library and against the truth over many seeds -----------------
 def test_agrees_with_statsmodels_exact_maximum_likelihood():
     """SARIMAX with the lagged outputs and inputs as regressors and MA(nc) errors is the same
