@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from .exceptions import OrderError
-from .fit import ArmaxFit, fit_armax
+from .fit import ArmaxFit, fit_armax, load_kernels
 from .recording import Recording
 
 __all__ = ["choose_orders", "OrderChoice", "default_nb", "default_nc"]
@@ -92,6 +92,7 @@ def _map(func, items, n_jobs, bar=None, cost=None):
             if bar is not None:
                 bar.update()
         return out
+    load_kernels()  # once here, not once per forked worker
     order = sorted(range(len(items)), key=lambda i: -cost(items[i])) if cost else list(range(len(items)))
     out = [None] * len(items)
     ctx = multiprocessing.get_context("fork")
