@@ -8,6 +8,7 @@ armaxmodal simulate --system supine --excitation random|sweep --out DATA.csv
 from __future__ import annotations
 
 import argparse
+import gc
 import sys
 from collections.abc import Sequence
 
@@ -343,3 +344,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ArmaxModalError, FileNotFoundError) as exc:
         print(f"armaxmodal: error: {exc}", file=sys.stderr)
         return 2
+
+
+def run() -> None:
+    """Console entry point: :func:`main`, then exit with its status."""
+    status = main()
+    # The process ends here with every output written and closed. Moving the live objects
+    # (the imported libraries, the fits) out of the collector's reach spares the
+    # interpreter's final collection, about 0.4 s of a 5 s command; only that scan is
+    # skipped. Not in main(): called in-process, it would pin the caller's objects.
+    gc.freeze()
+    sys.exit(status)
