@@ -292,6 +292,21 @@ def test_start_must_match_the_fit(supine_zoh):
         fit_armax(supine_zoh, 6, 7, 6, 0, start=fit)
     with pytest.raises(TypeError, match="ArmaxFit"):
         fit_armax(supine_zoh, 6, 7, 6, 0, start=np.zeros(3))
+    with pytest.raises(ValueError, match="stop"):
+        fit_armax(supine_zoh, 6, 7, 6, 0, stop="never")
+
+
+def test_a_sweep_grade_fit_continued_reaches_the_optimum():
+    """Chapter 2 (8,9,8,0): the sweep's cheap rule (last decrease under 1e-5) stops well
+    short of the optimum on this flat valley; continued under the default rule it gets there."""
+    rec = am.read_recording(fixture_path("chapter2_random_zoh"))
+    full = fit_armax(rec, 8, 9, 8, 0, shared_poles=True)
+    cheap = fit_armax(rec, 8, 9, 8, 0, shared_poles=True, stop="decrease", tol=1e-5)
+    a, c = full.modes(), cheap.modes()
+    assert np.max(np.abs(a.damping - c.damping) / a.damping_sd) > 0.3
+    again = fit_armax(rec, 8, 9, 8, 0, shared_poles=True, start=cheap)
+    b = again.modes()
+    assert np.all(np.abs(a.damping - b.damping) < 0.1 * a.damping_sd)
 
 
 # -- against an established library and against the truth over many seeds -----------------
