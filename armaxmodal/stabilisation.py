@@ -144,6 +144,13 @@ def _fit_job(recording: Recording, job, max_iter: int, tol: float):
         return None
 
 
+def _fit_and_poles(recording: Recording, job, max_iter: int, tol: float):
+    """A sweep job run in a worker: the fit and its pole rows (computing the rows there
+    keeps the parent's serial share small)."""
+    fit = _fit_job(recording, job, max_iter, tol)
+    return fit, ([] if fit is None else _poles_of(fit, job[0]))
+
+
 def _job_cost(job, n_sensors: int) -> float:
     """Relative run time of a sweep fit: about linear in na and in the number of sensors."""
     source, orders = job
@@ -229,20 +236,21 @@ def stabilisation_diagram(
     with tqdm(total=len(jobs), desc="stabilisation sweep", unit="fit", disable=not progress) as bar:
         bar.update(len(jobs) - len(todo))
         fitted = _map(
-            partial(_fit_job, recording, max_iter=max_iter, tol=fit_tol),
+            partial(_fit_and_poles, recording, max_iter=max_iter, tol=fit_tol),
             todo,
             n_jobs,
             bar,
             cost=partial(_job_cost, n_sensors=len(recording.sensors)),
         )
-        done = dict(zip(todo, fitted, strict=True))
-    fits = [known.get(job, done.get(job)) for job in jobs]
+    done = dict(zip(todo, fitted, strict=True))
+    done.update({job: (fit, _poles_of(fit, job[0])) for job, fit in known.items() if job in jobs})
     rows, kept = [], {}
-    for (source, o), fit in zip(jobs, fits, strict=True):
+    for source, o in jobs:
+        fit, fit_rows = done[(source, o)]
         if fit is None:
             continue
         kept[(source, o[0])] = fit
-        rows += _poles_of(fit, source)
+        rows += fit_rows
     if not rows:
         raise OrderError("no order in the sweep could be fitted; use lower orders or a longer record.")
     poles = pd.DataFrame(rows)
