@@ -179,7 +179,8 @@ def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL):
     )
     scores = [information_criterion(f) if f is not None else np.inf for f in fits]
     nk = int(jobs[int(np.argmin(scores))][1][3])
-    # only converged fits may stand in the sweep: its estimates can be the reported ones
+    # only fits that stopped on the sweep's rule, not at this stage's 8-iteration cap, may
+    # stand in the sweep
     reuse = {job: fit for job, fit in zip(jobs, fits, strict=True) if job[1][3] == nk and fit is not None}
     return nk, {job: fit for job, fit in reuse.items() if fit.converged.all()}
 
@@ -221,11 +222,10 @@ def stabilisation_diagram(
     progress : bool
         Show a progress bar.
     """
-    fit_tol = tol
-    tol = tolerances or Tolerances()
+    limits = tolerances or Tolerances()
     known: dict = {}
     if nk is None:
-        nk, known = _choose_nk(recording, range(0, -7, -1), (8, 10, 12), n_jobs, fit_tol)
+        nk, known = _choose_nk(recording, range(0, -7, -1), (8, 10, 12), n_jobs, tol)
     sources = [SHARED] + (list(recording.sensors) if per_sensor else [])
     order_list = [(na, default_nb(na, nk), default_nc(na), nk) for na in orders]
     # single sensors cannot support high orders (their bounds are wide): stop them earlier
@@ -236,7 +236,7 @@ def stabilisation_diagram(
     with tqdm(total=len(jobs), desc="stabilisation sweep", unit="fit", disable=not progress) as bar:
         bar.update(len(jobs) - len(todo))
         fitted = _map(
-            partial(_fit_and_poles, recording, max_iter=max_iter, tol=fit_tol),
+            partial(_fit_and_poles, recording, max_iter=max_iter, tol=tol),
             todo,
             n_jobs,
             bar,
@@ -254,9 +254,9 @@ def stabilisation_diagram(
     if not rows:
         raise OrderError("no order in the sweep could be fitted; use lower orders or a longer record.")
     poles = pd.DataFrame(rows)
-    poles["cls"] = _classify(poles, tol)
-    poles["rejected"] = _reject(poles, tol, recording)
-    return StabilisationDiagram(poles, order_list, tol, recording, kept)
+    poles["cls"] = _classify(poles, limits)
+    poles["rejected"] = _reject(poles, limits, recording)
+    return StabilisationDiagram(poles, order_list, limits, recording, kept)
 
 
 def _classify(poles: pd.DataFrame, tol: Tolerances) -> list[str]:
@@ -544,6 +544,7 @@ def _finished_pole(diagram: StabilisationDiagram, pole: pd.Series, cache: dict) 
     if poles.empty:
         return pole
     nearest = poles.iloc[int(np.argmin(np.abs(poles.pole.to_numpy() - pole.pole)))]
+    # the finished estimate, with the diagram's own columns (class, rejection) kept
     return pd.concat([nearest, pole.drop(nearest.index, errors="ignore")])
 
 
