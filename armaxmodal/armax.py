@@ -15,9 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.signal
 
-from ._kernels import _armax_residual
+from ._kernels import _armax_residual, _inverse_filter
 from ._validate import as_signal_matrix, as_signal_vector
 from .exceptions import DataError
 from .modal import discrete_modal_parameters
@@ -137,7 +136,8 @@ class ArmaxModel:
             idx = np.arange(n) - self.nk
             ok = (idx >= 0) & (idx < full.size)
             v[ok] += full[idx[ok]]
-        return scipy.signal.lfilter([1.0], self.a, v)
+        a = np.asarray(self.a, dtype=float)
+        return _inverse_filter((v / a[0])[None, :], np.ascontiguousarray(a / a[0]))[0]  # 1/A from rest
 
     def prediction_errors(self, y, u) -> np.ndarray:
         """One-step prediction errors ``(A y - q^-nk B u) / C`` from zero initial conditions."""

@@ -287,9 +287,9 @@ def _classify(poles: pd.DataFrame, tol: Tolerances) -> list[str]:
 
 def excited_band(recording: Recording, min_db: float = -30.0) -> tuple[float, float]:
     """Lowest and highest frequency (Hz) where the input PSD is within ``min_db`` of its peak."""
-    import scipy.signal
+    from .frf import welch_spectra
 
-    f, pxx = scipy.signal.welch(recording.base, recording.fs, nperseg=min(recording.n_samples, 1024))
+    f, pxx, _, _ = welch_spectra(recording.base, recording.base[:, None], recording.fs, min(recording.n_samples, 1024))
     live = f[pxx >= pxx.max() * 10 ** (min_db / 10)]
     return float(live.min()), float(live.max())
 

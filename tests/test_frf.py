@@ -1,4 +1,5 @@
 import numpy as np
+import pytest
 
 import armaxmodal as am
 from armaxmodal.frf import measured_frf, modal_frf
@@ -45,3 +46,34 @@ def test_h1_relative_error_matches_the_scatter_around_the_true_transmissibility(
     part_sd = np.tile(sigma.ravel() / np.sqrt(2), 2)  # log magnitude and phase, each
     z = np.concatenate([np.log(np.abs(ratio)).ravel(), np.angle(ratio).ravel()]) / part_sd
     assert 0.8 < np.sqrt(np.mean(z**2)) < 1.25
+
+
+@pytest.mark.parametrize("nperseg", [256, 301])
+def test_welch_spectra_equal_scipy_welch_and_csd(nperseg):
+    import scipy.signal
+
+    from armaxmodal.frf import welch_spectra
+
+    rng = np.random.default_rng(3)
+    u = rng.standard_normal(5000) + 0.3
+    y = np.column_stack([np.convolve(u, [0.5, 1.0, -0.2])[:5000], rng.standard_normal(5000)])
+    f, puu, puy, pyy = welch_spectra(u, y, 60.0, nperseg)
+    f_ref, puu_ref = scipy.signal.welch(u, 60.0, nperseg=nperseg)
+    np.testing.assert_allclose(f, f_ref, rtol=1e-14)
+    np.testing.assert_allclose(puu, puu_ref, rtol=1e-10)
+    for k in range(2):
+        np.testing.assert_allclose(puy[:, k], scipy.signal.csd(u, y[:, k], 60.0, nperseg=nperseg)[1], rtol=1e-10)
+        np.testing.assert_allclose(pyy[:, k], scipy.signal.welch(y[:, k], 60.0, nperseg=nperseg)[1], rtol=1e-10)
+
+
+def test_model_simulation_equals_lfilter():
+    import scipy.signal
+
+    from armaxmodal.armax import ArmaxModel
+
+    rng = np.random.default_rng(4)
+    u = rng.standard_normal(2000)
+    a = np.array([2.0, -2.4, 1.6])  # not monic: B/A is normalised as lfilter does
+    model = ArmaxModel(a, np.array([[0.3, 0.2, 0.1]]), np.array([1.0]), 1, 100.0)
+    expected = scipy.signal.lfilter(np.r_[0.0, 0.3, 0.2, 0.1], a, u)
+    np.testing.assert_allclose(model.simulate(u), expected, rtol=1e-10, atol=1e-12)
