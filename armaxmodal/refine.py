@@ -101,21 +101,15 @@ class _SeparableModel:
         den = 1 - mu * self.z_inv
         return 1 / den if order == 0 else self.dt * mu * self.z_inv / den**2
 
-    def _columns(self, lam):
-        """(L, 2, n_modes) plant pairs and (L, 2, n_modes) transient pairs."""
-        plant = np.stack([_pair(self._plant(p, 0), self._plant(np.conj(p), 0)) for p in lam], axis=2)
-        trans = np.stack([_pair(self._held(p, 0), self._held(np.conj(p), 0)) for p in lam], axis=2)
-        return plant, trans
-
     def _solve(self, x):
         if self._x is not None and np.array_equal(x, self._x):
             return
         lam = _poles(x)
-        plant, trans = self._columns(lam)
-        n = lam.size
-        phi = np.column_stack(
-            [plant.transpose(0, 2, 1).reshape(-1, 2 * n), self.u, trans.transpose(0, 2, 1).reshape(-1, 2 * n)]
-            + [np.ones_like(self.s)]
+        phi = np.hstack(
+            [_pair(self._plant(p, 0), self._plant(np.conj(p), 0)) for p in lam]
+            + [self.u[:, None]]
+            + [_pair(self._held(p, 0), self._held(np.conj(p), 0)) for p in lam]
+            + [np.ones_like(self.s)[:, None]]
         )
         a = np.vstack([phi.real, phi.imag])
         q, r = np.linalg.qr(a)
@@ -147,15 +141,11 @@ class _SeparableModel:
                 d_a = np.vstack([d_phi.real, d_phi.imag])
                 moved = d_a @ self.coef[cols]
                 term = moved - self.q @ (self.q.T @ moved)
-                term += self.q @ np.linalg.solve(self.r.T, _scatter(d_a.T @ self.resid, cols, self.coef.shape[0]))
+                back = np.zeros_like(self.coef)
+                back[cols] = d_a.T @ self.resid
+                term += self.q @ np.linalg.solve(self.r.T, back)
                 jac[:, 2 * j + k] = -term.ravel()
         return jac
-
-
-def _scatter(rows: np.ndarray, at: list[int], n_rows: int) -> np.ndarray:
-    out = np.zeros((n_rows, rows.shape[1]))
-    out[at] = rows
-    return out
 
 
 def refine_modes(
