@@ -63,9 +63,10 @@ def information_criterion(fit: ArmaxFit, kind: str = "bic") -> float:
     return fit_term + penalty
 
 
-def _fit_or_none(recording, orders, *, shared_poles, max_iter):
+def _fit_or_none(recording, orders, **options):
+    """A fit, or None when the record cannot support the orders (candidates are skipped)."""
     try:
-        return fit_armax(recording, *orders, shared_poles=shared_poles, max_iter=max_iter, warn=False)
+        return fit_armax(recording, *orders, warn=False, **options)
     except OrderError:
         return None
 
@@ -142,7 +143,7 @@ def choose_orders(
     from tqdm import tqdm
 
     with tqdm(total=len(candidates), desc="order search", unit="fit", disable=not progress) as bar:
-        fits = _map(run, candidates, n_jobs, bar)
+        fits = _map(run, candidates, n_jobs, bar, cost=lambda orders: orders[0])
     rows, best, best_value = [], None, np.inf
     for (na, nb, nc, nk), fit in zip(candidates, fits, strict=True):
         if fit is None:

@@ -24,7 +24,7 @@ import pandas as pd
 from .exceptions import OrderError
 from .fit import ArmaxFit, fit_armax
 from .modal import mode_record
-from .orders import _map, default_nb, default_nc, information_criterion
+from .orders import _fit_or_none, _map, default_nb, default_nc, information_criterion
 from .recording import Recording
 from .refine import ModalRefinement, refine_modes
 
@@ -136,12 +136,7 @@ def _row(source, fit, r, shape, energy):
 def _fit_job(recording: Recording, job, max_iter: int, tol: float):
     source, orders = job
     rec = recording if source == SHARED else recording.select([source])
-    try:
-        return fit_armax(
-            rec, *orders, shared_poles=source == SHARED, max_iter=max_iter, tol=tol, stop="decrease", warn=False
-        )
-    except OrderError:
-        return None
+    return _fit_or_none(rec, orders, shared_poles=source == SHARED, max_iter=max_iter, tol=tol, stop="decrease")
 
 
 def _fit_and_poles(recording: Recording, job, max_iter: int, tol: float):
