@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .exceptions import DataError
+
 __all__ = ["measured_frf", "modal_frf", "welch_spectra"]
 
 
@@ -50,6 +52,9 @@ def welch_spectra(u: np.ndarray, y: np.ndarray, fs: float, nperseg: int):
         Output PSDs.
     """
     n = u.shape[0]
+    if not 2 <= int(nperseg) <= n:
+        raise DataError(f"nperseg: expected a segment length between 2 and the {n} samples, got {nperseg}.")
+    nperseg = int(nperseg)
     step = nperseg - nperseg // 2
     starts = np.arange(0, n - nperseg + 1, step)
     window = 0.5 - 0.5 * np.cos(2 * np.pi * np.arange(nperseg) / nperseg)

@@ -77,3 +77,11 @@ def test_model_simulation_equals_lfilter():
     model = ArmaxModel(a, np.array([[0.3, 0.2, 0.1]]), np.array([1.0]), 1, 100.0)
     expected = scipy.signal.lfilter(np.r_[0.0, 0.3, 0.2, 0.1], a, u)
     np.testing.assert_allclose(model.simulate(u), expected, rtol=1e-10, atol=1e-12)
+
+
+def test_segment_longer_than_the_record_is_a_clear_error(fixtures_dir):
+    from armaxmodal.exceptions import DataError
+
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    with pytest.raises(DataError, match="nperseg"):
+        measured_frf(rec, nperseg=rec.n_samples + 1)
