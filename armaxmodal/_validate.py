@@ -68,6 +68,13 @@ def check_not_constant(x: np.ndarray, name: str) -> None:
         )
 
 
+def check_outputs_carry_signal(names, y: np.ndarray) -> None:
+    """Raise :class:`DataError` naming the outputs (columns of ``y``) that are constant."""
+    flat = [s for s, col in zip(names, y.T, strict=True) if np.ptp(col) <= 1e-12 * max(np.abs(col).max(), 1e-300)]
+    if flat:
+        raise DataError(f"sensor(s) {flat} carry no signal (constant); check the cable or drop them with outputs=.")
+
+
 def as_square_matrix(a, name: str, n: int | None = None) -> np.ndarray:
     """Return a finite float64 square matrix, optionally of size ``n``."""
     try:

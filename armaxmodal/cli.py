@@ -84,20 +84,34 @@ def _cmd_identify(args) -> int:
 
 
 def _cmd_stabilise(args) -> int:
+    from .prepare import check_band
     from .stabilisation import select_modes, stabilisation_diagram
 
     plot_format = _format(args.plot) if args.plot else None
-    rec = _load(args)
     try:
         lo, hi = (int(v) for v in args.orders.split(":"))
     except ValueError as exc:
         raise OrderError(f"--orders: expected LO:HI model orders such as 2:40, got {args.orders!r}.") from exc
     if not 1 <= lo <= hi:
         raise OrderError(f"--orders: expected 1 <= LO <= HI, got {args.orders!r}.")
-    band = _parse_pair(args.band, "--band") if args.band else None
-    diagram = stabilisation_diagram(rec, range(lo, hi + 1, 2), progress=not args.quiet)
-    selection = select_modes(diagram, args.modes, band)
+    band = check_band(_parse_pair(args.band, "--band")) if args.band else None
+    rec = _load(args)
+    check_band(band, rec.fs)
     if not args.quiet:
+        outputs = ", ".join(rec.sensors)
+        print(f"{args.data}: input {rec.input_name}; outputs {outputs}; {rec.n_samples} samples at {rec.fs:g} Hz")
+    diagram = stabilisation_diagram(rec, range(lo, hi + 1, 2), band=band, detrend=args.detrend, progress=not args.quiet)
+    try:
+        selection = select_modes(diagram, args.modes, band)
+    except OrderError:
+        # no mode: the diagram and the pole table still show the user why
+        _write_diagram(args, diagram, None, plot_format)
+        _print_warnings(diagram.warnings)
+        raise
+    if not args.quiet:
+        prep = diagram.preparation
+        if prep is not None and prep.analysis_fs != prep.original_fs:
+            print(f"analysis at {prep.analysis_fs:g} Hz (resampled from {prep.original_fs:g} Hz)")
         print(
             selection.modes[
                 [
@@ -112,6 +126,21 @@ def _cmd_stabilise(args) -> int:
                 ]
             ].to_string(float_format=lambda v: f"{v:.4f}")
         )
+        print(f"FRF rebuilt from the modes vs H1: {100 * selection.reconstruction_error:.1f} % error")
+    _print_warnings(selection.warnings)
+    _write_diagram(args, diagram, selection, plot_format)
+    if args.json:
+        write_json(selection.to_dict(args.shapes.replace("-", "_")), args.json)
+    return 0
+
+
+def _print_warnings(warnings) -> None:
+    """Data-quality warnings go to stderr, one line each, even with --quiet."""
+    for w in warnings:
+        print(f"warning [{w.code}]: {w.message}", file=sys.stderr)
+
+
+def _write_diagram(args, diagram, selection, plot_format) -> None:
     if args.plot:
         import matplotlib
 
@@ -121,12 +150,9 @@ def _cmd_stabilise(args) -> int:
         ax, _ = diagram.plot(selection)
         atomic_write(args.plot, lambda tmp: ax.figure.savefig(tmp, dpi=150, format=plot_format))
         plt.close(ax.figure)
-    if args.json:
-        write_json(selection.to_dict(args.shapes.replace("-", "_")), args.json)
     if args.csv:
         table = diagram.to_frame()
         atomic_write(args.csv, lambda tmp: table.to_csv(tmp, index=False))
-    return 0
 
 
 def _format(path: str) -> str:
@@ -287,6 +313,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", default=None, help="stabilisation plot (.png, .svg or .pdf)")
     p.add_argument("--json", default=None, help="selected modes as JSON")
     p.add_argument("--csv", default=None, help="every pole of the sweep as CSV")
+    p.add_argument(
+        "--detrend",
+        choices=["mean", "linear", "none"],
+        default="mean",
+        help="remove each channel's mean (default) or least-squares line before fitting",
+    )
     p.add_argument(
         "--shapes",
         choices=["shared", "per-sensor"],

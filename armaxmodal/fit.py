@@ -32,7 +32,7 @@ import pandas as pd
 import scipy.linalg
 
 from ._kernels import _armax_residual, _inverse_filter, _lagged_cross, _lagged_gram, _max_root_radius_below
-from ._validate import as_signal_matrix, check_fs, check_not_constant
+from ._validate import as_signal_matrix, check_fs, check_not_constant, check_outputs_carry_signal
 from .armax import ArmaxModel
 from .exceptions import ConvergenceWarning, DataError, OrderError
 from .modal import pole_uncertainty
@@ -216,9 +216,7 @@ def fit_armax(
         raise ValueError(f"stop: expected 'expected' or 'decrease', got {stop!r}.")
     u, y, fs, sensors, inputs = _unpack(data, fs)
     na, nb, nc, nk = _check_orders(na, nb, 0 if output_error else nc, nk)
-    flat = [s for s, col in zip(sensors, y.T, strict=True) if np.ptp(col) <= 1e-12 * max(np.abs(col).max(), 1e-300)]
-    if flat:
-        raise DataError(f"sensor(s) {flat} carry no signal (constant); check the cable or drop them with outputs=.")
+    check_outputs_carry_signal(sensors, y)
     # Non-causal taps (nk < 0): y[t] depends on u[t + lead - j]. Pairing y[:n-lead] with
     # u[lead:] gives the equivalent causal model (delay 0) on a window of the record.
     # Filtering by 1/C from rest commutes with delays, not with advances, so this keeps the

@@ -37,7 +37,6 @@ def plot_stabilisation(diagram, selection=None, ax=None):
     poles = diagram.poles[diagram.poles.source == "shared"]
     rec = diagram.recording
     tol = diagram.tolerances
-    f_hi = tol.max_freq_fraction * rec.fs
     rejected = poles[poles.rejected != ""]
     ax.scatter(
         rejected.freq_hz,
@@ -54,7 +53,6 @@ def plot_stabilisation(diagram, selection=None, ax=None):
         ax_d.scatter(sel.freq_hz, sel.damping, marker=marker, s=18, color=colour, alpha=0.8)
         ax.scatter(sel.freq_hz, sel.na, marker=marker, s=28, color=colour, label=f"{label} ({len(sel)})", zorder=3)
     ax.set_ylabel("model order na")
-    ax.set_xlim(0, f_hi)
     ax.set_title(
         f"Stabilisation: tolerances f {100 * tol.freq:g} %, ξ {100 * tol.damping:g} %, "
         f"shape 1-MAC {tol.shape:g}; nk = {diagram.orders[0][3]}",
@@ -82,20 +80,9 @@ def plot_stabilisation(diagram, selection=None, ax=None):
                 label="from selected modes" if k == 0 else None,
             )
         top = max(o[0] for o in diagram.orders)
-        for i, m in enumerate(selection.modes.itertuples(index=False)):
+        for m in selection.modes.itertuples(index=False):
             ax.axvline(m.freq_hz, color="k", lw=0.8, ls=":")
             ax_d.axvline(m.freq_hz, color="k", lw=0.8, ls=":")
-            # labels sit above the axes, alternating in height so neighbours never overlap
-            ax.annotate(
-                f"{m.freq_hz:.2f} Hz, ξ {m.damping:.3f}",
-                (m.freq_hz, 1.0),
-                xycoords=("data", "axes fraction"),
-                xytext=(0, 3 + 11 * (i % 2)),
-                textcoords="offset points",
-                ha="center",
-                va="bottom",
-                fontsize=8,
-            )
         ax.set_ylim(0, top * 1.05)
         err = selection.reconstruction_error
         ax.text(
@@ -106,6 +93,11 @@ def plot_stabilisation(diagram, selection=None, ax=None):
             fontsize=8,
             va="bottom",
         )
+    lo, hi = _frequency_span(diagram)
+    ax.set_xlim(lo, hi)
+    _limit_frf_axis(ax_f, f, h, lo, hi)
+    if selection is not None:
+        _label_modes(ax, selection.modes)
     ax_f.set_ylabel("|FRF| (output / base acceleration)")
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = ax_f.get_legend_handles_labels()
@@ -114,6 +106,61 @@ def plot_stabilisation(diagram, selection=None, ax=None):
     ax_d.set_xlabel("frequency (Hz)")
     ax_d.set_ylim(0, tol.max_damping)
     return ax, ax_d
+
+
+def _frequency_span(diagram) -> tuple[float, float]:
+    """The band of the analysis: the user's band, else up to the input's excited band."""
+    from .stabilisation import excited_band
+
+    rec = diagram.recording
+    f_hi = diagram.tolerances.max_freq_fraction * rec.fs
+    band = None if diagram.preparation is None else diagram.preparation.band
+    if band is not None:
+        width = band[1] - band[0]
+        return max(0.0, band[0] - 0.05 * width), min(f_hi, band[1] + 0.05 * width)
+    return 0.0, min(f_hi, 1.1 * excited_band(rec)[1])
+
+
+def _limit_frf_axis(ax_f, f, h, lo, hi, decades: float = 4.0) -> None:
+    """Log FRF axis over the curves inside the span, at most ``decades`` below the largest
+    (a near-zero channel, e.g. a signal-generator reference, would stretch it)."""
+    inside = (f >= lo) & (f <= hi) & (f > 0)
+    mags = np.abs(h[inside])
+    mags = mags[np.isfinite(mags) & (mags > 0)]
+    if mags.size == 0:
+        return
+    top = float(mags.max()) * 2
+    ax_f.set_ylim(max(float(mags.min()) / 2, top * 10**-decades), top)
+
+
+def _label_modes(ax, modes) -> None:
+    """Frequency and damping above each mode's line, lifted a row where it would overlap a
+    label already placed (close modes get rows of their own)."""
+    fig = ax.figure
+    renderer = fig.canvas.get_renderer()
+    placed, top_level = [], 0
+    xmin, xmax = ax.get_xlim()
+    for m in modes.itertuples(index=False):
+        if not xmin <= m.freq_hz <= xmax:
+            continue
+        for level in range(len(modes)):
+            label = ax.annotate(
+                f"{m.freq_hz:.2f} Hz, ξ {m.damping:.3g}",
+                (m.freq_hz, 1.0),
+                xycoords=("data", "axes fraction"),
+                xytext=(0, 3 + 11 * level),
+                textcoords="offset points",
+                ha="center",
+                va="bottom",
+                fontsize=8,
+            )
+            box = label.get_window_extent(renderer).expanded(1.05, 1.0)
+            if not any(box.overlaps(other) for other in placed):
+                placed.append(box)
+                top_level = max(top_level, level)
+                break
+            label.remove()
+    ax.set_title(ax.get_title(), fontsize=10, pad=6 + 11 * (top_level + 1))
 
 
 def _runs(f, mask):

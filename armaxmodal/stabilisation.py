@@ -25,6 +25,8 @@ from .exceptions import OrderError
 from .fit import ArmaxFit, fit_armax
 from .modal import mode_record
 from .orders import _fit_or_none, _map, default_nb, default_nc, information_criterion
+from .prepare import Preparation, prepare
+from .quality import QualityWarning
 from .recording import Recording
 from .refine import ModalRefinement, refine_modes
 
@@ -36,6 +38,10 @@ SHARED = "shared"
 # The fits whose estimates are reported are finished to fit_armax's default criterion.
 SWEEP_TOL = 1e-5
 CLASSES = ("new", "f", "f+d", "f+d+v")
+#: input delays the sweep searches (non-causal taps for band-limited data)
+NK_SEARCH = range(0, -7, -1)
+#: when the best delay is the most non-causal searched, this many more are tried once
+NK_EXTENSION = 3
 
 
 @dataclass(frozen=True)
@@ -67,6 +73,9 @@ class StabilisationDiagram:
     orders : list of (na, nb, nc, nk)
     tolerances : Tolerances
     recording : Recording
+        The record the sweep fitted (after :func:`armaxmodal.prepare.prepare`).
+    preparation : Preparation or None
+        What was done to the record first, with the quality warnings.
     """
 
     poles: pd.DataFrame
@@ -74,6 +83,13 @@ class StabilisationDiagram:
     tolerances: Tolerances
     recording: Recording
     fits: dict = field(repr=False, default_factory=dict)
+    preparation: Preparation | None = None
+
+    @property
+    def warnings(self) -> list[QualityWarning]:
+        """Data-quality findings of the preparation and of the sweep itself."""
+        found = list(self.preparation.warnings) if self.preparation is not None else []
+        return found + _nk_edge_warning(self.orders[0][3], self.recording)
 
     def to_frame(self) -> pd.DataFrame:
         """The tidy pole table without the complex columns (for CSV)."""
@@ -161,7 +177,7 @@ def choose_nk(recording: Recording, nk_values=range(0, -7, -1), na_values=(8, 10
     return _choose_nk(recording, nk_values, na_values, n_jobs)[0]
 
 
-def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL):
+def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=True):
     """``(nk, {(SHARED, orders): fit})`` -- the fits of the chosen delay are reused by the sweep."""
     jobs = [(SHARED, (na, default_nb(na, nk), default_nc(na), nk)) for na in na_values for nk in nk_values]
     # BIC differences between delays are large; 8 iterations settle the choice (checked on
@@ -174,6 +190,9 @@ def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL):
     )
     scores = [information_criterion(f) if f is not None else np.inf for f in fits]
     nk = int(jobs[int(np.argmin(scores))][1][3])
+    if extend and nk == min(nk_values):
+        # the best delay is the most non-causal one searched: look NK_EXTENSION further, once
+        return _choose_nk(recording, range(nk, nk - NK_EXTENSION - 1, -1), na_values, n_jobs, tol, extend=False)
     # only fits that stopped on the sweep's rule, not at this stage's 8-iteration cap, may
     # stand in the sweep
     reuse = {job: fit for job, fit in zip(jobs, fits, strict=True) if job[1][3] == nk and fit is not None}
@@ -184,6 +203,11 @@ def stabilisation_diagram(
     recording: Recording,
     orders=range(2, 31, 2),
     *,
+    band: tuple[float, float] | None = None,
+    detrend: str = "mean",
+    resample: bool = True,
+    align: bool = True,
+    prepared: bool = False,
     nk: int | None = None,
     per_sensor: bool = True,
     per_sensor_max_order: int = 20,
@@ -200,6 +224,15 @@ def stabilisation_diagram(
     recording : Recording
     orders : iterable of int
         The ``na`` values; ``nb`` and ``nc`` follow the module's rules.
+    band : (lo, hi), optional
+        Frequency band of interest, Hz: sets the analysis rate and, in :func:`select_modes`,
+        the band modes are taken from.
+    detrend, resample, align
+        Preparation of the record (:func:`armaxmodal.prepare.prepare`): remove each
+        channel's mean (or ``"linear"`` trend, or ``"none"``), resample a record sampled far
+        above its band, align channels late by whole samples.
+    prepared : bool
+        The record is already prepared: fit it as it is (no checks, no warnings).
     nk : int, optional
         Input delay; by default chosen by BIC (:func:`choose_nk`).
     per_sensor : bool
@@ -218,9 +251,13 @@ def stabilisation_diagram(
         Show a progress bar.
     """
     limits = tolerances or Tolerances()
+    preparation = None
+    if not prepared:
+        preparation = prepare(recording, band=band, detrend=detrend, resample=resample, align=align)
+        recording = preparation.recording
     known: dict = {}
     if nk is None:
-        nk, known = _choose_nk(recording, range(0, -7, -1), (8, 10, 12), n_jobs, tol)
+        nk, known = _choose_nk(recording, NK_SEARCH, (8, 10, 12), n_jobs, tol)
     sources = [SHARED] + (list(recording.sensors) if per_sensor else [])
     order_list = [(na, default_nb(na, nk), default_nc(na), nk) for na in orders]
     # single sensors cannot support high orders (their bounds are wide): stop them earlier
@@ -251,7 +288,25 @@ def stabilisation_diagram(
     poles = pd.DataFrame(rows)
     poles["cls"] = _classify(poles, limits)
     poles["rejected"] = _reject(poles, limits, recording)
-    return StabilisationDiagram(poles, order_list, limits, recording, kept)
+    return StabilisationDiagram(poles, order_list, limits, recording, kept, preparation)
+
+
+def _nk_edge_warning(nk: int, recording: Recording) -> list[QualityWarning]:
+    """The BIC-chosen delay at the most non-causal end of its search range: the data may
+    need more (an input that lags the outputs)."""
+    edge = min(NK_SEARCH) - NK_EXTENSION
+    if nk > edge:
+        return []
+    return [
+        QualityWarning(
+            "nk_at_search_edge",
+            (recording.input_name,),
+            f"the chosen input delay nk = {nk} sits at the edge of its search range "
+            f"({edge} to {max(NK_SEARCH)}): the outputs may lead the input by more (a late input "
+            "or a filter delay); look at the sensor_delay check and align the channels.",
+            float(nk),
+        )
+    ]
 
 
 def _classify(poles: pd.DataFrame, tol: Tolerances) -> list[str]:
@@ -345,6 +400,7 @@ class ModeSelection:
     weighted: pd.DataFrame
     diagram: StabilisationDiagram
     refinement: ModalRefinement | None = None
+    notes: tuple[QualityWarning, ...] = ()
 
     @property
     def reconstruction_error(self) -> float:
@@ -358,6 +414,11 @@ class ModeSelection:
             return float("nan")
         rebuilt = modal_frf(f[good], self.modes.freq_hz, self.modes.damping, self.shapes)
         return float(np.linalg.norm(rebuilt - h[good]) / np.linalg.norm(h[good]))
+
+    @property
+    def warnings(self) -> list[QualityWarning]:
+        """The diagram's data-quality warnings and the selection's own."""
+        return self.diagram.warnings + list(self.notes)
 
     def to_dict(self, shapes: str = "shared") -> dict:
         """The JSON contract of the ``stabilise`` command.
@@ -389,8 +450,12 @@ class ModeSelection:
             for r in self.per_sensor.drop(columns=["own_modal_constant"]).to_dict("records")
         ]
         t = self.diagram.tolerances
+        prep = self.diagram.preparation
         return {
-            "fs": rec.fs,
+            "fs": rec.fs if prep is None else prep.original_fs,
+            "analysis_fs": rec.fs,
+            "preprocessing": None if prep is None else prep.to_dict(),
+            "warnings": [w.to_dict() for w in self.warnings],
             "input": rec.input_name,
             "outputs": list(rec.sensors),
             "nk": self.diagram.orders[0][3],
@@ -434,12 +499,14 @@ def select_modes(
     n_modes : int, optional
         Keep the ``n_modes`` best-supported modes.
     band : (lo, hi), optional
-        Frequency band in Hz.
+        Frequency band in Hz (default: the diagram's band, if it was given one).
     refine : bool
         Refit the selected modes to the recording's DFT under the inter-sample behaviour the
         data choose (:func:`armaxmodal.refine.refine_modes`) and report the refit when the
         recording is band-limited, where the discrete ARMAX class is biased.
     """
+    if band is None and diagram.preparation is not None:
+        band = diagram.preparation.band
     poles = diagram.poles
     cand = poles[(poles.source == SHARED) & (poles.rejected == "")]
     if band is not None:

@@ -1,0 +1,288 @@
+"""Data-quality checks run before any fit: facts with a number, never guesses.
+
+Each check returns :class:`QualityWarning` records (a code from :data:`WARNING_CODES`, the
+channels concerned, a sentence with the measured number). The checks need nothing but the
+recording:
+
+* ``duplicate_channel`` -- an output equal or proportional to another output or to the
+  input (correlation within ``1e-6`` of +-1): an exported-twice channel adds no information
+  and, pooled, gives zero-width intervals.
+* ``inverted_sensor`` / ``sensor_delay`` -- below the first mode a base-excited structure
+  moves with its base: the absolute-acceleration transmissibility is ``1 + O(w^2)`` with a
+  phase of order ``w^3`` (``T = 1 - w^2 K^-1 M e + ...``). A low-frequency ``T`` near -1 is a
+  sensor mounted or exported upside down; a phase that grows *linearly* with frequency is a
+  time offset, ``phase = -w tau``. The slope is fitted with the cubic term over the
+  quasi-static lines, weighted by the H1 phase variance (Bendat & Piersol 9.2.4).
+  Recordings whose low-frequency transmissibility is not near +-1 (a force input, no
+  quasi-static band) are not tested, and the check says nothing.
+* ``narrowband_input`` -- the input's power sits in a narrow band (a sine ride): modes
+  outside it are not identifiable.
+* ``clipping`` -- runs of samples stuck at a channel's extreme value (the sensor's rail).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .frf import welch_spectra
+from .recording import Recording
+
+__all__ = ["QualityWarning", "WARNING_CODES", "check_quality", "estimate_delays", "DelayEstimate"]
+
+WARNING_CODES = (
+    "duplicate_channel",
+    "inverted_sensor",
+    "sensor_delay",
+    "narrowband_input",
+    "clipping",
+    "offset_removed",
+    "trend_removed",
+    "resampled",
+    "model_error_dominates",
+    "nk_at_search_edge",
+    "unexplained_peak",
+    "no_modes",
+)
+
+#: |correlation| above 1 - this is a copy: two physical sensors never agree this well
+#: (16-bit quantisation of a proportional copy leaves ~1e-9).
+DUPLICATE_TOLERANCE = 1e-6
+#: quasi-static band: |T| within these bounds of 1 and coherence at least MIN_COHERENCE
+QUASI_STATIC_MAGNITUDE = (0.8, 1.25)
+MIN_COHERENCE = 0.9
+#: a delay is reported when it exceeds this fraction of a sample and is significant at
+#: DELAY_ALPHA after Bonferroni correction over the channels; a held (zero-order-hold)
+#: input alone shows half a sample on every output, which is the hold, not a defect
+MIN_DELAY_SAMPLES = 0.75
+DELAY_ALPHA = 0.01
+#: the input is narrowband when the lines within 10 dB of its PSD peak span less than this
+#: fraction of the peak frequency (a sine ride: a few lines; the sine sweep and random rides
+#: of the fixtures: 0.7-3.7; an earthquake record: 0.85-2.9)
+NARROWBAND_FRACTION = 0.3
+#: samples at the extreme value (in runs of 3 or more) that make a channel clipped
+CLIP_MIN_SAMPLES = 5
+
+
+@dataclass(frozen=True)
+class QualityWarning:
+    """One data-quality finding: ``code`` (see :data:`WARNING_CODES`), the channels it
+    concerns, a sentence with the measured number, and that number (``value``, its unit in
+    the message)."""
+
+    code: str
+    channels: tuple[str, ...]
+    message: str
+    value: float | None = None
+
+    def __post_init__(self):
+        if self.code not in WARNING_CODES:
+            raise ValueError(f"unknown warning code {self.code!r}; expected one of {WARNING_CODES}.")
+
+    def to_dict(self) -> dict:
+        value = None if self.value is None or not np.isfinite(self.value) else float(self.value)
+        return {"code": self.code, "channels": list(self.channels), "message": self.message, "value": value}
+
+
+@dataclass(frozen=True)
+class DelayEstimate:
+    """Time offset of one output against the input from the low-frequency transmissibility.
+
+    ``delay_s`` is positive when the output lags; ``sign`` is the low-frequency
+    transmissibility's sign (-1: inverted); ``n_lines`` quasi-static lines were used."""
+
+    channel: str
+    delay_s: float
+    delay_sd_s: float
+    sign: int
+    n_lines: int
+    max_freq_hz: float
+
+
+def check_quality(recording: Recording) -> list[QualityWarning]:
+    """Every pre-fit check on ``recording`` (see the module docstring)."""
+    found = duplicate_channels(recording)
+    found += delay_and_inversion(recording)
+    found += narrowband_input(recording)
+    found += clipped_channels(recording)
+    return found
+
+
+def duplicate_channels(recording: Recording) -> list[QualityWarning]:
+    """Outputs equal or proportional to an earlier output or to the input."""
+    names = [recording.input_name, *recording.sensors]
+    data = np.column_stack([recording.base, recording.response])
+    data = data - data.mean(axis=0)
+    norms = np.linalg.norm(data, axis=0)
+    found, taken = [], set()
+    for j in range(1, len(names)):
+        if norms[j] == 0:
+            continue
+        for i in range(j):
+            if i in taken or norms[i] == 0:
+                continue
+            r = float(data[:, i] @ data[:, j] / (norms[i] * norms[j]))
+            gap = max(0.0, 1 - abs(r))
+            if gap <= DUPLICATE_TOLERANCE:
+                ratio = float(data[:, j] @ data[:, i] / norms[i] ** 2)
+                kind = "the input" if i == 0 else f"output '{names[i]}'"
+                how = "a copy of" if abs(ratio - 1) < 1e-9 else f"{ratio:.6g} times"
+                found.append(
+                    QualityWarning(
+                        "duplicate_channel",
+                        (names[j], names[i]),
+                        f"output '{names[j]}' is {how} {kind} (1 - |correlation| = {gap:.1e}): a copy carries "
+                        "no information of its own and was left out of the fit.",
+                        gap,
+                    )
+                )
+                taken.add(j)
+                break
+    return found
+
+
+def estimate_delays(recording: Recording) -> list[DelayEstimate]:
+    """Per output: time offset and sign from the quasi-static transmissibility (empty for an
+    output without a quasi-static band, e.g. a force input)."""
+    n = recording.n_samples
+    nperseg = int(min(n // 8, 2 ** int(np.ceil(np.log2(recording.fs * 20)))))
+    if nperseg < 16:
+        return []
+    f, puu, puy, pyy = welch_spectra(recording.base, recording.response, recording.fs, nperseg)
+    h = puy / puu[:, None]
+    coh = np.abs(puy) ** 2 / (puu[:, None] * pyy)
+    n_segments = max(1, (n - nperseg) // (nperseg // 2) + 1)
+    excited = puu >= puu.max() * 1e-3
+    out = []
+    for k, name in enumerate(recording.sensors):
+        est = _quasi_static_fit(f, h[:, k], coh[:, k], excited, n_segments)
+        if est is not None:
+            out.append(DelayEstimate(name, *est))
+    return out
+
+
+def _quasi_static_fit(f, h, coh, excited, n_segments):
+    """``(delay_s, sd_s, sign, n_lines, f_max)`` from the lowest contiguous run of excited,
+    coherent lines with |T| near 1, or None when there are fewer than 4 such lines."""
+    ok = excited & (coh >= MIN_COHERENCE) & (f > 0)
+    ok &= (np.abs(h) >= QUASI_STATIC_MAGNITUDE[0]) & (np.abs(h) <= QUASI_STATIC_MAGNITUDE[1])
+    if not ok.any():
+        return None
+    start = int(np.argmax(ok))
+    stop = start
+    while stop < ok.size and ok[stop]:
+        stop += 1
+    lines = slice(start, stop)
+    if stop - start < 4:
+        return None
+    sign = 1 if np.median(h[lines].real) > 0 else -1
+    phase = np.unwrap(np.angle(sign * h[lines]))
+    w = 2 * np.pi * f[lines]
+    g2 = np.clip(coh[lines], 1e-6, 1 - 1e-12)
+    sd = np.sqrt((1 - g2) / (2 * n_segments * g2))  # H1 phase standard deviation, rad
+    design = np.column_stack([-w, w**3]) / sd[:, None]
+    coef, *_ = np.linalg.lstsq(design, phase / sd, rcond=None)
+    resid = phase / sd - design @ coef
+    dof = max(1, resid.size - 2)
+    # the fitted model is approximate (higher terms): widen by the residual scatter
+    scale = max(1.0, float(resid @ resid) / dof)
+    cov = np.linalg.inv(design.T @ design) * scale
+    return float(coef[0]), float(np.sqrt(cov[0, 0])), sign, stop - start, float(f[stop - 1])
+
+
+def delay_and_inversion(recording: Recording) -> list[QualityWarning]:
+    """``inverted_sensor`` and ``sensor_delay`` warnings from :func:`estimate_delays`."""
+    from scipy.stats import norm
+
+    estimates = estimate_delays(recording)
+    found = []
+    inverted = [e.channel for e in estimates if e.sign < 0]
+    if inverted:
+        found.append(
+            QualityWarning(
+                "inverted_sensor",
+                tuple(inverted),
+                f"{', '.join(inverted)}: the low-frequency transmissibility is near -1 where a base-excited "
+                "structure moves with its base (+1): the sensor is mounted or exported upside down. "
+                "Shapes keep the measured sign.",
+                -1.0,
+            )
+        )
+    z = norm.ppf(1 - DELAY_ALPHA / (2 * max(1, len(recording.sensors))))
+    dt = 1.0 / recording.fs
+    late = [e for e in estimates if abs(e.delay_s) > max(z * e.delay_sd_s, MIN_DELAY_SAMPLES * dt)]
+    if late and len(late) == len(recording.sensors) and len(late) > 1 and all(e.delay_s < 0 for e in late):
+        lead = float(np.median([-e.delay_s for e in late]))
+        found.append(
+            QualityWarning(
+                "sensor_delay",
+                (recording.input_name,),
+                f"every output leads input '{recording.input_name}' by about {1e3 * lead:.1f} ms "
+                f"({lead * recording.fs:.2f} samples): the input is late.",
+                1e3 * lead,
+            )
+        )
+        return found
+    for e in late:
+        lo, hi = e.delay_s - 1.96 * e.delay_sd_s, e.delay_s + 1.96 * e.delay_sd_s
+        verb = "lags" if e.delay_s > 0 else "leads"
+        found.append(
+            QualityWarning(
+                "sensor_delay",
+                (e.channel,),
+                f"'{e.channel}' {verb} input '{recording.input_name}' by {1e3 * abs(e.delay_s):.1f} ms "
+                f"(95 % interval {1e3 * lo:.1f} to {1e3 * hi:.1f} ms, {e.delay_s * recording.fs:.2f} samples; "
+                f"phase slope over {e.n_lines} quasi-static lines up to {e.max_freq_hz:.2f} Hz).",
+                1e3 * e.delay_s,
+            )
+        )
+    return found
+
+
+def narrowband_input(recording: Recording) -> list[QualityWarning]:
+    """The width of the lines within 10 dB of the input's PSD peak against the peak frequency."""
+    n = recording.n_samples
+    nperseg = int(min(n // 4, 2 ** int(np.ceil(np.log2(recording.fs * 20)))))
+    if nperseg < 16:
+        return []
+    f, puu, _, _ = welch_spectra(recording.base, recording.base[:, None], recording.fs, nperseg)
+    peak = float(f[int(np.argmax(puu))])
+    live = puu >= 0.1 * puu.max()
+    width = float(np.count_nonzero(live) * (f[1] - f[0]))
+    if peak <= 0 or width >= NARROWBAND_FRACTION * peak:
+        return []
+    return [
+        QualityWarning(
+            "narrowband_input",
+            (recording.input_name,),
+            f"the input's power within 10 dB of its peak covers {width:.2f} Hz around {peak:.2f} Hz "
+            f"({f[live].min():.2f}-{f[live].max():.2f} Hz): a sine-like ride; modes away from it are not "
+            "excited and cannot be identified from this record.",
+            width,
+        )
+    ]
+
+
+def clipped_channels(recording: Recording) -> list[QualityWarning]:
+    """Channels with runs of samples stuck at their maximum or minimum."""
+    found = []
+    names = [recording.input_name, *recording.sensors]
+    for name, x in zip(names, np.column_stack([recording.base, recording.response]).T, strict=True):
+        stuck = 0
+        for rail in (x.max(), x.min()):
+            at = x == rail
+            # samples at the rail that belong to runs of at least 3
+            run = at[2:] & at[1:-1] & at[:-2]
+            stuck += int(np.count_nonzero(np.convolve(run, np.ones(3), mode="full") > 0))
+        if stuck >= CLIP_MIN_SAMPLES:
+            found.append(
+                QualityWarning(
+                    "clipping",
+                    (name,),
+                    f"'{name}' sits at its extreme value for {stuck} samples ({100 * stuck / x.size:.2f} %) in runs: "
+                    "the sensor or its recorder clipped; the peaks there are lost.",
+                    100 * stuck / x.size,
+                )
+            )
+    return found
