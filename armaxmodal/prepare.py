@@ -9,7 +9,7 @@ In this order, every step stated in the result (and in the JSON):
 4. channels found late or early by whole samples are aligned (a sensor with its own clock);
 5. each channel's mean (default) or linear trend is removed, so gravity on an accelerometer
    and sensor offsets do not bias the modes (MATLAB's ``detrend``);
-6. a record sampled far above its band is resampled to about ``fs = band_hi / 0.3`` with
+6. a record sampled far above its band is resampled to about ``fs = band_hi / 0.4`` with
    scipy's polyphase filter (a Kaiser-windowed anti-alias FIR of zero phase): high orders
    would otherwise be spent on the empty spectrum above the band, and one low order no
    longer resolves close modes at 400 Hz that it resolves at 50 Hz.
@@ -29,9 +29,9 @@ from .recording import Recording
 __all__ = ["prepare", "Preparation", "check_band", "DETRENDS"]
 
 DETRENDS = ("mean", "linear", "none")
-#: the band's upper edge sits at this fraction of the analysis rate (0.6 of its Nyquist),
+#: the band's upper edge sits at this fraction of the analysis rate (0.8 of its Nyquist),
 #: well inside the anti-alias filter's pass band
-BAND_FRACTION_OF_FS = 0.3
+BAND_FRACTION_OF_FS = 0.4
 #: output samples dropped at each end after resampling (the filter's half length)
 RESAMPLE_EDGE = 10
 #: an offset is worth a warning when it exceeds this fraction of the channel's RMS

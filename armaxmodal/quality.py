@@ -61,7 +61,7 @@ DELAY_ALPHA = 0.01
 #: fraction of the peak frequency (a sine ride: a few lines; the sine sweep and random rides
 #: of the fixtures: 0.7-3.7; an earthquake record: 0.85-2.9)
 NARROWBAND_FRACTION = 0.3
-#: samples at the extreme value (in runs of 3 or more) that make a channel clipped
+#: samples at the extreme value (with at least two in a row) that make a channel clipped
 CLIP_MIN_SAMPLES = 5
 
 
@@ -265,23 +265,22 @@ def narrowband_input(recording: Recording) -> list[QualityWarning]:
 
 
 def clipped_channels(recording: Recording) -> list[QualityWarning]:
-    """Channels with runs of samples stuck at their maximum or minimum."""
+    """Channels that dwell on their maximum or minimum (the rail of a sensor or recorder)."""
     found = []
     names = [recording.input_name, *recording.sensors]
     for name, x in zip(names, np.column_stack([recording.base, recording.response]).T, strict=True):
-        stuck = 0
+        stuck, held = 0, False
         for rail in (x.max(), x.min()):
             at = x == rail
-            # samples at the rail that belong to runs of at least 3
-            run = at[2:] & at[1:-1] & at[:-2]
-            stuck += int(np.count_nonzero(np.convolve(run, np.ones(3), mode="full") > 0))
-        if stuck >= CLIP_MIN_SAMPLES:
+            stuck += int(np.count_nonzero(at))
+            held |= bool(np.any(at[1:] & at[:-1]))  # a continuous signal does not dwell on its peak
+        if held and stuck >= CLIP_MIN_SAMPLES:
             found.append(
                 QualityWarning(
                     "clipping",
                     (name,),
-                    f"'{name}' sits at its extreme value for {stuck} samples ({100 * stuck / x.size:.2f} %) in runs: "
-                    "the sensor or its recorder clipped; the peaks there are lost.",
+                    f"'{name}' sits at its extreme value for {stuck} samples ({100 * stuck / x.size:.2f} %), "
+                    "some in a row: the sensor or its recorder clipped; the peaks there are lost.",
                     100 * stuck / x.size,
                 )
             )

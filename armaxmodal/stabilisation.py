@@ -29,6 +29,7 @@ from .prepare import Preparation, prepare
 from .quality import QualityWarning
 from .recording import Recording
 from .refine import ModalRefinement, refine_modes
+from .spread import N_SEGMENTS, apply_segment_spread, segment_spread
 
 __all__ = ["stabilisation_diagram", "StabilisationDiagram", "select_modes", "ModeSelection", "Tolerances"]
 
@@ -444,6 +445,13 @@ class ModeSelection:
                 freq_spread_hz=float(row.freq_spread),
                 damping_spread=float(row.damping_spread),
             )
+            if "segments_found" in self.modes:
+                record["segment_spread"] = {
+                    "segments_found": int(row.segments_found),
+                    "freq_sd_hz": _finite_or_none(row.freq_segment_sd),
+                    "damping_sd": _finite_or_none(row.damping_segment_sd),
+                }
+                record["model_error_dominates"] = bool(row.model_error_dominates)
             modes.append(record)
         per_sensor = [
             {k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in r.items()}
@@ -479,6 +487,7 @@ def select_modes(
     cluster_damping: float = 0.5,
     merge_mac: float = 0.8,
     refine: bool = True,
+    segments: int = N_SEGMENTS,
 ) -> ModeSelection:
     """Pick the physical modes from the shared-pole poles of a diagram.
 
@@ -504,6 +513,9 @@ def select_modes(
         Refit the selected modes to the recording's DFT under the inter-sample behaviour the
         data choose (:func:`armaxmodal.refine.refine_modes`) and report the refit when the
         recording is band-limited, where the discrete ARMAX class is biased.
+    segments : int
+        Refit each mode's representative orders on this many disjoint segments and widen
+        the intervals where their spread exceeds them (:mod:`armaxmodal.spread`); 0 skips.
     """
     if band is None and diagram.preparation is not None:
         band = diagram.preparation.band
@@ -590,8 +602,17 @@ def select_modes(
             refinement = None  # too few lines or a degenerate basis: the ARMAX values stand
         if refinement is not None and refinement.hold == "bandlimited":
             modes, shapes = _apply_refinement(modes, shapes, refinement, cluster_freq, cluster_damping)
+    notes: list[QualityWarning] = []
+    if segments >= 2:
+        orders = {o[0]: o for o in diagram.orders}
+        spread = segment_spread(diagram.recording, modes, lambda i: orders[int(modes.at[i, "na"])], segments)
+        modes, notes = apply_segment_spread(modes, spread, segments)
     per_sensor, weighted = _per_sensor_table(diagram, modes, shapes, cluster_freq)
-    return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement)
+    return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement, tuple(notes))
+
+
+def _finite_or_none(value) -> float | None:
+    return float(value) if np.isfinite(value) else None
 
 
 def _finished_pole(diagram: StabilisationDiagram, pole: pd.Series, cache: dict) -> pd.Series:

@@ -1,0 +1,67 @@
+"""Segment spread against simulated truth: a time-invariant ride keeps its statistical
+intervals; a ride whose stiffness changes half-way is flagged and its intervals widened."""
+
+import numpy as np
+import pytest
+
+import armaxmodal as am
+from armaxmodal.spread import apply_segment_spread
+from armaxmodal.stabilisation import select_modes, stabilisation_diagram
+
+FS = 60.0
+# the stiffer half of the changing ride: every spring 12 % stiffer (modes about 6 % higher)
+STIFFENING = 1.12
+
+
+def _ride(structure, seed, duration=60.0):
+    u = am.random_vibration(FS, duration, (0.5, 28.0), seed=seed)
+    return am.simulate_recording(structure, u, FS, noise=0.05, hold="zoh", seed=seed + 100)
+
+
+def test_a_time_invariant_ride_is_not_flagged(fixtures_dir):
+    rec = am.read_recording(fixtures_dir / "supine_random_zoh.csv")
+    selection = select_modes(stabilisation_diagram(rec, per_sensor=False))
+    assert not selection.modes.model_error_dominates.any()
+    assert (selection.modes.segments_found == 3).all()
+    assert "model_error_dominates" not in {w.code for w in selection.warnings}
+
+
+def test_a_stiffness_change_half_way_is_flagged_and_widened():
+    s = am.supine_human()
+    stiff = am.Structure(s.M, s.C, s.K * STIFFENING, s.names)
+    first, second = _ride(s, 1), _ride(stiff, 2)
+    rec = am.Recording(
+        FS,
+        np.concatenate([first.base, second.base]),
+        np.vstack([first.response, second.response]),
+        first.sensors,
+    )
+    selection = select_modes(stabilisation_diagram(rec, per_sensor=False), segments=3)
+    modes = selection.modes
+    assert modes.model_error_dominates.any()
+    assert "model_error_dominates" in {w.code for w in selection.warnings}
+    # the widened intervals of the first (best-determined) mode cover both halves' truths
+    f1 = [s.modes().freq_hz[0], stiff.modes().freq_hz[0]]
+    lo, hi = modes.freq_ci95_lo.iloc[0], modes.freq_ci95_hi.iloc[0]
+    assert modes.model_error_dominates.iloc[0]
+    assert lo <= min(f1) * 1.01 and hi >= max(f1) * 0.99, (lo, hi, f1)
+
+
+def test_widening_follows_the_chi_square_rule():
+    """Three segments: flagged when 2 s^2 / (3 sigma^2) exceeds the chi-square quantile."""
+    import pandas as pd
+    from scipy.stats import chi2, t
+
+    sigma = 0.01
+    base = {"freq_hz": 5.0, "damping": 0.2, "freq_ci95_lo": 5 - 1.96 * sigma, "freq_ci95_hi": 5 + 1.96 * sigma,
+            "damping_ci95_lo": 0.19, "damping_ci95_hi": 0.21}  # fmt: skip
+    crit = chi2.ppf(1 - 0.01 / 2, 2)
+    s_edge = sigma * np.sqrt(3 * crit / 2)
+    for s, flagged in ((0.98 * s_edge, False), (1.02 * s_edge, True)):
+        spread = pd.DataFrame([{"freq_segment_sd": s, "damping_segment_sd": 0.0, "segments_found": 3}])
+        out, notes = apply_segment_spread(pd.DataFrame([base]), spread)
+        assert bool(out.model_error_dominates.iloc[0]) is flagged
+        assert [w.code for w in notes] == (["model_error_dominates"] if flagged else [])
+        half = (out.freq_ci95_hi.iloc[0] - out.freq_ci95_lo.iloc[0]) / 2
+        want = max(t.ppf(0.975, 2) * s / np.sqrt(3), 1.96 * sigma) if flagged else 1.96 * sigma
+        assert half == pytest.approx(want, rel=1e-9)
