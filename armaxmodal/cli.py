@@ -22,14 +22,22 @@ SYSTEMS = {"supine": datasets.supine_human, "chapter2": datasets.chapter2_system
 
 
 def _add_data_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("data", help="recording: .csv[.gz], .mat or .uff")
-    p.add_argument("--input", default="base", help="input (base acceleration) column; default 'base'")
+    p.add_argument("data", nargs="+", help="recording: .csv[.gz], .mat or .uff; or one Xsens DOT export per sensor")
+    p.add_argument("--input", default="base", help="input (base acceleration) column or sensor; default 'base'")
     p.add_argument("--fs", type=float, default=None, help="sampling rate in Hz if the file has no time column")
     p.add_argument("--outputs", default=None, help="comma-separated output columns to use (default: all)")
+    p.add_argument("--axis", default="Acc_X", help="Xsens exports: the column to use; default Acc_X")
 
 
 def _load(args):
     outputs = args.outputs.split(",") if args.outputs else None
+    if len(args.data) > 1:
+        from .xsens import read_xsens
+
+        rec = read_xsens(args.data, input=args.input, axis=args.axis)
+        args.data = " + ".join(args.data)
+        return rec if outputs is None else rec.select(outputs)
+    args.data = args.data[0]
     return read_recording(args.data, input=args.input, fs=args.fs, outputs=outputs)
 
 

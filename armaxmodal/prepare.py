@@ -131,7 +131,7 @@ def prepare(
     if detrend not in DETRENDS:
         raise DataError(f"detrend: expected one of {DETRENDS}, got {detrend!r}.")
     check_outputs_carry_signal(recording.sensors, recording.response)
-    found = check_quality(recording)
+    found = list(recording.meta.get("read_warnings", ())) + check_quality(recording)
     dropped = tuple(w.channels[0] for w in found if w.code == "duplicate_channel")
     keep = [s for s in recording.sensors if s not in dropped]
     if not keep:

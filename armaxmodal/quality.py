@@ -37,6 +37,7 @@ WARNING_CODES = (
     "sensor_delay",
     "narrowband_input",
     "clipping",
+    "dropped_packet",
     "offset_removed",
     "trend_removed",
     "resampled",

@@ -101,17 +101,19 @@ def apply_segment_spread(modes: pd.DataFrame, spread: pd.DataFrame, n_segments: 
     t_k = t.ppf(0.975, n_segments - 1)
     dominates = np.zeros(len(modes), dtype=bool)
     for i, m in modes.iterrows():
-        for value, lo, hi, sd_col in (
-            ("freq_hz", "freq_ci95_lo", "freq_ci95_hi", "freq_segment_sd"),
-            ("damping", "damping_ci95_lo", "damping_ci95_hi", "damping_segment_sd"),
+        for value, lo, hi, sd_col, model_sd in (
+            ("freq_hz", "freq_ci95_lo", "freq_ci95_hi", "freq_segment_sd", "freq_sd_armax"),
+            ("damping", "damping_ci95_lo", "damping_ci95_hi", "damping_segment_sd", "damping_sd_armax"),
         ):
-            sigma = (m[hi] - m[lo]) / (2 * 1.96)
+            # judged against the interval of the estimator the segments use (ARMAX) when the
+            # reported one is another's (the band-limited refit)
+            sigma = m[model_sd] if model_sd in m else (m[hi] - m[lo]) / (2 * 1.96)
             s = m[sd_col]
             if not (np.isfinite(s) and sigma > 0) or m.segments_found < n_segments:
                 continue
             if (n_segments - 1) * s**2 / (n_segments * sigma**2) > crit:
                 dominates[i] = True
-                half = max(t_k * s / np.sqrt(n_segments), 1.96 * sigma)
+                half = max(t_k * s / np.sqrt(n_segments), (m[hi] - m[lo]) / 2)
                 modes.loc[i, [lo, hi]] = [m[value] - half, m[value] + half]
         if dominates[i]:
             flagged.append(i)

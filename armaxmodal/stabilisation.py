@@ -576,7 +576,7 @@ def select_modes(
         vectors.append(rep.vector)
     modes = pd.DataFrame(rows)
     if not modes.empty:
-        keep = _merge_duplicates(modes, vectors, merge_mac)
+        keep = _merge_duplicates(modes, vectors, merge_mac, diagram.recording.duration)
         modes, vectors = modes.loc[keep].reset_index(drop=True), [vectors[i] for i in keep]
     if modes.empty:
         raise OrderError(
@@ -591,6 +591,9 @@ def select_modes(
     modes = modes.loc[order].reset_index(drop=True)
     shapes = np.column_stack([vectors[i] for i in order])
     modes["estimator"] = "armax"
+    # the segment refits are ARMAX fits: their spread is judged against the ARMAX intervals
+    modes["freq_sd_armax"] = (modes.freq_ci95_hi - modes.freq_ci95_lo) / (2 * 1.96)
+    modes["damping_sd_armax"] = (modes.damping_ci95_hi - modes.damping_ci95_lo) / (2 * 1.96)
     refinement = None
     if refine:
         lo, hi = excited_band(diagram.recording)
@@ -602,6 +605,9 @@ def select_modes(
             refinement = None  # too few lines or a degenerate basis: the ARMAX values stand
         if refinement is not None and refinement.hold == "bandlimited":
             modes, shapes = _apply_refinement(modes, shapes, refinement, cluster_freq, cluster_damping)
+            # two modes the refit brought together are one peak
+            keep = _merge_duplicates(modes, list(shapes.T), merge_mac, diagram.recording.duration)
+            modes, shapes = modes.loc[keep].reset_index(drop=True), shapes[:, keep]
     notes: list[QualityWarning] = []
     if segments >= 2:
         orders = {o[0]: o for o in diagram.orders}
@@ -657,20 +663,29 @@ def _apply_refinement(modes, shapes, ref, max_freq_change, max_damping_change):
     return modes, shapes
 
 
-def _merge_duplicates(modes: pd.DataFrame, vectors: list, merge_mac: float) -> list[int]:
-    """Indices of the modes to keep after merging split (near-duplicate) modes."""
+def _merge_duplicates(modes: pd.DataFrame, vectors: list, merge_mac: float, duration_s: float) -> list[int]:
+    """Indices of the modes to keep after merging split (near-duplicate) modes.
+
+    A weaker mode is the better-supported one split by over-modelling when it lies within
+    that mode's half-power bandwidth (``2 xi f``) with a similar shape (MAC >= ``merge_mac``),
+    or, whatever its shape, within ``2 / duration_s`` of it: two frequencies that close cannot
+    be told apart by a record of this length. (Heavily damped modes are often closer than
+    their bandwidths -- the supine human's -- so the bandwidth alone decides nothing.)
+    """
     ranked = modes.sort_values(["support", "count", "energy"], ascending=False).index
     kept: list[int] = []
     for i in ranked:
-        f = modes.at[i, "freq_hz"]
-        duplicate = any(
-            abs(f - modes.at[j, "freq_hz"]) <= 2 * modes.at[j, "damping"] * modes.at[j, "freq_hz"]
-            and _mac(vectors[i], vectors[j]) >= merge_mac
-            for j in kept
-        )
-        if not duplicate:
+        if not any(_is_split(modes, vectors, i, j, merge_mac, duration_s) for j in kept):
             kept.append(i)
     return sorted(kept)
+
+
+def _is_split(modes, vectors, i, j, merge_mac, duration_s) -> bool:
+    """Mode ``i`` is mode ``j`` split in two (see :func:`_merge_duplicates`)."""
+    gap = abs(modes.at[i, "freq_hz"] - modes.at[j, "freq_hz"])
+    half_power = 2 * modes.at[j, "damping"] * modes.at[j, "freq_hz"]
+    unresolvable = gap <= 2.0 / duration_s
+    return unresolvable or (gap <= half_power and _mac(vectors[i], vectors[j]) >= merge_mac)
 
 
 def _per_sensor_table(diagram, modes, shapes, cluster_freq):
