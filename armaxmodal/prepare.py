@@ -34,6 +34,8 @@ DETRENDS = ("mean", "linear", "none")
 BAND_FRACTION_OF_FS = 0.4
 #: output samples dropped at each end after resampling (the filter's half length)
 RESAMPLE_EDGE = 10
+#: a line explaining more than this share of a channel's variance is a drift worth a warning
+DRIFT_FRACTION = 0.01
 #: an offset is worth a warning when it exceeds this fraction of the channel's RMS
 OFFSET_FRACTION = 0.05
 
@@ -214,6 +216,8 @@ def _detrend(rec: Recording, how: str) -> tuple[Recording, list[QualityWarning]]
                 float(np.max(np.abs(offset[big]) / rms[big])),
             )
         )
+    if how == "mean":
+        notes += _drift_left(names, data - coef[0], t, rec.duration)
     if how == "linear":
         drift = coef[1] * 2 / rec.duration  # per second
         listed = ", ".join(f"{n} {v:+.3g}/s" for n, v in zip(names, drift, strict=True))
@@ -226,6 +230,29 @@ def _detrend(rec: Recording, how: str) -> tuple[Recording, list[QualityWarning]]
             )
         )
     return replace(rec, base=clean[:, 0], response=clean[:, 1:]), notes
+
+
+def _drift_left(names, centred, t, duration) -> list[QualityWarning]:
+    """A ``drift`` warning for channels where a line explains more than
+    :data:`DRIFT_FRACTION` of the variance left after the mean (a drifting sensor or tilt)."""
+    slope = centred.T @ t / (t @ t)
+    explained = slope**2 * (t @ t) / np.maximum(np.sum(centred**2, axis=0), 1e-300)
+    big = explained > DRIFT_FRACTION
+    if not big.any():
+        return []
+    listed = ", ".join(
+        f"{n} {2 * b / duration:+.3g}/s ({100 * e:.1f} % of its variance)"
+        for n, b, e in zip(np.array(names)[big], slope[big], explained[big], strict=True)
+    )
+    return [
+        QualityWarning(
+            "drift",
+            tuple(np.array(names)[big]),
+            f"a linear drift remains after the mean was removed: {listed}. It biases the modes; rerun with "
+            "--detrend linear (detrend='linear').",
+            float(explained[big].max()),
+        )
+    ]
 
 
 def _resample_to_band(rec: Recording, band) -> tuple[Recording, QualityWarning | None]:

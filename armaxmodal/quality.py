@@ -39,6 +39,7 @@ WARNING_CODES = (
     "clipping",
     "dropped_packet",
     "offset_removed",
+    "drift",
     "trend_removed",
     "resampled",
     "model_error_dominates",

@@ -47,7 +47,7 @@ def _damaged(tmp: Path) -> dict:
     save("chest inverted", inv)
     drift = d.copy()
     drift[outs] += 0.05 * np.arange(len(d))[:, None] / 60.0
-    save("drift 0.05 m/s^2 per s", drift)
+    save("drift 0.05 m per s^3", drift)
     return cases
 
 

@@ -129,7 +129,8 @@ def test_offsets_and_drift_are_removed_and_reported(clean):
     y = clean.response + 9.81 + 0.02 * t[:, None]
     rec = _with(clean, response=y)
     mean_only = prepare(rec)
-    assert [w.code for w in mean_only.warnings] == ["offset_removed"]
+    assert [w.code for w in mean_only.warnings] == ["offset_removed", "drift"]
+    assert mean_only.warnings[1].channels == clean.sensors and "+0.02/s" in mean_only.warnings[1].message
     np.testing.assert_allclose(mean_only.recording.response.mean(axis=0), 0, atol=1e-9)
     linear = prepare(rec, detrend="linear")
     assert [w.code for w in linear.warnings] == ["offset_removed", "trend_removed"]
