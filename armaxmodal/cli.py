@@ -73,7 +73,8 @@ def _cmd_identify(args) -> int:
         if len(orders) != 4:
             raise OrderError(f"--orders: expected four integers na,nb,nc,nk, got {args.orders!r}.")
     band = _parse_pair(args.band, "--band") if args.band else None
-    result = identify(rec, orders, band=band, progress=not args.quiet)
+    result = identify(rec, orders, band=band, progress=not args.quiet, detrend=args.detrend)
+    _print_warnings(result.warnings)
     na, nb, nc, nk = result.fit.orders
     print(
         f"{args.data}: shared-pole ARMAX na={na} nb={nb} nc={nc} nk={nk}, "
@@ -300,6 +301,9 @@ def _cmd_simulate(args) -> int:
     return 0
 
 
+_DETREND_HELP = "remove each channel's mean (default) or least-squares line before fitting"
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="armaxmodal", description="Time-domain modal analysis of base-excited systems."
@@ -325,7 +329,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--detrend",
         choices=["mean", "linear", "none"],
         default="mean",
-        help="remove each channel's mean (default) or least-squares line before fitting",
+        help=_DETREND_HELP,
     )
     p.add_argument(
         "--shapes",
@@ -350,6 +354,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_data_args(p)
     p.add_argument("--orders", default="auto", help="'auto' (BIC) or na,nb,nc,nk; default auto")
     p.add_argument("--band", default=None, help="frequency band LO:HI in Hz")
+    p.add_argument("--detrend", choices=["mean", "linear", "none"], default="mean", help=_DETREND_HELP)
     p.add_argument("--json", default=None, help="write modes as JSON")
     p.add_argument("--csv", default=None, help="write every pole of every sensor as CSV")
     p.set_defaults(func=_cmd_identify)

@@ -8,11 +8,16 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from .exceptions import DataError
 
-__all__ = ["measured_frf", "modal_frf", "welch_spectra"]
+if TYPE_CHECKING:
+    from .recording import Recording
+
+__all__ = ["excited_band", "measured_frf", "modal_frf", "welch_spectra"]
 
 
 def default_nperseg(recording) -> int:
@@ -105,3 +110,10 @@ def modal_frf(freq_hz, freqs, dampings, shapes):
     r = -(lam**2)[None, :] * shapes  # (n_sensors, n_modes)
     out = r[None] / (w - lam[None, None]) + np.conj(r)[None] / (w - np.conj(lam)[None, None])
     return out.sum(axis=2)
+
+
+def excited_band(recording: Recording, min_db: float = -30.0) -> tuple[float, float]:
+    """Lowest and highest frequency (Hz) where the input PSD is within ``min_db`` of its peak."""
+    f, pxx, _, _ = welch_spectra(recording.base, recording.base[:, None], recording.fs, min(recording.n_samples, 1024))
+    live = f[pxx >= pxx.max() * 10 ** (min_db / 10)]
+    return float(live.min()), float(live.max())

@@ -17,6 +17,7 @@ import pandas as pd
 from .fit import ArmaxFit, fit_armax
 from .modal import mode_record
 from .orders import OrderChoice, choose_orders
+from .prepare import Preparation, prepare
 from .recording import Recording
 from .stabilisation import _POLE_COLUMNS, SHARED, Tolerances, _poles_of, _reject
 
@@ -38,8 +39,11 @@ class Identification:
     shapes : (n_sensors, n_modes) complex ndarray
         EPFRF modal constants per sensor (Eq. 3.24), the mode-shape components.
     recording : Recording
+        The record that was fitted (after preparation).
     order_table : DataFrame or None
         The criterion table when the orders were chosen automatically.
+    preparation : Preparation or None
+        What was done to the record before the fit, with the data-quality warnings.
     """
 
     fit: ArmaxFit
@@ -47,6 +51,12 @@ class Identification:
     shapes: np.ndarray
     recording: Recording
     order_table: pd.DataFrame | None = None
+    preparation: Preparation | None = None
+
+    @property
+    def warnings(self) -> tuple:
+        """Data-quality warnings found while preparing the record."""
+        return () if self.preparation is None else self.preparation.warnings
 
     def to_dict(self) -> dict:
         """The JSON contract: fs, input, outputs, modes (with shapes) and per_sensor rows."""
@@ -64,8 +74,12 @@ class Identification:
             for k, s in enumerate(rec.sensors)
         ]
         na, nb, nc, nk = self.fit.orders
+        prep = self.preparation
         return {
-            "fs": rec.fs,
+            "fs": rec.fs if prep is None else prep.original_fs,
+            "analysis_fs": rec.fs,
+            "preprocessing": None if prep is None else prep.to_dict(),
+            "warnings": [w.to_dict() for w in self.warnings],
             "input": rec.input_name,
             "outputs": list(rec.sensors),
             "orders": {"na": na, "nb": nb, "nc": nc, "nk": nk, "shared_poles": self.fit.shared_poles},
@@ -83,6 +97,10 @@ def identify(
     band: tuple[float, float] | None = None,
     max_damping: float = DEFAULT_MAX_DAMPING,
     progress: bool = False,
+    detrend: str = "mean",
+    resample: bool | None = None,
+    align: bool = True,
+    prepared: bool = False,
 ) -> Identification:
     """Fit the shared-pole ARMAX model and report its physical modes.
 
@@ -97,7 +115,24 @@ def identify(
         Poles damped more than this are not reported as modes.
     progress : bool
         Show a progress bar during the automatic order search.
+    detrend, align : see :func:`armaxmodal.prepare.prepare`
+        Each channel's mean is removed by default so gravity and offsets do not bias the modes.
+    resample : bool, optional
+        Resample to a rate suited to the band. Default: only when the orders are chosen
+        automatically, because fixed orders belong to the record's own rate.
+    prepared : bool
+        The record is already prepared: fit it as it is (no checks, no warnings).
+
+    Returns
+    -------
+    Identification
     """
+    preparation = None
+    if not prepared:
+        if resample is None:
+            resample = orders is None
+        preparation = prepare(recording, band=band, detrend=detrend, resample=resample, align=align)
+        recording = preparation.recording
     choice: OrderChoice | None = None
     if orders is None:
         choice = choose_orders(recording, progress=progress)
@@ -113,4 +148,5 @@ def identify(
     poles = poles.sort_values("freq_hz")
     shapes = np.column_stack(poles.vector.to_list()) if len(poles) else np.zeros((len(fit.models), 0))
     modes = poles.drop(columns=["source", "na", "energy", "vector"]).reset_index(drop=True)
-    return Identification(fit, modes, shapes, recording, None if choice is None else choice.table)
+    table = None if choice is None else choice.table
+    return Identification(fit, modes, shapes, recording, table, preparation)

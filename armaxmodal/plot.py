@@ -110,7 +110,7 @@ def plot_stabilisation(diagram, selection=None, ax=None):
 
 def _frequency_span(diagram) -> tuple[float, float]:
     """The band of the analysis: the user's band, else up to the input's excited band."""
-    from .stabilisation import excited_band
+    from .frf import excited_band
 
     rec = diagram.recording
     f_hi = diagram.tolerances.max_freq_fraction * rec.fs

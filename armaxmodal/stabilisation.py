@@ -23,6 +23,7 @@ import pandas as pd
 
 from .exceptions import OrderError
 from .fit import ArmaxFit, fit_armax
+from .frf import excited_band
 from .modal import mode_record
 from .orders import _fit_or_none, _map, default_nb, default_nc, information_criterion
 from .prepare import Preparation, prepare
@@ -334,15 +335,6 @@ def _classify(poles: pd.DataFrame, tol: Tolerances) -> list[str]:
                         label = "f+d+v"
                 cls[poles.index.get_loc(idx)] = label
     return cls
-
-
-def excited_band(recording: Recording, min_db: float = -30.0) -> tuple[float, float]:
-    """Lowest and highest frequency (Hz) where the input PSD is within ``min_db`` of its peak."""
-    from .frf import welch_spectra
-
-    f, pxx, _, _ = welch_spectra(recording.base, recording.base[:, None], recording.fs, min(recording.n_samples, 1024))
-    live = f[pxx >= pxx.max() * 10 ** (min_db / 10)]
-    return float(live.min()), float(live.max())
 
 
 def _reject(poles: pd.DataFrame, tol: Tolerances, recording: Recording) -> list[str]:

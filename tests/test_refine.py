@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import armaxmodal as am
+from armaxmodal.frf import excited_band
 from armaxmodal.refine import refine_modes
-from armaxmodal.stabilisation import excited_band
 
 
 def _start(fixtures_dir, name):
