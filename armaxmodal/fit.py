@@ -388,7 +388,7 @@ def _stable_c(c):
         return c
     r = np.roots(c)
     mag = np.abs(r)
-    r = np.where(mag > 1, 1 / np.conj(r), r)
+    r = np.where(mag > 1, 1 / np.conj(np.where(mag > 1, r, 1.0)), r)  # no 1/0 for a root at 0
     mag = np.abs(r)
     r = np.where(mag > _MAX_C_RADIUS, r * (_MAX_C_RADIUS / np.maximum(mag, 1e-300)), r)
     return np.real(np.poly(r))
@@ -455,7 +455,8 @@ def _stable_a(a):
     if _max_root_radius_below(a, 1.0):
         return a
     r = np.roots(a)
-    r = np.where(np.abs(r) > 1, 1 / np.conj(r), r)
+    out = np.abs(r) > 1
+    r = np.where(out, 1 / np.conj(np.where(out, r, 1.0)), r)
     r = np.where(np.abs(r) >= 0.9999, r * (0.9999 / np.abs(r)), r)
     return np.real(np.poly(r))
 

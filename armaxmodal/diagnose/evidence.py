@@ -1,0 +1,278 @@
+"""Statistical tests of a fitted model's residual, each a statistic with a p-value.
+
+In-sample least-squares residuals are orthogonal to the model's own regressors, so a plain
+regression of the residual on a candidate would understate it; the in-sample tests here are
+score (LM) tests in their F form: the residual regressed on the model's gradient columns and
+the candidate together (Breusch-Godfrey for whiteness, the same for trend terms). Whether a
+fix is kept is decided on held-out data elsewhere (:mod:`.loop`).
+
+Every p-value is corrected for the number of sensors times tests (Bonferroni), so the
+chance of naming any effect on a clean recording stays near ``alpha``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import stats
+from scipy.signal import lfilter
+
+from ..quality import MIN_DELAY_SAMPLES, estimate_delays
+from ..recording import Recording
+from .model import FittedModel, usable
+from .spectral import harmonic_f_test
+
+__all__ = ["Finding", "run_tests", "whiteness_p", "EFFECT_TESTS"]
+
+#: Lags of the residual in the Breusch-Godfrey whiteness test.
+WHITENESS_LAGS = 10
+#: The tests each round runs, in the order linear/structural effects come first.
+EFFECT_TESTS = ("input_delay", "offset_drift", "periodic_disturbance", "coloured_noise")
+#: A line in the residual is the input's (model error), not a disturbance, when the input
+#: itself carries a line there at this significance.
+INPUT_LINE_P = 1e-3
+#: A pole pair damped less than this is a line candidate (no structure is this lightly damped
+#: over a whole record; a sinusoidal disturbance gives an undamped pair).
+UNDAMPED = 2e-3
+#: Lines closer than this (Hz) are one line.
+LINE_MERGE_HZ = 0.05
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One effect the residual points to.
+
+    Attributes
+    ----------
+    effect : str
+        From :data:`armaxmodal.diagnose.EFFECTS`.
+    channels : tuple of str
+    statistic : str
+        Name of the test statistic.
+    value : float
+        Its value.
+    p : float
+        p-value corrected for sensors x tests.
+    parameters : dict
+        What the test measured (delay in ms, line frequency and amplitude...).
+    """
+
+    effect: str
+    channels: tuple[str, ...]
+    statistic: str
+    value: float
+    p: float
+    parameters: dict = field(default_factory=dict)
+
+    def evidence(self) -> dict:
+        return {"statistic": self.statistic, "value": float(self.value), "p": float(self.p)}
+
+
+def gradient_columns(model, y: np.ndarray, u: np.ndarray, eps: np.ndarray) -> np.ndarray:
+    """Columns of the one-step error's gradient of an ARMAX model, (n, na + nb + nc):
+    ``y(t-i)/C``, ``u(t-nk-j)/C`` and ``eps(t-i)/C`` (signs do not matter to a regression)."""
+    na, nb, nc, nk = model.orders
+    yc, uc, ec = (lfilter([1.0], model.c, x) for x in (y, u, eps))
+    cols = [_lag(yc, i) for i in range(1, na + 1)]
+    cols += [_lag(uc, nk + j) for j in range(nb)]
+    cols += [_lag(ec, i) for i in range(1, nc + 1)]
+    return np.column_stack(cols)
+
+
+def _lag(x: np.ndarray, k: int) -> np.ndarray:
+    """``x(t - k)`` with zeros outside the record (k may be negative)."""
+    out = np.zeros_like(x)
+    if k >= 0:
+        out[k:] = x[: x.size - k]
+    else:
+        out[:k] = x[-k:]
+    return out
+
+
+def lm_f_test(eps: np.ndarray, psi: np.ndarray, z: np.ndarray) -> tuple[float, float]:
+    """F form of the score test that ``z`` adds nothing to the regressors ``psi``: ``(F, p)``."""
+    base = np.linalg.lstsq(psi, eps, rcond=None)[0]
+    rss_r = float(np.sum((eps - psi @ base) ** 2))
+    full = np.column_stack([psi, z])
+    coef = np.linalg.lstsq(full, eps, rcond=None)[0]
+    rss_u = float(np.sum((eps - full @ coef) ** 2))
+    q, dof = z.shape[1], eps.size - full.shape[1]
+    f = ((rss_r - rss_u) / q) / max(rss_u / dof, 1e-300)
+    return f, float(stats.f.sf(f, q, dof))
+
+
+def run_tests(fitted: FittedModel, alpha: float = 0.01) -> tuple[list[Finding], dict]:
+    """Every effect test on ``fitted``; returns the significant findings (corrected p below
+    ``alpha``), strongest first within each tier, and the per-sensor statistics for the report."""
+    k_count = len(fitted.signals.sensors)
+    n_tests = len(EFFECT_TESTS) * k_count
+    eps = fitted.one_step_errors()
+    mask = usable(fitted.signals.n, fitted.spec)
+    table = {"whiteness_p": [], "trend_p": [], "line_p": []}
+    found = _delay_findings(fitted, n_tests)
+    found += _trend_findings(fitted, eps, mask, n_tests, table)
+    found += _line_findings(fitted, mask, n_tests, table)
+    found += _whiteness_findings(fitted, eps, mask, n_tests, table)
+    return [f for f in found if f.p < alpha], table
+
+
+def _delay_findings(fitted: FittedModel, n_tests: int) -> list[Finding]:
+    """A sensor or the input out of time, from the quasi-static transmissibility phase
+    (:func:`armaxmodal.quality.estimate_delays`): its slope is the time offset whatever ``nk``
+    the model needed, and a held input's half sample stays under the reporting floor."""
+    s = fitted.signals
+    rec = Recording(s.fs, s.u, s.y, s.sensors, s.input_name)
+    estimates = estimate_delays(rec)
+    late = []
+    for e in estimates:
+        z = abs(e.delay_s) / max(e.delay_sd_s, 1e-300)
+        p = min(1.0, 2 * stats.norm.sf(z) * n_tests)
+        if abs(e.delay_s) * s.fs >= MIN_DELAY_SAMPLES:
+            late.append((e, p))
+    if not late:
+        return []
+    fs = s.fs
+    if len(late) == len(s.sensors) > 1 and all(e.delay_s < 0 for e, _ in late):
+        lead = float(np.median([-e.delay_s for e, _ in late]))
+        sd = float(np.median([e.delay_sd_s for e, _ in late]))
+        p = max(p for _, p in late)
+        params = {"delay_ms": 1e3 * lead, "delay_ci95_ms": [1e3 * (lead - 1.96 * sd), 1e3 * (lead + 1.96 * sd)]}
+        params["delay_samples"] = lead * fs
+        return [Finding("input_delay", (s.input_name,), "phase_slope_z", lead / sd, p, params)]
+    out = []
+    for e, p in late:
+        params = {
+            "delay_ms": 1e3 * e.delay_s,
+            "delay_ci95_ms": [1e3 * (e.delay_s - 1.96 * e.delay_sd_s), 1e3 * (e.delay_s + 1.96 * e.delay_sd_s)],
+            "delay_samples": e.delay_s * fs,
+        }
+        out.append(Finding("input_delay", (e.channel,), "phase_slope_z", e.delay_s / e.delay_sd_s, p, params))
+    return out
+
+
+def _trend_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
+    """Offset and drift: score test of ``[1, t, t^2]`` (the terms the model does not yet have)
+    filtered by ``A / C`` like the model's own disturbance regressors."""
+    spec, s = fitted.spec, fitted.signals
+    tau = np.linspace(-1.0, 1.0, s.n)
+    terms = [d for d in range(3) if d > spec.trend_degree]
+    out = []
+    for k, m in enumerate(fitted.fit.models):
+        y = s.y[:, k] - fitted.disturbance()[:, k]
+        psi = gradient_columns(m, y, s.u, eps[:, k])
+        z = lfilter(m.a, m.c, np.column_stack([tau**d for d in terms]), axis=0)
+        f, p = lm_f_test(eps[mask, k], psi[mask], z[mask])
+        p = min(1.0, p * n_tests)
+        table["trend_p"].append(p)
+        if terms:
+            coef = np.linalg.lstsq(np.column_stack([psi, z])[mask], eps[mask, k], rcond=None)[0][-len(terms) :]
+            dur = s.n / s.fs
+            params = {"offset": float(coef[0]) if terms[0] == 0 else 0.0}
+            if 1 in terms:
+                params["drift_per_s"] = float(coef[terms.index(1)]) * 2 / dur
+            out.append(Finding("offset_drift", (s.sensors[k],), "score_F", f, p, params))
+    return out
+
+
+def _line_findings(fitted, mask, n_tests, table) -> list[Finding]:
+    """Spectral lines not coherent with the input (the input has no line there): Thomson's
+    multitaper harmonic F-test on the simulation residual and on the output itself. A model
+    of high enough order absorbs a line as an undamped pole pair, leaving the residual clean,
+    so such a pole's frequency is tested on the output too (corrected for those poles only)."""
+    s = fitted.signals
+    resid = fitted.simulation_errors()[mask]
+    u_test = harmonic_f_test(s.u[mask], s.fs)
+    undamped = _undamped_pole_freqs(fitted)
+    out = []
+    for k, name in enumerate(s.sensors):
+        output = (s.y[:, k] - fitted.disturbance()[:, k])[mask]  # lines already modelled are out
+        tests = [harmonic_f_test(resid[:, k], s.fs), harmonic_f_test(output, s.fs)]
+        # near an undamped pole the residual carries the spurious mode's own narrow response
+        clean = [t for t in tests[:1] if not any(abs(t.freq_hz - f) < LINE_MERGE_HZ for f in undamped)]
+        best = min(clean + tests[1:], key=lambda t: t.p_min)
+        p, f0, f_val = 2 * best.p_min, best.freq_hz, best.f_max
+        for f in undamped:
+            p_pole = 2 * len(undamped) * tests[1].p_at(f)
+            if p_pole < p:
+                p, f0, f_val = p_pole, f, float(tests[1].f_stat[np.argmin(np.abs(tests[1].freqs - f))])
+        p = min(1.0, p * n_tests)
+        table["line_p"].append(p)
+        if u_test.p_at(f0) < INPUT_LINE_P:
+            continue
+        amp = tests[1].amplitude_at(f0)
+        params = {"freq_hz": f0, "amp": amp[0], "amp_ci95": list(amp[1])}
+        out.append(Finding("periodic_disturbance", (name,), "multitaper_F", f_val, p, params))
+    return _merge_lines(out)
+
+
+def _undamped_pole_freqs(fitted) -> list[float]:
+    """Frequencies (Hz) of the model's pole pairs damped less than :data:`UNDAMPED`."""
+    _, f, xi, _ = fitted.fit.models[0].modal_parameters()
+    return [float(v) for v, x in zip(f, xi, strict=True) if abs(x) < UNDAMPED and 0 < v < fitted.signals.fs / 2]
+
+
+def _merge_lines(findings: list[Finding]) -> list[Finding]:
+    """One finding per line frequency, listing every sensor it was found in."""
+    merged: list[Finding] = []
+    for f in sorted(findings, key=lambda x: x.p):
+        same = [m for m in merged if abs(m.parameters["freq_hz"] - f.parameters["freq_hz"]) < LINE_MERGE_HZ]
+        if same and f.p < 0.01:
+            i = merged.index(same[0])
+            merged[i] = Finding(
+                same[0].effect,
+                same[0].channels + f.channels,
+                same[0].statistic,
+                same[0].value,
+                same[0].p,
+                same[0].parameters,
+            )
+        elif not same:
+            merged.append(f)
+    return merged
+
+
+def _whiteness_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
+    """Breusch-Godfrey: residual on the gradient columns and its own lags 1..L."""
+    s = fitted.signals
+    out = []
+    for k, m in enumerate(fitted.fit.models):
+        y = s.y[:, k] - fitted.disturbance()[:, k]
+        psi = gradient_columns(m, y, s.u, eps[:, k])
+        z = np.column_stack([_lag(eps[:, k], i) for i in range(1, WHITENESS_LAGS + 1)])
+        f, p = lm_f_test(eps[mask, k], psi[mask], z[mask])
+        table["whiteness_p"].append(min(1.0, p * len(s.sensors)))
+        p = min(1.0, p * n_tests)
+        out.append(Finding("coloured_noise", (s.sensors[k],), "breusch_godfrey_F", f, p, {"lags": WHITENESS_LAGS}))
+    return out
+
+
+def whiteness_p(fitted: FittedModel) -> list[float]:
+    """Breusch-Godfrey p-value per sensor (corrected for the sensors only)."""
+    table: dict = {"whiteness_p": []}
+    eps = fitted.one_step_errors()
+    _whiteness_findings(fitted, eps, usable(fitted.signals.n, fitted.spec), 1, table)
+    return table["whiteness_p"]
+
+
+def cross_correlation(fitted: FittedModel, max_lag: int = 25) -> dict:
+    """Residual-input cross-correlation at lags -max_lag..max_lag with its 99 % bound (the
+    region of MATLAB's ``resid``): the bound uses both autocorrelations, as the input is
+    coloured."""
+    s = fitted.signals
+    mask = usable(s.n, fitted.spec)
+    eps = fitted.one_step_errors()[mask]
+    u = s.u[mask] - s.u[mask].mean()
+    n = u.size
+    lags = np.arange(-max_lag, max_lag + 1)
+    ru = np.correlate(u, u, "full")[n - 1 : n + 2 * max_lag] / (u @ u)
+    out = {"lags": lags.tolist(), "ccf": [], "bound99": []}
+    for k in range(eps.shape[1]):
+        e = eps[:, k] - eps[:, k].mean()
+        full = np.correlate(e, u, "full") / np.sqrt((e @ e) * (u @ u))
+        ccf = full[n - 1 + lags]
+        re = np.correlate(e, e, "full")[n - 1 : n + 2 * max_lag] / (e @ e)
+        p1 = 1 + 2 * float(np.sum(re[1:] * ru[1:]))
+        out["ccf"].append(ccf.tolist())
+        out["bound99"].append(float(stats.norm.ppf(0.995) * np.sqrt(max(p1, 1e-3) / n)))
+    return out

@@ -1,0 +1,314 @@
+"""The loop: fit the baseline, test its residual, add the strongest effect, keep it only if the
+held-out error says so, repeat (at most a few rounds)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from ..exceptions import DataError
+from ..frf import welch_spectra
+from ..prepare import prepare
+from ..recording import Recording
+from .evidence import Finding, cross_correlation, run_tests, whiteness_p
+from .fixes import add_effect, effect_parameters
+from .model import FittedModel, HeldOut, ModelSpec, Signals, fit_model, held_out, usable
+
+__all__ = ["diagnose", "Diagnosis", "EFFECTS", "TESTED_EFFECTS"]
+
+#: The fixed vocabulary of effects (the JSON's ``effect``).
+EFFECTS = (
+    "input_delay",
+    "offset_drift",
+    "periodic_disturbance",
+    "stiffness_nonlinearity",
+    "unmodelled_mode",
+    "coloured_noise",
+    "clipping",
+    "time_varying",
+    "second_input",
+    "sensor_fault",
+)
+#: The effects this version tests and fixes; the others are listed as not tested.
+TESTED_EFFECTS = ("input_delay", "offset_drift", "periodic_disturbance", "coloured_noise")
+#: Linear/structural effects first: a wrong linear part fires every later test.
+_TIER = {"input_delay": 0, "offset_drift": 1, "periodic_disturbance": 1, "coloured_noise": 2}
+#: A disturbance on the output is judged on the simulation error: a one-step predictor can
+#: carry a line or an offset in its noise model (an undamped pole, A(1)) while the
+#: deterministic part -- the modes -- is wrong.
+_CRITERION = {"periodic_disturbance": "simulation", "offset_drift": "simulation"}
+#: Fewer samples than this per half cannot hold out a validation part.
+MIN_SAMPLES = 400
+
+
+@dataclass(frozen=True)
+class Stage:
+    """A fitted model with its held-out errors."""
+
+    model: FittedModel
+    held: HeldOut
+
+    def bic(self, kind: str = "one_step") -> float:
+        """BIC of the in-sample one-step (or simulation) errors: ``N sum log V_k + p log(N K)``."""
+        mask = usable(self.model.signals.n, self.model.spec)
+        errors = self.model.one_step_errors() if kind == "one_step" else self.model.simulation_errors()
+        e = errors[mask]
+        n, k = e.shape
+        p = self.model.spec.n_parameters(k) + len(self.model.spec.shifts)
+        return float(n * np.sum(np.log(np.mean(e**2, axis=0))) + p * np.log(n * k))
+
+    def summary(self, noise_floor: np.ndarray) -> dict:
+        s = self.model.signals
+        y = s.y
+        e1 = self.held.one_step[self.held.mask]
+        yy = y[self.held.mask] - y[self.held.mask].mean(axis=0)
+        return {
+            "fit_val_pct": self.held.fit_percent(y).tolist(),
+            "one_step_fit_pct": (100 * (1 - np.linalg.norm(e1, axis=0) / np.linalg.norm(yy, axis=0))).tolist(),
+            "resid_rms": self.held.rms().tolist(),
+            "sim_resid_rms": np.sqrt(np.mean(self.held.simulation[self.held.mask] ** 2, axis=0)).tolist(),
+            "noise_floor_rms": noise_floor.tolist(),
+            "whiteness_p": whiteness_p(self.model),
+        }
+
+
+@dataclass(frozen=True)
+class Effect:
+    """An accepted effect: the finding, its fitted parameters and the errors around the fix."""
+
+    finding: Finding
+    parameters: dict
+    error_before: float
+    error_after: float
+    dm_p: float
+    delta_bic: float
+    note: str = ""
+
+    def to_dict(self) -> dict:
+        out = {
+            "effect": self.finding.effect,
+            "channels": list(self.finding.channels),
+            "evidence": self.finding.evidence(),
+            "parameters": self.parameters,
+            "error_before": self.error_before,
+            "error_after": self.error_after,
+            "held_out_p": self.dm_p,
+            "delta_bic": self.delta_bic,
+        }
+        if self.note:
+            out["note"] = self.note
+        return out
+
+
+@dataclass(frozen=True)
+class Diagnosis:
+    """What :func:`diagnose` found. ``to_dict`` is the JSON contract of ``armaxmodal diagnose``."""
+
+    baseline: Stage
+    final: Stage
+    effects: tuple[Effect, ...]
+    unconfirmed: tuple[dict, ...]
+    noise_floor: np.ndarray
+    recording: Recording
+    original_fs: float
+    warnings: tuple = ()
+    tests: dict = field(default_factory=dict)
+
+    @property
+    def sensors(self) -> tuple[str, ...]:
+        return self.baseline.model.signals.sensors
+
+    def modes(self, stage: Stage) -> pd.DataFrame:
+        """The physical modes of a stage's model (identify's rejection rules)."""
+        from ..stabilisation import _POLE_COLUMNS, SHARED, Tolerances, _poles_of, _reject
+
+        poles = pd.DataFrame(_poles_of(stage.model.fit, SHARED), columns=_POLE_COLUMNS)
+        poles = poles[np.array(_reject(poles, Tolerances(), self.recording)) == ""]
+        return poles.sort_values("freq_hz")[["freq_hz", "damping", "freq_ci95_lo", "freq_ci95_hi"]]
+
+    def to_dict(self) -> dict:
+        na, nb, nc, nk = self.baseline.model.spec.orders
+
+        def modes(stage):
+            return [{k: float(v) for k, v in row.items()} for row in self.modes(stage).to_dict("records")]
+
+        final = self.final.summary(self.noise_floor)
+        final.update(modes_before=modes(self.baseline), modes_after=modes(self.final))
+        return {
+            "fs": self.original_fs,
+            "analysis_fs": self.recording.fs,
+            "input": self.recording.input_name,
+            "outputs": list(self.sensors),
+            "orders": {"na": na, "nb": nb, "nc": nc, "nk": nk, "shared_poles": True},
+            "validation": "two blocked folds: each half predicted by the model fitted on the other half",
+            "baseline": self.baseline.summary(self.noise_floor),
+            "effects": [e.to_dict() for e in self.effects],
+            "unconfirmed": list(self.unconfirmed),
+            "final": final,
+            "tests": self.tests,
+            "not_tested": [e for e in EFFECTS if e not in TESTED_EFFECTS],
+            "warnings": [w.to_dict() for w in self.warnings],
+        }
+
+
+def _signals(recording: Recording, band) -> tuple[Signals, Recording, tuple]:
+    """The record as recorded (no detrend, no alignment: those are what is tested), resampled
+    to the band when it is sampled far above it."""
+    prep = prepare(recording, band=band, detrend="none", align=False)
+    rec = prep.recording
+    if rec.n_samples < 2 * MIN_SAMPLES:
+        raise DataError(
+            f"diagnose: the record has {rec.n_samples} samples at {rec.fs:g} Hz; holding out half of it for "
+            f"validation needs at least {2 * MIN_SAMPLES}. Use a longer recording."
+        )
+    keep = tuple(w for w in prep.warnings if w.code in ("duplicate_channel", "resampled", "clipping", "narrowband_input"))
+    return Signals(rec.base, rec.response, rec.fs, rec.sensors, rec.input_name), rec, keep
+
+
+def _baseline_orders(rec: Recording, baseline) -> tuple[int, int, int, int]:
+    from ..identify import Identification
+    from ..orders import choose_orders
+
+    if baseline is None:
+        centred = prepare(rec, detrend="mean", align=False, resample=False).recording
+        return choose_orders(centred).orders
+    fit = baseline.fit if isinstance(baseline, Identification) else baseline
+    if tuple(fit.sensors) != tuple(rec.sensors) or not np.isclose(fit.fs, rec.fs):
+        raise DataError(
+            f"baseline: the model was fitted to sensors {list(fit.sensors)} at {fit.fs:g} Hz, this record has "
+            f"{list(rec.sensors)} at {rec.fs:g} Hz; give a model of this recording or none (it is then chosen by BIC)."
+        )
+    return fit.orders
+
+
+def _noise_floor(s: Signals, mask: np.ndarray) -> np.ndarray:
+    """RMS of the output part not coherent with the input (Welch H1): what a perfect linear
+    model of this input would still leave in its simulation error."""
+    u, y = s.u[mask], s.y[mask]
+    nperseg = int(min(u.size // 8, 2 ** int(np.ceil(np.log2(s.fs * 10)))))
+    f, puu, puy, pyy = welch_spectra(u, y, s.fs, nperseg)
+    coh = np.abs(puy) ** 2 / np.maximum(puu[:, None] * pyy, 1e-300)
+    df = f[1] - f[0]
+    return np.sqrt(np.sum((1 - coh) * pyy, axis=0) * df)
+
+
+def _held_out_p(before: HeldOut, after: HeldOut, idx: list[int], kind: str = "one_step") -> float:
+    """Diebold-Mariano test that the fix lowers the held-out squared one-step (or simulation)
+    error of the channels ``idx`` (one-sided; Newey-West variance of the loss difference)."""
+    mask = before.mask & after.mask
+    e0, e1 = (getattr(before, kind)[mask][:, idx], getattr(after, kind)[mask][:, idx])
+    scale = np.mean(e0**2, axis=0)
+    d = np.sum((e0**2 - e1**2) / scale, axis=1)
+    n = d.size
+    lag = int(4 * (n / 100) ** (2 / 9))
+    dc = d - d.mean()
+    var = dc @ dc / n
+    for j in range(1, lag + 1):
+        var += 2 * (1 - j / (lag + 1)) * (dc[j:] @ dc[:-j]) / n
+    z = d.mean() / np.sqrt(max(var, 1e-300) / n)
+    return float(stats.norm.sf(z))
+
+
+def _pooled_rms(held: HeldOut, idx: list[int], kind: str = "one_step") -> float:
+    return float(np.sqrt(np.mean(getattr(held, kind)[held.mask][:, idx] ** 2)))
+
+
+def diagnose(
+    recording: Recording,
+    baseline=None,
+    *,
+    band: tuple[float, float] | None = None,
+    alpha: float = 0.01,
+    max_rounds: int = 3,
+    progress: bool = False,
+) -> Diagnosis:
+    """Find what the model lacks, add it, refit, and report the error before and after.
+
+    Parameters
+    ----------
+    recording : Recording
+        As recorded: the diagnosis removes no mean and aligns nothing, as offsets and delays
+        are among what it tests (a record sampled far above its band is resampled).
+    baseline : Identification or ArmaxFit, optional
+        The model to start from; by default the orders chosen by BIC (as ``identify``).
+    band : (lo, hi), optional
+        Band of interest, Hz (sets the analysis rate as in ``stabilise``).
+    alpha : float
+        Family-wise significance of the tests (corrected for sensors x tests) and of the
+        held-out error drop a fix must show.
+    max_rounds : int
+        Effects added at most.
+    progress : bool
+        Print each stage.
+
+    Returns
+    -------
+    Diagnosis
+    """
+    if not isinstance(recording, Recording):
+        raise DataError(f"recording: expected a Recording, got {type(recording).__name__}.")
+    if not (0 < alpha < 0.5) or int(max_rounds) != max_rounds or max_rounds < 0:
+        raise DataError(f"alpha must be in (0, 0.5) and max_rounds a whole number >= 0; got {alpha!r}, {max_rounds!r}.")
+    signals, rec, warnings = _signals(recording, band)
+    orders = _baseline_orders(rec, baseline)
+    say = print if progress else (lambda *a, **k: None)
+    say(f"baseline: shared-pole ARMAX {orders} on {signals.n} samples at {signals.fs:g} Hz")
+    spec = ModelSpec(tuple(int(v) for v in orders))
+    model = fit_model(spec, signals)
+    stage = first = Stage(model, held_out(spec, signals, model))
+    effects, unconfirmed, tests = [], [], {}
+    for round_no in range(int(max_rounds)):
+        findings, tests = run_tests(stage.model, alpha)
+        findings.sort(key=lambda f: (_TIER[f.effect], f.p, -f.value))
+        say(f"round {round_no + 1}: " + (", ".join(f"{f.effect} {list(f.channels)}" for f in findings) or "no effect"))
+        step = None
+        for finding in findings:
+            step, reason = _try_fix(stage, finding, alpha)
+            if step is not None:
+                break
+            unconfirmed.append({"effect": finding.effect, "channels": list(finding.channels), "reason": reason,
+                                "evidence": finding.evidence()})  # fmt: skip
+        if step is None:
+            break
+        effect, stage = step
+        effects.append(effect)
+    if effects:
+        tests = run_tests(stage.model, alpha)[1]
+    floor = _noise_floor(signals, usable(signals.n, spec))
+    tests["cross_correlation"] = cross_correlation(stage.model)
+    return Diagnosis(first, stage, tuple(effects), tuple(unconfirmed), floor, rec, recording.fs, warnings, tests)
+
+
+def _try_fix(stage: Stage, finding: Finding, alpha: float):
+    """Refit with the finding's effect; ``((Effect, Stage), "")`` if the held-out error says
+    keep it, else ``(None, reason)``."""
+    s = stage.model.signals
+    spec = add_effect(stage.model.spec, finding, stage.model)
+    model = fit_model(spec, s, start=stage.model)
+    new = Stage(model, held_out(spec, s, model))
+    on_input = finding.channels == (s.input_name,)
+    idx = list(range(len(s.sensors))) if on_input else [s.sensors.index(c) for c in finding.channels]
+    before, after = _pooled_rms(stage.held, idx), _pooled_rms(new.held, idx)
+    kind = _CRITERION.get(finding.effect, "one_step")
+    p = _held_out_p(stage.held, new.held, idx, kind)
+    dbic = new.bic(kind) - stage.bic(kind)
+    params = effect_parameters(finding, model)
+    params["criterion"] = f"held-out {kind.replace('_', '-')} error"
+    if kind == "simulation":
+        params["sim_error_before"] = _pooled_rms(stage.held, idx, kind)
+        params["sim_error_after"] = _pooled_rms(new.held, idx, kind)
+    if finding.effect == "input_delay":
+        # B's taps absorb much of a delay, so the error may barely move: the phase slope names it
+        if after > before * 1.01:
+            return None, f"moving the channel raised the held-out error from {before:.4g} to {after:.4g}"
+        note = "the model's B taps absorb part of a delay, so the error changes little; named from the phase slope"
+        return (Effect(finding, params, before, after, p, dbic, note), new), ""
+    if p >= alpha or dbic >= 0:
+        return None, (
+            f"named by its test, but the fix did not lower the held-out error significantly "
+            f"({before:.4g} -> {after:.4g}, p = {p:.2g}, change in BIC {dbic:+.1f})"
+        )
+    return (Effect(finding, params, before, after, p, dbic), new), ""
