@@ -3,6 +3,7 @@
 armaxmodal info DATA [--input COL] [--fs HZ]
 armaxmodal modes --system supine|chapter2 [--json OUT]
 armaxmodal simulate --system supine --excitation random|sweep --out DATA.csv
+armaxmodal diagnose DATA [--input COL] [--fs HZ] [--json OUT] [--plot OUT]
 """
 
 from __future__ import annotations
@@ -141,6 +142,75 @@ def _cmd_stabilise(args) -> int:
     if args.json:
         write_json(selection.to_dict(args.shapes.replace("-", "_")), args.json)
     return 0
+
+
+def _cmd_diagnose(args) -> int:
+    from .diagnose import diagnose
+    from .prepare import check_band
+
+    plot_format = _format(args.plot) if args.plot else None
+    band = check_band(_parse_pair(args.band, "--band")) if args.band else None
+    rec = _load(args)
+    result = diagnose(rec, band=band, max_rounds=args.max_rounds, progress=not args.quiet)
+    _print_warnings(result.warnings)
+    report = result.to_dict()
+    print(_diagnosis_text(args.data, report))
+    outputs = []
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        from .diagnose.plot import plot_diagnosis
+
+        fig = plot_diagnosis(result)
+        outputs.append((args.plot, lambda tmp: fig.savefig(tmp, dpi=120, format=plot_format)))
+    if args.json:
+        outputs.append((args.json, lambda tmp: write_json(report, tmp)))
+    for path, write in outputs:
+        atomic_write(path, write)
+    if args.plot:
+        plt.close(fig)
+    return 0
+
+
+def _diagnosis_text(name: str, report: dict) -> str:
+    """The diagnosis as a person reads it: fits before and after, each effect with its numbers."""
+    sensors = report["outputs"]
+    base, final = report["baseline"], report["final"]
+    lines = [f"{name}: {len(sensors)} sensors at {report['analysis_fs']:g} Hz; baseline orders {report['orders']}"]
+    lines.append(f"{'sensor':>12} {'fit before %':>13} {'fit after %':>12} {'resid RMS':>10} {'noise floor':>12}")
+    for k, s in enumerate(sensors):
+        lines.append(
+            f"{s:>12} {base['fit_val_pct'][k]:13.1f} {final['fit_val_pct'][k]:12.1f} "
+            f"{final['sim_resid_rms'][k]:10.4g} {final['noise_floor_rms'][k]:12.4g}"
+        )
+    if not report["effects"]:
+        lines.append("no effect found: the residual is consistent with the model (tests listed in the JSON).")
+    for e in report["effects"]:
+        params = {k: v for k, v in e["parameters"].items() if not isinstance(v, dict)}
+        lines.append(
+            f"effect {e['effect']} on {', '.join(e['channels'])}: {e['evidence']['statistic']} p = {e['evidence']['p']:.2g}; "
+            f"held-out one-step RMS {e['error_before']:.4g} -> {e['error_after']:.4g}; {_short(params)}"
+        )
+        if e.get("note"):
+            lines.append(f"  note: {e['note']}")
+    for u in report["unconfirmed"]:
+        lines.append(f"unconfirmed {u['effect']} on {', '.join(u['channels'])}: {u['reason']}")
+    lines.append("not tested by this version: " + ", ".join(report["not_tested"]))
+    return "\n".join(lines)
+
+
+def _short(params: dict) -> str:
+    def fmt(v):
+        if isinstance(v, float):
+            return f"{v:.4g}"
+        if isinstance(v, list):
+            return "[" + ", ".join(fmt(x) for x in v) + "]"
+        return str(v)
+
+    return ", ".join(f"{k} {fmt(v)}" for k, v in params.items())
 
 
 def _print_warnings(warnings) -> None:
@@ -358,6 +428,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", default=None, help="write modes as JSON")
     p.add_argument("--csv", default=None, help="write every pole of every sensor as CSV")
     p.set_defaults(func=_cmd_identify)
+
+    p = sub.add_parser(
+        "diagnose", parents=[quiet], help="find the effect the model lacks, add it, refit, report before/after"
+    )
+    _add_data_args(p)
+    p.add_argument("--band", default=None, help="frequency band LO:HI in Hz (sets the analysis rate)")
+    p.add_argument("--max-rounds", type=int, default=3, help="effects added at most; default 3")
+    p.add_argument("--json", default=None, help="write the diagnosis as JSON")
+    p.add_argument("--plot", default=None, help="figure page (.png/.svg/.pdf)")
+    p.set_defaults(func=_cmd_diagnose)
 
     p = sub.add_parser("info", parents=[quiet], help="summarise a recording")
     _add_data_args(p)

@@ -20,7 +20,7 @@ from scipy.signal import lfilter
 
 from ..quality import MIN_DELAY_SAMPLES, estimate_delays
 from ..recording import Recording
-from .model import FittedModel, usable
+from .model import LINE_MERGE_HZ, UNDAMPED, FittedModel, usable
 from .spectral import harmonic_f_test
 
 __all__ = ["Finding", "run_tests", "whiteness_p", "EFFECT_TESTS"]
@@ -32,11 +32,6 @@ EFFECT_TESTS = ("input_delay", "offset_drift", "periodic_disturbance", "coloured
 #: A line in the residual is the input's (model error), not a disturbance, when the input
 #: itself carries a line there at this significance.
 INPUT_LINE_P = 1e-3
-#: A pole pair damped less than this is a line candidate (no structure is this lightly damped
-#: over a whole record; a sinusoidal disturbance gives an undamped pair).
-UNDAMPED = 2e-3
-#: Lines closer than this (Hz) are one line.
-LINE_MERGE_HZ = 0.05
 
 
 @dataclass(frozen=True)

@@ -7,10 +7,10 @@ from dataclasses import replace
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from .evidence import LINE_MERGE_HZ, Finding, _undamped_pole_freqs
-from .model import FittedModel, ModelSpec, usable
+from .evidence import Finding
+from .model import FittedModel, ModelSpec, Signals, fit_model, response_free_of, usable
 
-__all__ = ["add_effect", "effect_parameters"]
+__all__ = ["add_effect", "effect_parameters", "fit_effect"]
 
 #: C coefficients a richer noise model adds.
 EXTRA_NC_STEP = 6
@@ -28,31 +28,39 @@ def add_effect(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelS
     if finding.effect == "offset_drift":
         return replace(spec, trend_degree=min(2, max(1, spec.trend_degree + 1)))
     if finding.effect == "periodic_disturbance":
-        f0 = refine_line(fitted, finding.parameters["freq_hz"])
-        # a pole pair that had absorbed the line goes: the sinusoid now carries it
-        absorbed = [f for f in _undamped_pole_freqs(fitted) if abs(f - f0) < LINE_MERGE_HZ]
-        na, nb, nc, nk = spec.orders
-        orders = (max(2, na - 2 * len(absorbed)), nb, nc, nk)
-        return replace(spec, orders=orders, lines_hz=spec.lines_hz + (f0,))
+        f0 = refine_line(fitted, finding.parameters["freq_hz"], finding.channels)
+        return replace(spec, lines_hz=spec.lines_hz + (f0,))
     if finding.effect == "coloured_noise":
         return replace(spec, extra_nc=spec.extra_nc + EXTRA_NC_STEP)
     raise ValueError(f"no fix for effect {finding.effect!r}")
 
 
-def refine_line(fitted: FittedModel, freq_hz: float) -> float:
+def fit_effect(spec: ModelSpec, finding: Finding, signals: Signals) -> FittedModel:
+    """Fit ``spec`` (the finding's effect added) at the baseline's orders."""
+    return fit_model(spec, signals)
+
+
+def refine_line(fitted: FittedModel, freq_hz: float, channels) -> float:
     """The line's frequency to a small fraction of the record's resolution: the maximum of
-    the simulation residual's periodogram summed over sensors (least squares for one sine)."""
+    the periodogram (least squares for one sine) of the channels' residual from a response
+    model that cannot carry the line (:func:`~.model.response_free_of`), summed over channels."""
     s = fitted.signals
     mask = usable(s.n, fitted.spec)
-    r = fitted.simulation_errors()[mask]
     t = np.flatnonzero(mask) / s.fs
+    trial = replace(fitted.spec, lines_hz=fitted.spec.lines_hz + (freq_hz,))
+    idx = [s.sensors.index(c) for c in channels]
+    y = s.y - fitted.disturbance()
+    r = (y - response_free_of(trial, fitted.fit, s.u, y))[mask][:, idx]
 
     def power(f):
         e = np.exp(-2j * np.pi * f * t)
         return -float(np.sum(np.abs(e @ r) ** 2))
 
     df = s.fs / s.n
-    res = minimize_scalar(power, bounds=(freq_hz - df, freq_hz + df), method="bounded", options={"xatol": 1e-6 * df})
+    grid = freq_hz + np.linspace(-df, df, 81)
+    best = grid[int(np.argmin([power(f) for f in grid]))]
+    step = grid[1] - grid[0]
+    res = minimize_scalar(power, bounds=(best - step, best + step), method="bounded", options={"xatol": 1e-4 * step})
     return float(res.x)
 
 

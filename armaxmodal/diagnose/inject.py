@@ -35,8 +35,10 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, **pa
     effect : str
         ``"input_delay"`` (``samples``, may be fractional: the channel is recorded that late),
         ``"offset_drift"`` (``offset`` in signal units, ``drift_per_s``),
-        ``"periodic_disturbance"`` (``freq_hz``, ``amp`` as a fraction of each channel's RMS),
-        ``"coloured_noise"`` (``level`` as a fraction of RMS, AR(1) ``pole``).
+        ``"periodic_disturbance"`` (``freq_hz``; ``amp``, the line's RMS as a fraction of
+        each channel's RMS),
+        ``"coloured_noise"`` (``level`` as a fraction of RMS; AR(1) ``pole``, or with
+        ``freq_hz`` an AR(2) resonance of radius ``pole`` there).
     channels : sequence of str, optional
         Where: default every output (an input delay: the input).
     seed : int
@@ -67,7 +69,11 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, **pa
         else:
             w = rng.standard_normal(t.size)
             pole = float(params.get("pole", 0.95))
-            v = lfilter([1.0], [1.0, -pole], w)
+            if "freq_hz" in params:  # narrowband: an AR(2) resonance of radius ``pole``
+                wn = 2 * np.pi * float(params["freq_hz"]) / recording.fs
+                v = lfilter([1.0], [1.0, -2 * pole * np.cos(wn), pole**2], w)
+            else:
+                v = lfilter([1.0], [1.0, -pole], w)
             x += float(params["level"]) * rms * v / np.std(v)
     meta = dict(recording.meta, injected={"effect": effect, "channels": names, **params})
     return replace(recording, base=base, response=y, meta=meta)

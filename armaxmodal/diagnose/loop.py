@@ -14,8 +14,8 @@ from ..frf import welch_spectra
 from ..prepare import prepare
 from ..recording import Recording
 from .evidence import Finding, cross_correlation, run_tests, whiteness_p
-from .fixes import add_effect, effect_parameters
-from .model import FittedModel, HeldOut, ModelSpec, Signals, fit_model, held_out, usable
+from .fixes import add_effect, effect_parameters, fit_effect
+from .model import LINE_MERGE_HZ, UNDAMPED, FittedModel, HeldOut, ModelSpec, Signals, fit_model, held_out, usable
 
 __all__ = ["diagnose", "Diagnosis", "EFFECTS", "TESTED_EFFECTS"]
 
@@ -127,6 +127,8 @@ class Diagnosis:
 
         poles = pd.DataFrame(_poles_of(stage.model.fit, SHARED), columns=_POLE_COLUMNS)
         poles = poles[np.array(_reject(poles, Tolerances(), self.recording)) == ""]
+        for f in stage.model.spec.lines_hz:  # a pole pair that duplicates a modelled line is not a mode
+            poles = poles[~((abs(poles.freq_hz - f) < LINE_MERGE_HZ) & (poles.damping < UNDAMPED))]
         return poles.sort_values("freq_hz")[["freq_hz", "damping", "freq_ci95_lo", "freq_ci95_hi"]]
 
     def to_dict(self) -> dict:
@@ -164,7 +166,8 @@ def _signals(recording: Recording, band) -> tuple[Signals, Recording, tuple]:
             f"diagnose: the record has {rec.n_samples} samples at {rec.fs:g} Hz; holding out half of it for "
             f"validation needs at least {2 * MIN_SAMPLES}. Use a longer recording."
         )
-    keep = tuple(w for w in prep.warnings if w.code in ("duplicate_channel", "resampled", "clipping", "narrowband_input"))
+    kept = ("duplicate_channel", "resampled", "clipping", "narrowband_input")
+    keep = tuple(w for w in prep.warnings if w.code in kept)
     return Signals(rec.base, rec.response, rec.fs, rec.sensors, rec.input_name), rec, keep
 
 
@@ -277,7 +280,8 @@ def diagnose(
         effects.append(effect)
     if effects:
         tests = run_tests(stage.model, alpha)[1]
-    floor = _noise_floor(signals, usable(signals.n, spec))
+    clean = Signals(signals.u, signals.y - stage.model.disturbance(), signals.fs, signals.sensors, signals.input_name)
+    floor = _noise_floor(clean, usable(signals.n, spec))
     tests["cross_correlation"] = cross_correlation(stage.model)
     return Diagnosis(first, stage, tuple(effects), tuple(unconfirmed), floor, rec, recording.fs, warnings, tests)
 
@@ -286,8 +290,8 @@ def _try_fix(stage: Stage, finding: Finding, alpha: float):
     """Refit with the finding's effect; ``((Effect, Stage), "")`` if the held-out error says
     keep it, else ``(None, reason)``."""
     s = stage.model.signals
-    spec = add_effect(stage.model.spec, finding, stage.model)
-    model = fit_model(spec, s, start=stage.model)
+    model = fit_effect(add_effect(stage.model.spec, finding, stage.model), finding, s)
+    spec = model.spec
     new = Stage(model, held_out(spec, s, model))
     on_input = finding.channels == (s.input_name,)
     idx = list(range(len(s.sensors))) if on_input else [s.sensors.index(c) for c in finding.channels]

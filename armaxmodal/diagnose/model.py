@@ -5,9 +5,9 @@ An effect is added without touching the numba fitter:
 * channel shifts (a late sensor or input) move that channel by a fractional number of
   samples before the fit (Fourier shift: the data are band-limited);
 * additive output disturbances ``y = G u + H e + phi theta`` (offset, drift, sinusoids) are
-  estimated by backfitting: fit ARMAX to ``y - phi theta``, then ``theta`` by least squares
-  of the one-step errors on the regressors filtered by ``A / C`` -- exact GLS for ``theta``
-  given the dynamics, so three passes converge;
+  estimated by backfitting: ``theta`` from least squares of the output on the regressors,
+  ARMAX fitted to ``y - phi theta``, ``theta`` again from the simulation residual, three
+  passes (see :func:`_disturbance_ls` for why not GLS);
 * a richer noise model raises ``nc``.
 
 Held-out errors (see :func:`held_out`) come from two blocked folds: a model fitted on one half
@@ -145,11 +145,13 @@ class FittedModel:
     def simulation_errors(self) -> np.ndarray:
         """Output minus the noise-free simulated response (and the disturbance), (n, K)."""
         s, d = self.signals, self.disturbance()
-        return np.column_stack([s.y[:, k] - d[:, k] - m.simulate(s.u) for k, m in enumerate(self.fit.models)])
+        return s.y - d - self.simulated()
 
     def simulated(self) -> np.ndarray:
-        """The noise-free response to the input, (n, K)."""
-        return np.column_stack([m.simulate(self.signals.u) for m in self.fit.models])
+        """The noise-free response to the input, (n, K), without roots that duplicate a
+        modelled disturbance (:func:`response_free_of`)."""
+        s = self.signals
+        return response_free_of(self.spec, self.fit, s.u, s.y - self.disturbance(), slice(*self.window))
 
 
 def usable(n: int, spec: ModelSpec) -> np.ndarray:
@@ -195,25 +197,76 @@ def fit_model(
             start=fit,
         )
         if phi.shape[1]:
-            theta, cov = _disturbance_gls(fit, u, y, phi[lo:hi], spec)
+            theta, cov = _disturbance_ls(fit, u, y, phi[lo:hi], spec, theta)
     return FittedModel(spec, fit, theta, cov, (lo, hi), shifted)
 
 
-def _disturbance_gls(fit: ArmaxFit, u, y, phi, spec):
-    """Disturbance coefficients given the dynamics: one-step errors of ``y`` regressed on the
-    regressors filtered by ``A / C`` (the errors are linear in them)."""
+#: A pole pair within this distance (Hz) of a modelled line (or a real root near 1 with a
+#: modelled trend) and damped less than UNDAMPED duplicates the disturbance.
+LINE_MERGE_HZ = 0.05
+UNDAMPED = 2e-3
+
+
+def response_free_of(
+    spec: ModelSpec, fit: ArmaxFit, u: np.ndarray, y: np.ndarray, rows: slice = slice(None)
+) -> np.ndarray:
+    """The response ``B'/A' u`` per sensor, (n, K): ``A'`` is the fit's A without the roots
+    that duplicate a modelled disturbance (a pole pair on a line, a root at 1 with a trend) and
+    ``B'`` is refitted to ``y[rows]`` (the model's fit window) by least squares for that ``A'``
+    (the response is linear in B).
+
+    PEM happily spends a spare pole pair on a line (it predicts a sinusoid perfectly), but
+    that pole, driven by the broadband input, rings near the line in the simulated response
+    and corrupts every estimate built on the simulation residual."""
+    fs = fit.fs
+    roots = np.roots(fit.models[0].a)
+    f_root = np.abs(np.angle(roots)) * fs / (2 * np.pi)
+    freqs = list(spec.lines_hz) + ([0.0] if spec.trend_degree >= 0 else [])
+    dup = np.zeros(roots.size, bool)
+    for f in freqs:
+        slack = max(2 * np.pi * f / fs * UNDAMPED, 1e-3)
+        dup |= (np.abs(f_root - f) < LINE_MERGE_HZ) & (np.abs(roots) > 1 - slack)
+    if not dup.any():
+        return np.column_stack([m.simulate(u) for m in fit.models])
+    uf = lfilter([1.0], np.real(np.poly(roots[~dup])), u)
+    _, nb, _, nk = fit.orders
+    x = np.column_stack([_shifted(uf, nk + j) for j in range(nb)])
+    return x @ np.linalg.lstsq(x[rows], y[rows], rcond=None)[0]
+
+
+def _shifted(x: np.ndarray, k: int) -> np.ndarray:
+    """``x(t - k)`` with zeros outside the record (k may be negative)."""
+    out = np.zeros_like(x)
+    if k >= 0:
+        out[k:] = x[: x.size - k]
+    else:
+        out[:k] = x[-k:]
+    return out
+
+
+def _disturbance_ls(fit: ArmaxFit, u, y, phi, spec, theta):
+    """Disturbance coefficients given the dynamics: least squares of the simulation residual
+    ``y - G u`` on the regressors, with a Newey-West covariance (the residual is coloured).
+
+    Not GLS through the noise model: a root of A that has absorbed part of a line zeroes the
+    ``A / C``-filtered regressor there, starving the estimate; ``G`` is taken without such
+    roots (:func:`response_free_of`)."""
     mask = usable(u.size, spec)
     q = phi.shape[1]
-    theta = np.zeros((q, len(fit.models)))
+    x = phi[mask]
+    xtx_inv = np.linalg.pinv(x.T @ x)
     cov = np.zeros((len(fit.models), q, q))
-    for k, m in enumerate(fit.models):
-        eps0 = m.prediction_errors(y[:, k], u)
-        z = lfilter(m.a, m.c, phi, axis=0)
-        coef, *_ = np.linalg.lstsq(z[mask], eps0[mask], rcond=None)
-        resid = eps0[mask] - z[mask] @ coef
-        sigma2 = float(resid @ resid) / max(1, mask.sum() - q)
-        theta[:, k] = coef
-        cov[k] = sigma2 * np.linalg.pinv(z[mask].T @ z[mask])
+    lag = int(4 * mask.sum() ** (1 / 3))
+    resid = y - response_free_of(spec, fit, u, y - phi @ theta)
+    theta = xtx_inv @ (x.T @ resid[mask])
+    for k in range(len(fit.models)):
+        r = resid[mask, k]
+        score = x * (r - x @ theta[:, k])[:, None]
+        meat = score.T @ score
+        for j in range(1, lag + 1):
+            g = score[j:].T @ score[:-j]
+            meat += (1 - j / (lag + 1)) * (g + g.T)
+        cov[k] = xtx_inv @ meat @ xtx_inv
     return theta, cov
 
 
