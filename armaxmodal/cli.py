@@ -191,7 +191,8 @@ def _diagnosis_text(name: str, report: dict) -> str:
     for e in report["effects"]:
         params = {k: v for k, v in e["parameters"].items() if not isinstance(v, dict)}
         lines.append(
-            f"effect {e['effect']} on {', '.join(e['channels'])}: {e['evidence']['statistic']} p = {e['evidence']['p']:.2g}; "
+            f"effect {e['effect']} on {', '.join(e['channels'])}: "
+            f"{e['evidence']['statistic']} p = {e['evidence']['p']:.2g}; "
             f"held-out one-step RMS {e['error_before']:.4g} -> {e['error_after']:.4g}; {_short(params)}"
         )
         if e.get("note"):

@@ -138,9 +138,7 @@ class FittedModel:
     def one_step_errors(self) -> np.ndarray:
         """One-step prediction errors on the whole record, (n, K)."""
         s, d = self.signals, self.disturbance()
-        return np.column_stack(
-            [m.prediction_errors(s.y[:, k] - d[:, k], s.u) for k, m in enumerate(self.fit.models)]
-        )
+        return np.column_stack([m.prediction_errors(s.y[:, k] - d[:, k], s.u) for k, m in enumerate(self.fit.models)])
 
     def simulation_errors(self) -> np.ndarray:
         """Output minus the noise-free simulated response (and the disturbance), (n, K)."""
