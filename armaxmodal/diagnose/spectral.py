@@ -25,6 +25,8 @@ __all__ = ["harmonic_f_test", "LineTest"]
 #: Time-bandwidth product and number of tapers (2NW - 1).
 NW = 8.0
 N_TAPERS = 15
+#: Zero-padding factor of the frequency grid.
+PAD = 4
 
 
 @dataclass(frozen=True)
@@ -32,8 +34,8 @@ class LineTest:
     """The strongest line of a signal.
 
     ``p_min`` is the smallest p-value over the frequencies tested, corrected (Bonferroni) for
-    the number of independent bands (``n_bins / NW``); ``freq_hz`` its frequency refined on a
-    grid 8x finer; ``amplitude`` the line's peak amplitude with a 95 % interval.
+    every point of the padded grid tested; ``freq_hz`` its frequency on the padded
+    grid; ``amplitude`` the line's peak amplitude with a 95 % interval.
     """
 
     freqs: np.ndarray
@@ -75,31 +77,26 @@ def _line_spectrum(x: np.ndarray, fs: float, nfft: int):
 
 
 def harmonic_f_test(x: np.ndarray, fs: float) -> LineTest:
-    """The harmonic F-test on ``x`` (n,) sampled at ``fs`` Hz, away from 0 Hz and Nyquist."""
+    """The harmonic F-test on ``x`` (n,) sampled at ``fs`` Hz, away from 0 Hz and Nyquist.
+
+    Evaluated on a grid :data:`PAD` times finer than the Fourier bins: half a bin off a line,
+    the line leaks into the F denominator (the odd tapers' spectra are not proportional to
+    their means), which caps F whatever the line's size."""
     n = x.size
-    freqs, f_stat, mu_bins, den_bins = _line_spectrum(x, fs, n)
+    freqs, f_stat, mu, den = _line_spectrum(x, fs, PAD * n)
     w = NW * fs / n  # half-bandwidth of the tapers, Hz
     inside = (freqs > 2 * w) & (freqs < fs / 2 - 2 * w)
     i = int(np.argmax(np.where(inside, f_stat, -np.inf)))
-    n_bands = max(1.0, inside.sum() / NW)
+    # the line amplitude decorrelates over 1/T, not over the tapers' bandwidth, and the
+    # padded grid's maximum is higher still: every grid point counts as a test. Measured on
+    # white and MA(2) noise (n = 4000): 5.0 % / 6 % of records below p = 0.05 (bands of
+    # width W gave 60 %)
+    n_bands = max(1.0, float(inside.sum()))
     p_min = float(min(1.0, stats.f.sf(f_stat[i], 2, 2 * N_TAPERS - 2) * n_bands))
-    # refine on a finer grid around the peak
-    fine, f_fine, mu, den = _line_spectrum(x, fs, 8 * n)
-    near = np.abs(fine - freqs[i]) <= fs / n
-    j = int(np.argmax(np.where(near, f_fine, -np.inf)))
-    amp = 2 * abs(mu[j])
-    # |mu| has a complex Gaussian error of variance den / ((K-1) sum U^2) per component pair
+    # mu has a complex Gaussian error of variance den / ((K-1) sum U^2)
     u0sq = float(np.sum(_tapers(n).sum(axis=1) ** 2))
-    sd_all = 2 * np.sqrt(den / (2 * (N_TAPERS - 1) * u0sq))
-    sd = sd_all[j]
-    return LineTest(
-        freqs,
-        f_stat,
-        p_min,
-        float(f_stat[i]),
-        float(fine[j]),
-        amp,
-        (amp - 1.96 * sd, amp + 1.96 * sd),
-        2 * np.abs(mu_bins),
-        2 * np.sqrt(den_bins / (2 * (N_TAPERS - 1) * u0sq)),
-    )
+    amps = 2 * np.abs(mu)
+    amp_sd = 2 * np.sqrt(den / (2 * (N_TAPERS - 1) * u0sq))
+    amp, sd = float(amps[i]), float(amp_sd[i])
+    ci = (amp - 1.96 * sd, amp + 1.96 * sd)
+    return LineTest(freqs, f_stat, p_min, float(f_stat[i]), float(freqs[i]), amp, ci, amps, amp_sd)
