@@ -373,19 +373,32 @@ def write_recording_uff(recording: Recording, path: str | os.PathLike) -> Path:
     return atomic_write(path, write)
 
 
-def write_json(obj, path: str | os.PathLike) -> Path:
-    """Write ``obj`` as indented JSON (numpy scalars and arrays converted)."""
+def strict_json(obj):
+    """``obj`` with numpy values made plain and every non-finite float made ``None``: strict
+    JSON has no NaN or Infinity, and strict parsers reject them."""
+    if isinstance(obj, dict):
+        return {str(k): strict_json(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [strict_json(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return strict_json(obj.tolist())
+    if isinstance(obj, np.generic):
+        obj = obj.item()
+    if isinstance(obj, float) and not np.isfinite(obj):
+        return None
+    if isinstance(obj, complex):
+        raise TypeError("cannot write a complex number to JSON; split it into real and imaginary parts")
+    return obj
 
-    def default(o):
-        if isinstance(o, np.ndarray):
-            return o.tolist()
-        if isinstance(o, np.generic):
-            return o.item()
-        raise TypeError(f"cannot write {type(o).__name__} to JSON")
+
+def write_json(obj, path: str | os.PathLike) -> Path:
+    """Write ``obj`` as indented strict JSON (numpy values converted, NaN and infinities as
+    ``null``; ``allow_nan=False`` so a bare NaN can never slip through)."""
+    clean = strict_json(obj)
 
     def write(tmp: str) -> None:
         with open(tmp, "w", encoding="utf-8") as fh:
-            json.dump(obj, fh, indent=2, default=default)
+            json.dump(clean, fh, indent=2, allow_nan=False)
             fh.write("\n")
 
     return atomic_write(path, write)

@@ -171,3 +171,16 @@ def test_real_shake_table_csv_needs_its_header_skipped(realdata_dir):
     """Xsens exports carry 7 header lines; reading them raw must fail clearly, not crash."""
     with pytest.raises(DataError):
         am.read_recording(realdata_dir / "mini_shake_table_imu" / "flex3" / "northridge__g.csv.gz")
+
+
+def test_json_is_strict_nan_and_infinity_become_null(tmp_path):
+    """Strict parsers reject bare NaN: the writer turns every non-finite number into null."""
+    import json
+
+    from armaxmodal.io import write_json
+
+    path = write_json(
+        {"a": float("nan"), "b": np.array([1.5, np.inf]), "c": [np.float64(-np.inf), 2]}, tmp_path / "x.json"
+    )
+    data = json.loads(path.read_text(), parse_constant=lambda c: pytest.fail(f"bare {c} written"))
+    assert data == {"a": None, "b": [1.5, None], "c": [None, 2]}
