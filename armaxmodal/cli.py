@@ -180,14 +180,14 @@ def _diagnosis_text(name: str, report: dict) -> str:
     sensors = report["outputs"]
     base, final = report["baseline"], report["final"]
     lines = [f"{name}: {len(sensors)} sensors at {report['analysis_fs']:g} Hz; baseline orders {report['orders']}"]
-    lines.append(f"{'sensor':>12} {'fit before %':>13} {'fit after %':>12} {'resid RMS':>10} {'noise floor':>12}")
+    lines.append(f"{'sensor':>12} {'fit before %':>13} {'fit after %':>12} {'resid RMS':>10} {'H1 floor':>12}")
     for k, s in enumerate(sensors):
         lines.append(
             f"{s:>12} {base['fit_val_pct'][k]:13.1f} {final['fit_val_pct'][k]:12.1f} "
             f"{final['sim_resid_rms'][k]:10.4g} {final['noise_floor_rms'][k]:12.4g}"
         )
     if not report["effects"]:
-        lines.append("no effect found: the residual is consistent with the model (tests listed in the JSON).")
+        lines.append("no effect kept (the tests' p-values are in the JSON's 'tests').")
     for e in report["effects"]:
         params = {k: v for k, v in e["parameters"].items() if not isinstance(v, dict)}
         lines.append(
@@ -200,6 +200,7 @@ def _diagnosis_text(name: str, report: dict) -> str:
     for u in report["unconfirmed"]:
         lines.append(f"unconfirmed {u['effect']} on {', '.join(u['channels'])}: {u['reason']}")
     lines.append("not tested by this version: " + ", ".join(report["not_tested"]))
+    lines.append("verdict: " + report["verdict"])
     return "\n".join(lines)
 
 

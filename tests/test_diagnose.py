@@ -42,7 +42,7 @@ def test_clean_ride_has_no_effect(clean):
     d = _run(clean)
     assert d.effects == () and d.unconfirmed == ()
     js = d.to_dict()
-    assert js["effects"] == []
+    assert js["effects"] == [] and js["verdict"].startswith("no effect")
     assert min(js["final"]["whiteness_p"]) > 0.01
 
 

@@ -140,6 +140,7 @@ class Diagnosis:
         final = self.final.summary(self.noise_floor)
         final.update(modes_before=modes(self.baseline), modes_after=modes(self.final))
         return {
+            "verdict": _verdict(self, final["whiteness_p"]),
             "fs": self.original_fs,
             "analysis_fs": self.recording.fs,
             "input": self.recording.input_name,
@@ -154,6 +155,21 @@ class Diagnosis:
             "not_tested": [e for e in EFFECTS if e not in TESTED_EFFECTS],
             "warnings": [w.to_dict() for w in self.warnings],
         }
+
+
+def _verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float = 0.01) -> str:
+    """One sentence a person can act on, unsure where the data leave doubt."""
+    coloured = [s for s, p in zip(diagnosis.sensors, whiteness, strict=True) if p < alpha]
+    if coloured:
+        return (
+            f"unsure: the residual of {', '.join(coloured)} is still not white after the fixes; an effect this "
+            "version does not test (a nonlinearity, a time change, a missing mode) may remain. Look at the figure."
+        )
+    if diagnosis.unconfirmed:
+        return "unsure: some tests fired but their fixes did not lower the held-out error (see 'unconfirmed')."
+    if diagnosis.effects:
+        return "the effects listed explain the residual: it is white after the fixes."
+    return "no effect: the residual is consistent with the model."
 
 
 def _signals(recording: Recording, band) -> tuple[Signals, Recording, tuple]:
