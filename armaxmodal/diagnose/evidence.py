@@ -21,6 +21,7 @@ from scipy.signal import lfilter
 from ..quality import MIN_DELAY_SAMPLES, estimate_delays
 from ..recording import Recording
 from .model import LINE_MERGE_HZ, UNDAMPED, FittedModel, usable
+from .model import lagged as _lag
 from .spectral import harmonic_f_test
 
 __all__ = ["Finding", "run_tests", "whiteness_p", "EFFECT_TESTS"]
@@ -73,16 +74,6 @@ def gradient_columns(model, y: np.ndarray, u: np.ndarray, eps: np.ndarray) -> np
     cols += [_lag(uc, nk + j) for j in range(nb)]
     cols += [_lag(ec, i) for i in range(1, nc + 1)]
     return np.column_stack(cols)
-
-
-def _lag(x: np.ndarray, k: int) -> np.ndarray:
-    """``x(t - k)`` with zeros outside the record (k may be negative)."""
-    out = np.zeros_like(x)
-    if k >= 0:
-        out[k:] = x[: x.size - k]
-    else:
-        out[:k] = x[-k:]
-    return out
 
 
 def lm_f_test(eps: np.ndarray, psi: np.ndarray, z: np.ndarray) -> tuple[float, float]:

@@ -228,11 +228,11 @@ def response_free_of(
         return np.column_stack([m.simulate(u) for m in fit.models])
     uf = lfilter([1.0], np.real(np.poly(roots[~dup])), u)
     _, nb, _, nk = fit.orders
-    x = np.column_stack([_shifted(uf, nk + j) for j in range(nb)])
+    x = np.column_stack([lagged(uf, nk + j) for j in range(nb)])
     return x @ np.linalg.lstsq(x[rows], y[rows], rcond=None)[0]
 
 
-def _shifted(x: np.ndarray, k: int) -> np.ndarray:
+def lagged(x: np.ndarray, k: int) -> np.ndarray:
     """``x(t - k)`` with zeros outside the record (k may be negative)."""
     out = np.zeros_like(x)
     if k >= 0:
