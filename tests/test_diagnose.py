@@ -155,3 +155,37 @@ def test_cli_writes_strict_json_with_the_contract(tmp_path, clean):
     assert {"statistic", "p"} <= first["evidence"].keys()
     assert first["error_after"] <= first["error_before"]
     assert fig.stat().st_size > 10_000
+
+
+@pytest.fixture(scope="module")
+def nonlinear_rides():
+    """The supine human with a cubic spring between chest and pelvis (its force equal to 0.3
+    of the linear spring's at the RMS deflection), and its linear twin (ratio 0)."""
+    from armaxmodal.diagnose.inject import cubic_spring_ride
+
+    u = am.random_vibration(60.0, 120.0, band=(0.5, 28.0), seed=1)
+    return {r: cubic_spring_ride(am.supine_human(), u, 60.0, (1, 2), r, seed=2) for r in (0.0, 0.3)}
+
+
+def test_cubic_spring_ride_reduces_to_the_exact_linear_simulation():
+    from armaxmodal.diagnose.inject import cubic_spring_ride
+
+    u = am.random_vibration(60.0, 20.0, band=(0.5, 28.0), seed=5)
+    rk4 = cubic_spring_ride(am.supine_human(), u, 60.0, (1, 2), 0.0, noise=0.0)
+    exact = am.simulate(am.supine_human(), u, 60.0, hold="bandlimited")
+    assert np.max(np.abs(rk4.response - exact)) < 1e-4 * np.std(exact)
+
+
+def test_a_cubic_spring_is_named_between_the_right_segments(nonlinear_rides):
+    d = _run(nonlinear_rides[0.3])
+    effect = _first(d)
+    assert effect.finding.effect == "stiffness_nonlinearity"
+    assert effect.parameters["between"] == ["chest", "pelvis"]
+    assert {"chest", "pelvis"} <= set(effect.finding.channels)
+    assert effect.parameters["sim_error_after"] < 0.95 * effect.parameters["sim_error_before"]
+    assert effect.error_after < effect.error_before
+
+
+def test_the_linear_twin_has_no_nonlinearity(nonlinear_rides):
+    d = _run(nonlinear_rides[0.0])
+    assert d.effects == ()

@@ -29,7 +29,7 @@ __all__ = ["Finding", "run_tests", "whiteness_p", "EFFECT_TESTS"]
 #: Lags of the residual in the Breusch-Godfrey whiteness test.
 WHITENESS_LAGS = 10
 #: The tests each round runs, in the order linear/structural effects come first.
-EFFECT_TESTS = ("input_delay", "offset_drift", "periodic_disturbance", "coloured_noise")
+EFFECT_TESTS = ("input_delay", "offset_drift", "periodic_disturbance", "coloured_noise", "stiffness_nonlinearity")
 #: A line in the residual is the input's (model error), not a disturbance, when the input
 #: itself carries a line there at this significance.
 INPUT_LINE_P = 1e-3
@@ -60,18 +60,21 @@ class Finding:
     value: float
     p: float
     parameters: dict = field(default_factory=dict)
+    #: What the fix needs beyond the parameters (a nonlinear term's regressor block).
+    payload: object = field(default=None, compare=False, repr=False)
 
     def evidence(self) -> dict:
         return {"statistic": self.statistic, "value": float(self.value), "p": float(self.p)}
 
 
 def gradient_columns(model, y: np.ndarray, u: np.ndarray, eps: np.ndarray) -> np.ndarray:
-    """Columns of the one-step error's gradient of an ARMAX model, (n, na + nb + nc):
+    """Columns of the one-step error's gradient of an ARMAX model, (n, na + n_in nb + nc):
     ``y(t-i)/C``, ``u(t-nk-j)/C`` and ``eps(t-i)/C`` (signs do not matter to a regression)."""
     na, nb, nc, nk = model.orders
-    yc, uc, ec = (lfilter([1.0], model.c, x) for x in (y, u, eps))
+    yc, ec = (lfilter([1.0], model.c, x) for x in (y, eps))
+    uc = lfilter([1.0], model.c, u, axis=0).reshape(y.size, -1)
     cols = [_lag(yc, i) for i in range(1, na + 1)]
-    cols += [_lag(uc, nk + j) for j in range(nb)]
+    cols += [_lag(uc[:, m], nk + j) for m in range(uc.shape[1]) for j in range(nb)]
     cols += [_lag(ec, i) for i in range(1, nc + 1)]
     return np.column_stack(cols)
 
@@ -88,6 +91,15 @@ def lm_f_test(eps: np.ndarray, psi: np.ndarray, z: np.ndarray) -> tuple[float, f
     return f, float(stats.f.sf(f, q, dof))
 
 
+def _projected_f(e: np.ndarray, z: np.ndarray, p: int) -> tuple[float, float]:
+    """:func:`lm_f_test` with the regressors already projected out of ``e`` and ``z``."""
+    coef = np.linalg.lstsq(z, e, rcond=None)[0]
+    rss_r, rss_u = float(e @ e), float(np.sum((e - z @ coef) ** 2))
+    q, dof = z.shape[1], e.size - p - z.shape[1]
+    f = ((rss_r - rss_u) / q) / max(rss_u / dof, 1e-300)
+    return f, float(stats.f.sf(f, q, dof))
+
+
 def run_tests(fitted: FittedModel, alpha: float = 0.01) -> tuple[list[Finding], dict]:
     """Every effect test on ``fitted``; returns the significant findings (corrected p below
     ``alpha``), strongest first within each tier, and the per-sensor statistics for the report."""
@@ -100,6 +112,7 @@ def run_tests(fitted: FittedModel, alpha: float = 0.01) -> tuple[list[Finding], 
     found += _trend_findings(fitted, eps, mask, n_tests, table)
     found += _line_findings(fitted, mask, n_tests, table)
     found += _whiteness_findings(fitted, eps, mask, n_tests, table)
+    found += _nonlinear_findings(fitted, eps, mask, n_tests, table)
     return [f for f in found if f.p < alpha], table
 
 
@@ -146,7 +159,7 @@ def _trend_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
     out = []
     for k, m in enumerate(fitted.fit.models):
         y = s.y[:, k] - fitted.disturbance()[:, k]
-        psi = gradient_columns(m, y, s.u, eps[:, k])
+        psi = gradient_columns(m, y, s.inputs(fitted.spec), eps[:, k])
         z = lfilter(m.a, m.c, np.column_stack([tau**d for d in terms]), axis=0)
         f, p = lm_f_test(eps[mask, k], psi[mask], z[mask])
         p = min(1.0, p * n_tests)
@@ -224,7 +237,7 @@ def _whiteness_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
     out = []
     for k, m in enumerate(fitted.fit.models):
         y = s.y[:, k] - fitted.disturbance()[:, k]
-        psi = gradient_columns(m, y, s.u, eps[:, k])
+        psi = gradient_columns(m, y, s.inputs(fitted.spec), eps[:, k])
         z = np.column_stack([_lag(eps[:, k], i) for i in range(1, WHITENESS_LAGS + 1)])
         f, p = lm_f_test(eps[mask, k], psi[mask], z[mask])
         table["whiteness_p"].append(min(1.0, p * len(s.sensors)))
@@ -262,3 +275,77 @@ def cross_correlation(fitted: FittedModel, max_lag: int = 25) -> dict:
         out["ccf"].append(ccf.tolist())
         out["bound99"].append(float(stats.norm.ppf(0.995) * np.sqrt(max(p1, 1e-3) / n)))
     return out
+
+
+#: Candidate nonlinear restoring forces of a deflection ``d``.
+TERM_KINDS = {"cubic": lambda d: d**3, "quadratic": lambda d: d**2, "abs_times": lambda d: np.abs(d) * d}
+
+
+def deflections(fitted: FittedModel) -> dict[tuple[str, str], np.ndarray]:
+    """Deflections of the model's simulated response: each sensor relative to the base and
+    each pair of sensors, (n,) each, keyed by (sensor, other or input). Displacements come
+    from the simulated relative accelerations integrated twice in the frequency domain,
+    from half the lowest mode (and the input's excited band) up."""
+    from ..frf import excited_band
+
+    s = fitted.signals
+    rel = fitted.simulated() - s.u[:, None]
+    # below the first mode the relative motion is quasi-static and a double integral only
+    # amplifies the model's low-frequency error: integrate from half the lowest mode up
+    _, f_modes, xi, _ = fitted.fit.models[0].modal_parameters()
+    physical = f_modes[(xi > 0) & (xi < 0.6)]
+    f_first = float(physical.min()) if physical.size else 0.0
+    f_lo = max(excited_band(Recording(s.fs, s.u, s.y, s.sensors, s.input_name))[0], 0.5 * f_first, 3 * s.fs / s.n)
+    f = np.fft.rfftfreq(s.n, 1 / s.fs)
+    spec = np.fft.rfft(rel, axis=0)
+    gain = np.where(f >= f_lo, -1.0 / np.maximum((2 * np.pi * f) ** 2, 1e-300), 0.0)
+    disp = np.fft.irfft(spec * gain[:, None], s.n, axis=0)
+    out = {(name, s.input_name): disp[:, k] for k, name in enumerate(s.sensors)}
+    for k in range(len(s.sensors)):
+        for j in range(k + 1, len(s.sensors)):
+            out[(s.sensors[k], s.sensors[j])] = disp[:, k] - disp[:, j]
+    return out
+
+
+def _nonlinear_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
+    """Score test of candidate restoring forces built from the simulated response (cubic,
+    quadratic, |d| d of every deflection), entering through the structure's dynamics as a
+    second input ``B_nl / A``: the one-step error's gradient in ``B_nl`` is the term filtered
+    by 1/C (lags 0..TERM_LAGS-1 tested). The candidate with the largest summed F over
+    sensors is tested; p corrected for candidates x sensors x tests."""
+    from .model import TERM_LAGS
+
+    s = fitted.signals
+    defl = deflections(fitted)
+    candidates = [(kind, pair) for pair in defl for kind in TERM_KINDS]
+    # the score test against each candidate shares the gradient columns: project them out once
+    bases, resid = [], []
+    dist = fitted.disturbance()
+    for k, m in enumerate(fitted.fit.models):
+        q, _ = np.linalg.qr(gradient_columns(m, s.y[:, k] - dist[:, k], s.inputs(fitted.spec), eps[:, k])[mask])
+        bases.append(q)
+        resid.append(eps[mask, k] - q @ (q.T @ eps[mask, k]))
+    best, best_sum, best_ps = None, -np.inf, None
+    for kind, pair in candidates:
+        term = TERM_KINDS[kind](defl[pair])
+        term = term / max(float(np.std(term)), 1e-300)
+        fs_, ps = [], []
+        for k, m in enumerate(fitted.fit.models):
+            z = lfilter([1.0], m.c, term)
+            cols = np.column_stack([_lag(z, j) for j in range(TERM_LAGS)])[mask]
+            f, p = _projected_f(resid[k], cols - bases[k] @ (bases[k].T @ cols), bases[k].shape[1])
+            fs_.append(f)
+            ps.append(p)
+        if sum(fs_) > best_sum:
+            best, best_sum, best_ps = (kind, pair, term), sum(fs_), ps
+    if best is None:
+        return []
+    kind, pair, term = best
+    scale = len(candidates) * n_tests
+    ps = [min(1.0, p * scale) for p in best_ps]
+    table["nonlinear_p"] = ps
+    channels = tuple(name for name, p in zip(s.sensors, ps, strict=True) if p < 0.01)
+    if not channels:
+        return []
+    params = {"term": kind, "between": list(pair)}
+    return [Finding("stiffness_nonlinearity", channels, "score_F", best_sum, min(ps), params, payload=term)]

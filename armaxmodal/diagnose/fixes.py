@@ -32,6 +32,10 @@ def add_effect(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelS
         return replace(spec, lines_hz=spec.lines_hz + (f0,))
     if finding.effect == "coloured_noise":
         return replace(spec, extra_nc=spec.extra_nc + EXTRA_NC_STEP)
+    if finding.effect == "stiffness_nonlinearity":
+        name = f"{finding.parameters['term']}:{'-'.join(finding.parameters['between'])}#{len(spec.terms) + 1}"
+        fitted.signals.extra[name] = finding.payload
+        return replace(spec, terms=spec.terms + (name,))
     raise ValueError(f"no fix for effect {finding.effect!r}")
 
 
@@ -95,6 +99,16 @@ def effect_parameters(finding: Finding, fitted: FittedModel) -> dict:
             amps[name] = {"amp": amp, "amp_ci95": [amp - 1.96 * sd, amp + 1.96 * sd]}
         first = amps[finding.channels[0]]
         return {"freq_hz": spec.lines_hz[-1], "amp": first["amp"], "amp_ci95": first["amp_ci95"], "per_channel": amps}
+    if finding.effect == "stiffness_nonlinearity":
+        # the term's share of each channel: RMS of its simulated contribution over the output's
+        u = np.zeros((s.n, 1 + len(spec.terms)))
+        u[:, -1] = s.extra[spec.terms[-1]]
+        share = {
+            name: float(np.std(fitted.fit.models[k].simulate(u)) / np.std(s.y[:, k]))
+            for k, name in enumerate(s.sensors)
+            if name in finding.channels
+        }
+        return {**finding.parameters, "rms_share_of_output": share}
     if finding.effect == "coloured_noise":
         return {"nc": spec.orders[2] + spec.extra_nc, "nc_before": spec.orders[2] + spec.extra_nc - EXTRA_NC_STEP}
     return dict(finding.parameters)

@@ -33,13 +33,23 @@ EFFECTS = (
     "sensor_fault",
 )
 #: The effects this version tests and fixes; the others are listed as not tested.
-TESTED_EFFECTS = ("input_delay", "offset_drift", "periodic_disturbance", "coloured_noise")
+TESTED_EFFECTS = ("input_delay", "offset_drift", "periodic_disturbance", "coloured_noise", "stiffness_nonlinearity")
 #: Linear/structural effects first: a wrong linear part fires every later test.
-_TIER = {"input_delay": 0, "offset_drift": 1, "periodic_disturbance": 1, "coloured_noise": 2}
+_TIER = {
+    "input_delay": 0,
+    "offset_drift": 1,
+    "periodic_disturbance": 1,
+    "coloured_noise": 2,
+    "stiffness_nonlinearity": 3,
+}
 #: A disturbance on the output is judged on the simulation error: a one-step predictor can
 #: carry a line or an offset in its noise model (an undamped pole, A(1)) while the
 #: deterministic part -- the modes -- is wrong.
-_CRITERION = {"periodic_disturbance": "simulation", "offset_drift": "simulation"}
+_CRITERION = {
+    "periodic_disturbance": "simulation",
+    "offset_drift": "simulation",
+    "stiffness_nonlinearity": "simulation",
+}
 #: Fewer samples than this per half cannot hold out a validation part.
 MIN_SAMPLES = 400
 

@@ -26,6 +26,8 @@ from ..fit import ArmaxFit, fit_armax
 
 __all__ = ["Signals", "ModelSpec", "FittedModel", "fit_model", "held_out", "HeldOut"]
 
+#: Lags of a nonlinear term in its score test.
+TERM_LAGS = 3
 #: Backfitting passes between the ARMAX fit and the disturbance coefficients.
 BACKFIT_PASSES = 3
 #: Iteration cap of each refit (the baseline's parameters are the start of every refit).
@@ -41,10 +43,16 @@ class Signals:
     fs: float
     sensors: tuple[str, ...]
     input_name: str
+    #: Named extra inputs (n,) a spec's ``terms`` refer to (nonlinear terms).
+    extra: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def n(self) -> int:
         return self.u.size
+
+    def inputs(self, spec: ModelSpec) -> np.ndarray:
+        """The measured input and the spec's extra inputs, (n, 1 + len(spec.terms))."""
+        return np.column_stack([self.u] + [self.extra[name] for name in spec.terms])
 
 
 @dataclass(frozen=True)
@@ -62,6 +70,9 @@ class ModelSpec:
         Sinusoidal disturbances (a sine and a cosine per sensor each).
     extra_nc : int
         C coefficients beyond ``orders``'s nc.
+    terms : tuple of str
+        Names of extra inputs in :attr:`Signals.extra` (a nonlinear term of the simulated
+        response): each enters through the dynamics like the base input, ``B_m / A``.
     """
 
     orders: tuple[int, int, int, int]
@@ -69,6 +80,7 @@ class ModelSpec:
     trend_degree: int = -1
     lines_hz: tuple[float, ...] = ()
     extra_nc: int = 0
+    terms: tuple[str, ...] = ()
 
     @property
     def n_disturbance(self) -> int:
@@ -76,12 +88,14 @@ class ModelSpec:
 
     def n_parameters(self, n_sensors: int) -> int:
         na, nb, nc, _ = self.orders
-        return na + n_sensors * (nb + nc + self.extra_nc + self.n_disturbance)
+        n_in = 1 + len(self.terms)
+        return na + n_sensors * (n_in * nb + nc + self.extra_nc + self.n_disturbance)
 
 
-def disturbance_columns(spec: ModelSpec, n: int, fs: float) -> np.ndarray:
+def disturbance_columns(spec: ModelSpec, signals: Signals) -> np.ndarray:
     """Regressors of the additive disturbances, (n, q): ``[1, tau, tau^2][:degree+1]`` with
     ``tau`` the time scaled to [-1, 1], then ``sin, cos`` of each line."""
+    n, fs = signals.n, signals.fs
     tau = np.linspace(-1.0, 1.0, n)
     cols = [tau**d for d in range(spec.trend_degree + 1)]
     t = np.arange(n) / fs
@@ -132,13 +146,14 @@ class FittedModel:
 
     def disturbance(self) -> np.ndarray:
         """The fitted disturbance on every sample, (n, K)."""
-        phi = disturbance_columns(self.spec, self.signals.n, self.signals.fs)
+        phi = disturbance_columns(self.spec, self.signals)
         return phi @ self.theta
 
     def one_step_errors(self) -> np.ndarray:
         """One-step prediction errors on the whole record, (n, K)."""
         s, d = self.signals, self.disturbance()
-        return np.column_stack([m.prediction_errors(s.y[:, k] - d[:, k], s.u) for k, m in enumerate(self.fit.models)])
+        u = s.inputs(self.spec)
+        return np.column_stack([m.prediction_errors(s.y[:, k] - d[:, k], u) for k, m in enumerate(self.fit.models)])
 
     def simulation_errors(self) -> np.ndarray:
         """Output minus the noise-free simulated response (and the disturbance), (n, K)."""
@@ -149,7 +164,7 @@ class FittedModel:
         """The noise-free response to the input, (n, K), without roots that duplicate a
         modelled disturbance (:func:`response_free_of`)."""
         s = self.signals
-        return response_free_of(self.spec, self.fit, s.u, s.y - self.disturbance(), slice(*self.window))
+        return response_free_of(self.spec, self.fit, s.inputs(self.spec), s.y - self.disturbance(), slice(*self.window))
 
 
 def usable(n: int, spec: ModelSpec) -> np.ndarray:
@@ -171,10 +186,10 @@ def fit_model(
     shifted = apply_shifts(signals, spec.shifts)
     lo, hi = window or (0, signals.n)
     na, nb, nc, nk = spec.orders
-    phi = disturbance_columns(spec, signals.n, signals.fs)
+    phi = disturbance_columns(spec, signals)
     k_count = len(signals.sensors)
     cov = np.zeros((k_count, phi.shape[1], phi.shape[1]))
-    u, y = shifted.u[lo:hi], shifted.y[lo:hi]
+    u, y = shifted.inputs(spec)[lo:hi], shifted.y[lo:hi]
     # start from plain least squares of the output on the regressors: the response to a
     # zero-mean broadband input is nearly orthogonal to an offset, a trend or a line, and an
     # ARMAX fitted with the disturbance left in would carry it in its poles (a root near 1)
@@ -226,9 +241,9 @@ def response_free_of(
         dup |= (np.abs(f_root - f) < LINE_MERGE_HZ) & (np.abs(roots) > 1 - slack)
     if not dup.any():
         return np.column_stack([m.simulate(u) for m in fit.models])
-    uf = lfilter([1.0], np.real(np.poly(roots[~dup])), u)
+    uf = lfilter([1.0], np.real(np.poly(roots[~dup])), u, axis=0).reshape(u.shape[0], -1)
     _, nb, _, nk = fit.orders
-    x = np.column_stack([lagged(uf, nk + j) for j in range(nb)])
+    x = np.column_stack([lagged(uf[:, m], nk + j) for m in range(uf.shape[1]) for j in range(nb)])
     return x @ np.linalg.lstsq(x[rows], y[rows], rcond=None)[0]
 
 
