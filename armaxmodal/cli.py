@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import gc
+import os
 import sys
 from collections.abc import Sequence
 
@@ -17,15 +18,77 @@ import numpy as np
 
 from . import datasets
 from .exceptions import ArmaxModalError, DataError, OrderError
-from .io import atomic_write, read_recording, write_json, write_recording_csv
+from .io import read_recording, write_all, write_json, write_recording_csv
 
 SYSTEMS = {"supine": datasets.supine_human, "chapter2": datasets.chapter2_system}
+#: Output options checked before any work (every command that writes files).
+OUTPUT_OPTIONS = ("json", "csv", "plot", "out")
+#: A simulation longer than this many samples is refused (it would run for minutes and fill memory).
+MAX_SIMULATED_SAMPLES = 10_000_000
+
+
+def _number(kind, lo: float, lo_open: bool, what: str):
+    """An argparse type: a finite number of ``kind`` above ``lo`` (strictly when ``lo_open``)."""
+
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}") from exc
+        if not np.isfinite(value) or value < lo or (lo_open and value == lo):
+            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}")
+        return value
+
+    return parse
+
+
+_POSITIVE_INT = _number(int, 1, False, "a whole number >= 1")
+_NONNEG_INT = _number(int, 0, False, "a whole number >= 0")
+_POSITIVE = _number(float, 0.0, True, "a finite number > 0")
+_NONNEG = _number(float, 0.0, False, "a finite number >= 0")
+
+
+def check_output_paths(args) -> None:
+    """Every output path usable before any work: not a directory, its parent a directory (or
+    creatable), not one of the input files, and no two outputs the same file."""
+    from pathlib import Path
+
+    inputs = [Path(p).resolve() for p in _input_files(args)]
+    seen = {}
+    for option in OUTPUT_OPTIONS:
+        value = getattr(args, option, None)
+        if value is None:
+            continue
+        path = Path(value).resolve()
+        flag = f"--{option}"
+        if path.is_dir():
+            raise DataError(f"{flag} {value}: is a directory; give a file name inside it.")
+        if path in inputs:
+            raise DataError(f"{flag} {value}: is an input file; writing there would destroy it. Choose another name.")
+        if path in seen:
+            raise DataError(f"{flag} and {seen[path]} name the same file {value}; give each its own.")
+        seen[path] = flag
+        parent = next((q for q in path.parents if q.exists()), None)
+        if parent is not None and not parent.is_dir():
+            raise DataError(f"{flag} {value}: {parent} is a file, not a folder; choose a path in a folder.")
+        if parent is not None and not os.access(parent, os.W_OK):
+            raise DataError(f"{flag} {value}: no permission to write in {parent}.")
+
+
+def _input_files(args) -> list[str]:
+    data = getattr(args, "data", None)
+    files = list(data) if isinstance(data, list) else ([data] if data else [])
+    for option in ("modes", "recording"):
+        value = getattr(args, option, None)
+        if isinstance(value, str):
+            files.append(value)
+    return files
 
 
 def _add_data_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("data", nargs="+", help="recording: .csv[.gz], .mat or .uff; or one Xsens DOT export per sensor")
     p.add_argument("--input", default="base", help="input (base acceleration) column or sensor; default 'base'")
-    p.add_argument("--fs", type=float, default=None, help="sampling rate in Hz if the file has no time column")
+    p.add_argument("--fs", type=_POSITIVE, default=None, help="sampling rate in Hz if the file has no time column")
     p.add_argument("--outputs", default=None, help="comma-separated output columns to use (default: all)")
     p.add_argument("--axis", default="Acc_X", help="Xsens exports: the column to use; default Acc_X")
 
@@ -85,11 +148,13 @@ def _cmd_identify(args) -> int:
         ["freq_hz", "damping", "damped_freq_hz", "freq_ci95_lo", "freq_ci95_hi", "damping_ci95_lo", "damping_ci95_hi"]
     ]
     print(table.to_string(float_format=lambda v: f"{v:.4f}"))
+    outputs = []
     if args.json:
-        write_json(result.to_dict(), args.json)
+        outputs.append((args.json, lambda tmp: write_json(result.to_dict(), tmp)))
     if args.csv:
         poles = result.fit.modes().drop(columns=["pole", "residue"])
-        atomic_write(args.csv, lambda tmp: poles.to_csv(tmp, index=False))
+        outputs.append((args.csv, lambda tmp: poles.to_csv(tmp, index=False)))
+    write_all(outputs)
     return 0
 
 
@@ -115,8 +180,8 @@ def _cmd_stabilise(args) -> int:
         selection = select_modes(diagram, args.modes, band)
     except OrderError:
         # no mode: the diagram and the pole table still show the user why
-        _write_diagram(args, diagram, None, plot_format)
         _print_warnings(diagram.warnings)
+        _write_outputs(_diagram_outputs(args, diagram, None, plot_format))
         raise
     if not args.quiet:
         prep = diagram.preparation
@@ -138,9 +203,11 @@ def _cmd_stabilise(args) -> int:
         )
         print(f"FRF rebuilt from the modes vs H1: {100 * selection.reconstruction_error:.1f} % error")
     _print_warnings(selection.warnings)
-    _write_diagram(args, diagram, selection, plot_format)
+    outputs = _diagram_outputs(args, diagram, selection, plot_format)
     if args.json:
-        write_json(selection.to_dict(args.shapes.replace("-", "_")), args.json)
+        report = selection.to_dict(args.shapes.replace("-", "_"))
+        outputs.append((args.json, lambda tmp: write_json(report, tmp)))
+    _write_outputs(outputs)
     return 0
 
 
@@ -160,18 +227,13 @@ def _cmd_diagnose(args) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
         from .diagnose.plot import plot_diagnosis
 
         fig = plot_diagnosis(result)
         outputs.append((args.plot, lambda tmp: fig.savefig(tmp, dpi=120, format=plot_format)))
     if args.json:
         outputs.append((args.json, lambda tmp: write_json(report, tmp)))
-    for path, write in outputs:
-        atomic_write(path, write)
-    if args.plot:
-        plt.close(fig)
+    _write_outputs(outputs)
     return 0
 
 
@@ -221,19 +283,29 @@ def _print_warnings(warnings) -> None:
         print(f"warning [{w.code}]: {w.message}", file=sys.stderr)
 
 
-def _write_diagram(args, diagram, selection, plot_format) -> None:
+def _diagram_outputs(args, diagram, selection, plot_format) -> list:
+    """The stabilisation plot and pole table as ``(path, write)`` pairs for :func:`write_all`."""
+    outputs = []
     if args.plot:
         import matplotlib
 
         matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
         ax, _ = diagram.plot(selection)
-        atomic_write(args.plot, lambda tmp: ax.figure.savefig(tmp, dpi=150, format=plot_format))
-        plt.close(ax.figure)
+        outputs.append((args.plot, lambda tmp: ax.figure.savefig(tmp, dpi=150, format=plot_format)))
     if args.csv:
         table = diagram.to_frame()
-        atomic_write(args.csv, lambda tmp: table.to_csv(tmp, index=False))
+        outputs.append((args.csv, lambda tmp: table.to_csv(tmp, index=False)))
+    return outputs
+
+
+def _write_outputs(outputs) -> None:
+    """All outputs or none, then the figures closed."""
+    import matplotlib.pyplot as plt
+
+    try:
+        write_all(outputs)
+    finally:
+        plt.close("all")
 
 
 def _format(path: str) -> str:
@@ -259,6 +331,9 @@ def _modal_noise_levels(data: dict) -> dict:
 
 def _cmd_invert(args) -> int:
     import json
+
+    if args.plot and not args.recording:
+        raise DataError("--plot shows the predicted against the measured motion: give --recording DATA.")
 
     from .inverse import evphc, inner_solve, model_update, pia
     from .inverse._modal_data import body_mass_bounds, modes_from_json
@@ -306,41 +381,36 @@ def _cmd_invert(args) -> int:
             print(f"note: {flag}")
         if prediction is not None:
             print(prediction.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+    outputs = []
     if args.plot:
-        if prediction is None:
-            raise DataError("--plot shows the predicted against the measured motion: give --recording DATA.")
         import matplotlib
 
         matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
         from .plot import plot_prediction
 
         axes = plot_prediction(rec, prediction.attrs["prediction"], prediction.fit_percent.to_numpy())
-        atomic_write(args.plot, lambda tmp: axes[0].figure.savefig(tmp, dpi=150, format=plot_format))
-        plt.close(axes[0].figure)
+        outputs.append((args.plot, lambda tmp: axes[0].figure.savefig(tmp, dpi=150, format=plot_format)))
     if args.json:
         comps = sol.components
-        write_json(
-            {
-                "method": sol.method,
-                "M": sol.structure.M,
-                "C": sol.structure.C,
-                "K": sol.structure.K,
-                "names": list(sol.structure.names),
-                "components": None if comps is None else _components_dict(comps),
-                "components_std": None if sol.std is None else _components_dict(sol.std),
-                "modes": sol.modes.to_dict()["modes"],
-                "misfits": sol.misfits,
-                "flags": sol.flags,
-                "converged": sol.converged,
-                "time_s": sol.time_s,
-                "prediction_fit_percent": None
-                if prediction is None
-                else dict(zip(prediction.sensor, map(float, prediction.fit_percent), strict=True)),
-            },
-            args.json,
-        )
+        report = {
+            "method": sol.method,
+            "M": sol.structure.M,
+            "C": sol.structure.C,
+            "K": sol.structure.K,
+            "names": list(sol.structure.names),
+            "components": None if comps is None else _components_dict(comps),
+            "components_std": None if sol.std is None else _components_dict(sol.std),
+            "modes": sol.modes.to_dict()["modes"],
+            "misfits": sol.misfits,
+            "flags": sol.flags,
+            "converged": sol.converged,
+            "time_s": sol.time_s,
+            "prediction_fit_percent": None
+            if prediction is None
+            else dict(zip(prediction.sensor, map(float, prediction.fit_percent), strict=True)),
+        }
+        outputs.append((args.json, lambda tmp: write_json(report, tmp)))
+    _write_outputs(outputs)
     return 0
 
 
@@ -362,6 +432,15 @@ def _cmd_simulate(args) -> int:
     from .simulate import random_vibration, simulate_recording, sine_sweep
 
     structure = SYSTEMS[args.system]()
+    if args.duration * args.fs > MAX_SIMULATED_SAMPLES:
+        raise DataError(
+            f"--duration {args.duration:g} s at --fs {args.fs:g} Hz is {args.duration * args.fs:.3g} samples, "
+            f"more than {MAX_SIMULATED_SAMPLES:.0e}; simulate a shorter ride."
+        )
+    if args.duration * args.fs < 200:
+        raise DataError(
+            f"--duration {args.duration:g} s at {args.fs:g} Hz gives under 200 samples; nothing to identify."
+        )
     if args.excitation == "random":
         u = random_vibration(args.fs, args.duration, (0.5, min(28.0, 0.47 * args.fs)), seed=args.seed)
     else:
@@ -392,7 +471,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _add_data_args(p)
     p.add_argument("--orders", default="2:30", help="range of na, LO:HI (even steps); default 2:30")
-    p.add_argument("--modes", type=int, default=None, help="number of modes to keep (default: automatic)")
+    p.add_argument("--modes", type=_POSITIVE_INT, default=None, help="number of modes to keep (default: automatic)")
     p.add_argument("--band", default=None, help="frequency band LO:HI in Hz")
     p.add_argument("--plot", default=None, help="stabilisation plot (.png, .svg or .pdf)")
     p.add_argument("--json", default=None, help="selected modes as JSON")
@@ -415,7 +494,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("modes", help="modes JSON written by 'stabilise --json'")
     p.add_argument("--recording", default=None, help="the recording, for the measured transmissibility")
     p.add_argument("--input", default="base")
-    p.add_argument("--fs", type=float, default=None)
+    p.add_argument("--fs", type=_POSITIVE, default=None)
     p.add_argument("--method", choices=["model_update", "evphc", "pia", "inner"], default="model_update")
     p.add_argument("--total-mass", type=float, default=None, help="subject mass in kg (sets the scale)")
     p.add_argument("--json", default=None, help="write M, C, K, components and modes as JSON")
@@ -436,7 +515,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _add_data_args(p)
     p.add_argument("--band", default=None, help="frequency band LO:HI in Hz (sets the analysis rate)")
-    p.add_argument("--max-rounds", type=int, default=3, help="effects added at most; default 3")
+    p.add_argument("--max-rounds", type=_NONNEG_INT, default=3, help="effects added at most; default 3")
     p.add_argument("--json", default=None, help="write the diagnosis as JSON")
     p.add_argument("--plot", default=None, help="figure page (.png/.svg/.pdf)")
     p.set_defaults(func=_cmd_diagnose)
@@ -453,11 +532,11 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("simulate", parents=[quiet], help="simulate a base-excitation ride of a reference structure")
     p.add_argument("--system", choices=sorted(SYSTEMS), default="supine")
     p.add_argument("--excitation", choices=["random", "sweep"], default="random")
-    p.add_argument("--fs", type=float, default=60.0)
-    p.add_argument("--duration", type=float, default=120.0)
-    p.add_argument("--noise", type=float, default=0.05, help="sensor noise, fraction of RMS")
+    p.add_argument("--fs", type=_POSITIVE, default=60.0)
+    p.add_argument("--duration", type=_POSITIVE, default=120.0, help="seconds; default 120")
+    p.add_argument("--noise", type=_NONNEG, default=0.05, help="sensor noise, fraction of RMS")
     p.add_argument("--hold", choices=["zoh", "bandlimited"], default="bandlimited")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=_NONNEG_INT, default=0)
     p.add_argument("--out", required=True, help="CSV file to write")
     p.set_defaults(func=_cmd_simulate)
     return parser
@@ -467,10 +546,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        check_output_paths(args)
         return args.func(args)
     except (ArmaxModalError, FileNotFoundError) as exc:
         print(f"armaxmodal: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        # outputs are staged and moved in whole, so an interrupted run leaves none behind
+        print("armaxmodal: interrupted; no output was written.", file=sys.stderr)
+        return 130
 
 
 def run() -> None:

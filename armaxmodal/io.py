@@ -320,6 +320,30 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
     return path
 
 
+def write_all(outputs) -> list[Path]:
+    """Write every ``(path, write)`` pair or none: each ``write(tmp)`` fills a temporary file
+    beside its target; only when all have succeeded are they moved into place."""
+    staged: list[tuple[str, Path]] = []
+    try:
+        for path, write in outputs:
+            path = Path(path)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+            os.close(fd)
+            staged.append((tmp, path))
+            write(tmp)
+        umask = os.umask(0)
+        os.umask(umask)
+        for tmp, path in staged:
+            os.chmod(tmp, 0o666 & ~umask)
+            os.replace(tmp, path)
+    finally:
+        for tmp, _ in staged:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+    return [path for _, path in staged]
+
+
 def write_recording_csv(recording: Recording, path: str | os.PathLike, float_format: str = "%.9g") -> Path:
     """Write ``time``, the input and every sensor as CSV, with subject lines if known."""
 

@@ -118,7 +118,8 @@ def _poles_of(fit: ArmaxFit, source: str) -> list[dict]:
     """Rows for one fit: shared fit -> one source with shapes over sensors."""
     rows = []
     if source == SHARED:
-        frame = fit.modes().query(f"sensor == '{fit.sensors[0]}'")
+        table = fit.modes()
+        frame = table[table.sensor == fit.sensors[0]]  # not query(): sensor names are free text
         mu = frame.pole.to_numpy()
         shapes = np.array([m.modal_constants(mu)[0] for m in fit.models]) if mu.size else np.zeros((0, 0))
         for i, r in enumerate(frame.itertuples(index=False)):

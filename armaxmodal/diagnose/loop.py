@@ -172,8 +172,9 @@ def _verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float = 0.01) 
     coloured = [s for s, p in zip(diagnosis.sensors, whiteness, strict=True) if p < alpha]
     if coloured:
         return (
-            f"unsure: the residual of {', '.join(coloured)} is still not white after the fixes; an effect this "
-            "version does not test (a nonlinearity, a time change, a missing mode) may remain. Look at the figure."
+            f"unsure: the residual of {', '.join(coloured)} is still not white after the fixes; an effect the "
+            "fixes do not capture (a non-smooth nonlinearity such as friction or a clearance, a time change, a "
+            "missing mode) may remain. Look at the figure."
         )
     if diagnosis.unconfirmed:
         return "unsure: some tests fired but their fixes did not lower the held-out error (see 'unconfirmed')."

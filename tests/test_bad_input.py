@@ -1,0 +1,69 @@
+"""Bad input through the CLI: each case a typed, one-line error naming the fix, before any
+work, and no file written or damaged (issue 11's matrix, the rows fixed so far)."""
+
+import shutil
+
+import pytest
+
+from armaxmodal.cli import main
+
+CASES = [
+    # (arguments with {data} and {tmp}, expected words in the message)
+    (["stabilise", "{data}", "--csv", "{data}"], "is an input file"),
+    (["stabilise", "{data}", "--json", "{tmp}"], "is a directory"),
+    (["stabilise", "{data}", "--json", "{data}/x.json"], "is a file, not a folder"),
+    (["stabilise", "{data}", "--json", "{tmp}/a.json", "--csv", "{tmp}/a.json"], "name the same file"),
+    (["stabilise", "{data}", "--modes", "0"], "whole number >= 1"),
+    (["stabilise", "{data}", "--modes", "-1"], "whole number >= 1"),
+    (["stabilise", "{data}", "--orders", "3:1"], "LO <= HI"),
+    (["stabilise", "{data}", "--band", "40:10"], "lower edge first"),
+    (["stabilise", "{data}", "--band", "10:40"], "Nyquist"),
+    (["stabilise", "{data}", "--fs", "nan"], "finite number > 0"),
+    (["identify", "{data}", "--orders", "10,16,10"], "four integers"),
+    (["simulate", "--duration", "0", "--out", "{tmp}/s.csv"], "finite number > 0"),
+    (["simulate", "--duration", "-5", "--out", "{tmp}/s.csv"], "finite number > 0"),
+    (["simulate", "--duration", "nan", "--out", "{tmp}/s.csv"], "finite number > 0"),
+    (["simulate", "--duration", "1e7", "--out", "{tmp}/s.csv"], "shorter ride"),
+    (["simulate", "--seed", "-1", "--out", "{tmp}/s.csv"], "whole number >= 0"),
+    (["simulate", "--noise", "-1", "--out", "{tmp}/s.csv"], "finite number >= 0"),
+    (["diagnose", "{data}", "--max-rounds", "-2"], "whole number >= 0"),
+    (["invert", "{tmp}/missing.json", "--plot", "{tmp}/p.png"], "--recording"),
+]
+
+
+@pytest.mark.parametrize(("argv", "words"), CASES)
+def test_bad_input_is_a_one_line_error_and_touches_nothing(tmp_path, fixtures_dir, capsys, argv, words):
+    data = tmp_path / "ride.csv"
+    shutil.copy(fixtures_dir / "supine_random.csv", data)
+    before = data.read_bytes()
+    args = [a.format(data=data, tmp=tmp_path) for a in argv]
+    try:
+        status = main(args)
+    except SystemExit as exc:  # argparse's own usage errors
+        status = exc.code
+    err = capsys.readouterr().err
+    assert status == 2
+    assert words in err
+    assert "Traceback" not in err
+    assert data.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ride.csv"]
+
+
+def test_interrupt_is_one_line_and_exit_130(monkeypatch, fixtures_dir, capsys, tmp_path):
+    import armaxmodal.stabilisation as stab
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(stab, "stabilisation_diagram", interrupted)
+    status = main(["stabilise", str(fixtures_dir / "supine_random.csv"), "--json", str(tmp_path / "m.json")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 130 and len(err) == 1 and "interrupted" in err[0]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_sensor_name_with_an_apostrophe_works(tmp_path, fixtures_dir):
+    text = (fixtures_dir / "supine_random.csv").read_text().replace("head", "subject's head", 1)
+    data = tmp_path / "ride.csv"
+    data.write_text(text)
+    assert main(["identify", str(data), "--orders", "6,7,6,0", "--json", str(tmp_path / "m.json"), "--quiet"]) == 0
