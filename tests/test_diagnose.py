@@ -189,3 +189,31 @@ def test_a_cubic_spring_is_named_between_the_right_segments(nonlinear_rides):
 def test_the_linear_twin_has_no_nonlinearity(nonlinear_rides):
     d = _run(nonlinear_rides[0.0])
     assert d.effects == ()
+
+
+def _two_regimes(stiffening: float) -> am.Recording:
+    """60 s of the supine human, then 60 s with every spring stiffer by ``stiffening``."""
+    s = am.supine_human()
+    rides = []
+    for seed, k in ((1, 1.0), (2, stiffening)):
+        u = am.random_vibration(60.0, 60.0, (0.5, 28.0), seed=seed)
+        structure = am.Structure(s.M, s.C, s.K * k, s.names)
+        rides.append(am.simulate_recording(structure, u, 60.0, noise=0.05, seed=seed + 100, hold="bandlimited"))
+    a, b = rides
+    return am.Recording(60.0, np.concatenate([a.base, b.base]), np.vstack([a.response, b.response]), a.sensors)
+
+
+def test_a_stiffness_change_half_way_is_named_with_its_time_and_size():
+    effect = _first(_run(_two_regimes(1.12)))
+    assert effect.finding.effect == "time_varying"
+    p = effect.parameters
+    assert abs(p["change_time_s"] - 60.0) <= 120.0 / 6  # within one window of the change
+    f1 = am.supine_human().modes().freq_hz[0]
+    assert p["modes_each_side"][0]["freq_before_hz"] == pytest.approx(f1, rel=0.02)
+    assert p["modes_each_side"][0]["freq_after_hz"] == pytest.approx(f1 * np.sqrt(1.12), rel=0.02)
+    assert p["sim_error_after"] < 0.7 * p["sim_error_before"]
+
+
+def test_a_time_invariant_twin_is_not_time_varying():
+    d = _run(_two_regimes(1.0))
+    assert "time_varying" not in {e.finding.effect for e in d.effects}

@@ -29,7 +29,16 @@ __all__ = ["Finding", "run_tests", "whiteness_p", "EFFECT_TESTS"]
 #: Lags of the residual in the Breusch-Godfrey whiteness test.
 WHITENESS_LAGS = 10
 #: The tests each round runs, in the order linear/structural effects come first.
-EFFECT_TESTS = ("input_delay", "offset_drift", "periodic_disturbance", "coloured_noise", "stiffness_nonlinearity")
+EFFECT_TESTS = (
+    "input_delay",
+    "offset_drift",
+    "periodic_disturbance",
+    "coloured_noise",
+    "time_varying",
+    "stiffness_nonlinearity",
+)
+#: Windows of the windowed re-identification (time variation).
+N_WINDOWS = 6
 #: A line in the residual is the input's (model error), not a disturbance, when the input
 #: itself carries a line there at this significance.
 INPUT_LINE_P = 1e-3
@@ -112,6 +121,7 @@ def run_tests(fitted: FittedModel, alpha: float = 0.01) -> tuple[list[Finding], 
     found += _trend_findings(fitted, eps, mask, n_tests, table)
     found += _line_findings(fitted, mask, n_tests, table)
     found += _whiteness_findings(fitted, eps, mask, n_tests, table)
+    found += _time_findings(fitted, mask, n_tests, table)
     found += _nonlinear_findings(fitted, eps, mask, n_tests, table)
     return [f for f in found if f.p < alpha], table
 
@@ -349,3 +359,79 @@ def _nonlinear_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
         return []
     params = {"term": kind, "between": list(pair)}
     return [Finding("stiffness_nonlinearity", channels, "score_F", best_sum, min(ps), params, payload=term)]
+
+
+def _window_modes(fitted: FittedModel, mask: np.ndarray):
+    """Windowed re-identification at the model's orders: per window, the frequency and its
+    standard deviation of the pole nearest each of the full fit's modes (NaN when none is
+    within 15 %); the windows' input RMS; the windows' edges. Reuses the full fit as start."""
+    from ..stabilisation import SHARED, _poles_of
+    from .model import fit_model
+
+    def modes_of(fit):
+        rows = [r for r in _poles_of(fit, SHARED) if 0 < r["damping"] < 0.6]
+        return np.array([[r["freq_hz"], r["freq_sd"]] for r in rows]).reshape(-1, 2)
+
+    s = fitted.signals
+    idx = np.flatnonzero(mask)
+    edges = np.linspace(idx[0], idx[-1] + 1, N_WINDOWS + 1).astype(int)
+    ref = modes_of(fitted.fit)
+    freq = np.full((N_WINDOWS, len(ref)), np.nan)
+    sd = np.full_like(freq, np.nan)
+    for w in range(N_WINDOWS):
+        fw = modes_of(fit_model(fitted.spec, s, (edges[w], edges[w + 1]), start=fitted).fit)
+        for m, f0 in enumerate(ref[:, 0]):
+            if fw.size:
+                j = int(np.argmin(np.abs(fw[:, 0] - f0)))
+                if abs(fw[j, 0] - f0) < 0.15 * f0:
+                    freq[w, m], sd[w, m] = fw[j]
+    rms = np.array([np.std(s.u[edges[w] : edges[w + 1]]) for w in range(N_WINDOWS)])
+    return ref, freq, sd, rms, edges
+
+
+def _time_findings(fitted, mask, n_tests, table) -> list[Finding]:
+    """Time variation: modes re-identified on consecutive windows; for each mode and each
+    window boundary a Chow-type z of the means after against before (the windows' own
+    standard deviations), corrected for modes x boundaries x tests. A shift that follows
+    the windows' input RMS more closely than their order is amplitude dependence, left to
+    the nonlinearity test; with a ride whose level rises in time the two are confounded and
+    the parameters say so."""
+    from .model import PiecewiseModel
+
+    if isinstance(fitted, PiecewiseModel) or fitted.signals.n < N_WINDOWS * 200:
+        return []
+    ref, freq, sd, rms, edges = _window_modes(fitted, mask)
+    best = (0.0, None, None)
+    for m in range(ref.shape[0]):
+        ok = np.isfinite(freq[:, m]) & np.isfinite(sd[:, m]) & (sd[:, m] > 0)
+        if ok.sum() < N_WINDOWS:
+            continue
+        for b in range(2, N_WINDOWS - 1):  # at least two windows each side
+            f_b, f_a = freq[:b, m], freq[b:, m]
+            var = np.sum(sd[:b, m] ** 2) / b**2 + np.sum(sd[b:, m] ** 2) / (N_WINDOWS - b) ** 2
+            z = abs(f_a.mean() - f_b.mean()) / np.sqrt(var)
+            if z > best[0]:
+                best = (z, m, b)
+    z, m, b = best
+    if m is None:
+        return []
+    n_checks = ref.shape[0] * (N_WINDOWS - 3)
+    p = min(1.0, 2 * stats.norm.sf(z) * n_checks * n_tests)
+    table["time_varying_p"] = p
+    order = np.arange(N_WINDOWS)
+    r_time = abs(np.corrcoef(order, freq[:, m])[0, 1])
+    r_amp = abs(np.corrcoef(rms, freq[:, m])[0, 1]) if np.std(rms) > 0 else 0.0
+    confounded = abs(np.corrcoef(order, rms)[0, 1]) > 0.8 if np.std(rms) > 0 else False
+    if r_amp > r_time and not confounded:
+        return []
+    s = fitted.signals
+    params = {
+        "change_time_s": float(edges[b] / s.fs),
+        "mode_hz": float(ref[m, 0]),
+        "freq_before_hz": float(np.mean(freq[:b, m])),
+        "freq_after_hz": float(np.mean(freq[b:, m])),
+        "window_freqs_hz": freq[:, m].tolist(),
+        "window_input_rms": rms.tolist(),
+        "confounded_with_amplitude": bool(confounded),
+    }
+    return [Finding("time_varying", tuple(s.sensors), "chow_z", z, p, params, payload=int(edges[b]))]

@@ -68,8 +68,10 @@ def refine_line(fitted: FittedModel, freq_hz: float, channels) -> float:
     return float(res.x)
 
 
-def effect_parameters(finding: Finding, fitted: FittedModel) -> dict:
+def effect_parameters(finding: Finding, fitted) -> dict:
     """The effect's parameters in the refitted model, with 95 % intervals where the fit gives them."""
+    if finding.effect == "time_varying":
+        return {**finding.parameters, "modes_each_side": _modes_each_side(fitted)}
     spec, s = fitted.spec, fitted.signals
     if finding.effect == "offset_drift":
         dur = s.n / s.fs
@@ -112,3 +114,27 @@ def effect_parameters(finding: Finding, fitted: FittedModel) -> dict:
     if finding.effect == "coloured_noise":
         return {"nc": spec.orders[2] + spec.extra_nc, "nc_before": spec.orders[2] + spec.extra_nc - EXTRA_NC_STEP}
     return dict(finding.parameters)
+
+
+def _modes_each_side(piecewise) -> list[dict]:
+    """Each mode of the fit before the change with its nearest match after it."""
+    from ..stabilisation import SHARED, _poles_of
+
+    def modes(fit):
+        return [r for r in _poles_of(fit, SHARED) if 0 < r["damping"] < 0.6]
+
+    after = modes(piecewise.after.fit)
+    out = []
+    for r in sorted(modes(piecewise.before.fit), key=lambda r: r["freq_hz"]):
+        if not after:
+            break
+        a = min(after, key=lambda x: abs(x["freq_hz"] - r["freq_hz"]))
+        out.append(
+            {
+                "freq_before_hz": float(r["freq_hz"]),
+                "freq_after_hz": float(a["freq_hz"]),
+                "damping_before": float(r["damping"]),
+                "damping_after": float(a["damping"]),
+            }
+        )
+    return out

@@ -15,7 +15,20 @@ from ..prepare import prepare
 from ..recording import Recording
 from .evidence import Finding, cross_correlation, run_tests, whiteness_p
 from .fixes import add_effect, effect_parameters, fit_effect
-from .model import LINE_MERGE_HZ, UNDAMPED, FittedModel, HeldOut, ModelSpec, Signals, fit_model, held_out, usable
+from .model import (
+    LINE_MERGE_HZ,
+    UNDAMPED,
+    FittedModel,
+    HeldOut,
+    ModelSpec,
+    PiecewiseModel,
+    Signals,
+    fit_model,
+    fit_piecewise,
+    held_out,
+    held_out_piecewise,
+    usable,
+)
 
 __all__ = ["diagnose", "Diagnosis", "EFFECTS", "TESTED_EFFECTS"]
 
@@ -33,13 +46,21 @@ EFFECTS = (
     "sensor_fault",
 )
 #: The effects this version tests and fixes; the others are listed as not tested.
-TESTED_EFFECTS = ("input_delay", "offset_drift", "periodic_disturbance", "coloured_noise", "stiffness_nonlinearity")
+TESTED_EFFECTS = (
+    "input_delay",
+    "offset_drift",
+    "periodic_disturbance",
+    "coloured_noise",
+    "time_varying",
+    "stiffness_nonlinearity",
+)
 #: Linear/structural effects first: a wrong linear part fires every later test.
 _TIER = {
     "input_delay": 0,
     "offset_drift": 1,
     "periodic_disturbance": 1,
     "coloured_noise": 2,
+    "time_varying": 3,
     "stiffness_nonlinearity": 3,
 }
 #: A disturbance on the output is judged on the simulation error: a one-step predictor can
@@ -49,6 +70,7 @@ _CRITERION = {
     "periodic_disturbance": "simulation",
     "offset_drift": "simulation",
     "stiffness_nonlinearity": "simulation",
+    "time_varying": "simulation",
 }
 #: Fewer samples than this per half cannot hold out a validation part.
 MIN_SAMPLES = 400
@@ -67,7 +89,8 @@ class Stage:
         errors = self.model.one_step_errors() if kind == "one_step" else self.model.simulation_errors()
         e = errors[mask]
         n, k = e.shape
-        p = self.model.spec.n_parameters(k) + len(self.model.spec.shifts)
+        pieces = 2 if isinstance(self.model, PiecewiseModel) else 1
+        p = pieces * self.model.spec.n_parameters(k) + len(self.model.spec.shifts)
         return float(n * np.sum(np.log(np.mean(e**2, axis=0))) + p * np.log(n * k))
 
     def summary(self, noise_floor: np.ndarray) -> dict:
@@ -305,6 +328,8 @@ def diagnose(
             break
         effect, stage = step
         effects.append(effect)
+        if isinstance(stage.model, PiecewiseModel):
+            break  # the tests assume one model; a record split in two is reported as it is
     if effects:
         tests = run_tests(stage.model, alpha)[1]
     clean = Signals(signals.u, signals.y - stage.model.disturbance(), signals.fs, signals.sensors, signals.input_name)
@@ -317,9 +342,13 @@ def _try_fix(stage: Stage, finding: Finding, alpha: float):
     """Refit with the finding's effect; ``((Effect, Stage), "")`` if the held-out error says
     keep it, else ``(None, reason)``."""
     s = stage.model.signals
-    model = fit_effect(add_effect(stage.model.spec, finding, stage.model), finding, s)
-    spec = model.spec
-    new = Stage(model, held_out(spec, s, model))
+    if finding.effect == "time_varying":
+        change = finding.payload
+        model = fit_piecewise(stage.model.spec, s, change)
+        new = Stage(model, held_out_piecewise(model.spec, s, change))
+    else:
+        model = fit_effect(add_effect(stage.model.spec, finding, stage.model), finding, s)
+        new = Stage(model, held_out(model.spec, s, model))
     on_input = finding.channels == (s.input_name,)
     idx = list(range(len(s.sensors))) if on_input else [s.sensors.index(c) for c in finding.channels]
     before, after = _pooled_rms(stage.held, idx), _pooled_rms(new.held, idx)
