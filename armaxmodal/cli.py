@@ -429,8 +429,12 @@ def _cmd_modes(args) -> int:
 
 
 def _cmd_simulate(args) -> int:
+    from .diagnose.inject import check_effect
     from .simulate import random_vibration, simulate_recording, sine_sweep
 
+    effects = [_parse_effect(text) for text in args.effect or ()]
+    for effect, _, params in effects:  # before the simulation
+        check_effect(effect, params)
     structure = SYSTEMS[args.system]()
     if args.duration * args.fs > MAX_SIMULATED_SAMPLES:
         raise DataError(
@@ -446,10 +450,32 @@ def _cmd_simulate(args) -> int:
     else:
         u = sine_sweep(args.fs, args.duration)
     rec = simulate_recording(structure, u, args.fs, noise=args.noise, seed=args.seed, hold=args.hold)
+    for effect, channels, params in effects:
+        from .diagnose.inject import inject
+
+        rec = inject(rec, effect, channels, seed=args.seed, **params)
     write_recording_csv(rec, args.out)
     if not args.quiet:
         print(f"wrote {args.out}: {rec.n_samples} samples, outputs {', '.join(rec.sensors)}")
     return 0
+
+
+def _parse_effect(text: str):
+    """``EFFECT[:CH1+CH2][:key=value,...]`` -> (effect, channels or None, params)."""
+    parts = text.split(":")
+    effect, channels, params = parts[0], None, {}
+    if len(parts) > 1 and parts[1]:
+        channels = parts[1].split("+")
+    if len(parts) > 2 and parts[2]:
+        for item in parts[2].split(","):
+            key, _, value = item.partition("=")
+            try:
+                params[key] = float(value)
+            except ValueError as exc:
+                raise DataError(f"--effect {text!r}: expected key=number pairs, got {item!r}.") from exc
+    if len(parts) > 3:
+        raise DataError(f"--effect {text!r}: expected EFFECT[:CH1+CH2][:key=value,...].")
+    return effect, channels, params
 
 
 _DETREND_HELP = "remove each channel's mean (default) or least-squares line before fitting"
@@ -537,6 +563,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--noise", type=_NONNEG, default=0.05, help="sensor noise, fraction of RMS")
     p.add_argument("--hold", choices=["zoh", "bandlimited"], default="bandlimited")
     p.add_argument("--seed", type=_NONNEG_INT, default=0)
+    p.add_argument(
+        "--effect",
+        action="append",
+        help="plant an effect the diagnosis is not told: EFFECT[:CH1+CH2][:key=value,...], e.g. "
+        "periodic_disturbance:head:freq_hz=11.7,amp=0.1 or input_delay:legs:samples=2.5 (repeatable)",
+    )
     p.add_argument("--out", required=True, help="CSV file to write")
     p.set_defaults(func=_cmd_simulate)
     return parser

@@ -217,3 +217,26 @@ def test_a_stiffness_change_half_way_is_named_with_its_time_and_size():
 def test_a_time_invariant_twin_is_not_time_varying():
     d = _run(_two_regimes(1.0))
     assert "time_varying" not in {e.finding.effect for e in d.effects}
+
+
+def test_two_effects_are_named_in_turn_without_undoing_each_other(clean):
+    """A late sensor and a line: the second round's refit must start from the record as
+    recorded (refitting the shifted one moved the sensor twice, and a third round then
+    'found' the opposite delay)."""
+    late = inject(clean, "input_delay", ["legs"], samples=2.0)
+    rec = inject(late, "periodic_disturbance", ["head"], freq_hz=11.7, amp=0.1)
+    d = _run(rec)
+    named = [(e.finding.effect, e.finding.channels) for e in d.effects]
+    assert named == [("input_delay", ("legs",)), ("periodic_disturbance", ("head",))]
+    assert d.effects[0].parameters["delay_samples"] == pytest.approx(2.0, abs=0.2)
+    assert d.to_dict()["verdict"].startswith("the effects listed explain")
+
+
+def test_simulate_cli_plants_effects_and_refuses_bad_ones(tmp_path, capsys):
+    out = tmp_path / "ride.csv"
+    args = ["simulate", "--duration", "20", "--out", str(out), "--quiet"]
+    assert main([*args, "--effect", "offset_drift:chest:offset=0.5"]) == 0
+    rec = am.read_recording(out)
+    assert rec.response[:, 1].mean() == pytest.approx(0.5, abs=0.05)
+    assert main([*args, "--effect", "periodic_disturbance:head"]) == 2
+    assert "freq_hz, amp" in capsys.readouterr().err

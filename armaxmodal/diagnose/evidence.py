@@ -187,29 +187,46 @@ def _trend_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
 def _line_findings(fitted, mask, n_tests, table) -> list[Finding]:
     """Spectral lines not coherent with the input (the input has no line there): Thomson's
     multitaper harmonic F-test on the simulation residual and on the output itself. A model
-    of high enough order absorbs a line as an undamped pole pair, leaving the residual clean,
-    so such a pole's frequency is tested on the output too (corrected for those poles only)."""
+    of high enough order absorbs a line as an undamped pole pair; at such a pole's frequency
+    the line is tested in the residual of the response without that pair
+    (:func:`~.model.response_free_of`), corrected for those poles only."""
+    from dataclasses import replace
+
+    from .model import response_free_of
+
     s = fitted.signals
     resid = fitted.simulation_errors()[mask]
     u_test = harmonic_f_test(s.u[mask], s.fs)
     undamped = _undamped_pole_freqs(fitted)
+    y_free = s.y - fitted.disturbance()
+    pole_resid = {
+        f: (
+            y_free
+            - response_free_of(
+                replace(fitted.spec, lines_hz=fitted.spec.lines_hz + (f,)), fitted.fit, s.inputs(fitted.spec), y_free
+            )
+        )[mask]  # fmt: skip
+        for f in undamped
+    }
     out = []
     for k, name in enumerate(s.sensors):
-        output = (s.y[:, k] - fitted.disturbance()[:, k])[mask]  # lines already modelled are out
-        tests = [harmonic_f_test(resid[:, k], s.fs), harmonic_f_test(output, s.fs)]
+        tests = [harmonic_f_test(resid[:, k], s.fs), harmonic_f_test(y_free[mask, k], s.fs)]
         # near an undamped pole the residual carries the spurious mode's own narrow response
         clean = [t for t in tests[:1] if not any(abs(t.freq_hz - f) < LINE_MERGE_HZ for f in undamped)]
         best = min(clean + tests[1:], key=lambda t: t.p_min)
         p, f0, f_val = 2 * best.p_min, best.freq_hz, best.f_max
+        amp_test = tests[1]
         for f in undamped:
-            p_pole = 2 * len(undamped) * tests[1].p_at(f)
+            at_pole = harmonic_f_test(pole_resid[f][:, k], s.fs)
+            p_pole = 2 * len(undamped) * at_pole.p_at(f)
             if p_pole < p:
-                p, f0, f_val = p_pole, f, float(tests[1].f_stat[np.argmin(np.abs(tests[1].freqs - f))])
+                p, f0, amp_test = p_pole, f, at_pole
+                f_val = float(at_pole.f_stat[np.argmin(np.abs(at_pole.freqs - f))])
         p = min(1.0, p * n_tests)
         table["line_p"].append(p)
         if u_test.p_at(f0) < INPUT_LINE_P:
             continue
-        amp = tests[1].amplitude_at(f0)
+        amp = amp_test.amplitude_at(f0)
         params = {"freq_hz": f0, "amp": amp[0], "amp_ci95": list(amp[1])}
         out.append(Finding("periodic_disturbance", (name,), "multitaper_F", f_val, p, params))
     return _merge_lines(out)

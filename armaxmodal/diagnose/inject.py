@@ -16,6 +16,30 @@ from .model import fractional_shift
 __all__ = ["inject", "INJECTABLE"]
 
 INJECTABLE = ("input_delay", "offset_drift", "periodic_disturbance", "coloured_noise")
+#: Each effect's parameters: required, then optional.
+PARAMETERS = {
+    "input_delay": (("samples",), ()),
+    "offset_drift": ((), ("offset", "drift_per_s")),
+    "periodic_disturbance": (("freq_hz", "amp"), ()),
+    "coloured_noise": (("level",), ("pole", "freq_hz")),
+}
+
+
+def check_effect(effect: str, params: dict) -> None:
+    """Raise :class:`DataError` unless ``effect`` is injectable with exactly these parameters."""
+    if effect not in INJECTABLE:
+        raise DataError(f"effect: expected one of {INJECTABLE}, got {effect!r}.")
+    required, optional = PARAMETERS[effect]
+    missing = [k for k in required if k not in params]
+    unknown = [k for k in params if k not in required + optional]
+    if missing or unknown:
+        raise DataError(
+            f"effect {effect!r}: needs {', '.join(required) or 'no parameter'}"
+            f"{' (optional ' + ', '.join(optional) + ')' if optional else ''}; "
+            f"missing {missing or 'none'}, unknown {unknown or 'none'}."
+        )
+    if any(not np.isfinite(float(v)) for v in params.values()):
+        raise DataError(f"effect {effect!r}: parameters must be finite numbers, got {params}.")
 
 
 def _channel(rec: Recording, name: str) -> int | None:
@@ -50,8 +74,7 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, **pa
     Recording
         With ``meta["injected"]`` recording what was planted.
     """
-    if effect not in INJECTABLE:
-        raise DataError(f"effect: expected one of {INJECTABLE}, got {effect!r}.")
+    check_effect(effect, params)
     default = [recording.input_name] if effect == "input_delay" else list(recording.sensors)
     names = list(channels) if channels is not None else default
     base, y = recording.base.copy(), np.array(recording.response, dtype=float)

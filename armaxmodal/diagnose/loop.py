@@ -341,7 +341,7 @@ def diagnose(
 def _try_fix(stage: Stage, finding: Finding, alpha: float):
     """Refit with the finding's effect; ``((Effect, Stage), "")`` if the held-out error says
     keep it, else ``(None, reason)``."""
-    s = stage.model.signals
+    s = stage.model.raw
     if finding.effect == "time_varying":
         change = finding.payload
         model = fit_piecewise(stage.model.spec, s, change)

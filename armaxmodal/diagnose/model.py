@@ -132,7 +132,8 @@ def apply_shifts(signals: Signals, shifts) -> Signals:
 
 @dataclass(frozen=True)
 class FittedModel:
-    """A :class:`ModelSpec` fitted on ``window`` of the (shifted) signals.
+    """A :class:`ModelSpec` fitted on ``window`` of the (shifted) signals; ``raw`` keeps
+    them unshifted, for refits (shifting twice would double a delay's fix).
 
     ``theta`` is (q, K): disturbance coefficients per sensor, ``theta_cov`` (K, q, q).
     """
@@ -143,6 +144,8 @@ class FittedModel:
     theta_cov: np.ndarray
     window: tuple[int, int]
     signals: Signals = field(repr=False)
+    #: The signals before the spec's shifts (what a refit must start from).
+    raw: Signals = field(default=None, repr=False)
 
     def disturbance(self) -> np.ndarray:
         """The fitted disturbance on every sample, (n, K)."""
@@ -211,7 +214,7 @@ def fit_model(
         )
         if phi.shape[1]:
             theta, cov = _disturbance_ls(fit, u, y, phi[lo:hi], spec, theta)
-    return FittedModel(spec, fit, theta, cov, (lo, hi), shifted)
+    return FittedModel(spec, fit, theta, cov, (lo, hi), shifted, signals)
 
 
 #: A pole pair within this distance (Hz) of a modelled line (or a real root near 1 with a
@@ -342,6 +345,10 @@ class PiecewiseModel:
     @property
     def fit(self) -> ArmaxFit:
         return self.before.fit
+
+    @property
+    def raw(self) -> Signals:
+        return self.before.raw
 
     def _join(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         out = a.copy()
