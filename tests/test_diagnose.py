@@ -30,7 +30,7 @@ def clean(fixtures_dir):
 
 
 def _run(rec, **kw):
-    return diagnose(rec, baseline=am.fit_armax(rec, *ORDERS, shared_poles=True), **kw)
+    return diagnose(rec, baseline=am.fit_armax(rec, *ORDERS, shared_poles=True, warn=False), **kw)
 
 
 def _first(d):

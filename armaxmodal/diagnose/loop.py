@@ -13,7 +13,7 @@ from ..exceptions import DataError
 from ..frf import welch_spectra
 from ..prepare import prepare
 from ..recording import Recording
-from .evidence import Finding, cross_correlation, run_tests, whiteness_p
+from .evidence import EFFECT_TESTS, Finding, cross_correlation, run_tests, whiteness_p
 from .fixes import add_effect, effect_parameters, fit_effect
 from .model import (
     LINE_MERGE_HZ,
@@ -46,14 +46,7 @@ EFFECTS = (
     "sensor_fault",
 )
 #: The effects this version tests and fixes; the others are listed as not tested.
-TESTED_EFFECTS = (
-    "input_delay",
-    "offset_drift",
-    "periodic_disturbance",
-    "coloured_noise",
-    "time_varying",
-    "stiffness_nonlinearity",
-)
+TESTED_EFFECTS = EFFECT_TESTS
 #: Linear/structural effects first: a wrong linear part fires every later test.
 _TIER = {
     "input_delay": 0,
