@@ -13,8 +13,12 @@ def as_signal_matrix(x, name: str, channel_names: Sequence[str] | None = None) -
     """Return ``x`` as a C-contiguous float64 array of shape (n_samples, n_channels).
 
     A 1-D input becomes one column. NaN or inf raise :class:`DataError` naming the channel
-    and the first bad sample.
+    and the first bad sample; complex samples raise too (casting would drop the imaginary part).
     """
+    if np.iscomplexobj(x):
+        raise DataError(
+            f"{name}: expected real samples, got complex ones; pass the real part if that is what was measured."
+        )
     try:
         arr = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError) as exc:

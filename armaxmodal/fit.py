@@ -214,8 +214,17 @@ def fit_armax(
     """
     if stop not in ("expected", "decrease"):
         raise ValueError(f"stop: expected 'expected' or 'decrease', got {stop!r}.")
+    if isinstance(max_iter, bool) or not float(max_iter).is_integer() or max_iter < 1:
+        raise OrderError(f"max_iter: expected a whole number >= 1, got {max_iter!r}.")
+    if not (np.isfinite(tol) and tol > 0):
+        raise OrderError(f"tol: expected a finite number > 0, got {tol!r}.")
     u, y, fs, sensors, inputs = _unpack(data, fs)
     na, nb, nc, nk = _check_orders(na, nb, 0 if output_error else nc, nk)
+    if abs(nk) > y.shape[0] // 4:
+        raise OrderError(
+            f"nk = {nk} moves the input by {abs(nk)} of the record's {y.shape[0]} samples ({abs(nk) / fs:g} s): "
+            "no modal model has a delay that long. Check the time base, or align the channels first."
+        )
     check_outputs_carry_signal(sensors, y)
     # Non-causal taps (nk < 0): y[t] depends on u[t + lead - j]. Pairing y[:n-lead] with
     # u[lead:] gives the equivalent causal model (delay 0) on a window of the record.
@@ -268,6 +277,12 @@ def fit_armax(
         c = a.copy() if output_error else c
         models.append(ArmaxModel(a, b, c, nk, fs, float(info["noise_variance"][k]), sensors[k], inputs))
     fit_pct = np.array([_nrmse_fit(y[:, k], m.simulate(u), t0, y.shape[0] - lead) for k, m in enumerate(models)])
+    # a fit that is not a valid model is never reported as converged: poles on or outside the
+    # unit circle (its simulation diverges) or a non-finite loss
+    valid = np.array(
+        [np.all(np.abs(m.poles()) < 1.0) and np.isfinite(v) for m, v in zip(models, info["loss"], strict=True)]
+    )
+    info["converged"] = np.asarray(info["converged"]) & valid
     result = ArmaxFit(
         models=tuple(models),
         shared_poles=shared_poles,
