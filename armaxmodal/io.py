@@ -139,6 +139,12 @@ def _fs_from_time(t: np.ndarray, path: Path) -> float:
             f"{path.name}: the time column is not uniformly spaced: the step after row "
             f"{worst} is {steps[worst]:.6g} s against a median of {dt:.6g} s (a dropped or "
             "repeated sample?). Resample the data to a uniform grid first."
+            + (
+                " A step of a second or more suggests the time column is in milliseconds: convert it to "
+                "seconds, or drop it and give --fs."
+                if dt >= 1
+                else ""
+            )
         )
     # The mean step over the whole record is far less sensitive to printed rounding; ten
     # significant digits is more than any printed time column carries.
@@ -146,7 +152,45 @@ def _fs_from_time(t: np.ndarray, path: Path) -> float:
 
 
 # -- CSV ------------------------------------------------------------------------------
+def _check_csv_layout(path: Path) -> None:
+    """Name the usual export mistakes before pandas turns them into a tokenizer error: a
+    gzip file named .csv, another delimiter, metadata lines before the header."""
+    import gzip
+
+    with open(path, "rb") as fh:
+        head = fh.read(1 << 16)
+    if head[:2] == b"\x1f\x8b":
+        if path.suffix.lower() != ".gz":
+            raise DataError(
+                f"{path.name}: the file is gzip-compressed; name it {path.name}.gz (read as is) or unzip it."
+            )
+        head = gzip.decompress(head) if len(head) < (1 << 16) else gzip.open(path).read(1 << 16)
+    lines = [
+        ln for ln in head.decode("utf-8", errors="replace").splitlines()[:-1] if ln.strip() and not ln.startswith("#")
+    ]
+    if not lines:
+        return
+    commas = [ln.count(",") for ln in lines[:200]]
+    if max(commas) == 0:
+        for sep, name in ((";", "semicolons"), ("\t", "tabs")):
+            if sum(sep in ln for ln in lines[:200]) > 0.8 * len(lines[:200]):
+                raise DataError(
+                    f"{path.name}: the columns are separated by {name}, not commas; re-export as comma-separated "
+                    "CSV (with a '.' decimal point)."
+                )
+        return
+    fields = max(set(commas), key=commas.count)
+    leading = next((i for i, c in enumerate(commas) if c == fields), 0)
+    if leading:
+        raise DataError(
+            f"{path.name}: {leading} line(s) before the header have fewer fields than the data (first: "
+            f"{lines[0][:40]!r}): metadata lines. Put '#' before each (they are then read as comments) or "
+            "delete them. Xsens DOT exports are read as they are when you pass one file per sensor."
+        )
+
+
 def _read_csv(path: Path):
+    _check_csv_layout(path)
     info = _csv_comments(path)
     try:
         frame = pd.read_csv(path, comment="#", skipinitialspace=True, dtype=str, keep_default_na=False)

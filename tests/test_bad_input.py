@@ -108,3 +108,30 @@ def test_an_unstable_fit_is_never_converged(fixtures_dir):
     stable = np.array([np.all(np.abs(m.poles()) < 1) for m in fit.models])
     assert not stable.all()  # the case still arises
     assert not fit.converged[~stable].any()
+
+
+@pytest.mark.parametrize(
+    ("make", "words"),
+    [
+        (lambda text: "Exported by ShakerLab v2\nOperator: A\n" + text, "metadata lines"),
+        (lambda text: text.replace(",", ";"), "semicolons"),
+        (lambda text: text.replace(",", "\t"), "tabs"),
+    ],
+)
+def test_csv_export_mistakes_are_named(tmp_path, fixtures_dir, capsys, make, words):
+    plain = "".join(
+        ln for ln in (fixtures_dir / "supine_random.csv").read_text().splitlines(True) if not ln.startswith("#")
+    )
+    data = tmp_path / "ride.csv"
+    data.write_text(make(plain))
+    assert main(["info", str(data)]) == 2
+    assert words in capsys.readouterr().err
+
+
+def test_a_gzip_file_named_csv_is_named(tmp_path, fixtures_dir, capsys):
+    import gzip
+
+    data = tmp_path / "ride.csv"
+    data.write_bytes(gzip.compress((fixtures_dir / "supine_random.csv").read_bytes()))
+    assert main(["info", str(data)]) == 2
+    assert "gzip-compressed" in capsys.readouterr().err
