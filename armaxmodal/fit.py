@@ -410,7 +410,15 @@ def _stable_c(c):
 
 
 def _damped(g_mat, damping):
-    """Levenberg-Marquardt damping scaled by the diagonal, plus a tiny ridge for round-off."""
+    """Levenberg-Marquardt damping scaled by the diagonal, plus a tiny ridge for round-off.
+
+    Non-finite normal equations mean the fit has broken down numerically (orders far above
+    what the record supports): an :class:`OrderError` here, not a traceback from LAPACK."""
+    if not np.all(np.isfinite(g_mat)):
+        raise OrderError(
+            "the fit's normal equations became non-finite: the model orders are far above what this record "
+            "supports (or the data are degenerate). Lower the orders."
+        )
     d = np.diag(g_mat).copy()
     d[d <= 0] = 1.0
     return g_mat + np.diag(damping * d + 1e-13 * d)
@@ -705,11 +713,12 @@ def _shared_start(ys, uT, na, nb, nc, nk, t0, t1, oe, evaluate):
 
     state, losses = evaluate(theta)
     # Second start: output error by Steiglitz-McBride; keep whichever is more likely. A
-    # degenerate input (one sinusoid) can leave the subspace step without a Cholesky factor:
-    # then the first start stands alone.
+    # degenerate input (one sinusoid) can leave the subspace step without a Cholesky factor,
+    # and at very high orders its iterations can diverge to non-finite values (ValueError
+    # from the factorisation): then the first start stands alone.
     try:
         alt = _project_shared(_output_error_start(ys, uT, theta, na, nb, nc, nk, t0, t1), na, nb, nc, n_in, n_out, oe)
-    except np.linalg.LinAlgError:
+    except (np.linalg.LinAlgError, ValueError):
         alt = None
     if alt is not None:
         state_alt, losses_alt = evaluate(alt)
