@@ -123,7 +123,23 @@ def run_tests(fitted: FittedModel, alpha: float = 0.01) -> tuple[list[Finding], 
     found += _whiteness_findings(fitted, eps, mask, n_tests, table)
     found += _time_findings(fitted, mask, n_tests, table)
     found += _nonlinear_findings(fitted, eps, mask, n_tests, table)
-    return [f for f in found if f.p < alpha], table
+    significant = [f for f in found if f.p < alpha]
+    return _merge_per_sensor(significant, ("offset_drift", "coloured_noise")), table
+
+
+def _merge_per_sensor(findings: list[Finding], effects) -> list[Finding]:
+    """One finding per effect whose fix acts on every sensor (a trend, a richer C), listing
+    each sensor where it is significant, strongest first."""
+    out = [f for f in findings if f.effect not in effects]
+    for effect in effects:
+        group = sorted((f for f in findings if f.effect == effect), key=lambda f: f.p)
+        if group:
+            channels = tuple(c for f in group for c in f.channels)
+            per_channel = {f.channels[0]: f.parameters for f in group}
+            top = group[0]
+            params = {**top.parameters, "per_channel": per_channel}
+            out.append(Finding(effect, channels, top.statistic, top.value, top.p, params))
+    return out
 
 
 def _delay_findings(fitted: FittedModel, n_tests: int) -> list[Finding]:
