@@ -172,9 +172,10 @@ def _quasi_static_fit(f, h, coh, excited, n_segments):
     if not ok.any():
         return None
     start = int(np.argmax(ok))
-    # quasi-static means below the first resonance: a run found only above the rise of |T|
-    # (low lines drowned in noise) is past a mode, where the phase is not a delay
-    rise = np.flatnonzero(excited & (f > 0) & (np.abs(h) > QUASI_STATIC_MAGNITUDE[1]))
+    # quasi-static means below the first resonance: a run found only above the coherent rise
+    # of |T| (low lines drowned in noise) is past a mode, where the phase is not a delay;
+    # incoherent lines below the excited band do not count as a rise
+    rise = np.flatnonzero(excited & (coh >= MIN_COHERENCE) & (f > 0) & (np.abs(h) > QUASI_STATIC_MAGNITUDE[1]))
     if rise.size and rise[0] < start:
         return None
     stop = start
