@@ -8,9 +8,9 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from .evidence import Finding
-from .model import FittedModel, ModelSpec, Signals, fit_model, response_free_of, usable
+from .model import FittedModel, ModelSpec, response_free_of, usable
 
-__all__ = ["add_effect", "effect_parameters", "fit_effect"]
+__all__ = ["add_effect", "effect_parameters"]
 
 #: C coefficients a richer noise model adds.
 EXTRA_NC_STEP = 6
@@ -37,11 +37,6 @@ def add_effect(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelS
         fitted.signals.extra[name] = finding.payload
         return replace(spec, terms=spec.terms + (name,))
     raise ValueError(f"no fix for effect {finding.effect!r}")
-
-
-def fit_effect(spec: ModelSpec, finding: Finding, signals: Signals) -> FittedModel:
-    """Fit ``spec`` (the finding's effect added) at the baseline's orders."""
-    return fit_model(spec, signals)
 
 
 def refine_line(fitted: FittedModel, freq_hz: float, channels) -> float:

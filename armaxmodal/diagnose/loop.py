@@ -14,7 +14,7 @@ from ..frf import welch_spectra
 from ..prepare import prepare
 from ..recording import Recording
 from .evidence import EFFECT_TESTS, Finding, cross_correlation, run_tests, whiteness_p
-from .fixes import add_effect, effect_parameters, fit_effect
+from .fixes import add_effect, effect_parameters
 from .model import (
     LINE_MERGE_HZ,
     UNDAMPED,
@@ -340,7 +340,7 @@ def _try_fix(stage: Stage, finding: Finding, alpha: float):
         model = fit_piecewise(stage.model.spec, s, change)
         new = Stage(model, held_out_piecewise(model.spec, s, change))
     else:
-        model = fit_effect(add_effect(stage.model.spec, finding, stage.model), finding, s)
+        model = fit_model(add_effect(stage.model.spec, finding, stage.model), s)
         new = Stage(model, held_out(model.spec, s, model))
     on_input = finding.channels == (s.input_name,)
     idx = list(range(len(s.sensors))) if on_input else [s.sensors.index(c) for c in finding.channels]
