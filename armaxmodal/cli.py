@@ -4,6 +4,8 @@ armaxmodal info DATA [--input COL] [--fs HZ]
 armaxmodal modes --system supine|chapter2 [--json OUT]
 armaxmodal simulate --system supine --excitation random|sweep --out DATA.csv
 armaxmodal diagnose DATA [--input COL] [--fs HZ] [--json OUT] [--plot OUT]
+armaxmodal study MANIFEST_OR_FOLDER --out DIR [--report FILE] [--jobs N] [--scheduler ADDRESS]
+armaxmodal lump DATA A B [--json OUT] [--plot OUT]
 """
 
 from __future__ import annotations
@@ -57,7 +59,7 @@ def check_output_paths(args) -> None:
     seen = {}
     for option in OUTPUT_OPTIONS:
         value = getattr(args, option, None)
-        if value is None:
+        if value is None or (option == "out" and args.command == "study"):  # a study's --out is a folder
             continue
         path = Path(value).resolve()
         flag = f"--{option}"
@@ -571,6 +573,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--out", required=True, help="CSV file to write")
     p.set_defaults(func=_cmd_simulate)
+
+    from .lumping.command import add_parser as add_lump
+    from .study.command import add_parser as add_study
+
+    add_study(sub, [quiet], {"positive_int": _POSITIVE_INT})
+    add_lump(sub, [quiet], _POSITIVE)
     return parser
 
 

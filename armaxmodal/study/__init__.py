@@ -1,0 +1,30 @@
+"""Studies: many subjects and rides through one stabilisation and selection, the thesis's
+Chapter 3 tables and figures, and a self-contained HTML report.
+
+* :func:`run_study` -- read a manifest or folder, analyse every recording in parallel (local
+  processes or a dask.distributed cluster), resume from a per-recording cache.
+* :func:`write_study` -- ``summary.csv``, ``modes.csv``, ``study.json``, figures and report,
+  written whole or not at all.
+* :func:`make_study` -- a synthetic study with known truth (15 subjects x 2 rides).
+"""
+
+from .job import StudySettings, analyse_recording
+from .manifest import Entry, read_manifest
+from .output import write_study
+from .run import Study, run_study
+from .synthetic import make_study
+from .tables import StudyTables, build_tables, match_modes
+
+__all__ = [
+    "Entry",
+    "Study",
+    "StudySettings",
+    "StudyTables",
+    "analyse_recording",
+    "build_tables",
+    "make_study",
+    "match_modes",
+    "read_manifest",
+    "run_study",
+    "write_study",
+]

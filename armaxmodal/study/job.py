@@ -1,0 +1,124 @@
+"""One recording of a study: stabilise, select, summarise -- a plain dict that pickles to any
+worker and back, and is cached as JSON."""
+
+from __future__ import annotations
+
+import base64
+import hashlib
+import io
+import json
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .. import __version__
+from ..recording import Recording
+
+__all__ = ["StudySettings", "analyse_recording"]
+
+
+@dataclass(frozen=True)
+class StudySettings:
+    """What every recording of a study goes through (recorded in ``study.json``).
+
+    Attributes
+    ----------
+    input : str
+        The base-acceleration channel.
+    orders : (lo, hi)
+        The swept AR orders (even steps), as ``stabilise --orders``.
+    modes : int or None
+        Modes kept per recording (None: the automatic selection).
+    band : (lo, hi) Hz or None
+    detrend : {"mean", "linear", "none"}
+    sensors : tuple of str or None
+        The sensors analysed (None: those most recordings share, chosen by the study).
+    lump : (a, b) or None
+        A pair of segments to test for lumping (Chapter 5) where a recording has both.
+    """
+
+    input: str = "base"
+    orders: tuple[int, int] = (2, 30)
+    modes: int | None = None
+    band: tuple[float, float] | None = None
+    detrend: str = "mean"
+    sensors: tuple[str, ...] | None = None
+    lump: tuple[str, str] | None = None
+
+    def to_dict(self) -> dict:
+        return {**asdict(self), "armaxmodal_version": __version__}
+
+    def key(self) -> str:
+        """Hash of everything that changes a recording's result."""
+        return hashlib.sha256(json.dumps(self.to_dict(), sort_keys=True).encode()).hexdigest()[:16]
+
+
+def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[str, ...]) -> dict:
+    """Stabilisation diagram, automatic selection and the thumbnail of one recording.
+
+    The modes come from ``sensors`` (the study's common set); the lumping check may use
+    any of the recording's channels. Runs single-threaded (one BLAS thread, no inner process
+    pool): the study parallelises over recordings, and the result is the same wherever it runs.
+
+    Returns
+    -------
+    dict with ``sensors``, ``fs``, ``analysis_fs``, ``nk``, ``modes`` (one dict per mode:
+    frequency in Hz, damping ratio, 95 % intervals, Eq. 3.35-3.36 weighted values and the
+    normalised shape per sensor), ``per_sensor`` (Table 3.2 rows), ``warnings``,
+    ``reconstruction_error``, ``lump`` and ``figure_png`` (base64).
+    """
+    from threadpoolctl import threadpool_limits
+
+    from ..stabilisation import select_modes, stabilisation_diagram
+
+    start = time.perf_counter()
+    lo, hi = settings.orders
+    with threadpool_limits(limits=1, user_api="blas"):
+        diagram = stabilisation_diagram(
+            rec.select(sensors), range(lo, hi + 1, 2), band=settings.band, detrend=settings.detrend, n_jobs=1
+        )
+        selection = select_modes(diagram, settings.modes, settings.band)
+        report = selection.to_dict("per_sensor")
+        figure = _thumbnail(diagram, selection)
+        lump = _lump(rec, settings)
+    weighted = selection.weighted.set_index("mode")
+    for i, mode in enumerate(report["modes"], start=1):
+        mode["rank"] = i
+        mode["freq_hz_weighted"] = float(weighted.freq_hz.get(i, np.nan))
+        mode["damping_weighted"] = float(weighted.damping.get(i, np.nan))
+    return {
+        "sensors": list(sensors),
+        "fs": report["fs"],
+        "analysis_fs": report["analysis_fs"],
+        "n_samples": rec.n_samples,
+        "nk": report["nk"],
+        "modes": report["modes"],
+        "per_sensor": report["per_sensor"],
+        "warnings": report["warnings"],
+        "reconstruction_error": report["reconstruction_error"],
+        "lump": lump,
+        "figure_png": figure,
+        "seconds": time.perf_counter() - start,
+    }
+
+
+def _thumbnail(diagram, selection) -> str:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ax, _ = diagram.plot(selection)
+    buf = io.BytesIO()
+    ax.figure.savefig(buf, format="png", dpi=72)
+    plt.close(ax.figure)
+    return base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def _lump(rec: Recording, settings: StudySettings) -> dict | None:
+    if settings.lump is None or not set(settings.lump) <= set(rec.sensors):
+        return None
+    from ..lumping import lump_check
+
+    return lump_check(rec, *settings.lump, wavelet=False).to_dict()

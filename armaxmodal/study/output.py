@@ -1,0 +1,81 @@
+"""A study's files, written whole or not at all."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pandas as pd
+
+from ..io import write_all
+from .plot import plot_shapes
+from .report import render_report
+from .run import Study
+
+__all__ = ["write_study", "lump_table"]
+
+
+def lump_table(study: Study) -> pd.DataFrame:
+    """One row per recording that has a lumping verdict."""
+    rows = []
+    for r in study.recordings:
+        lump = r.get("lump")
+        if lump:
+            rows.append(
+                {
+                    "file": r["file"],
+                    "subject": r["subject"],
+                    "ride": r["ride"],
+                    "verdict": lump["verdict"],
+                    "first_disagreement_hz": lump["first_disagreement_hz"],
+                    "message": lump["message"],
+                }
+            )
+    return pd.DataFrame(rows, columns=["file", "subject", "ride", "verdict", "first_disagreement_hz", "message"])
+
+
+def write_study(study: Study, out: str | Path, report: str | Path | None = None) -> list[Path]:
+    """Write ``summary.csv``, ``modes.csv``, ``per_sensor.csv``, ``subjects.csv``,
+    ``shapes.csv``, ``lump.csv`` (when asked), ``study.json``, ``shapes_<ride>.png`` and the
+    HTML report (default ``out/report.html``) -- all staged, then moved in together.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(out)
+    t = study.tables
+    data = json.dumps(study.to_dict(), indent=1, allow_nan=False) + "\n"
+    lumps = lump_table(study)
+    figures = {ride: plot_shapes(t, ride, study.sensors) for ride in sorted(t.shapes.ride.unique())}
+    try:
+        html = render_report(study, figures, lumps)
+        outputs = [
+            (out / "summary.csv", lambda tmp: t.summary.to_csv(tmp, index=False)),
+            (out / "modes.csv", lambda tmp: t.modes.to_csv(tmp, index=False)),
+            (out / "per_sensor.csv", lambda tmp: t.per_sensor.to_csv(tmp, index=False)),
+            (out / "subjects.csv", lambda tmp: t.subjects.to_csv(tmp, index=False)),
+            (out / "shapes.csv", lambda tmp: t.shapes.to_csv(tmp, index=False)),
+            (out / "study.json", lambda tmp: Path(tmp).write_text(data, encoding="utf-8")),
+            (Path(report) if report else out / "report.html", lambda tmp: Path(tmp).write_text(html, "utf-8")),
+        ]
+        if not lumps.empty:
+            outputs.append((out / "lump.csv", lambda tmp: lumps.to_csv(tmp, index=False)))
+        for ride, fig in figures.items():
+            outputs.append(
+                (out / f"shapes_{_safe(ride)}.png", lambda tmp, fig=fig: fig.savefig(tmp, dpi=110, format="png"))
+            )
+        return write_all(outputs)
+    finally:
+        for fig in figures.values():
+            plt.close(fig)
+
+
+def _safe(name: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_" else "_" for c in str(name))

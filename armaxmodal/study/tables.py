@@ -1,0 +1,197 @@
+"""A study's tables: modes matched across recordings, Table 3.2 per sensor, Table 3.3 per
+subject and across subjects, and the Fig. 3.7 geometric-mean mode shapes."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+from scipy.optimize import linear_sum_assignment
+
+__all__ = ["StudyTables", "build_tables", "match_modes"]
+
+#: a recording's mode is the ride's mode r when their frequencies are within this ratio
+MATCH_RATIO = 1.25
+SHAPE_FLOOR = 1e-6  # |phi| below this is taken as this in the geometric mean
+
+
+@dataclass
+class StudyTables:
+    """Tidy tables (one row per observation) a person loads with pandas.
+
+    Attributes
+    ----------
+    modes : DataFrame
+        One row per recording and mode: file, subject, ride, mode (matched across the ride's
+        recordings; empty for a mode no other recording has), rank (order in its own
+        recording), freq_hz, damping, their 95 % intervals, the Eq. 3.35-3.36 weighted values.
+    per_sensor : DataFrame
+        Table 3.2: one row per recording, sensor and mode; NaN where the sensor's own model
+        does not show the mode (the thesis's X), ``shown`` says which.
+    subjects : DataFrame
+        Table 3.3 rows: per ride, subject and mode the mean over that subject's recordings.
+    summary : DataFrame
+        Table 3.3's Average and SD rows: per ride and mode the mean and sample SD over subjects.
+    shapes : DataFrame
+        One row per recording, mode and sensor: the shape magnitude (largest component 1).
+    geomean : DataFrame
+        Per ride, mode and sensor the geometric mean of the subjects' magnitudes (Fig. 3.7).
+    """
+
+    modes: pd.DataFrame
+    per_sensor: pd.DataFrame
+    subjects: pd.DataFrame
+    summary: pd.DataFrame
+    shapes: pd.DataFrame
+    geomean: pd.DataFrame
+    notes: list[str] = field(default_factory=list)
+
+    def shape_records(self) -> list[dict]:
+        return self.geomean.to_dict("records")
+
+
+def match_modes(freqs: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Number the modes of several recordings consistently.
+
+    The reference is the per-rank median of the recordings with the most common number of
+    modes; each recording's modes are assigned to reference modes by least total
+    log-frequency distance (Hungarian algorithm), within :data:`MATCH_RATIO`.
+
+    Parameters
+    ----------
+    freqs : list of 1-D arrays
+        Each recording's natural frequencies, Hz, ascending.
+
+    Returns
+    -------
+    reference : (n_ref,) ndarray, Hz
+    labels : list of int arrays
+        Per recording, the 1-based reference mode of each of its modes, 0 where none fits.
+    """
+    counts = pd.Series([f.size for f in freqs])
+    usual = int(counts.mode().max()) if len(counts) else 0
+    typical = [f for f in freqs if f.size == usual]
+    reference = np.median(np.array(typical), axis=0) if usual else np.zeros(0)
+    labels = []
+    for f in freqs:
+        lab = np.zeros(f.size, dtype=int)
+        if f.size and reference.size:
+            cost = np.abs(np.log(f[:, None] / reference[None, :]))
+            rows, cols = linear_sum_assignment(cost)
+            ok = cost[rows, cols] <= np.log(MATCH_RATIO)
+            lab[rows[ok]] = cols[ok] + 1
+        labels.append(lab)
+    return reference, labels
+
+
+def build_tables(recordings: list[dict], sensors) -> StudyTables:
+    """All tables from the analysed recordings (see :class:`StudyTables`)."""
+    mode_rows, sensor_rows, shape_rows, notes = [], [], [], []
+    for ride in sorted({r["ride"] for r in recordings}):
+        group = [r for r in recordings if r["ride"] == ride]
+        reference, labels = match_modes([np.array([m["freq_hz"] for m in r["modes"]], float) for r in group])
+        for r, lab in zip(group, labels, strict=True):
+            n_unmatched = int(np.sum(lab == 0))
+            if n_unmatched:
+                notes.append(
+                    f"{r['file']}: {n_unmatched} mode(s) match none of the modes of ride {ride!r} "
+                    f"({np.round(reference, 2).tolist()} Hz); listed without a mode number"
+                )
+            mode_rows += _mode_rows(r, lab)
+            sensor_rows += _sensor_rows(r, lab)
+            shape_rows += _shape_rows(r, lab)
+    modes = pd.DataFrame(mode_rows, columns=MODE_COLUMNS)
+    per_sensor = pd.DataFrame(sensor_rows, columns=SENSOR_COLUMNS)
+    shapes = pd.DataFrame(shape_rows, columns=["file", "subject", "ride", "mode", "sensor", "mag"])
+    subjects, summary = _across_subjects(modes)
+    return StudyTables(modes, per_sensor, subjects, summary, shapes, _geomean(shapes, sensors), notes)
+
+
+MODE_COLUMNS = [
+    "file",
+    "subject",
+    "ride",
+    "mode",
+    "rank",
+    "freq_hz",
+    "damping",
+    "freq_ci95_lo",
+    "freq_ci95_hi",
+    "damping_ci95_lo",
+    "damping_ci95_hi",
+    "freq_hz_weighted",
+    "damping_weighted",
+    "mass_kg",
+]
+SENSOR_COLUMNS = ["file", "subject", "ride", "sensor", "mode", "rank", "shown", "freq_hz", "damping"]
+
+
+def _num(v) -> float:
+    return np.nan if v is None else float(v)
+
+
+def _mode_rows(r: dict, labels) -> list[dict]:
+    rows = []
+    for m, lab in zip(r["modes"], labels, strict=True):
+        rows.append({
+            "file": r["file"], "subject": r["subject"], "ride": r["ride"],
+            "mode": int(lab) if lab else pd.NA, "rank": m["rank"],
+            "freq_hz": _num(m["freq_hz"]), "damping": _num(m["damping"]),
+            "freq_ci95_lo": _num(m["freq_ci95"][0]), "freq_ci95_hi": _num(m["freq_ci95"][1]),
+            "damping_ci95_lo": _num(m["damping_ci95"][0]), "damping_ci95_hi": _num(m["damping_ci95"][1]),
+            "freq_hz_weighted": _num(m["freq_hz_weighted"]), "damping_weighted": _num(m["damping_weighted"]),
+            "mass_kg": _num(r.get("mass_kg")),
+        })  # fmt: skip
+    return rows
+
+
+def _sensor_rows(r: dict, labels) -> list[dict]:
+    rows = []
+    for p in r["per_sensor"]:
+        lab = labels[p["mode"] - 1]
+        rows.append({
+            "file": r["file"], "subject": r["subject"], "ride": r["ride"], "sensor": p["sensor"],
+            "mode": int(lab) if lab else pd.NA, "rank": p["mode"], "shown": p["freq_hz"] is not None,
+            "freq_hz": _num(p["freq_hz"]), "damping": _num(p["damping"]),
+        })  # fmt: skip
+    return rows
+
+
+def _shape_rows(r: dict, labels) -> list[dict]:
+    return [
+        {"file": r["file"], "subject": r["subject"], "ride": r["ride"], "mode": int(lab), "sensor": s,
+         "mag": _num(v["mag"])}
+        for m, lab in zip(r["modes"], labels, strict=True) if lab
+        for s, v in m["shape"].items()
+    ]  # fmt: skip
+
+
+def _across_subjects(modes: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Table 3.3: a subject's recordings of one ride averaged first, then mean and SD over subjects."""
+    values = ["freq_hz", "damping", "freq_hz_weighted", "damping_weighted"]
+    matched = modes.dropna(subset=["mode"]).astype({"mode": int})
+    subjects = matched.groupby(["ride", "subject", "mode"], as_index=False)[values].mean()
+    subjects["recordings"] = matched.groupby(["ride", "subject", "mode"]).size().to_numpy()
+    grouped = subjects.groupby(["ride", "mode"])
+    summary = grouped[values].agg(["mean", "std"])
+    summary.columns = [f"{v}_{'sd' if s == 'std' else s}" for v, s in summary.columns]
+    summary = summary.rename(columns={"damping_mean": "damping_mean"}).reset_index()
+    summary["n"] = grouped.size().to_numpy()
+    first = ["ride", "mode", "freq_hz_mean", "freq_hz_sd", "damping_mean", "damping_sd", "n"]
+    return subjects, summary[first + [c for c in summary.columns if c not in first]]
+
+
+def _geomean(shapes: pd.DataFrame, sensors) -> pd.DataFrame:
+    """Fig. 3.7: per subject the mean log-magnitude, then the geometric mean over subjects."""
+    if shapes.empty:
+        return pd.DataFrame(columns=["ride", "mode", "sensor", "geomean", "n"])
+    logs = shapes.assign(log=np.log(np.clip(shapes.mag.to_numpy(float), SHAPE_FLOOR, None)))
+    per_subject = logs.groupby(["ride", "mode", "sensor", "subject"], as_index=False).log.mean()
+    out = per_subject.groupby(["ride", "mode", "sensor"], as_index=False).log.agg(["mean", "size"])
+    out = out.rename(columns={"size": "n"})
+    out["geomean"] = np.exp(out.pop("mean"))
+    out["sensor"] = pd.Categorical(out.sensor, categories=list(sensors), ordered=True)
+    return out.sort_values(["ride", "mode", "sensor"]).reset_index(drop=True)[
+        ["ride", "mode", "sensor", "geomean", "n"]
+    ]
