@@ -229,3 +229,24 @@ def test_report_is_self_contained_and_renders_in_a_headless_browser(finished, tm
     assert 'data-figures="12/12"' in run.stdout
     console_errors = [line for line in run.stderr.splitlines() if "CONSOLE" in line and "rror" in line]
     assert not console_errors
+
+
+def test_average_subject_model_reproduces_the_mean_modes_and_scales_by_mass(finished):
+    from armaxmodal.study.model import average_subject_models
+
+    study, _, truth = finished
+    models, scaled = average_subject_models(study)
+    scaled = pd.DataFrame(scaled)
+    for m in models:
+        assert "reason" not in m, m.get("reason")
+        mean = study.tables.summary[study.tables.summary.ride == m["ride"]].set_index("mode")
+        fitted = pd.DataFrame(m["model_modes"]).set_index("mode")
+        assert np.allclose(fitted.freq_hz, mean.freq_hz_mean, rtol=0.03)
+        # Eq. 4.7: every subject's masses sum to its mass, and springs scale by the same ratio
+        mine = scaled[scaled.ride == m["ride"]]
+        for _, g in mine.groupby("subject"):
+            masses = g[g.component.str.startswith("masses")].value.sum()
+            assert masses == pytest.approx(g.mass_kg.iloc[0], rel=1e-9)
+            alpha = g.mass_kg.iloc[0] / m["mass_kg"]
+            k1 = g[g.component == "k1"].value.iloc[0]
+            assert k1 == pytest.approx(alpha * m["components"]["k"][0], rel=1e-9)

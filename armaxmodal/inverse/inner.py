@@ -113,7 +113,9 @@ def inner_solve(
     ub = np.r_[hi[1:], np.full(a_real.shape[1] - n, np.inf)]
     # m1 = 1 fixes the scale; its column moves to the right-hand side.
     res = scipy.optimize.lsq_linear(a_real[:, free], -a_real[:, 0], bounds=(lb, ub), method="bvls", tol=1e-14)
-    x = np.r_[1.0, res.x]
+    # BVLS may end a hair outside its bounds (seen: a spring of -2e-13 N/m, which the chain
+    # then refuses as negative); the bounds are exact constraints, so clip to them
+    x = np.r_[1.0, np.clip(res.x, lb, ub)]
     m, c, c_s = x[:n], x[n : 2 * n] * w_ref, x[2 * n : 3 * n - 1] * w_ref
     k, k_s = x[3 * n - 1 : 4 * n - 1] * w_ref**2, x[4 * n - 1 :] * w_ref**2
     scale = total_mass / m.sum() if total_mass is not None else (m1 if m1 is not None else 1.0)

@@ -164,12 +164,14 @@ def model_update(
     s = build(res.x)
     mass_scale = total_mass / s.masses.sum() if total_mass is not None else (m1 if m1 is not None else 1.0)
     comps = s.chain_components()
+    # components read back from C and K carry round-off (seen: a damper of -9e-14 N s/m where
+    # the optimiser's bound is 0); the bounds are exact, so clip to them
     s = Structure.from_chain(
         comps.masses * mass_scale,
-        comps.k * mass_scale,
-        comps.c * mass_scale,
-        comps.k_s * mass_scale,
-        comps.c_s * mass_scale,
+        np.maximum(comps.k, 0.0) * mass_scale,
+        np.maximum(comps.c, 0.0) * mass_scale,
+        np.maximum(comps.k_s, 0.0) * mass_scale,
+        np.maximum(comps.c_s, 0.0) * mass_scale,
         names,
     )
     std = _component_std(res, scale, n, total_mass, mass_scale, s.chain_components())

@@ -31,6 +31,7 @@ def add_parser(sub, parents, numbers: dict) -> None:
     p.add_argument("--detrend", choices=["mean", "linear", "none"], default="mean")
     p.add_argument("--sensors", default=None, help="comma-separated sensors to analyse (default: those most share)")
     p.add_argument("--lump", default=None, help="A,B: test whether segments A and B can be lumped (e.g. legs,feet)")
+    p.add_argument("--model", action="store_true", help="fit the average subject's chain and scale it to each subject")
     p.set_defaults(func=_cmd_study)
 
 
@@ -84,7 +85,13 @@ def _cmd_study(args) -> int:
     settings = _settings(args)
     _check_paths(args)
     study = run_study(
-        args.source, args.out, settings, jobs=args.jobs, scheduler=args.scheduler, progress=not args.quiet
+        args.source,
+        args.out,
+        settings,
+        jobs=args.jobs,
+        scheduler=args.scheduler,
+        progress=not args.quiet,
+        model=args.model,
     )
     written = write_study(study, args.out, args.report)
     if not args.quiet:

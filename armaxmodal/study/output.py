@@ -65,6 +65,9 @@ def write_study(study: Study, out: str | Path, report: str | Path | None = None)
             (out / "study.json", lambda tmp: Path(tmp).write_text(data, encoding="utf-8")),
             (Path(report) if report else out / "report.html", lambda tmp: Path(tmp).write_text(html, "utf-8")),
         ]
+        if study.scaled is not None:
+            scaled = pd.DataFrame(study.scaled, columns=["ride", "subject", "mass_kg", "component", "value"])
+            outputs.append((out / "model_scaled.csv", lambda tmp: scaled.to_csv(tmp, index=False)))
         if not lumps.empty:
             outputs.append((out / "lump.csv", lambda tmp: lumps.to_csv(tmp, index=False)))
         for ride, fig in figures.items():

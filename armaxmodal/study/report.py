@@ -71,6 +71,31 @@ def _table_3_2(study) -> str:
     return _table(wide.reset_index(), 4)
 
 
+def _models(study) -> str:
+    if study.models is None:
+        return ""
+    parts = ["<h2>Physical model of the average subject (Section 4.4; Eq. 4.7 scales it to each subject)</h2>"]
+    for m in study.models:
+        ride = html.escape(str(m["ride"]))
+        if "reason" in m:
+            parts.append(f"<p class=fail>ride {ride}: no model ({html.escape(m['reason'])})</p>")
+            continue
+        comps = m["components"]
+        rows = [
+            {"component": f"{name}{i + 1}", "value": float(v)}
+            for name in ("masses", "k", "c", "k_s", "c_s")
+            for i, v in enumerate(comps[name])
+        ]
+        parts.append(
+            f"<h3>ride: {ride} ({m['mass_kg']:.1f} kg)</h3>"
+            + _table(pd.DataFrame(rows), 5)
+            + "<p>its modes</p>"
+            + _table(pd.DataFrame(m["model_modes"]))
+        )
+        parts += [f"<p class=note>{html.escape(f)}</p>" for f in m.get("flags", [])]
+    return "".join(parts)
+
+
 def render_report(study, shape_figures: dict, lump_rows: pd.DataFrame | None = None) -> str:
     """The HTML text of the report (see module docstring).
 
@@ -110,6 +135,7 @@ def render_report(study, shape_figures: dict, lump_rows: pd.DataFrame | None = N
 <h2>Across subjects (Table 3.3 form: mean and sample SD)</h2>{_table(study.tables.summary)}
 <h2>Per subject</h2>{_table_3_3(study)}
 <h2>Mode shapes (Fig. 3.7 form)</h2>{shapes}
+{_models(study)}
 {lump}
 <h2>Failures</h2>{"<ul>" + fails + "</ul>" if fails else "<p>none</p>"}
 <h2>Stabilisation diagrams (click to enlarge)</h2><div class=thumbs>{thumbs}</div>

@@ -48,19 +48,26 @@ class Study:
     tables: StudyTables
     reused: int = 0
     notes: list[str] = field(default_factory=list)
+    models: list[dict] | None = None
+    scaled: list[dict] | None = None
 
     def to_dict(self) -> dict:
         """The ``study.json`` contract: settings, recordings, failures, summary."""
         recordings = [{k: v for k, v in r.items() if k != "figure_png"} for r in self.recordings]
         return strict_json(
             {
-                "settings": {**self.settings.to_dict(), "sensors": list(self.sensors)},
+                "settings": {
+                    **self.settings.to_dict(),
+                    "sensors": list(self.sensors),
+                    "model": self.models is not None,
+                },
                 "recordings": recordings,
                 "failures": self.failures,
                 "summary": self.tables.summary.to_dict("records"),
                 "subjects": self.tables.subjects.to_dict("records"),
                 "shape_geomean": self.tables.shape_records(),
                 "notes": self.notes,
+                "models": self.models,
             }
         )
 
@@ -73,6 +80,7 @@ def run_study(
     jobs: int | None = None,
     scheduler: str | None = None,
     progress: bool = False,
+    model: bool = False,
 ) -> Study:
     """Analyse every recording of a manifest or folder.
 
@@ -90,6 +98,9 @@ def run_study(
         Address of a dask.distributed scheduler (``tcp://host:8786``); overrides ``jobs``.
     progress : bool
         A tqdm bar over recordings.
+    model : bool
+        Also fit the chain model of each ride's average subject and scale it to every subject
+        (:func:`armaxmodal.study.model.average_subject_models`).
 
     Returns
     -------
@@ -126,7 +137,12 @@ def run_study(
     recordings = [_record(entry, digest, results[entry.row]) for entry, _, digest in loaded if entry.row in results]
     failures.sort(key=lambda f: str(f["file"]))
     tables = build_tables(recordings, sensors)
-    return Study(settings, sensors, recordings, failures, tables, reused, notes + tables.notes)
+    study = Study(settings, sensors, recordings, failures, tables, reused, notes + tables.notes)
+    if model:
+        from .model import average_subject_models
+
+        study.models, study.scaled = average_subject_models(study)
+    return study
 
 
 def _load_all(entries, settings, failures, progress) -> list[tuple[Entry, object, str]]:
