@@ -1,0 +1,96 @@
+"""Deliberate bugs, one at a time: does the suite notice? (issue 11's check, kept runnable)
+
+Each mutant is a one-line change a tired developer could make; the script applies it to the
+working tree, runs the test files that cover that code, restores the file, and reports
+whether a test failed (killed) or not (survived).
+
+    python scripts/mutation_check.py [--tests tests/test_guards.py tests/test_fit.py ...]
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+# (file, original text, mutated text, what it models)
+MUTANTS = [
+    ("armaxmodal/modal.py", "dxi = (-(li**2)[:, None]", "dxi = ((li**2)[:, None]", "sign error in the damping SD"),
+    (
+        "armaxmodal/modal.py",
+        "df = (lr[:, None] * dlam.real + li[:, None]",
+        "df = (lr[:, None] * dlam.real - li[:, None]",
+        "sign error in the frequency SD",
+    ),
+    (
+        "armaxmodal/modal.py",
+        "dmu = -powers / deriv[:, None]",
+        "dmu = powers / deriv[:, None]",
+        "root sensitivity sign (cancels in a variance: equivalent)",
+    ),
+    (
+        "armaxmodal/fit.py",
+        "_signals(y - eps if oe else y, uT, eps)",
+        "_signals(y, uT, eps)",
+        "output-error gradient of the ARMAX form",
+    ),
+    (
+        "armaxmodal/stabilisation.py",
+        "return float(abs(np.vdot(a, b)) ** 2 / den)",
+        "return float(abs(np.dot(a, b)) ** 2 / den)",
+        "MAC without conjugation",
+    ),
+    ("armaxmodal/stabilisation.py", "max_damping: float = 0.6", "max_damping: float = 1.0", "damping ceiling 1.0"),
+    ("armaxmodal/orders.py", "return na + 1 - min(nk, 0)", "return na - min(nk, 0)", "default_nb one tap short"),
+    ("armaxmodal/refine.py", "r = r * mu * lam / (mu - 1.0)", "r = r", "zoh residue conversion dropped"),
+    ("armaxmodal/stabilisation.py", "if row.damping <= 0:", "if row.damping < 0:", "a zero-damping pole kept"),
+    (
+        "armaxmodal/stabilisation.py",
+        "elif row.freq_hz > f_max:",
+        "elif row.freq_hz >= 2 * f_max:",
+        "Nyquist rule loosened",
+    ),
+    ("armaxmodal/modal.py", "lam = np.log(mu) * fs", "lam = np.log(mu) / fs", "time step inverted"),
+    ("armaxmodal/refine.py", "shapes = -r / lam**2", "shapes = r / lam**2", "EPFRF modal constant sign"),
+]
+DEFAULT_TESTS = [
+    "tests/test_guards.py",
+    "tests/test_fit.py",
+    "tests/test_refine.py",
+    "tests/test_stabilisation.py",
+    "tests/test_armax.py",
+]
+
+
+def run(tests: list[str]) -> bool:
+    cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", *tests]
+    return subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True).returncode == 0
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--tests", nargs="+", default=DEFAULT_TESTS)
+    args = parser.parse_args()
+    killed = 0
+    for path, old, new, what in MUTANTS:
+        file = ROOT / path
+        text = file.read_text()
+        if text.count(old) != 1:
+            print(f"SKIP  {what}: pattern not found once in {path}")
+            continue
+        start = time.perf_counter()
+        try:
+            file.write_text(text.replace(old, new))
+            passed = run(args.tests)
+        finally:
+            file.write_text(text)
+        killed += not passed
+        print(f"{'SURVIVED' if passed else 'killed  '}  {what} ({path}, {time.perf_counter() - start:.0f} s)")
+    print(f"{killed} of {len(MUTANTS)} mutants killed")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,123 @@
+"""Direct tests of small pieces whose plausible bugs the end-to-end tests let through (a
+deliberate-bug check of the suite killed 4 of 10): the delta-method pole uncertainty, the
+output-error gradient, the MAC, the rejection ceiling, the nb rule, the zoh residue map."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import armaxmodal as am
+import armaxmodal.fit as fitmod
+from armaxmodal.frf import excited_band
+from armaxmodal.modal import discrete_modal_parameters, pole_uncertainty
+from armaxmodal.orders import default_nb
+from armaxmodal.refine import refine_modes
+from armaxmodal.stabilisation import Tolerances, _mac, _reject
+
+FS = 60.0
+
+
+def _poles_after(a, fs):
+    mu = np.roots(a)
+    return mu[mu.imag > 0]
+
+
+def test_pole_uncertainty_equals_the_finite_difference_propagation():
+    rng = np.random.default_rng(4)
+    lam = 2 * np.pi * np.array([-0.25 * 5.8 + 5.6j, -0.3 * 13.5 + 12.9j])
+    mu = np.exp(np.r_[lam, lam.conj()] / FS)
+    a = np.real(np.poly(mu))
+    m = rng.standard_normal((4, 4))
+    cov = 1e-8 * (m @ m.T + 4 * np.eye(4))
+    base = _poles_after(a, FS)
+    f0, x0, _ = discrete_modal_parameters(base, FS)
+    jac_f, jac_x = np.zeros((2, 4)), np.zeros((2, 4))
+    h = 1e-7
+    for i in range(4):
+        d = np.zeros(5)
+        d[i + 1] = h
+        fu, xu, _ = discrete_modal_parameters(_poles_after(a + d, FS), FS)
+        fd, xd, _ = discrete_modal_parameters(_poles_after(a - d, FS), FS)
+        order_u = [int(np.argmin(np.abs(fu - f))) for f in f0]
+        order_d = [int(np.argmin(np.abs(fd - f))) for f in f0]
+        jac_f[:, i] = (fu[order_u] - fd[order_d]) / (2 * h)
+        jac_x[:, i] = (xu[order_u] - xd[order_d]) / (2 * h)
+    sd_f, sd_x = pole_uncertainty(a, base, cov, FS)
+    np.testing.assert_allclose(sd_f, np.sqrt(np.einsum("ki,ij,kj->k", jac_f, cov, jac_f)), rtol=1e-4)
+    np.testing.assert_allclose(sd_x, np.sqrt(np.einsum("ki,ij,kj->k", jac_x, cov, jac_x)), rtol=1e-4)
+
+
+def test_output_error_gradient_is_exact(fixtures_dir):
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    y = np.ascontiguousarray(rec.response[:1500, 0])
+    u_t = np.ascontiguousarray(rec.base[None, :1500])
+    na, nb, nc, nk = 4, 5, 0, 0
+    t0, t1 = na + nb, y.size
+    theta = fitmod._hannan_rissanen(y, u_t, na, nb, 2, nk, t0, t1)[: na + nb]
+    eps, _, c = fitmod._residual_and_loss(y, u_t, theta, na, nb, nc, nk, t0, t1, oe=True)
+    _, g = fitmod._normal_equations(y, u_t, eps, c, fitmod._columns(na, nb, nc, nk, 1), t0, t1, oe=True)
+    numeric = np.zeros_like(theta)
+    h = 1e-7
+    for i in range(theta.size):
+        step = np.zeros_like(theta)
+        step[i] = h
+        up = fitmod._residual_and_loss(y, u_t, theta + step, na, nb, nc, nk, t0, t1, oe=True)[1]
+        down = fitmod._residual_and_loss(y, u_t, theta - step, na, nb, nc, nk, t0, t1, oe=True)[1]
+        numeric[i] = (up - down) / (2 * h)
+    np.testing.assert_allclose(-2 * g, numeric, rtol=0, atol=1e-4 * np.abs(numeric).max())
+
+
+def test_mac_is_one_for_any_complex_scaling_and_is_conjugate_symmetric():
+    rng = np.random.default_rng(1)
+    a = rng.standard_normal(4) + 1j * rng.standard_normal(4)
+    assert _mac(a, a * (0.3 - 2.1j)) == pytest.approx(1.0, abs=1e-12)
+    b = rng.standard_normal(4) + 1j * rng.standard_normal(4)
+    expect = abs(np.sum(np.conj(a) * b)) ** 2 / (np.sum(np.abs(a) ** 2) * np.sum(np.abs(b) ** 2))
+    assert _mac(a, b) == pytest.approx(expect, rel=1e-12) and _mac(b, a) == pytest.approx(expect, rel=1e-12)
+    assert _mac(a, np.conj(a)) < 0.99  # a complex shape is not its own conjugate
+    assert _mac(a, np.zeros(4)) == 0.0
+
+
+def test_rejection_rules_and_their_ceiling(fixtures_dir):
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    tol = Tolerances()
+    rows = [
+        (8.0, 0.30, 1.0, ""),
+        (8.0, 0.59, 1.0, ""),
+        (8.0, 0.61, 1.0, "over-damped"),  # the 0.6 ceiling, not 1.0
+        (8.0, -0.01, 1.0, "negative damping"),
+        (0.01, 0.2, 1.0, "near 0 Hz"),
+        (27.5, 0.05, 1.0, "near Nyquist"),
+        (8.0, 0.3, 0.005, "negligible residue"),
+    ]
+    poles = pd.DataFrame(
+        [{"source": "shared", "na": 10, "freq_hz": f, "damping": x, "energy": e} for f, x, e, _ in rows]
+    )
+    assert _reject(poles, tol, rec) == [r[3] for r in rows]
+
+
+@pytest.mark.parametrize("na, nk, nb", [(10, 0, 11), (10, -5, 16), (8, -1, 10), (8, 3, 9)])
+def test_default_nb_keeps_na_plus_one_causal_taps_plus_one_per_noncausal_step(na, nk, nb):
+    assert default_nb(na, nk) == nb
+
+
+def test_zoh_refit_shapes_match_the_exact_modal_constants(fixtures_dir):
+    rec = am.read_recording(fixtures_dir / "supine_random_zoh.csv")
+    truth = json.loads((fixtures_dir / "supine_random_zoh.truth.json").read_text())["modes"]
+    f = np.array([m["freq_hz"] for m in truth])
+    x = np.array([m["damping"] for m in truth])
+    ref = refine_modes(rec, f * 1.01, x * 1.05, band_hz=excited_band(rec), hold="zoh")
+    want = np.array(
+        [
+            [m["shape"][s]["mag"] * np.exp(1j * np.radians(m["shape"][s]["phase_deg"])) for m in truth]
+            for s in rec.sensors
+        ]
+    )
+    # absolute scale, not normalised: the zoh map r = R mu lambda / (mu - 1) sets magnitude and phase
+    modal = am.supine_human().modes().modal_constants
+    assert np.max(np.abs(ref.shapes - modal) / np.abs(modal).max(axis=0)) < 0.08
+    got = ref.shapes / ref.shapes[np.argmax(np.abs(ref.shapes), axis=0), np.arange(4)]
+    want = want / want[np.argmax(np.abs(want), axis=0), np.arange(4)]
+    assert np.max(np.abs(got - want)) < 0.06
