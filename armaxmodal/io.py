@@ -87,6 +87,12 @@ def read_recording(
         raise DataError(f"{path.name}: unknown output channel(s) {missing}; channels are {list(channels)}.")
     if not names:
         raise DataError(f"{path.name}: only the input channel '{input}' is present; no outputs.")
+    empty = [c for c in [input, *names] if np.all(np.isnan(channels[c]))]
+    if empty:
+        raise DataError(
+            f"{path.name}: channel(s) {empty} hold no values (every sample empty, NA or NaN): a sensor that "
+            "recorded nothing. Delete the column, or choose the outputs with outputs=... (CLI: --outputs)."
+        )
     lengths = {c: channels[c].size for c in [input, *names]}
     if len(set(lengths.values())) > 1:
         raise DataError(f"{path.name}: channels differ in length {lengths}; trim them to a common length.")
@@ -189,6 +195,9 @@ def _check_csv_layout(path: Path) -> None:
         )
 
 
+_MISSING = ("", "na", "n/a", "nan", "null", "none", "-")
+
+
 def _read_csv(path: Path):
     _check_csv_layout(path)
     info = _csv_comments(path)
@@ -206,6 +215,9 @@ def _read_csv(path: Path):
         text = frame[col].str.strip()
         values = pd.to_numeric(text, errors="coerce").to_numpy(dtype=float)
         bad = np.isnan(values) & ~text.str.lower().isin(["nan"]).to_numpy()
+        if text.str.lower().isin(_MISSING).all():
+            channels[col] = np.full(len(text), np.nan)  # refused by name if it is used
+            continue
         if bad.all():
             continue  # a text column (labels, comments): not a channel
         if bad.any():
@@ -318,6 +330,7 @@ def _read_uff(path: Path):
         AttributeError,
     ) as exc:
         raise DataError(f"{path.name}: not a readable UFF file ({exc}).") from exc
+    _check_uff_complete(path)
     sets = [sets] if isinstance(sets, dict) else list(sets)
     series = [s for s in sets if s.get("type") == 58]
     if not series:
@@ -343,6 +356,20 @@ def _read_uff(path: Path):
         raise DataError(f"{path.name}: channels have different sample steps {sorted(steps)}.")
     file_fs = 1.0 / steps.pop() if steps else None
     return channels, file_fs, {}
+
+
+def _check_uff_complete(path: Path) -> None:
+    """Every UFF data set closes with a ``-1`` line; pyuff silently drops a set the file ends
+    inside, so a truncated file would lose its last channels without a word."""
+    with open(path, "rb") as fh:
+        fh.seek(0, os.SEEK_END)
+        fh.seek(max(fh.tell() - 256, 0))
+        tail = fh.read().rstrip()
+    if tail.rsplit(b"\n", 1)[-1].strip() != b"-1":
+        raise DataError(
+            f"{path.name}: the file ends inside a data set (no closing '-1' line): it is truncated, "
+            "and its last channels would be lost. Copy or export it again."
+        )
 
 
 # -- writers --------------------------------------------------------------------------

@@ -138,3 +138,33 @@ def test_a_gzip_file_named_csv_is_named(tmp_path, fixtures_dir, capsys):
     data.write_bytes(gzip.compress((fixtures_dir / "supine_random.csv").read_bytes()))
     assert main(["info", str(data)]) == 2
     assert "gzip-compressed" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("cell", ["", "NA", "n/a", "null"])
+def test_an_all_missing_column_is_named_not_dropped(tmp_path, fixtures_dir, capsys, cell):
+    import pandas as pd
+
+    import armaxmodal as am
+
+    frame = pd.read_csv(fixtures_dir / "supine_random.csv", comment="#")
+    frame.insert(3, "feet", cell)
+    data = tmp_path / "ride.csv"
+    frame.to_csv(data, index=False)
+    assert main(["info", str(data)]) == 2
+    assert "['feet'] hold no values" in capsys.readouterr().err
+    # choosing the other outputs is the way out the message names
+    assert am.read_recording(data, outputs=["head", "legs"]).sensors == ("head", "legs")
+
+
+@pytest.mark.parametrize("fraction", [0.3, 0.55, 0.93])
+def test_a_truncated_uff_file_is_refused_not_shortened(tmp_path, fixtures_dir, capsys, fraction):
+    import armaxmodal as am
+    from armaxmodal.io import write_recording_uff
+
+    full = write_recording_uff(am.read_recording(fixtures_dir / "supine_random.csv"), tmp_path / "full.uff")
+    assert am.read_recording(full).sensors == ("head", "chest", "pelvis", "legs")
+    cut = tmp_path / "cut.uff"
+    data = full.read_bytes()
+    cut.write_bytes(data[: int(len(data) * fraction)])
+    assert main(["info", str(cut)]) == 2
+    assert "truncated" in capsys.readouterr().err

@@ -88,6 +88,7 @@ def test_rejection_rules_and_their_ceiling(fixtures_dir):
         (8.0, 0.59, 1.0, ""),
         (8.0, 0.61, 1.0, "over-damped"),  # the 0.6 ceiling, not 1.0
         (8.0, -0.01, 1.0, "negative damping"),
+        (8.0, 0.0, 1.0, "negative damping"),  # an undamped pole pair is a line, not a mode
         (0.01, 0.2, 1.0, "near 0 Hz"),
         (27.5, 0.05, 1.0, "near Nyquist"),
         (8.0, 0.3, 0.005, "negligible residue"),
