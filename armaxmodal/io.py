@@ -367,7 +367,7 @@ def _check_uff_complete(path: Path) -> None:
         tail = fh.read().rstrip()
     if tail.rsplit(b"\n", 1)[-1].strip() != b"-1":
         raise DataError(
-            f"{path.name}: the file ends inside a data set (no closing '-1' line): it is truncated, "
+            f"{path.name}: the UFF file ends inside a data set (no closing '-1' line): it is truncated, "
             "and its last channels would be lost. Copy or export it again."
         )
 

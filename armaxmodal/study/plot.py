@@ -23,11 +23,13 @@ def plot_shapes(tables: StudyTables, ride: str, sensors):
     geo = tables.geomean[tables.geomean.ride == ride]
     summary = tables.summary[tables.summary.ride == ride].set_index("mode")
     modes = sorted(int(m) for m in shapes["mode"].unique())
-    fig, axes = plt.subplots(
-        1, max(len(modes), 1), figsize=(3.2 * max(len(modes), 1), 3.4), layout="constrained", squeeze=False
-    )
+    ncols = min(max(len(modes), 1), 4)
+    nrows = -(-max(len(modes), 1) // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(3.2 * ncols, 3.4 * nrows), layout="constrained", squeeze=False)
+    for ax in axes.flat[len(modes) :]:
+        ax.set_axis_off()
     x = np.arange(1, len(sensors) + 1)
-    for ax, mode in zip(axes[0], modes, strict=False):
+    for ax, mode in zip(axes.flat, modes, strict=False):
         for _, g in shapes[shapes["mode"] == mode].groupby("file"):
             mags = g.set_index("sensor").mag.reindex(sensors).to_numpy(float)
             ax.plot(x, mags, "--", lw=0.8, alpha=0.7)

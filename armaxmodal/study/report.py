@@ -20,7 +20,7 @@ td.gap{color:#b00;text-align:center}.thumbs{display:flex;flex-wrap:wrap;gap:10px
 figure{margin:0;text-align:center;font-size:0.8em}.thumbs img{width:260px;cursor:zoom-in;border:1px solid #ddd}
 #full{display:none;position:fixed;inset:0;background:rgba(0,0,0,.8);align-items:center;justify-content:center}
 #full.on{display:flex}#full img{max-width:95vw;max-height:95vh;background:#fff}
-.fail{color:#900}.note{color:#555}
+.fail{color:#900}.note{color:#555}img{max-width:100%}.wide{overflow-x:auto}
 """
 SCRIPT = """
 document.querySelectorAll('.thumbs img').forEach(function(img){img.addEventListener('click',function(){
@@ -39,7 +39,8 @@ def _png(fig) -> str:
 
 
 def _table(frame: pd.DataFrame, digits: int = 4) -> str:
-    return frame.to_html(index=False, na_rep="X", float_format=lambda v: f"{v:.{digits}g}", border=0)
+    html_table = frame.to_html(index=False, na_rep="X", float_format=lambda v: f"{v:.{digits}g}", border=0)
+    return f"<div class=wide>{html_table}</div>"
 
 
 def _table_3_3(study) -> str:

@@ -194,8 +194,10 @@ def _common_sensors(loaded, settings, failures) -> tuple[tuple[str, ...], list[s
                 }
             )
     extra = sorted({s for _, rec, _ in loaded for s in rec.sensors} - set(sensors))
-    if extra:
-        notes.append(f"sensor(s) {extra} are on too few recordings to enter the modes; they are used by --lump only")
+    if extra and settings.sensors:
+        notes.append(f"channel(s) {extra} not analysed: not among the chosen sensors {list(sensors)}")
+    elif extra:
+        notes.append(f"sensor(s) {extra} are on fewer than half the recordings: not in the modes (--lump may use them)")
     return sensors, notes
 
 
