@@ -250,3 +250,20 @@ def test_average_subject_model_reproduces_the_mean_modes_and_scales_by_mass(fini
             alpha = g.mass_kg.iloc[0] / m["mass_kg"]
             k1 = g[g.component == "k1"].value.iloc[0]
             assert k1 == pytest.approx(alpha * m["components"]["k"][0], rel=1e-9)
+
+
+def test_a_subject_without_mass_is_named_when_scaling_is_asked(study_dir, tmp_path):
+    manifest = _small_manifest(study_dir, tmp_path)
+    table = pd.read_csv(manifest)
+    # Sub02 sweep: no mass in the manifest nor in the file's '# mass_kg:' line
+    source = Path(table.loc[2, "file"])
+    copy = tmp_path / source.name
+    copy.write_text("".join(ln for ln in source.read_text().splitlines(True) if not ln.startswith("# mass_kg")))
+    table.loc[2, ["file", "mass_kg"]] = [str(copy), None]
+    table.to_csv(manifest, index=False)
+    body = StudySettings(sensors=("head", "chest", "pelvis", "legs"))
+    study = run_study(manifest, tmp_path / "out", body, jobs=1, model=True)
+    assert any("Sub02_sweep.csv: no mass_kg" in n for n in study.notes)
+    assert [m.get("reason") for m in study.models] == [None] * len(study.models) and len(study.models) == 2
+    scaled = pd.DataFrame(study.scaled)
+    assert set(scaled.subject) == {"Sub01"} and not study.failures

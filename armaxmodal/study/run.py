@@ -142,6 +142,11 @@ def run_study(
         from .model import average_subject_models
 
         study.models, study.scaled = average_subject_models(study)
+        study.notes += [
+            f"{r['file']}: no mass_kg, so the average subject's model is not scaled to {r['subject']} (Eq. 4.7)"
+            for r in recordings
+            if r.get("mass_kg") is None
+        ]
     return study
 
 
