@@ -240,3 +240,19 @@ def test_simulate_cli_plants_effects_and_refuses_bad_ones(tmp_path, capsys):
     assert rec.response[:, 1].mean() == pytest.approx(0.5, abs=0.05)
     assert main([*args, "--effect", "periodic_disturbance:head"]) == 2
     assert "freq_hz, amp" in capsys.readouterr().err
+
+
+def test_a_mode_the_baseline_lacks_is_named_and_found(clean):
+    # a shared-pole model of order 6 holds three of the four modes of Table 4.3
+    d = diagnose(clean, baseline=am.fit_armax(clean, 6, 12, 6, -5, shared_poles=True, warn=False))
+    effect = _first(d)
+    assert effect.finding.effect == "unmodelled_mode"
+    p = effect.parameters
+    assert p["na"] == 8 and p["sim_error_after"] < 0.9 * p["sim_error_before"]
+    exact = am.supine_human().modes()
+    (added,) = p["added_modes"]
+    k = int(np.argmin(np.abs(exact.freq_hz - added["freq_hz"])))
+    assert added["freq_hz"] == pytest.approx(exact.freq_hz[k], rel=0.03)
+    assert added["damping"] == pytest.approx(exact.damping[k], rel=0.15)
+    # at the right order the FRF agrees with H1 within its random error: nothing to name
+    assert min(_run(clean).to_dict()["tests"]["frf_misfit_p"]) == 1.0

@@ -20,6 +20,7 @@ from scipy.signal import lfilter
 
 from ..quality import MIN_DELAY_SAMPLES, estimate_delays
 from ..recording import Recording
+from .missing_mode import mode_findings
 from .model import LINE_MERGE_HZ, UNDAMPED, FittedModel, usable
 from .model import lagged as _lag
 from .spectral import harmonic_f_test
@@ -31,6 +32,7 @@ WHITENESS_LAGS = 10
 #: The tests each round runs, in the order linear/structural effects come first.
 EFFECT_TESTS = (
     "input_delay",
+    "unmodelled_mode",
     "offset_drift",
     "periodic_disturbance",
     "coloured_noise",
@@ -118,13 +120,14 @@ def run_tests(fitted: FittedModel, alpha: float = 0.01) -> tuple[list[Finding], 
     mask = usable(fitted.signals.n, fitted.spec)
     table = {"whiteness_p": [], "trend_p": [], "line_p": []}
     found = _delay_findings(fitted, n_tests)
+    found += mode_findings(fitted, n_tests, table)
     found += _trend_findings(fitted, eps, mask, n_tests, table)
     found += _line_findings(fitted, mask, n_tests, table)
     found += _whiteness_findings(fitted, eps, mask, n_tests, table)
     found += _time_findings(fitted, mask, n_tests, table)
     found += _nonlinear_findings(fitted, eps, mask, n_tests, table)
     significant = [f for f in found if f.p < alpha]
-    return _merge_per_sensor(significant, ("offset_drift", "coloured_noise")), table
+    return _merge_per_sensor(significant, ("offset_drift", "coloured_noise", "unmodelled_mode")), table
 
 
 def _merge_per_sensor(findings: list[Finding], effects) -> list[Finding]:
@@ -138,7 +141,7 @@ def _merge_per_sensor(findings: list[Finding], effects) -> list[Finding]:
             per_channel = {f.channels[0]: f.parameters for f in group}
             top = group[0]
             params = {**top.parameters, "per_channel": per_channel}
-            out.append(Finding(effect, channels, top.statistic, top.value, top.p, params))
+            out.append(Finding(effect, channels, top.statistic, top.value, top.p, params, payload=top.payload))
     return out
 
 

@@ -32,6 +32,9 @@ def add_effect(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelS
         return replace(spec, lines_hz=spec.lines_hz + (f0,))
     if finding.effect == "coloured_noise":
         return replace(spec, extra_nc=spec.extra_nc + EXTRA_NC_STEP)
+    if finding.effect == "unmodelled_mode":  # one more pole pair; nb and nc follow na's rules
+        na, nb, nc, nk = spec.orders
+        return replace(spec, orders=(na + 2, nb + 2, nc + 2, nk))
     if finding.effect == "stiffness_nonlinearity":
         name = f"{finding.parameters['term']}:{'-'.join(finding.parameters['between'])}#{len(spec.terms) + 1}"
         fitted.signals.extra[name] = finding.payload
@@ -106,6 +109,10 @@ def effect_parameters(finding: Finding, fitted) -> dict:
             if name in finding.channels
         }
         return {**finding.parameters, "rms_share_of_output": share}
+    if finding.effect == "unmodelled_mode":
+        from .missing_mode import added_modes
+
+        return {**finding.parameters, "na": spec.orders[0], "added_modes": added_modes(finding.payload, fitted)}
     if finding.effect == "coloured_noise":
         return {"nc": spec.orders[2] + spec.extra_nc, "nc_before": spec.orders[2] + spec.extra_nc - EXTRA_NC_STEP}
     return dict(finding.parameters)

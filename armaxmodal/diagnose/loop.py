@@ -50,6 +50,7 @@ TESTED_EFFECTS = EFFECT_TESTS
 #: Linear/structural effects first: a wrong linear part fires every later test.
 _TIER = {
     "input_delay": 0,
+    "unmodelled_mode": 1,
     "offset_drift": 1,
     "periodic_disturbance": 1,
     "coloured_noise": 2,
@@ -60,6 +61,7 @@ _TIER = {
 #: carry a line or an offset in its noise model (an undamped pole, A(1)) while the
 #: deterministic part -- the modes -- is wrong.
 _CRITERION = {
+    "unmodelled_mode": "simulation",
     "periodic_disturbance": "simulation",
     "offset_drift": "simulation",
     "stiffness_nonlinearity": "simulation",
