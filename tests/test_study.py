@@ -267,3 +267,23 @@ def test_a_subject_without_mass_is_named_when_scaling_is_asked(study_dir, tmp_pa
     assert [m.get("reason") for m in study.models] == [None] * len(study.models) and len(study.models) == 2
     scaled = pd.DataFrame(study.scaled)
     assert set(scaled.subject) == {"Sub01"} and not study.failures
+
+
+def test_a_folder_study_takes_subjects_from_the_files_and_notes_a_mixed_rate(study_dir, tmp_path):
+    from scipy.signal import resample_poly
+
+    import armaxmodal as am
+    from armaxmodal.io import write_recording_csv
+
+    folder, _ = study_dir
+    rides = tmp_path / "rides"
+    rides.mkdir()
+    shutil.copy(folder / "Sub01_random.csv", rides / "a.csv")
+    r = am.read_recording(folder / "Sub02_random.csv")
+    faster = am.Recording(100.0, resample_poly(r.base, 5, 3), resample_poly(r.response, 5, 3, axis=0), r.sensors,
+                          subject=r.subject, mass_kg=r.mass_kg)  # fmt: skip
+    write_recording_csv(faster, rides / "b.csv")
+    study = run_study(rides, tmp_path / "out", StudySettings(), jobs=2)
+    assert [r["subject"] for r in study.recordings] == ["Sub01", "Sub02"]
+    assert any("mixed sample rates" in n and "b.csv (100 Hz)" in n for n in study.notes)
+    assert not study.failures and study.recordings[1]["fs"] == 100.0

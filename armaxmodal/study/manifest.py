@@ -114,7 +114,8 @@ def _from_folder(folder: Path) -> list[Entry]:
     files = sorted(p for p in folder.iterdir() if p.is_file() and p.name.lower().endswith(RECORDING_SUFFIXES))
     if not files:
         raise DataError(f"{folder}: no recordings ({', '.join(RECORDING_SUFFIXES)}) and no manifest.csv in it.")
-    return [Entry(i, p.resolve(), p.name, p.name.split(".")[0], "all") for i, p in enumerate(files, start=1)]
+    # subject "" : taken from the file's '# subject:' line when the study reads it, else its name
+    return [Entry(i, p.resolve(), p.name, "", "all") for i, p in enumerate(files, start=1)]
 
 
 def _mass(text: str) -> float | None:
