@@ -398,16 +398,15 @@ class ModeSelection:
 
     @property
     def reconstruction_error(self) -> float:
-        """Relative RMS difference between the FRF rebuilt from the selected modes and the
-        measured H1 FRF, over frequencies where every sensor's coherence is at least 0.8."""
-        from .frf import measured_frf, modal_frf
+        """Relative RMS difference between the FRF rebuilt from the selected modes (with a
+        constant residual per sensor) and the measured H1, over coherent lines of the band,
+        at a resolution that resolves the narrowest mode (:mod:`armaxmodal.frf_check`)."""
+        from .frf_check import reconstruction_error
 
-        f, h, coh = measured_frf(self.diagram.recording)
-        good = (np.min(coh, axis=1) >= 0.8) & (f > 0)
-        if not good.any():
-            return float("nan")
-        rebuilt = modal_frf(f[good], self.modes.freq_hz, self.modes.damping, self.shapes)
-        return float(np.linalg.norm(rebuilt - h[good]) / np.linalg.norm(h[good]))
+        prep = self.diagram.preparation
+        modes = self.modes
+        band = prep.band if prep is not None else None
+        return reconstruction_error(self.diagram.recording, modes.freq_hz, modes.damping, self.shapes, band)[0]
 
     @property
     def warnings(self) -> list[QualityWarning]:
@@ -607,6 +606,9 @@ def select_modes(
         spread = segment_spread(diagram.recording, modes, lambda i: orders[int(modes.at[i, "na"])], segments)
         modes, notes = apply_segment_spread(modes, spread, segments)
     per_sensor, weighted = _per_sensor_table(diagram, modes, shapes, cluster_freq)
+    from .frf_check import unexplained_peaks
+
+    notes += unexplained_peaks(diagram.recording, modes.freq_hz.to_numpy(), modes.damping.to_numpy(), band)
     return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement, tuple(notes))
 
 

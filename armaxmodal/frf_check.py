@@ -1,0 +1,103 @@
+"""Does the modal model explain the measured FRF? The FRF rebuilt from the selected modes
+against an H1 fine enough to resolve the narrowest of them, and the clear, coherent FRF
+peaks no selected mode accounts for (thesis Section 3.3.3's check, made quantitative)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .frf import excited_band, modal_frf, welch_spectra
+from .quality import QualityWarning
+from .recording import Recording
+
+__all__ = ["resolving_nperseg", "reconstruction_error", "unexplained_peaks"]
+
+#: lines per half-power bandwidth of the narrowest mode the comparison needs
+LINES_PER_BANDWIDTH = 4
+#: fewest Welch segments kept (the H1's random error grows as segments get fewer)
+MIN_SEGMENTS = 4
+MIN_COHERENCE = 0.8
+
+
+def resolving_nperseg(recording: Recording, freq_hz, damping) -> int:
+    """Welch segment length whose line spacing puts :data:`LINES_PER_BANDWIDTH` lines in the
+    half-power bandwidth ``2 xi f`` of the narrowest mode, within 8 s and the record (at least
+    :data:`MIN_SEGMENTS` half-overlapping segments)."""
+    bw = 2 * np.min(np.asarray(damping, float) * np.asarray(freq_hz, float)) if len(freq_hz) else 0.0
+    longest = 2 * recording.n_samples // (MIN_SEGMENTS + 1)
+    want = recording.fs * LINES_PER_BANDWIDTH / bw if bw > 0 else longest
+    return int(np.clip(2 ** int(np.ceil(np.log2(max(want, 16)))), min(256, longest), longest))
+
+
+def _measured(recording: Recording, nperseg: int):
+    f, puu, puy, pyy = welch_spectra(recording.base, recording.response, recording.fs, nperseg)
+    return f, puy / puu[:, None], np.abs(puy) ** 2 / np.maximum(puu[:, None] * pyy, 1e-300)
+
+
+def reconstruction_error(recording: Recording, freq_hz, damping, shapes, band=None) -> tuple[float, int]:
+    """Relative RMS difference between the FRF rebuilt from the modes and the measured H1,
+    over lines in ``band`` (default: the excited band) where every sensor's coherence is at
+    least 0.8, at the resolution of :func:`resolving_nperseg`. Each sensor's rebuilt FRF gets
+    a constant residual term (least squares), the usual stand-in for modes outside the band
+    and a direct term. Returns ``(error, nperseg)``; the error is NaN without such lines."""
+    n = resolving_nperseg(recording, freq_hz, damping)
+    f, h, coh = _measured(recording, n)
+    lo, hi = band if band is not None else excited_band(recording)
+    good = (np.min(coh, axis=1) >= MIN_COHERENCE) & (f > 0) & (f >= lo) & (f <= hi)
+    if not good.any():
+        return float("nan"), n
+    rebuilt = modal_frf(f[good], freq_hz, damping, shapes)
+    rebuilt = rebuilt + np.mean(h[good] - rebuilt, axis=0, keepdims=True)
+    return float(np.linalg.norm(rebuilt - h[good]) / np.linalg.norm(h[good])), n
+
+
+def unexplained_peaks(recording: Recording, freq_hz, damping, band=None) -> list[QualityWarning]:
+    """Coherent peaks of the measured FRF with no selected mode within its half-power
+    bandwidth ``2 xi f`` (at least 1 % or 3 lines): each a ``unexplained_peak`` warning."""
+    from scipy.signal import find_peaks
+
+    n = resolving_nperseg(recording, freq_hz, damping)
+    f, h, coh = _measured(recording, n)
+    lo, hi = band if band is not None else excited_band(recording)
+    df = f[1] - f[0]
+    out = []
+    for k, sensor in enumerate(recording.sensors):
+        mag = np.abs(h[:, k])
+        ok = (coh[:, k] >= MIN_COHERENCE) & (f >= lo) & (f <= hi)
+        # a peak stands out by a third of its height over both neighbouring valleys
+        peaks, props = find_peaks(np.where(ok, mag, 0.0), prominence=0.0)
+        for i, prom in zip(peaks, props["prominences"], strict=True):
+            # a mode spans LINES_PER_BANDWIDTH lines or more: a noise bump is a line or two wide,
+            # and a bump far below the sensor's strongest response is not a clear peak
+            span = slice(max(i - LINES_PER_BANDWIDTH, 0), i + LINES_PER_BANDWIDTH + 1)
+            if prom < 0.33 * mag[i] or mag[i] < 0.05 * mag[ok].max() or mag[i] < mag[span].max():
+                continue
+            if not ok[max(i - 2, 0) : i + 3].all():
+                continue
+            near = [
+                abs(f[i] - fm) <= max(2 * fm * x, 0.01 * fm, 3 * df) for fm, x in zip(freq_hz, damping, strict=True)
+            ]
+            if not any(near):
+                out.append((float(f[i]), sensor, float(mag[i])))
+    return _merged(out, df)
+
+
+def _merged(peaks, df) -> list[QualityWarning]:
+    """One warning per peak seen on several sensors (within 3 % or 3 lines of each other)."""
+    groups: list[list] = []
+    for p in sorted(peaks):
+        if groups and p[0] - groups[-1][-1][0] <= max(0.03 * p[0], 3 * df):
+            groups[-1].append(p)
+        else:
+            groups.append([p])
+    warnings = []
+    for g in groups:
+        f0 = max(g, key=lambda p: p[2])[0]
+        sensors = tuple(sorted({p[1] for p in g}))
+        warnings.append(QualityWarning(
+            "unexplained_peak", sensors,
+            f"the measured FRF has a clear, coherent peak at {f0:.2f} Hz ({', '.join(sensors)}) that no "
+            "selected mode explains: a mode the selection missed (widen --orders or --modes), or a disturbance "
+            "(run 'armaxmodal diagnose')", f0,
+        ))  # fmt: skip
+    return warnings

@@ -1,0 +1,44 @@
+"""The modal model against the measured FRF: the reconstruction error separates a complete
+selection from one missing modes, and a clear coherent peak no selected mode explains is named."""
+
+import numpy as np
+import pytest
+
+import armaxmodal as am
+from armaxmodal.frf_check import reconstruction_error, resolving_nperseg, unexplained_peaks
+from armaxmodal.stabilisation import select_modes, stabilisation_diagram
+
+
+@pytest.fixture(scope="module")
+def supine(fixtures_dir):
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    return select_modes(stabilisation_diagram(rec, range(2, 31, 2)))
+
+
+def test_the_error_separates_a_complete_selection_from_an_incomplete_one(supine):
+    rec, m, shapes = supine.diagram.recording, supine.modes, supine.shapes
+    full = reconstruction_error(rec, m.freq_hz, m.damping, shapes)[0]
+    assert full < 0.02 and supine.reconstruction_error == pytest.approx(full)
+    for keep in ([0, 1], [0, 2, 3], [1, 2, 3]):
+        assert reconstruction_error(rec, m.freq_hz[keep], m.damping[keep], shapes[:, keep])[0] > 0.15
+    # heavily damped modes make no prominent peak of their own: nothing is called unexplained
+    assert not [w for w in supine.warnings if w.code == "unexplained_peak"]
+
+
+@pytest.fixture(scope="module")
+def light():
+    """Two lightly damped modes (about 4 and 11 Hz, 1-2 %) on a random ride."""
+    s = am.Structure.from_chain([10.0, 5.0], [8000.0, 0.0], [8.0, 0.0], [12000.0], [5.0], ("m1", "m2"))
+    u = am.random_vibration(50.0, 240.0, (0.5, 24.0), seed=3)
+    return s, am.simulate_recording(s, u, 50.0, noise=0.02, seed=4, hold="bandlimited")
+
+
+def test_a_missing_lightly_damped_mode_is_named_at_its_frequency(light):
+    s, rec = light
+    modes = s.modes()
+    assert np.all(modes.damping < 0.02)
+    assert resolving_nperseg(rec, modes.freq_hz, modes.damping) >= 512  # lines fine enough for 1 % damping
+    assert unexplained_peaks(rec, modes.freq_hz, modes.damping) == []
+    (w,) = unexplained_peaks(rec, modes.freq_hz[:1], modes.damping[:1])
+    assert w.code == "unexplained_peak" and w.value == pytest.approx(modes.damped_freq_hz[1], rel=0.01)
+    assert set(w.channels) == {"m1", "m2"}
