@@ -256,3 +256,14 @@ def test_a_mode_the_baseline_lacks_is_named_and_found(clean):
     assert added["damping"] == pytest.approx(exact.damping[k], rel=0.15)
     # at the right order the FRF agrees with H1 within its random error: nothing to name
     assert min(_run(clean).to_dict()["tests"]["frf_misfit_p"]) == 1.0
+
+
+def test_a_disturbance_fits_beside_a_nonlinear_term(clean):
+    # a term makes the input (n, 2): the disturbance fit once took its size for n (stiff3 IMU ride)
+    from armaxmodal.diagnose.model import ModelSpec, Signals, fit_model
+
+    n = 3000
+    y = clean.response[:n] + np.array([0.3, 0.0, -0.2, 0.0])
+    s = Signals(clean.base[:n], y, clean.fs, clean.sensors, "base", {"t": np.tanh(clean.base[:n])})
+    fitted = fit_model(ModelSpec((6, 12, 6, -5), trend_degree=0, terms=("t",)), s)
+    assert fitted.theta[0] == pytest.approx([0.3, 0.0, -0.2, 0.0], abs=0.05)

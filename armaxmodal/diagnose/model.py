@@ -267,7 +267,7 @@ def _disturbance_ls(fit: ArmaxFit, u, y, phi, spec, theta):
     Not GLS through the noise model: a root of A that has absorbed part of a line zeroes the
     ``A / C``-filtered regressor there, starving the estimate; ``G`` is taken without such
     roots (:func:`response_free_of`)."""
-    mask = usable(u.size, spec)
+    mask = usable(u.shape[0], spec)  # u is (n, inputs) once a term enters
     q = phi.shape[1]
     x = phi[mask]
     xtx_inv = np.linalg.pinv(x.T @ x)
