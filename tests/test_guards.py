@@ -122,3 +122,43 @@ def test_zoh_refit_shapes_match_the_exact_modal_constants(fixtures_dir):
     got = ref.shapes / ref.shapes[np.argmax(np.abs(ref.shapes), axis=0), np.arange(4)]
     want = want / want[np.argmax(np.abs(want), axis=0), np.arange(4)]
     assert np.max(np.abs(got - want)) < 0.06
+
+
+def test_mode_record_normalises_the_shape_and_keeps_the_supplemented_flags():
+    from types import SimpleNamespace
+
+    from armaxmodal.modal import mode_record
+
+    row = SimpleNamespace(freq_hz=5.0, damping=0.2, damped_freq_hz=4.9, freq_ci95_lo=4.8, freq_ci95_hi=5.2,
+                          damping_ci95_lo=0.1, damping_ci95_hi=0.3)  # fmt: skip
+    shape = np.array([0.5j, -2.0 + 0j, 1.0 + 1.0j])
+    rec = mode_record(row, shape, ("a", "b", "c"), np.array([False, True, False]))
+    assert rec["shape"]["b"] == {"mag": 1.0, "phase_deg": 0.0, "supplemented": True}
+    assert rec["shape"]["a"]["mag"] == pytest.approx(0.25) and rec["shape"]["a"]["phase_deg"] == pytest.approx(-90.0)
+    assert rec["shape"]["c"]["supplemented"] is False
+    assert rec["freq_ci95"] == [4.8, 5.2] and rec["damping_ci95"] == [0.1, 0.3]
+    assert (rec["freq_hz"], rec["damping"], rec["damped_freq_hz"]) == (5.0, 0.2, 4.9)
+    zero = mode_record(row, np.zeros(3, complex), ("a", "b", "c"))
+    assert all(v["mag"] == 0.0 for v in zero["shape"].values())  # no division by a zero component
+
+
+def test_thesis_equations_agree_with_the_log_map_at_the_nyquist_edge():
+    from armaxmodal.modal import thesis_frequency_damping
+
+    # a pole on the negative real axis (the Nyquist frequency) and one just inside it
+    mu = np.array([-0.5 + 0j, 0.3 * np.exp(1j * np.pi * (1 - 1e-6))])
+    f, x = thesis_frequency_damping(mu, 0.01)
+    f_ref, x_ref, _ = discrete_modal_parameters(mu, 100.0)
+    np.testing.assert_allclose(f, f_ref, rtol=1e-9)
+    np.testing.assert_allclose(x, x_ref, rtol=1e-9)
+
+
+def test_continuous_parameters_of_slow_zero_and_real_axis_poles():
+    from armaxmodal.modal import continuous_modal_parameters, discrete_to_continuous
+
+    f, x, fd = continuous_modal_parameters(np.array([-0.1 + 0.5j, 0j]))  # |lambda| < 1 rad/s, and 0
+    assert x[0] == pytest.approx(0.1 / np.hypot(0.1, 0.5)) and f[0] == pytest.approx(np.hypot(0.1, 0.5) / (2 * np.pi))
+    assert np.isnan(x[1]) and f[1] == 0.0 and fd[0] == pytest.approx(0.5 / (2 * np.pi))
+    # a real negative discrete pole given as a float is still the Nyquist-frequency pole
+    lam = discrete_to_continuous(np.array([-0.5]), 100.0)
+    assert lam[0] == pytest.approx(100.0 * (np.log(0.5) + 1j * np.pi))
