@@ -342,8 +342,10 @@ def _cmd_invert(args) -> int:
 
     try:
         data = json.loads(open(args.modes, encoding="utf-8").read())
-    except (OSError, json.JSONDecodeError) as exc:
-        raise DataError(f"{args.modes}: not a readable modes JSON ({exc}).") from exc
+    except (OSError, json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise DataError(f"{args.modes}: not a readable modes JSON ({exc}); write one with 'stabilise --json'.") from exc
+    if not isinstance(data, dict) or not data.get("modes"):
+        raise DataError(f"{args.modes}: no modes in this JSON; 'stabilise --json' writes them under \"modes\".")
     plot_format = _format(args.plot) if args.plot else None
     lam, shapes, sensors = modes_from_json(data)
     bounds = None
@@ -354,6 +356,11 @@ def _cmd_invert(args) -> int:
         from .frf import default_nperseg, h1_relative_error, measured_frf
 
         rec = read_recording(args.recording, input=args.input, fs=args.fs)
+        if set(rec.sensors) != set(sensors):
+            raise DataError(
+                f"--recording {args.recording}: its sensors {list(rec.sensors)} are not the modes' {sensors}; "
+                "give the recording the modes were identified from."
+            )
         f, h, coh = measured_frf(rec)
         keep = (f > 0.5) & (np.min(coh, axis=1) >= 0.8)
         frf = (f[keep], h[keep])
@@ -524,7 +531,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--input", default="base")
     p.add_argument("--fs", type=_POSITIVE, default=None)
     p.add_argument("--method", choices=["model_update", "evphc", "pia", "inner"], default="model_update")
-    p.add_argument("--total-mass", type=float, default=None, help="subject mass in kg (sets the scale)")
+    p.add_argument("--total-mass", type=_POSITIVE, default=None, help="subject mass in kg (sets the scale)")
     p.add_argument("--json", default=None, help="write M, C, K, components and modes as JSON")
     p.add_argument("--plot", default=None, help="predicted vs measured acceleration per sensor (.png/.svg/.pdf)")
     p.set_defaults(func=_cmd_invert)

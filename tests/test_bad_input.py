@@ -168,3 +168,30 @@ def test_a_truncated_uff_file_is_refused_not_shortened(tmp_path, fixtures_dir, c
     cut.write_bytes(data[: int(len(data) * fraction)])
     assert main(["info", str(cut)]) == 2
     assert "truncated" in capsys.readouterr().err
+
+
+def test_invert_refuses_bad_modal_files_with_one_line(tmp_path, fixtures_dir, capsys):
+    import json
+
+    binary = tmp_path / "modes.json"
+    binary.write_bytes(bytes(range(256)))
+    empty = tmp_path / "empty.json"
+    empty.write_text(json.dumps({"outputs": ["head"], "modes": []}))
+    text = tmp_path / "text.json"
+    mode = {"freq_hz": "abc", "damping": 0.1, "shape": {"head": {"mag": 1.0, "phase_deg": 0.0}}}
+    text.write_text(json.dumps({"outputs": ["head"], "modes": [mode]}))
+    good = tmp_path / "good.json"
+    good.write_text(json.dumps({"outputs": ["head"], "modes": [dict(mode, freq_hz=5.0)]}))
+    cases = [
+        ([str(binary)], "not a readable modes JSON"),
+        ([str(empty)], "no modes in this JSON"),
+        ([str(text)], "not a number"),
+        ([str(good), "--recording", str(fixtures_dir / "chapter2_random_zoh.csv")], "are not the modes'"),
+    ]
+    for argv, words in cases:
+        assert main(["invert", *argv, "--quiet"]) == 2
+        err = capsys.readouterr().err
+        assert words in err and "Traceback" not in err
+    with pytest.raises(SystemExit):
+        main(["invert", str(good), "--total-mass", "-70"])
+    assert "finite number > 0" in capsys.readouterr().err

@@ -68,4 +68,8 @@ def modes_from_json(data: dict) -> tuple[np.ndarray, np.ndarray, list]:
         )
     except (KeyError, TypeError) as exc:
         raise StructureError(f"modes JSON: missing field {exc}; write it with 'armaxmodal stabilise --json'.") from exc
+    except ValueError as exc:  # a frequency, damping or shape entry that is not a number
+        raise StructureError(
+            f"modes JSON: a value is not a number ({exc}); write it with 'armaxmodal stabilise --json'."
+        ) from exc
     return lam, shapes, sensors
