@@ -162,6 +162,8 @@ def test_study_refuses_bad_arguments_before_any_work(study_dir, tmp_path):
     (tmp_path / "afile").write_text("x")
     with pytest.raises(DataError, match="is a file"):
         run_and_raise(["study", str(folder), "--out", str(tmp_path / "afile")])
+    with pytest.raises(DataError, match="write into the study's input"):
+        run_and_raise(["study", str(folder), "--out", str(folder)])
     with pytest.raises(DataError, match="two different sensor names"):
         run_and_raise(["study", str(folder), "--out", str(tmp_path / "o"), "--lump", "legs"])
     with pytest.raises(DataError, match="'file' column"):

@@ -66,10 +66,12 @@ def _check_paths(args) -> None:
     if out.exists() and not out.is_dir():
         raise DataError(f"--out {args.out}: is a file; give a folder (it is created if missing).")
     source = Path(args.source).resolve()
-    if out.resolve() == source or (
-        source.is_file() and out.resolve() == source.parent and args.report is None and source.name == "report.html"
-    ):
-        raise DataError(f"--out {args.out}: would overwrite the study's input; choose another folder.")
+    # the study's own files must not land on the manifest, nor among the recordings of a
+    # folder study (the next run would read summary.csv as a recording)
+    written = {"summary.csv", "modes.csv", "per_sensor.csv", "subjects.csv", "shapes.csv", "lump.csv",
+               "model_scaled.csv", "study.json", "report.html"}  # fmt: skip
+    if out.resolve() == source or (source.is_file() and out.resolve() == source.parent and source.name in written):
+        raise DataError(f"--out {args.out}: would write into the study's input; choose another folder.")
     if args.report:
         report = Path(args.report)
         if report.is_dir():
