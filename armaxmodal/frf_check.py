@@ -10,7 +10,7 @@ from .frf import excited_band, modal_frf, welch_spectra
 from .quality import QualityWarning
 from .recording import Recording
 
-__all__ = ["resolving_nperseg", "reconstruction_error", "unexplained_peaks"]
+__all__ = ["resolving_nperseg", "reconstruction_error", "unexplained_peaks", "coherent_peaks", "peak_support"]
 
 #: lines per half-power bandwidth of the narrowest mode the comparison needs
 LINES_PER_BANDWIDTH = 4
@@ -51,35 +51,59 @@ def reconstruction_error(recording: Recording, freq_hz, damping, shapes, band=No
     return float(np.linalg.norm(rebuilt - h[good]) / np.linalg.norm(h[good])), n
 
 
-def unexplained_peaks(recording: Recording, freq_hz, damping, band=None) -> list[QualityWarning]:
-    """Coherent peaks of the measured FRF with no selected mode within its half-power
-    bandwidth ``2 xi f`` (at least 1 % or 3 lines): each a ``unexplained_peak`` warning."""
+def coherent_peaks(recording: Recording, nperseg: int, band=None) -> list[tuple[float, str, float]]:
+    """Clear, coherent peaks of each sensor's measured FRF: ``(freq_hz, sensor, |H1|)``.
+
+    A clear peak: coherence at least 0.8 on it and two lines either side, a third of its
+    height above both neighbouring valleys, the highest within :data:`LINES_PER_BANDWIDTH`
+    lines either side (a mode spans that many lines at the resolution of
+    :func:`resolving_nperseg`; a noise bump is a line or two wide), and at least 5 % of the
+    sensor's strongest coherent response.
+    """
     from scipy.signal import find_peaks
 
-    n = resolving_nperseg(recording, freq_hz, damping)
-    f, h, coh = _measured(recording, n)
+    f, h, coh = _measured(recording, nperseg)
     lo, hi = band if band is not None else excited_band(recording)
-    df = f[1] - f[0]
     out = []
     for k, sensor in enumerate(recording.sensors):
         mag = np.abs(h[:, k])
         ok = (coh[:, k] >= MIN_COHERENCE) & (f >= lo) & (f <= hi)
-        # a peak stands out by a third of its height over both neighbouring valleys
+        if not ok.any():
+            continue
         peaks, props = find_peaks(np.where(ok, mag, 0.0), prominence=0.0)
         for i, prom in zip(peaks, props["prominences"], strict=True):
-            # a mode spans LINES_PER_BANDWIDTH lines or more: a noise bump is a line or two wide,
-            # and a bump far below the sensor's strongest response is not a clear peak
             span = slice(max(i - LINES_PER_BANDWIDTH, 0), i + LINES_PER_BANDWIDTH + 1)
             if prom < 0.33 * mag[i] or mag[i] < 0.05 * mag[ok].max() or mag[i] < mag[span].max():
                 continue
-            if not ok[max(i - 2, 0) : i + 3].all():
-                continue
-            near = [
-                abs(f[i] - fm) <= max(2 * fm * x, 0.01 * fm, 3 * df) for fm, x in zip(freq_hz, damping, strict=True)
-            ]
-            if not any(near):
+            if ok[max(i - 2, 0) : i + 3].all():
                 out.append((float(f[i]), sensor, float(mag[i])))
-    return _merged(out, df)
+    return out
+
+
+def _explains(freq_hz: float, line_hz: float, modes_hz, damping) -> bool:
+    """A mode lies within the peak's half-power bandwidth ``2 xi f`` (at least 1 % or 3 lines)."""
+    return any(
+        abs(freq_hz - fm) <= max(2 * fm * x, 0.01 * fm, 3 * line_hz) for fm, x in zip(modes_hz, damping, strict=True)
+    )
+
+
+def unexplained_peaks(recording: Recording, freq_hz, damping, band=None) -> list[QualityWarning]:
+    """Coherent peaks of the measured FRF (:func:`coherent_peaks`) with no selected mode
+    within its half-power bandwidth: each a ``unexplained_peak`` warning."""
+    n = resolving_nperseg(recording, freq_hz, damping)
+    df = recording.fs / n
+    peaks = coherent_peaks(recording, n, band)
+    return _merged([p for p in peaks if not _explains(p[0], df, freq_hz, damping)], df)
+
+
+def peak_support(recording: Recording, freq_hz: float, damping: float, band=None) -> float | None:
+    """Frequency of the clear, coherent FRF peak (:func:`coherent_peaks`) that a mode at
+    ``freq_hz`` explains, or None: the data's own evidence for a mode whose poles alone are
+    not conclusive (a lightly damped pole whose damping estimate crosses zero)."""
+    n = resolving_nperseg(recording, [freq_hz], [max(damping, 1e-6)])
+    df = recording.fs / n
+    near = [p for p in coherent_peaks(recording, n, band) if _explains(p[0], df, [freq_hz], [max(damping, 0.0)])]
+    return max(near, key=lambda p: p[2])[0] if near else None
 
 
 def _merged(peaks, df) -> list[QualityWarning]:

@@ -45,6 +45,7 @@ WARNING_CODES = (
     "model_error_dominates",
     "nk_at_search_edge",
     "unexplained_peak",
+    "damping_unresolved",
     "no_modes",
 )
 

@@ -24,6 +24,7 @@ import pandas as pd
 from .exceptions import OrderError
 from .fit import ArmaxFit, fit_armax
 from .frf import excited_band
+from .frf_check import peak_support
 from .modal import mode_record
 from .orders import _fit_or_none, _map, default_nb, default_nc, information_criterion
 from .prepare import Preparation, prepare
@@ -40,6 +41,12 @@ SHARED = "shared"
 # The fits whose estimates are reported are finished to fit_armax's default criterion.
 SWEEP_TOL = 1e-5
 CLASSES = ("new", "f", "f+d", "f+d+v")
+#: rejection reason of a pole whose damping estimate is not positive but whose 95 % interval
+#: reaches above zero: a lightly damped mode the record cannot resolve in damping. Such poles
+#: count towards a mode's support, never as its estimate (see :func:`select_modes`).
+UNRESOLVED_DAMPING = "damping not resolved"
+#: a finished fit's pole farther than this (relative frequency) is another pole, not this one finished
+FINISHED_MAX_SHIFT = 0.05
 #: input delays the sweep searches (non-causal taps for band-limited data)
 NK_SEARCH = range(0, -7, -1)
 #: when the best delay is the most non-causal searched, this many more are tried once
@@ -346,7 +353,8 @@ def _reject(poles: pd.DataFrame, tol: Tolerances, recording: Recording) -> list[
     reasons = []
     for row, e_max in zip(poles.itertuples(index=False), top, strict=True):
         if row.damping <= 0:
-            reasons.append("negative damping")
+            sd = getattr(row, "damping_sd", 0.0)
+            reasons.append(UNRESOLVED_DAMPING if row.damping + 1.96 * sd > 0 else "negative damping")
         elif row.damping > tol.max_damping:
             reasons.append("over-damped")
         elif row.freq_hz < f_min:
@@ -511,63 +519,27 @@ def select_modes(
     """
     if band is None and diagram.preparation is not None:
         band = diagram.preparation.band
-    poles = diagram.poles
-    cand = poles[(poles.source == SHARED) & (poles.rejected == "")]
-    if band is not None:
-        cand = cand[(cand.freq_hz >= band[0]) & (cand.freq_hz <= band[1])]
+    cand = _candidates(diagram.poles, band)
     nas = sorted({o[0] for o in diagram.orders})
-    clusters: list[list[int]] = []
-    for na in nas:
-        group = cand[cand.na == na].sort_values("energy", ascending=False)
-        for idx, row in group.iterrows():
-            best, best_d = None, np.inf
-            for ci, members in enumerate(clusters):
-                if any(cand.at[m, "na"] == na for m in members):
-                    continue
-                f_c = float(np.median(cand.loc[members, "freq_hz"]))
-                x_c = float(np.median(cand.loc[members, "damping"]))
-                df, dx = abs(row.freq_hz - f_c) / f_c, abs(row.damping - x_c) / x_c
-                if df <= cluster_freq and dx <= cluster_damping and df + 0.1 * dx < best_d:
-                    best, best_d = ci, df + 0.1 * dx
-            if best is None:
-                clusters.append([idx])
-            else:
-                clusters[best].append(idx)
+    kept = cand[cand.rejected == ""]
+    clusters = _cluster(kept, nas, cluster_freq, cluster_damping)
+    clusters = [c for c in clusters if _supported(len(c), len(nas), min_support)]
+    left = cand.drop(index=[m for c in clusters for m in c])
+    clusters += _rescued_clusters(diagram, left, nas, cluster_freq, min_support, band)
     bic = {na: information_criterion(fit) for (src, na), fit in diagram.fits.items() if src == SHARED}
     finished: dict[int, pd.DataFrame] = {}
-    rows, vectors = [], []
+    rows, vectors, unresolved = [], [], []
     for members in clusters:
         sub = cand.loc[members]
-        support = len(members) / len(nas)
-        if len(members) < 3 or support < min_support:
+        rep = _representative(diagram, sub[sub.damping > 0], bic, finished)
+        if rep is None:
             continue
-        f, x = sub.freq_hz.to_numpy(), sub.damping.to_numpy()
-        dist = np.abs(f[:, None] - f[None]) / f.mean() + np.abs(x[:, None] - x[None]) / x.mean()
-        medoid = sub.iloc[int(np.argmin(dist.sum(axis=1)))]
-        rep = sub.loc[min(members, key=lambda m: (bic.get(int(cand.at[m, "na"]), np.inf), cand.at[m, "na"]))]
-        rep = _finished_pole(diagram, rep, finished)
-        rows.append(
-            {
-                "freq_hz": rep.freq_hz,
-                "damping": rep.damping,
-                "damped_freq_hz": rep.damped_freq_hz,
-                "freq_ci95_lo": rep.freq_ci95_lo,
-                "freq_ci95_hi": rep.freq_ci95_hi,
-                "damping_ci95_lo": rep.damping_ci95_lo,
-                "damping_ci95_hi": rep.damping_ci95_hi,
-                "na": int(rep.na),
-                "count": len(members),
-                "support": support,
-                "freq_spread": float(np.std(f, ddof=1)),
-                "damping_spread": float(np.std(x, ddof=1)),
-                "medoid_freq_hz": medoid.freq_hz,
-                "medoid_damping": medoid.damping,
-                "energy": float(sub.energy.median()),
-            }
-        )
+        rows.append(_mode_row(rep, sub, len(nas)))
         vectors.append(rep.vector)
+        unresolved.append(int((sub.damping <= 0).sum()))
     modes = pd.DataFrame(rows)
     if not modes.empty:
+        modes["orders_damping_unresolved"] = unresolved
         keep = _merge_duplicates(modes, vectors, merge_mac, diagram.recording.duration)
         modes, vectors = modes.loc[keep].reset_index(drop=True), [vectors[i] for i in keep]
     if modes.empty:
@@ -588,18 +560,7 @@ def select_modes(
     modes["damping_sd_armax"] = (modes.damping_ci95_hi - modes.damping_ci95_lo) / (2 * 1.96)
     refinement = None
     if refine:
-        lo, hi = excited_band(diagram.recording)
-        if band is not None:  # modes outside the user's band are not in the refit: fit only inside it
-            lo, hi = max(lo, band[0]), min(hi, band[1])
-        try:
-            refinement = refine_modes(diagram.recording, modes.freq_hz, modes.damping, band_hz=(lo, hi))
-        except (OrderError, np.linalg.LinAlgError):
-            refinement = None  # too few lines or a degenerate basis: the ARMAX values stand
-        if refinement is not None and refinement.hold == "bandlimited":
-            modes, shapes = _apply_refinement(modes, shapes, refinement, cluster_freq, cluster_damping)
-            # two modes the refit brought together are one peak
-            keep = _merge_duplicates(modes, list(shapes.T), merge_mac, diagram.recording.duration)
-            modes, shapes = modes.loc[keep].reset_index(drop=True), shapes[:, keep]
+        modes, shapes, refinement = _refined(diagram, modes, shapes, band, cluster_freq, cluster_damping, merge_mac)
     notes: list[QualityWarning] = []
     if segments >= 2:
         orders = {o[0]: o for o in diagram.orders}
@@ -609,7 +570,137 @@ def select_modes(
     from .frf_check import unexplained_peaks
 
     notes += unexplained_peaks(diagram.recording, modes.freq_hz.to_numpy(), modes.damping.to_numpy(), band)
+    notes += _unresolved_damping_notes(modes, len(nas))
     return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement, tuple(notes))
+
+
+def _representative(diagram, resolved: pd.DataFrame, bic: dict, finished: dict) -> pd.Series | None:
+    """The cluster's pole from the fit of lowest BIC, finished to full convergence; the next
+    order's when finishing takes a lightly damped pole's damping to zero or below (None when
+    every one does: the record gives this mode no damping estimate)."""
+    ranked = sorted(resolved.index, key=lambda m: (bic.get(int(resolved.at[m, "na"]), np.inf), resolved.at[m, "na"]))
+    for m in ranked:
+        rep = _finished_pole(diagram, resolved.loc[m], finished)
+        if rep.damping > 0:
+            return rep
+    return None
+
+
+def _refined(diagram, modes, shapes, band, cluster_freq, cluster_damping, merge_mac):
+    """The frequency-domain refit (:func:`armaxmodal.refine.refine_modes`), reported for a
+    band-limited record; ``(modes, shapes, refinement or None)``."""
+    lo, hi = excited_band(diagram.recording)
+    if band is not None:  # modes outside the user's band are not in the refit: fit only inside it
+        lo, hi = max(lo, band[0]), min(hi, band[1])
+    try:
+        refinement = refine_modes(diagram.recording, modes.freq_hz, modes.damping, band_hz=(lo, hi))
+    except (OrderError, np.linalg.LinAlgError):
+        return modes, shapes, None  # too few lines or a degenerate basis: the ARMAX values stand
+    if refinement.hold == "bandlimited":
+        modes, shapes = _apply_refinement(modes, shapes, refinement, cluster_freq, cluster_damping)
+        # two modes the refit brought together are one peak
+        keep = _merge_duplicates(modes, list(shapes.T), merge_mac, diagram.recording.duration)
+        modes, shapes = modes.loc[keep].reset_index(drop=True), shapes[:, keep]
+    return modes, shapes, refinement
+
+
+def _unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[QualityWarning]:
+    """A ``damping_unresolved`` note for every mode whose damping interval reaches zero or
+    whose damping estimate is not positive at some orders of the sweep."""
+    notes = []
+    for m in modes.itertuples(index=False):
+        crossed = int(m.orders_damping_unresolved)
+        if crossed == 0 and m.damping_ci95_lo > 0:
+            continue
+        notes.append(QualityWarning(
+            "damping_unresolved", (),
+            f"mode at {m.freq_hz:.3f} Hz: damping {m.damping:.2g}, 95 % interval [{m.damping_ci95_lo:.2g}, "
+            f"{m.damping_ci95_hi:.2g}]; its estimate is not positive at {crossed} of {n_orders} orders. The frequency "
+            f"is determined ([{m.freq_ci95_lo:.4g}, {m.freq_ci95_hi:.4g}] Hz), the damping is below what this record "
+            "resolves: a longer record, or more excitation near this frequency, narrows it", float(m.freq_hz),
+        ))  # fmt: skip
+    return notes
+
+
+def _supported(count: int, n_orders: int, min_support: float) -> bool:
+    """A cluster is a mode when it holds poles of at least three orders and ``min_support``
+    of the swept ones."""
+    return count >= 3 and count / n_orders >= min_support
+
+
+def _candidates(poles: pd.DataFrame, band) -> pd.DataFrame:
+    """Shared-pole poles that may form a mode: the kept ones and those whose damping the
+    record does not resolve (they count towards support, see :func:`select_modes`)."""
+    cand = poles[(poles.source == SHARED) & poles.rejected.isin(["", UNRESOLVED_DAMPING])]
+    if band is not None:
+        cand = cand[(cand.freq_hz >= band[0]) & (cand.freq_hz <= band[1])]
+    return cand
+
+
+def _cluster(cand: pd.DataFrame, nas, cluster_freq: float, cluster_damping: float | None) -> list[list[int]]:
+    """Greedy clustering across orders (see :func:`select_modes`): lists of ``cand`` indices.
+    ``cluster_damping=None`` groups by frequency alone."""
+    clusters: list[list[int]] = []
+    for na in nas:
+        group = cand[cand.na == na].sort_values("energy", ascending=False)
+        for idx, row in group.iterrows():
+            best, best_d = None, np.inf
+            for ci, members in enumerate(clusters):
+                if any(cand.at[m, "na"] == na for m in members):
+                    continue
+                f_c = float(np.median(cand.loc[members, "freq_hz"]))
+                x_c = float(np.median(cand.loc[members, "damping"]))
+                df = abs(row.freq_hz - f_c) / f_c
+                dx = 0.0 if cluster_damping is None else abs(row.damping - x_c) / x_c
+                if df <= cluster_freq and (cluster_damping is None or dx <= cluster_damping) and df + 0.1 * dx < best_d:
+                    best, best_d = ci, df + 0.1 * dx
+            if best is None:
+                clusters.append([idx])
+            else:
+                clusters[best].append(idx)
+    return clusters
+
+
+def _rescued_clusters(diagram, rest: pd.DataFrame, nas, cluster_freq: float, min_support: float, band) -> list:
+    """Lightly damped modes the damping rule splits: poles the selection left, whose damping
+    the record does not resolve (the 95 % interval reaches zero, or the estimate crosses it),
+    grouped by frequency alone. A group is a mode when it has the usual support, a positive
+    estimate at some order, and the measured FRF a clear, coherent peak there -- the data's
+    own evidence, which noise poles lack."""
+    light = rest[rest.damping - 1.96 * rest.damping_sd <= 0]
+    found = []
+    for members in _cluster(light, nas, cluster_freq, None):
+        sub = light.loc[members]
+        if not _supported(len(members), len(nas), min_support) or not (sub.damping > 0).any():
+            continue
+        if peak_support(diagram.recording, float(sub.freq_hz.median()), 0.0, band) is not None:
+            found.append(members)
+    return found
+
+
+def _mode_row(rep: pd.Series, sub: pd.DataFrame, n_orders: int) -> dict:
+    """One selected mode: the representative pole's estimate, the cluster's medoid and spread."""
+    f, x = sub.freq_hz.to_numpy(), sub.damping.to_numpy()
+    x_scale = max(abs(float(np.mean(x))), float(np.median(sub.damping_sd)), 1e-12)  # damping may cross zero
+    dist = np.abs(f[:, None] - f[None]) / f.mean() + np.abs(x[:, None] - x[None]) / x_scale
+    medoid = sub.iloc[int(np.argmin(dist.sum(axis=1)))]
+    row = {k: rep[k] for k in _ESTIMATE_COLUMNS}
+    row.update(
+        na=int(rep.na),
+        count=len(sub),
+        support=len(sub) / n_orders,
+        freq_spread=float(np.std(f, ddof=1)),
+        damping_spread=float(np.std(x, ddof=1)),
+        medoid_freq_hz=medoid.freq_hz,
+        medoid_damping=medoid.damping,
+        energy=float(sub.energy.median()),
+    )
+    return row
+
+
+_ESTIMATE_COLUMNS = (
+    "freq_hz", "damping", "damped_freq_hz", "freq_ci95_lo", "freq_ci95_hi", "damping_ci95_lo", "damping_ci95_hi",
+)  # fmt: skip
 
 
 def _finite_or_none(value) -> float | None:
@@ -628,6 +719,8 @@ def _finished_pole(diagram: StabilisationDiagram, pole: pd.Series, cache: dict) 
     if poles.empty:
         return pole
     nearest = poles.iloc[int(np.argmin(np.abs(poles.pole.to_numpy() - pole.pole)))]
+    if abs(nearest.freq_hz / pole.freq_hz - 1) > FINISHED_MAX_SHIFT:
+        return pole  # finishing moved this pole away (a weak one): the sweep's estimate stands
     # the finished estimate, with the diagram's own columns (class, rejection) kept
     return pd.concat([nearest, pole.drop(nearest.index, errors="ignore")])
 

@@ -164,3 +164,69 @@ def test_a_single_sinusoid_input_gets_a_clear_answer():
     assert fit.converged.all()
     with pytest.raises(OrderError, match="check that the input excites the structure"):
         select_modes(stabilisation_diagram(rec, range(2, 13, 2), per_sensor=False))
+
+
+@pytest.fixture(scope="module")
+def light_diagram():
+    """Two lightly damped modes (about 4 and 11 Hz, 1-2 %) and their sweep."""
+    s = am.Structure.from_chain([10.0, 5.0], [8000.0, 0.0], [8.0, 0.0], [12000.0], [5.0], ("m1", "m2"))
+    u = am.random_vibration(50.0, 240.0, (0.5, 24.0), seed=3)
+    rec = am.simulate_recording(s, u, 50.0, noise=0.02, seed=4, hold="bandlimited")
+    return s, stabilisation_diagram(rec, range(2, 21, 2), per_sensor=False)
+
+
+def _crossing_zero(poles: pd.DataFrame, near_hz: float) -> pd.DataFrame:
+    """The diagram as a record too short for this mode's damping would give it: the shared
+    estimates near ``near_hz`` scatter about zero by their (widened) standard error."""
+    from armaxmodal.stabilisation import _reject
+
+    poles = poles.copy()
+    at = poles.index[(poles.source == "shared") & (np.abs(poles.freq_hz / near_hz - 1) < 0.02)]
+    x0 = float(poles.loc[at, "damping"].median())
+    scatter = np.resize([0.2, -0.6, 2.5, 0.05, 1.4, 0.3, 0.7, -0.3, 3.0, 0.1], len(at))
+    poles.loc[at, "damping"] = x0 * scatter
+    poles.loc[at, "damping_sd"] = x0
+    return poles, at
+
+
+def test_a_mode_whose_damping_crosses_zero_is_kept_where_the_frf_shows_its_peak(light_diagram):
+    from dataclasses import replace
+
+    from armaxmodal.stabilisation import _reject
+
+    s, diagram = light_diagram
+    truth = s.modes()
+    poles, at = _crossing_zero(diagram.poles, truth.freq_hz[0])
+    poles["rejected"] = _reject(poles, diagram.tolerances, diagram.recording)
+    assert (poles.loc[at, "rejected"] == "damping not resolved").sum() == 2  # the two negative ones
+    damaged = replace(diagram, poles=poles)
+    selection = select_modes(damaged, segments=0)
+    f = selection.modes.freq_hz.to_numpy()
+    assert len(f) == 2 and abs(f[0] / truth.freq_hz[0] - 1) < 0.005, f
+    (note,) = [w for w in selection.warnings if w.code == "damping_unresolved"]
+    assert note.value == pytest.approx(f[0]) and "not positive at 2 of 10 orders" in note.message
+    assert selection.modes.orders_damping_unresolved.tolist() == [2, 0]
+    # without the rescue (the old rule: kept poles, relative damping) the mode is lost
+    from armaxmodal.stabilisation import _cluster, _supported
+
+    old = [c for c in _cluster(poles[poles.rejected == ""], range(2, 21, 2), 0.05, 0.5) if _supported(len(c), 10, 0.4)]
+    assert all(abs(poles.loc[c, "freq_hz"].median() / truth.freq_hz[0] - 1) > 0.02 for c in old)
+
+
+def test_poles_crossing_zero_without_an_frf_peak_stay_rejected(light_diagram):
+    from dataclasses import replace
+
+    from armaxmodal.stabilisation import _reject
+
+    s, diagram = light_diagram
+    # the same scatter planted at 7 Hz, where neither sensor's FRF has a peak
+    fake = diagram.poles[(diagram.poles.source == "shared")].groupby("na").head(1).copy()
+    fake["freq_hz"] = 7.0 * (1 + 0.001 * np.arange(len(fake)))
+    fake["energy"] = fake.groupby("na").energy.transform("max")
+    poles = pd.concat([diagram.poles, fake], ignore_index=True)
+    poles, at = _crossing_zero(poles, 7.0)
+    assert len(at) == 10
+    poles["rejected"] = _reject(poles, diagram.tolerances, diagram.recording)
+    selection = select_modes(replace(diagram, poles=poles), segments=0)
+    assert np.allclose(selection.modes.freq_hz, s.modes().freq_hz, rtol=0.005)
+    assert not [w for w in selection.warnings if w.code == "damping_unresolved"]
