@@ -269,7 +269,10 @@ def _csv_comments(path: Path) -> dict:
 
 # -- MAT ------------------------------------------------------------------------------
 def _read_mat(path: Path):
+    import zlib
+
     import scipy.io
+    from scipy.io.matlab import MatReadError
 
     try:
         data = scipy.io.loadmat(path, squeeze_me=False)
@@ -277,8 +280,11 @@ def _read_mat(path: Path):
         raise DataError(
             f"{path.name}: MATLAB v7.3 (HDF5) files are not supported; save with save(..., '-v7') or export to CSV."
         ) from exc
-    except (ValueError, TypeError, IndexError, OSError, struct.error, EOFError) as exc:
-        raise DataError(f"{path.name}: not a readable MAT file ({exc}).") from exc
+    except (
+        MatReadError, ValueError, TypeError, IndexError, KeyError, OSError, struct.error, EOFError, zlib.error,
+        UnicodeDecodeError, OverflowError, MemoryError,
+    ) as exc:  # fmt: skip  -- what scipy raises on random bytes (tests/test_fuzz.py)
+        raise DataError(f"{path.name}: not a readable MAT file ({type(exc).__name__}: {exc}).") from exc
     arrays = {k: v for k, v in data.items() if not k.startswith("__") and isinstance(v, np.ndarray)}
     numeric = {k: np.squeeze(v) for k, v in arrays.items() if v.dtype.kind in "fiu" and v.size > 0}
     file_fs = None
@@ -295,7 +301,8 @@ def _read_mat(path: Path):
     if "sensors" in arrays and arrays["sensors"].dtype.kind in "OU":
         sensor_names = [str(np.squeeze(s)) for s in np.ravel(arrays["sensors"])]
     vectors = [v for v in numeric.values() if v.ndim == 1]
-    n = max((v.size for v in vectors), default=max((max(v.shape) for v in numeric.values()), default=0))
+    matrices = [v for v in numeric.values() if v.ndim >= 2]
+    n = max((v.size for v in vectors), default=max((max(v.shape) for v in matrices), default=0))
     channels: dict[str, np.ndarray] = {}
     for key, v in numeric.items():
         v = v.astype(float)

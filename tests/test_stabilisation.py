@@ -178,7 +178,6 @@ def light_diagram():
 def _crossing_zero(poles: pd.DataFrame, near_hz: float) -> pd.DataFrame:
     """The diagram as a record too short for this mode's damping would give it: the shared
     estimates near ``near_hz`` scatter about zero by their (widened) standard error."""
-    from armaxmodal.stabilisation import _reject
 
     poles = poles.copy()
     at = poles.index[(poles.source == "shared") & (np.abs(poles.freq_hz / near_hz - 1) < 0.02)]
