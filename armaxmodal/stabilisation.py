@@ -51,6 +51,9 @@ FINISHED_MAX_SHIFT = 0.05
 NK_SEARCH = range(0, -7, -1)
 #: when the best delay is the most non-causal searched, this many more are tried once
 NK_EXTENSION = 3
+#: samples the record must hold per parameter of one sensor's model (about 3 na + 1 - nk) at
+#: the sweep's highest order: fewer, and the fits describe the noise (and take minutes each)
+SAMPLES_PER_PARAMETER = 20
 
 
 @dataclass(frozen=True)
@@ -265,6 +268,7 @@ def stabilisation_diagram(
     if not prepared:
         preparation = prepare(recording, band=band, detrend=detrend, resample=resample, align=align)
         recording = preparation.recording
+    _check_top_order(max(orders), recording)
     known: dict = {}
     if nk is None:
         nk, known = _choose_nk(recording, NK_SEARCH, (8, 10, 12), n_jobs, tol)
@@ -299,6 +303,19 @@ def stabilisation_diagram(
     poles["cls"] = _classify(poles, limits)
     poles["rejected"] = _reject(poles, limits, recording)
     return StabilisationDiagram(poles, order_list, limits, recording, kept, preparation)
+
+
+def _check_top_order(na: int, recording: Recording) -> None:
+    """Refuse, before any fit, a sweep whose highest order the record cannot support."""
+    per_sensor = 3 * na + 1 - (min(NK_SEARCH) - NK_EXTENSION)
+    top = (recording.n_samples // SAMPLES_PER_PARAMETER - 1 + min(NK_SEARCH) - NK_EXTENSION) // 3
+    if per_sensor * SAMPLES_PER_PARAMETER > recording.n_samples:
+        top = max(top, 2)
+        raise OrderError(
+            f"orders up to na = {na}: a model of that order has about {per_sensor} parameters per sensor, and "
+            f"this record ({recording.n_samples} samples at {recording.fs:g} Hz) supports at most na = {top} "
+            f"({SAMPLES_PER_PARAMETER} samples a parameter). Lower the top order, e.g. --orders 2:{min(top, 40)}."
+        )
 
 
 def _nk_edge_warning(nk: int, recording: Recording) -> list[QualityWarning]:

@@ -16,6 +16,7 @@ CASES = [
     (["stabilise", "{data}", "--modes", "0"], "whole number >= 1"),
     (["stabilise", "{data}", "--modes", "-1"], "whole number >= 1"),
     (["stabilise", "{data}", "--orders", "3:1"], "LO <= HI"),
+    (["stabilise", "{data}", "--orders", "2:1000"], "supports at most na = 116"),
     (["stabilise", "{data}", "--band", "40:10"], "lower edge first"),
     (["stabilise", "{data}", "--band", "10:40"], "Nyquist"),
     (["stabilise", "{data}", "--fs", "nan"], "finite number > 0"),
