@@ -135,6 +135,8 @@ def _resolve_fs(file_fs: float | None, user_fs: float | None, path: Path) -> flo
 def _fs_from_time(t: np.ndarray, path: Path) -> float:
     if t.size < 2:
         raise DataError(f"{path.name}: the time column needs at least two samples.")
+    if not np.all(np.isfinite(t)):
+        raise DataError(f"{path.name}: the time column holds NaN or infinite values; fix it, or drop it and give --fs.")
     steps = np.diff(t)
     dt = float(np.median(steps))
     if dt <= 0:
@@ -162,6 +164,7 @@ def _check_csv_layout(path: Path) -> None:
     """Name the usual export mistakes before pandas turns them into a tokenizer error: a
     gzip file named .csv, another delimiter, metadata lines before the header."""
     import gzip
+    import zlib
 
     with open(path, "rb") as fh:
         head = fh.read(1 << 16)
@@ -170,7 +173,10 @@ def _check_csv_layout(path: Path) -> None:
             raise DataError(
                 f"{path.name}: the file is gzip-compressed; name it {path.name}.gz (read as is) or unzip it."
             )
-        head = gzip.decompress(head) if len(head) < (1 << 16) else gzip.open(path).read(1 << 16)
+        try:
+            head = gzip.decompress(head) if len(head) < (1 << 16) else gzip.open(path).read(1 << 16)
+        except (EOFError, OSError, zlib.error) as exc:
+            raise DataError(f"{path.name}: a damaged or truncated gzip file ({exc}); copy or export it again.") from exc
     lines = [
         ln for ln in head.decode("utf-8", errors="replace").splitlines()[:-1] if ln.strip() and not ln.startswith("#")
     ]

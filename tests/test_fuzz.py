@@ -17,7 +17,7 @@ import os
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import armaxmodal as am
@@ -58,6 +58,8 @@ def _sound(rec: am.Recording, max_samples: int) -> None:
 
 
 @given(data=st.binary(min_size=0, max_size=2000), suffix=st.sampled_from([".csv", ".mat", ".uff", ".csv.gz"]))
+@example(data=b"", suffix=".mat")  # found by the long profile: scipy's MatReadError
+@example(data=b"\x1f\x8b", suffix=".csv.gz")  # found by the long profile: gzip's EOFError
 def test_random_bytes_give_a_typed_error(tmp_path, data, suffix):
     path = tmp_path / f"junk{suffix}"
     path.write_bytes(data)
@@ -154,6 +156,8 @@ mat_value = st.one_of(
         max_size=6,
     )
 )
+@example(variables={"base": 0.0})  # found: max() of an empty sequence
+@example(variables={"time": np.array([0.0, np.inf, 0.0])})  # found: ZeroDivisionError
 def test_a_mat_file_of_random_variables_gives_a_recording_or_a_typed_error(tmp_path, variables):
     from scipy.io import savemat
 
