@@ -125,3 +125,72 @@ def _merged(peaks, df) -> list[QualityWarning]:
             "(run 'armaxmodal diagnose')", f0,
         ))  # fmt: skip
     return warnings
+
+
+# -- close modes: is a split of one peak what the data need? --------------------------------
+#: a split is kept when the FRF with both modes fits significantly better than with one (F-test)
+SPLIT_ALPHA = 0.01
+
+
+def close_pairs(freq_hz, damping) -> list[tuple[int, int]]:
+    """Neighbouring modes whose half-power bands overlap (``|f_i - f_j| < xi_i f_i + xi_j f_j``)."""
+    f, x = np.asarray(freq_hz, float), np.asarray(damping, float)
+    order = np.argsort(f)
+    return [
+        (int(i), int(j))
+        for i, j in zip(order[:-1], order[1:], strict=True)
+        if f[j] - f[i] < x[i] * f[i] + x[j] * f[j]
+    ]
+
+
+def _modal_basis(f: np.ndarray, freq_hz, damping) -> np.ndarray:
+    """Real least-squares basis of ``sum_m r_m/(iw - l_m) + conj(r_m)/(iw - conj(l_m)) + c``
+    with complex r_m and c: columns for Re r_m, Im r_m, Re c, Im c (complex valued)."""
+    w = 2j * np.pi * f[:, None]
+    wn = 2 * np.pi * np.asarray(freq_hz, float)
+    x = np.asarray(damping, float)
+    lam = -x * wn + 1j * wn * np.sqrt(np.clip(1 - x**2, 0.0, None))
+    a, b = 1.0 / (w - lam), 1.0 / (w - np.conj(lam))
+    ones = np.ones((f.size, 1))
+    return np.hstack([a + b, 1j * (a - b), ones, 1j * ones])
+
+
+def split_test(recording: Recording, freq_hz, damping, weaker: int, band=None) -> tuple[float, float]:
+    """Does the measured FRF need mode ``weaker`` beside the others? ``(F, p)``.
+
+    Each sensor's H1 (at the resolution of :func:`resolving_nperseg`, coherent lines of the
+    band, every other line as overlapped segments make neighbours correlated) is fitted by
+    linear least squares with the modes' poles fixed -- a complex residue per mode and
+    sensor and a complex constant -- weighted by the H1's own random error. With and without
+    the mode, the residual sums give ``F = ((RSS_without - RSS_with) / q) / (RSS_with / dof)``
+    with q = 2 per sensor (its residue) + 2 (its pole, chosen from the same data).
+    """
+    from scipy.stats import f as f_dist
+
+    from .frf import h1_relative_error
+
+    n = resolving_nperseg(recording, freq_hz, damping)
+    f, h, coh = _measured(recording, n)
+    lo, hi = band if band is not None else excited_band(recording)
+    good = (np.min(coh, axis=1) >= MIN_COHERENCE) & (f > 0) & (f >= lo) & (f <= hi)
+    idx = np.flatnonzero(good)[::2]
+    sigma = h1_relative_error(coh[idx], recording.n_samples, n) * np.abs(h[idx])  # (lines, sensors)
+    keep = [m for m in range(len(freq_hz)) if m != weaker]
+    rss = []
+    for modes in (range(len(freq_hz)), keep):
+        basis = _modal_basis(f[idx], np.asarray(freq_hz)[list(modes)], np.asarray(damping)[list(modes)])
+        total = 0.0
+        for k in range(h.shape[1]):
+            a = basis / sigma[:, k : k + 1]
+            y = h[idx, k] / sigma[:, k]
+            a_real, y_real = np.vstack([a.real, a.imag]), np.concatenate([y.real, y.imag])
+            coef = np.linalg.lstsq(a_real, y_real, rcond=None)[0]
+            total += float(np.sum((y_real - a_real @ coef) ** 2))
+        rss.append(total)
+    n_obs = 2 * idx.size * h.shape[1]
+    q = 2 * h.shape[1] + 2
+    dof = n_obs - (2 * len(freq_hz) + 2) * h.shape[1] - 2 * len(freq_hz)
+    if dof <= 0 or rss[0] <= 0:
+        return float("nan"), float("nan")
+    stat = ((rss[1] - rss[0]) / q) / (rss[0] / dof)
+    return float(stat), float(f_dist.sf(stat, q, dof))

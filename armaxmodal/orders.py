@@ -78,16 +78,18 @@ def _single_blas_thread() -> None:
     threadpool_limits(limits=1, user_api="blas")
 
 
-def _map(func, items, n_jobs, bar=None, cost=None):
+def _map(func, items, n_jobs, bar=None, cost=None, min_items: int = 4):
     """``map`` over forked worker processes when it pays, else in this process.
 
     ``bar`` (a tqdm bar) is advanced as results arrive. ``cost(item)``, if given, estimates
     an item's run time: the workers then take the longest first, so no long job starts last
-    and leaves a core idle. Results come back in the order of ``items``.
+    and leaves a core idle. Fewer than ``min_items`` items run here (forking a pool costs
+    about 0.1 s: worth it for two long fits, not for a few short ones). Results come back in
+    the order of ``items``.
     """
     n_jobs = n_jobs or os.cpu_count() or 1
     out = []
-    if n_jobs <= 1 or len(items) < 4 or "fork" not in multiprocessing.get_all_start_methods():
+    if n_jobs <= 1 or len(items) < min_items or "fork" not in multiprocessing.get_all_start_methods():
         for item in items:
             out.append(func(item))
             if bar is not None:

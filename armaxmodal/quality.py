@@ -46,6 +46,7 @@ WARNING_CODES = (
     "nk_at_search_edge",
     "unexplained_peak",
     "damping_unresolved",
+    "split_merged",
     "no_modes",
 )
 

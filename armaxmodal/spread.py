@@ -12,6 +12,8 @@ spread is significantly larger, the interval is widened to the segments' own
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 import pandas as pd
 
@@ -36,7 +38,9 @@ def _segments(recording: Recording, k: int) -> list[Recording]:
     ]  # fmt: skip
 
 
-def segment_spread(recording: Recording, modes: pd.DataFrame, orders_of, n_segments: int = N_SEGMENTS):
+def segment_spread(
+    recording: Recording, modes: pd.DataFrame, orders_of, n_segments: int = N_SEGMENTS, n_jobs: int | None = None
+):
     """Between-segment standard deviation of each mode's frequency and damping.
 
     Parameters
@@ -48,6 +52,8 @@ def segment_spread(recording: Recording, modes: pd.DataFrame, orders_of, n_segme
     orders_of : callable
         ``orders_of(i) -> (na, nb, nc, nk)``: the orders of mode ``i``'s representative fit.
     n_segments : int
+    n_jobs : int, optional
+        Worker processes for the segment fits (default: all cores).
 
     Returns
     -------
@@ -55,17 +61,19 @@ def segment_spread(recording: Recording, modes: pd.DataFrame, orders_of, n_segme
         Per mode: ``freq_segment_sd`` (Hz), ``damping_segment_sd``, ``segments_found``
         (segments in which a pole within 5 % of the mode's frequency was found).
     """
-    from .orders import _fit_or_none
-    from .stabilisation import SHARED, _poles_of
+    from .orders import _map
 
     parts = _segments(recording, n_segments)
-    poles_by_orders: dict = {}
+    wanted = sorted({tuple(orders_of(i)) for i in range(len(modes))})
+    jobs = [(orders, k) for orders in wanted for k in range(n_segments)]
+    # every segment refit of every representative order at once, over the worker processes
+    found = _map(partial(_segment_poles, parts), jobs, n_jobs, cost=lambda job: job[0][0], min_items=2)
+    poles_by_orders: dict = {orders: [] for orders in wanted}
+    for (orders, _), poles in zip(jobs, found, strict=True):
+        poles_by_orders[orders].append(poles)
     rows = []
     for i, mode in enumerate(modes.itertuples(index=False)):
         orders = tuple(orders_of(i))
-        if orders not in poles_by_orders:
-            fits = [_fit_or_none(p, orders, shared_poles=True, max_iter=30, tol=1e-6, stop="decrease") for p in parts]
-            poles_by_orders[orders] = [pd.DataFrame(_poles_of(f, SHARED)) if f is not None else None for f in fits]
         f_seg, x_seg = [], []
         for poles in poles_by_orders[orders]:
             if poles is None or poles.empty:
@@ -85,6 +93,16 @@ def segment_spread(recording: Recording, modes: pd.DataFrame, orders_of, n_segme
             }
         )
     return pd.DataFrame(rows)
+
+
+def _segment_poles(parts: list[Recording], job) -> pd.DataFrame | None:
+    """The shared-pole poles of one segment's refit at the given orders (None: not fitted)."""
+    from .orders import _fit_or_none
+    from .stabilisation import SHARED, _poles_of
+
+    orders, k = job
+    fit = _fit_or_none(parts[k], orders, shared_poles=True, max_iter=30, tol=1e-6, stop="decrease")
+    return pd.DataFrame(_poles_of(fit, SHARED)) if fit is not None else None
 
 
 def apply_segment_spread(modes: pd.DataFrame, spread: pd.DataFrame, n_segments: int = N_SEGMENTS):

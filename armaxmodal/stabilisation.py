@@ -268,7 +268,7 @@ def stabilisation_diagram(
     if not prepared:
         preparation = prepare(recording, band=band, detrend=detrend, resample=resample, align=align)
         recording = preparation.recording
-    _check_top_order(max(orders), recording)
+    _check_top_order(max(orders), recording, preparation)
     known: dict = {}
     if nk is None:
         nk, known = _choose_nk(recording, NK_SEARCH, (8, 10, 12), n_jobs, tol)
@@ -305,17 +305,23 @@ def stabilisation_diagram(
     return StabilisationDiagram(poles, order_list, limits, recording, kept, preparation)
 
 
-def _check_top_order(na: int, recording: Recording) -> None:
+def _check_top_order(na: int, recording: Recording, preparation: Preparation | None) -> None:
     """Refuse, before any fit, a sweep whose highest order the record cannot support."""
     per_sensor = 3 * na + 1 - (min(NK_SEARCH) - NK_EXTENSION)
-    top = (recording.n_samples // SAMPLES_PER_PARAMETER - 1 + min(NK_SEARCH) - NK_EXTENSION) // 3
-    if per_sensor * SAMPLES_PER_PARAMETER > recording.n_samples:
-        top = max(top, 2)
-        raise OrderError(
-            f"orders up to na = {na}: a model of that order has about {per_sensor} parameters per sensor, and "
-            f"this record ({recording.n_samples} samples at {recording.fs:g} Hz) supports at most na = {top} "
-            f"({SAMPLES_PER_PARAMETER} samples a parameter). Lower the top order, e.g. --orders 2:{min(top, 40)}."
-        )
+    if per_sensor * SAMPLES_PER_PARAMETER <= recording.n_samples:
+        return
+    top = max((recording.n_samples // SAMPLES_PER_PARAMETER - 1 + min(NK_SEARCH) - NK_EXTENSION) // 3, 2)
+    narrow = [w for w in (preparation.warnings if preparation else ()) if w.code == "narrowband_input"]
+    resampled = preparation is not None and preparation.analysis_fs != preparation.original_fs
+    record = f"{recording.n_samples} samples at {recording.fs:g} Hz" + (
+        f", resampled from {preparation.original_fs:g} Hz to the input's band" if resampled else ""
+    )
+    lead = f"{narrow[0].message.rstrip('.')}; check that the input excites the structure. " if narrow else ""
+    raise OrderError(
+        f"{lead}Orders up to na = {na} need about {per_sensor} parameters per sensor; this record ({record}) "
+        f"supports at most na = {top} ({SAMPLES_PER_PARAMETER} samples a parameter). Lower the top order, "
+        f"e.g. --orders 2:{min(top, 40)}."
+    )
 
 
 def _nk_edge_warning(nk: int, recording: Recording) -> list[QualityWarning]:
@@ -505,6 +511,7 @@ def select_modes(
     merge_mac: float = 0.8,
     refine: bool = True,
     segments: int = N_SEGMENTS,
+    n_jobs: int | None = None,
 ) -> ModeSelection:
     """Pick the physical modes from the shared-pole poles of a diagram.
 
@@ -533,6 +540,9 @@ def select_modes(
     segments : int
         Refit each mode's representative orders on this many disjoint segments and widen
         the intervals where their spread exceeds them (:mod:`armaxmodal.spread`); 0 skips.
+    n_jobs : int, optional
+        Worker processes for the finishing and segment fits (default: all cores; 1 inside a
+        process that may not start its own, e.g. a dask worker).
     """
     if band is None and diagram.preparation is not None:
         band = diagram.preparation.band
@@ -544,7 +554,8 @@ def select_modes(
     left = cand.drop(index=[m for c in clusters for m in c])
     clusters += _rescued_clusters(diagram, left, nas, cluster_freq, min_support, band)
     bic = {na: information_criterion(fit) for (src, na), fit in diagram.fits.items() if src == SHARED}
-    finished: dict[int, pd.DataFrame] = {}
+    firsts = [_ranked(cand.loc[c][cand.loc[c].damping > 0], bic) for c in clusters]
+    finished = _finish_fits(diagram, {ranked[0] for ranked in firsts if ranked}, n_jobs)
     rows, vectors, unresolved = [], [], []
     for members in clusters:
         sub = cand.loc[members]
@@ -578,11 +589,12 @@ def select_modes(
     refinement = None
     if refine:
         modes, shapes, refinement = _refined(diagram, modes, shapes, band, cluster_freq, cluster_damping, merge_mac)
-    notes: list[QualityWarning] = []
+    modes, shapes, notes = _justified_splits(diagram.recording, modes, shapes, band)
     if segments >= 2:
         orders = {o[0]: o for o in diagram.orders}
-        spread = segment_spread(diagram.recording, modes, lambda i: orders[int(modes.at[i, "na"])], segments)
-        modes, notes = apply_segment_spread(modes, spread, segments)
+        spread = segment_spread(diagram.recording, modes, lambda i: orders[int(modes.at[i, "na"])], segments, n_jobs)
+        modes, spread_notes = apply_segment_spread(modes, spread, segments)
+        notes += spread_notes
     per_sensor, weighted = _per_sensor_table(diagram, modes, shapes, cluster_freq)
     from .frf_check import unexplained_peaks
 
@@ -595,12 +607,30 @@ def _representative(diagram, resolved: pd.DataFrame, bic: dict, finished: dict) 
     """The cluster's pole from the fit of lowest BIC, finished to full convergence; the next
     order's when finishing takes a lightly damped pole's damping to zero or below (None when
     every one does: the record gives this mode no damping estimate)."""
-    ranked = sorted(resolved.index, key=lambda m: (bic.get(int(resolved.at[m, "na"]), np.inf), resolved.at[m, "na"]))
-    for m in ranked:
-        rep = _finished_pole(diagram, resolved.loc[m], finished)
+    for na in _ranked(resolved, bic):
+        rep = _finished_pole(diagram, resolved[resolved.na == na].iloc[0], finished)
         if rep.damping > 0:
             return rep
     return None
+
+
+def _ranked(poles: pd.DataFrame, bic: dict) -> list[int]:
+    """The orders of ``poles`` (one pole each), lowest BIC first."""
+    return sorted((int(na) for na in poles.na), key=lambda na: (bic.get(na, np.inf), na))
+
+
+def _finish_fits(diagram: StabilisationDiagram, nas, n_jobs: int | None) -> dict:
+    """``{na: poles}`` of the shared fits of orders ``nas`` continued to :func:`fit_armax`'s
+    default tolerance (the sweep stops its fits early), over the worker processes."""
+    nas = sorted(nas)
+    fits = [diagram.fits[(SHARED, na)] for na in nas]
+    done = _map(partial(_finished_poles, diagram.recording), fits, n_jobs, cost=lambda fit: fit.orders[0], min_items=2)
+    return dict(zip(nas, done, strict=True))
+
+
+def _finished_poles(recording: Recording, fit: ArmaxFit) -> pd.DataFrame:
+    done = fit_armax(recording, *fit.orders, shared_poles=True, max_iter=100, start=fit, warn=False)
+    return pd.DataFrame(_poles_of(done, SHARED))
 
 
 def _refined(diagram, modes, shapes, band, cluster_freq, cluster_damping, merge_mac):
@@ -619,6 +649,34 @@ def _refined(diagram, modes, shapes, band, cluster_freq, cluster_damping, merge_
         keep = _merge_duplicates(modes, list(shapes.T), merge_mac, diagram.recording.duration)
         modes, shapes = modes.loc[keep].reset_index(drop=True), shapes[:, keep]
     return modes, shapes, refinement
+
+
+def _justified_splits(recording: Recording, modes: pd.DataFrame, shapes: np.ndarray, band):
+    """Two modes whose half-power bands overlap stay two only where the measured FRF needs
+    both (:func:`armaxmodal.frf_check.split_test` at ``SPLIT_ALPHA``); otherwise the weaker
+    (less supported) is dropped and a ``split_merged`` note says so with the F-test's p.
+    Returns ``(modes, shapes, notes)``."""
+    from .frf_check import SPLIT_ALPHA, close_pairs, split_test
+
+    notes: list[QualityWarning] = []
+    while True:
+        rank = modes.sort_values(["support", "count", "energy"], ascending=False).index.tolist()
+        for i, j in close_pairs(modes.freq_hz, modes.damping):
+            weaker, stronger = (i, j) if rank.index(i) > rank.index(j) else (j, i)
+            stat, p = split_test(recording, modes.freq_hz, modes.damping, weaker, band)
+            if not p <= SPLIT_ALPHA and np.isfinite(p):
+                break
+        else:
+            return modes, shapes, notes
+        f_weak, f_strong = modes.at[weaker, "freq_hz"], modes.at[stronger, "freq_hz"]
+        notes.append(QualityWarning(
+            "split_merged", (),
+            f"modes at {f_strong:.3f} and {f_weak:.3f} Hz overlap within their half-power bands and the measured FRF "
+            f"does not need both (F = {stat:.2f}, p = {p:.2g}): one peak split by the model; {f_strong:.3f} Hz is "
+            "reported", float(f_weak),
+        ))  # fmt: skip
+        keep = [m for m in range(len(modes)) if m != weaker]
+        modes, shapes = modes.iloc[keep].reset_index(drop=True), shapes[:, keep]
 
 
 def _unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[QualityWarning]:
@@ -729,9 +787,7 @@ def _finished_pole(diagram: StabilisationDiagram, pole: pd.Series, cache: dict) 
     tolerance (the sweep stops its fits early); ``cache`` holds the finished fits' poles."""
     na = int(pole.na)
     if na not in cache:
-        fit = diagram.fits[(SHARED, na)]
-        done = fit_armax(diagram.recording, *fit.orders, shared_poles=True, max_iter=100, start=fit, warn=False)
-        cache[na] = pd.DataFrame(_poles_of(done, SHARED))
+        cache[na] = _finished_poles(diagram.recording, diagram.fits[(SHARED, na)])
     poles = cache[na]
     if poles.empty:
         return pole

@@ -42,3 +42,28 @@ def test_a_missing_lightly_damped_mode_is_named_at_its_frequency(light):
     (w,) = unexplained_peaks(rec, modes.freq_hz[:1], modes.damping[:1])
     assert w.code == "unexplained_peak" and w.value == pytest.approx(modes.damped_freq_hz[1], rel=0.01)
     assert set(w.channels) == {"m1", "m2"}
+
+
+def test_split_test_merges_a_fake_split_and_keeps_real_close_modes(light, fixtures_dir):
+    from armaxmodal.frf_check import close_pairs, split_test
+
+    # one lightly damped peak given two modes 1 % apart: the FRF does not need the second
+    s, rec = light
+    m = s.modes()
+    f = np.r_[m.freq_hz[0], 1.01 * m.freq_hz[0], m.freq_hz[1]]
+    x = np.r_[m.damping[0], m.damping[0], m.damping[1]]
+    assert close_pairs(f, x) == [(0, 1)]
+    assert split_test(rec, f, x, 1)[1] > 0.5
+    # two real modes within each other's half-power band (4.57 and 4.92 Hz, 4 %): both needed
+    c = am.Structure.from_chain([10.0, 10.0], [8000.0, 9000.0], [25.0, 25.0], [400.0], [0.0], ("a", "b"))
+    mc = c.modes()
+    assert close_pairs(mc.freq_hz, mc.damping) == [(0, 1)]
+    u = am.random_vibration(50.0, 240.0, (0.5, 24.0), seed=5)
+    rc = am.simulate_recording(c, u, 50.0, noise=0.05, seed=6, hold="bandlimited")
+    assert split_test(rc, mc.freq_hz, mc.damping, 0)[1] < 1e-10
+    assert split_test(rc, mc.freq_hz, mc.damping, 1)[1] < 1e-10
+    # the supine human's heavily damped modes all overlap their neighbours; each is needed
+    sup = am.read_recording(fixtures_dir / "supine_random.csv")
+    t = am.supine_human().modes()
+    assert close_pairs(t.freq_hz, t.damping) == [(0, 1), (1, 2), (2, 3)]
+    assert max(split_test(sup, t.freq_hz, t.damping, k)[1] for k in range(4)) < 1e-10

@@ -229,3 +229,29 @@ def test_poles_crossing_zero_without_an_frf_peak_stay_rejected(light_diagram):
     selection = select_modes(replace(diagram, poles=poles), segments=0)
     assert np.allclose(selection.modes.freq_hz, s.modes().freq_hz, rtol=0.005)
     assert not [w for w in selection.warnings if w.code == "damping_unresolved"]
+
+
+def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
+    from armaxmodal.stabilisation import _justified_splits
+
+    s, diagram = light_diagram
+    m = s.modes()
+    modes = pd.DataFrame(
+        {
+            "freq_hz": [m.freq_hz[0], 1.01 * m.freq_hz[0], m.freq_hz[1]],
+            "damping": [m.damping[0], m.damping[0], m.damping[1]],
+            "support": [1.0, 0.5, 1.0],
+            "count": [10, 5, 10],
+            "energy": [1.0, 0.2, 1.0],
+        }
+    )
+    shapes = np.column_stack([m.modal_constants[:, 0], 0.3 * m.modal_constants[:, 0], m.modal_constants[:, 1]])
+    kept, kept_shapes, notes = _justified_splits(diagram.recording, modes, shapes, None)
+    assert kept.freq_hz.tolist() == [m.freq_hz[0], m.freq_hz[1]]  # the better-supported one stays
+    np.testing.assert_array_equal(kept_shapes, shapes[:, [0, 2]])
+    (note,) = notes
+    assert note.code == "split_merged" and note.value == pytest.approx(1.01 * m.freq_hz[0])
+    # the true modes alone: nothing to merge
+    true = modes.iloc[[0, 2]].reset_index(drop=True)
+    again, _, none = _justified_splits(diagram.recording, true, shapes[:, [0, 2]], None)
+    assert len(again) == 2 and none == []

@@ -78,7 +78,7 @@ def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[st
         diagram = stabilisation_diagram(
             rec.select(sensors), range(lo, hi + 1, 2), band=settings.band, detrend=settings.detrend, n_jobs=1
         )
-        selection = select_modes(diagram, settings.modes, settings.band)
+        selection = select_modes(diagram, settings.modes, settings.band, n_jobs=1)
         report = selection.to_dict("per_sensor")
         figure = _thumbnail(diagram, selection)
         lump = _lump(rec, settings)
