@@ -681,18 +681,24 @@ def _justified_splits(recording: Recording, modes: pd.DataFrame, shapes: np.ndar
 
 def _unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[QualityWarning]:
     """A ``damping_unresolved`` note for every mode whose damping interval reaches zero or
-    whose damping estimate is not positive at some orders of the sweep."""
+    whose damping estimate is not positive at some orders of the sweep, with the reason."""
     notes = []
     for m in modes.itertuples(index=False):
         crossed = int(m.orders_damping_unresolved)
         if crossed == 0 and m.damping_ci95_lo > 0:
             continue
+        facts = [f"damping {m.damping:.2g}, 95 % interval [{m.damping_ci95_lo:.2g}, {m.damping_ci95_hi:.2g}]"]
+        if crossed:
+            facts.append(f"its estimate is not positive at {crossed} of {n_orders} orders")
+        if getattr(m, "model_error_dominates", False):
+            why = ("the interval is the spread of the record's thirds (model_error_dominates): the thirds disagree "
+                   "about this damping; run 'armaxmodal diagnose'")  # fmt: skip
+        else:
+            why = "the damping is below what this record resolves: a longer record, or more excitation here, narrows it"
         notes.append(QualityWarning(
             "damping_unresolved", (),
-            f"mode at {m.freq_hz:.3f} Hz: damping {m.damping:.2g}, 95 % interval [{m.damping_ci95_lo:.2g}, "
-            f"{m.damping_ci95_hi:.2g}]; its estimate is not positive at {crossed} of {n_orders} orders. The frequency "
-            f"is determined ([{m.freq_ci95_lo:.4g}, {m.freq_ci95_hi:.4g}] Hz), the damping is below what this record "
-            "resolves: a longer record, or more excitation near this frequency, narrows it", float(m.freq_hz),
+            f"mode at {m.freq_hz:.3f} Hz ([{m.freq_ci95_lo:.4g}, {m.freq_ci95_hi:.4g}] Hz): {'; '.join(facts)}. {why}",
+            float(m.freq_hz),
         ))  # fmt: skip
     return notes
 
