@@ -267,3 +267,30 @@ def test_a_disturbance_fits_beside_a_nonlinear_term(clean):
     s = Signals(clean.base[:n], y, clean.fs, clean.sensors, "base", {"t": np.tanh(clean.base[:n])})
     fitted = fit_model(ModelSpec((6, 12, 6, -5), trend_degree=0, terms=("t",)), s)
     assert fitted.theta[0] == pytest.approx([0.3, 0.0, -0.2, 0.0], abs=0.05)
+
+
+def _baseline_model(rec):
+    from armaxmodal.diagnose.model import ModelSpec, Signals, fit_model
+
+    signals = Signals(rec.base, rec.response, rec.fs, rec.sensors, rec.input_name)
+    return fit_model(ModelSpec(ORDERS), signals)
+
+
+def test_an_output_ahead_beyond_the_noncausal_taps_is_timed_by_the_cross_correlation(clean):
+    """An IMU on its own clock runs ahead of the table by more than nk reaches; where no
+    quasi-static band can time it, the residual's correlation with future input does."""
+    from armaxmodal.diagnose.evidence import _lead_findings
+
+    n_tests = 7 * len(clean.sensors)
+    ahead = inject(clean, "input_delay", ["legs"], samples=-14.0)
+    found = {f.channels[0]: f for f in _lead_findings(_baseline_model(ahead), n_tests, set())}
+    legs = found["legs"]
+    assert legs.p < 1e-6 and legs.parameters["delay_samples"] == pytest.approx(-14, abs=1)
+    assert all(found[s].p > 0.01 for s in ("head", "chest", "pelvis"))
+    # every output ahead by the same amount: the input is late
+    late_input = inject(clean, "input_delay", ["base"], samples=14.0)
+    (f,) = _lead_findings(_baseline_model(late_input), n_tests, set())
+    assert f.channels == ("base",) and f.parameters["delay_samples"] == pytest.approx(14, abs=1)
+    # within the model's reach (nk = -5) there is nothing to find, and a timed sensor is left alone
+    assert all(f.p > 0.01 for f in _lead_findings(_baseline_model(clean), n_tests, set()))
+    assert "legs" not in {f.channels[0] for f in _lead_findings(_baseline_model(ahead), n_tests, {"legs"})}

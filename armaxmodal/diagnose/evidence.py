@@ -39,6 +39,9 @@ EFFECT_TESTS = (
     "time_varying",
     "stiffness_nonlinearity",
 )
+#: Lags of the residual-input cross-correlation searched for an output that leads the input
+#: beyond the model's non-causal taps (an IMU on its own clock: 15-22 samples on the shake table).
+LEAD_MAX_LAG = 40
 #: Windows of the windowed re-identification (time variation).
 N_WINDOWS = 6
 #: A line in the residual is the input's (model error), not a disturbance, when the input
@@ -120,6 +123,7 @@ def run_tests(fitted: FittedModel, alpha: float = 0.01) -> tuple[list[Finding], 
     mask = usable(fitted.signals.n, fitted.spec)
     table = {"whiteness_p": [], "trend_p": [], "line_p": []}
     found = _delay_findings(fitted, n_tests)
+    found += _lead_findings(fitted, n_tests, {c for f in found for c in f.channels})
     found += mode_findings(fitted, n_tests, table)
     found += _trend_findings(fitted, eps, mask, n_tests, table)
     found += _line_findings(fitted, mask, n_tests, table)
@@ -177,6 +181,45 @@ def _delay_findings(fitted: FittedModel, n_tests: int) -> list[Finding]:
         }
         out.append(Finding("input_delay", (e.channel,), "phase_slope_z", e.delay_s / e.delay_sd_s, p, params))
     return out
+
+
+def _lead_findings(fitted: FittedModel, n_tests: int, timed: set) -> list[Finding]:
+    """An output ahead of the input by more than the model's non-causal taps reach, where the
+    quasi-static phase slope cannot time it (no quasi-static band, as on IMUs): its one-step
+    residual correlates with *future* input beyond lag ``nk`` (MATLAB ``resid``'s region, with
+    the bound of :func:`cross_correlation`; Bonferroni over those lags, sensors and tests). The
+    lead is the lag of the largest correlation there -- the direct term of an acceleration
+    transmissibility puts it at the first future sample the output answers. Every output
+    ahead by the same amount is the input being late. Sensors already timed are left alone."""
+    s = fitted.signals
+    ccf = cross_correlation(fitted, LEAD_MAX_LAG)
+    lags = np.asarray(ccf["lags"])
+    beyond = lags < min(fitted.spec.orders[3], 0)
+    if not beyond.any():
+        return []
+    found = []
+    for k, name in enumerate(s.sensors):
+        if name in timed:
+            continue
+        z = np.abs(np.asarray(ccf["ccf"][k])[beyond]) * stats.norm.ppf(0.995) / ccf["bound99"][k]
+        i = int(np.argmax(z))
+        p = min(1.0, 2 * float(stats.norm.sf(z[i])) * int(beyond.sum()) * n_tests)
+        found.append((name, float(-lags[beyond][i]), float(z[i]), p))
+    leading = [f for f in found if f[3] < 0.01]
+    if len(leading) == len(s.sensors) > 1 and np.ptp([f[1] for f in leading]) <= 1:
+        lead = float(np.median([f[1] for f in leading]))
+        return [_lead_finding(s.input_name, lead, max(f[2] for f in leading), max(f[3] for f in leading), s.fs)]
+    return [_lead_finding(name, -lead, z, p, s.fs) for name, lead, z, p in found]
+
+
+def _lead_finding(channel: str, delay_samples: float, z: float, p: float, fs: float) -> Finding:
+    """An ``input_delay`` finding from the cross-correlation (whole samples, no interval)."""
+    params = {
+        "delay_samples": delay_samples,
+        "delay_ms": 1e3 * delay_samples / fs,
+        "method": "residual-input cross-correlation beyond the model's non-causal taps",
+    }
+    return Finding("input_delay", (channel,), "residual_input_ccf_z", z, p, params)
 
 
 def _trend_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:

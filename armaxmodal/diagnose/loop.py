@@ -355,8 +355,9 @@ def _try_fix(stage: Stage, finding: Finding, alpha: float):
     if kind == "simulation":
         params["sim_error_before"] = _pooled_rms(stage.held, idx, kind)
         params["sim_error_after"] = _pooled_rms(new.held, idx, kind)
-    if finding.effect == "input_delay":
-        # B's taps absorb much of a delay, so the error may barely move: the phase slope names it
+    if finding.effect == "input_delay" and finding.statistic != "residual_input_ccf_z":
+        # B's taps absorb much of a delay, so the error may barely move: the phase slope names it.
+        # A lead found by the cross-correlation is beyond B's reach: it must lower the error.
         if after > before * 1.01:
             return None, f"moving the channel raised the held-out error from {before:.4g} to {after:.4g}"
         note = "the model's B taps absorb part of a delay, so the error changes little; named from the phase slope"
