@@ -186,7 +186,10 @@ def _quasi_static_fit(f, h, coh, excited, n_segments):
     lines = slice(start, stop)
     if stop - start < 4:
         return None
-    sign = 1 if np.median(h[lines].real) > 0 else -1
+    # the sign from the lowest lines, where a delay has rotated the phase least: over the whole
+    # run a lead of 14 samples at 60 Hz turns it past 90 degrees, and a median of the real part
+    # took that for an inverted sensor (and the delay for +18 samples)
+    sign = 1 if np.mean(h[start : start + 2].real) > 0 else -1
     phase = np.unwrap(np.angle(sign * h[lines]))
     w = 2 * np.pi * f[lines]
     g2 = np.clip(coh[lines], 1e-6, 1 - 1e-12)
