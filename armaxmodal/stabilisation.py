@@ -546,28 +546,9 @@ def select_modes(
     """
     if band is None and diagram.preparation is not None:
         band = diagram.preparation.band
-    cand = _candidates(diagram.poles, band)
     nas = sorted({o[0] for o in diagram.orders})
-    kept = cand[cand.rejected == ""]
-    clusters = _cluster(kept, nas, cluster_freq, cluster_damping)
-    clusters = [c for c in clusters if _supported(len(c), len(nas), min_support)]
-    left = cand.drop(index=[m for c in clusters for m in c])
-    clusters += _rescued_clusters(diagram, left, nas, cluster_freq, min_support, band)
-    bic = {na: information_criterion(fit) for (src, na), fit in diagram.fits.items() if src == SHARED}
-    firsts = [_ranked(cand.loc[c][cand.loc[c].damping > 0], bic) for c in clusters]
-    finished = _finish_fits(diagram, {ranked[0] for ranked in firsts if ranked}, n_jobs)
-    rows, vectors, unresolved = [], [], []
-    for members in clusters:
-        sub = cand.loc[members]
-        rep = _representative(diagram, sub[sub.damping > 0], bic, finished)
-        if rep is None:
-            continue
-        rows.append(_mode_row(rep, sub, len(nas)))
-        vectors.append(rep.vector)
-        unresolved.append(int((sub.damping <= 0).sum()))
-    modes = pd.DataFrame(rows)
+    modes, vectors = _clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs)
     if not modes.empty:
-        modes["orders_damping_unresolved"] = unresolved
         keep = _merge_duplicates(modes, vectors, merge_mac, diagram.recording.duration)
         modes, vectors = modes.loc[keep].reset_index(drop=True), [vectors[i] for i in keep]
     if modes.empty:
@@ -601,6 +582,28 @@ def select_modes(
     notes += unexplained_peaks(diagram.recording, modes.freq_hz.to_numpy(), modes.damping.to_numpy(), band)
     notes += _unresolved_damping_notes(modes, len(nas))
     return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement, tuple(notes))
+
+
+def _clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs):
+    """One mode per supported cluster (the kept poles', then the rescued lightly damped
+    ones), each from its representative fit: ``(modes, shape vectors)``."""
+    cand = _candidates(diagram.poles, band)
+    clusters = _cluster(cand[cand.rejected == ""], nas, cluster_freq, cluster_damping)
+    clusters = [c for c in clusters if _supported(len(c), len(nas), min_support)]
+    left = cand.drop(index=[m for c in clusters for m in c])
+    clusters += _rescued_clusters(diagram, left, nas, cluster_freq, min_support, band)
+    bic = {na: information_criterion(fit) for (src, na), fit in diagram.fits.items() if src == SHARED}
+    firsts = [_ranked(cand.loc[c][cand.loc[c].damping > 0], bic) for c in clusters]
+    finished = _finish_fits(diagram, {ranked[0] for ranked in firsts if ranked}, n_jobs)
+    rows, vectors = [], []
+    for members in clusters:
+        sub = cand.loc[members]
+        rep = _representative(diagram, sub[sub.damping > 0], bic, finished)
+        if rep is None:
+            continue
+        rows.append({**_mode_row(rep, sub, len(nas)), "orders_damping_unresolved": int((sub.damping <= 0).sum())})
+        vectors.append(rep.vector)
+    return pd.DataFrame(rows), vectors
 
 
 def _representative(diagram, resolved: pd.DataFrame, bic: dict, finished: dict) -> pd.Series | None:
