@@ -185,6 +185,15 @@ class Diagnosis:
         }
 
 
+def _tier(finding: Finding) -> int:
+    """The finding's place in a round. A lead found by the residual-input cross-correlation
+    waits for the disturbances and missing modes (tier 1): their misfit also correlates with
+    the input near the model's reach; a phase-slope delay comes first."""
+    if finding.statistic == "residual_input_ccf_z":
+        return _TIER["coloured_noise"]
+    return _TIER[finding.effect]
+
+
 def _verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float = 0.01) -> str:
     """One sentence a person can act on, unsure where the data leave doubt."""
     coloured = [s for s, p in zip(diagnosis.sensors, whiteness, strict=True) if p < alpha]
@@ -310,7 +319,7 @@ def diagnose(
     effects, unconfirmed, tests = [], [], {}
     for round_no in range(int(max_rounds)):
         findings, tests = run_tests(stage.model, alpha)
-        findings.sort(key=lambda f: (_TIER[f.effect], f.p, -f.value))
+        findings.sort(key=lambda f: (_tier(f), f.p, -f.value))
         say(f"round {round_no + 1}: " + (", ".join(f"{f.effect} {list(f.channels)}" for f in findings) or "no effect"))
         step = None
         for finding in findings:
