@@ -54,7 +54,8 @@ def stages(rec: am.Recording) -> None:
     held = held_out(spec, signals, model)
     clock.lap("held-out folds (two refits)")
     k, eps = len(signals.sensors), model.one_step_errors()
-    n_tests, mask, table = len(ev.EFFECT_TESTS) * k, usable(signals.n, spec), {}
+    n_tests, mask = len(ev.EFFECT_TESTS) * k, usable(signals.n, spec)
+    table = {"whiteness_p": [], "trend_p": [], "line_p": []}  # as run_tests starts it
     found = ev._delay_findings(model, n_tests)
     clock.lap("test: delay (quasi-static phase slope)")
     found += ev._lead_findings(model, n_tests, set())
