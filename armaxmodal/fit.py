@@ -32,6 +32,7 @@ import pandas as pd
 import scipy.linalg
 
 from ._kernels import _armax_residual, _inverse_filter, _lagged_cross, _lagged_gram, _max_root_radius_below
+from ._threads import single_blas_thread
 from ._validate import as_signal_matrix, check_fs, check_not_constant, check_outputs_carry_signal
 from .armax import ArmaxModel
 from .exceptions import ConvergenceWarning, DataError, OrderError
@@ -154,6 +155,7 @@ class ArmaxFit:
 
 
 # -- public entry point -----------------------------------------------------------------
+@single_blas_thread
 def fit_armax(
     data: Recording | tuple,
     na: int,

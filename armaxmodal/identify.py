@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from ._threads import single_blas_thread
 from .fit import ArmaxFit, fit_armax
 from .modal import mode_record
 from .orders import OrderChoice, choose_orders
@@ -90,6 +91,7 @@ class Identification:
         }
 
 
+@single_blas_thread
 def identify(
     recording: Recording,
     orders: tuple[int, int, int, int] | None = None,

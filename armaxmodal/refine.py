@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.optimize
 
+from ._threads import single_blas_thread
 from .exceptions import OrderError
 from .recording import Recording
 
@@ -160,6 +161,7 @@ def _sandwich_sd(jac: np.ndarray, resid: np.ndarray, n_par: int) -> np.ndarray:
     return np.sqrt(np.clip(np.diag(bread @ meat @ bread) * scale, 0, None))
 
 
+@single_blas_thread
 def refine_modes(
     recording: Recording,
     freq_hz,

@@ -21,6 +21,7 @@ from functools import partial
 import numpy as np
 import pandas as pd
 
+from ._threads import single_blas_thread
 from .exceptions import OrderError
 from .fit import ArmaxFit, fit_armax
 from .frf import excited_band
@@ -212,6 +213,7 @@ def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=Tr
     return nk, {job: fit for job, fit in reuse.items() if fit.converged.all()}
 
 
+@single_blas_thread
 def stabilisation_diagram(
     recording: Recording,
     orders=range(2, 31, 2),
@@ -500,6 +502,7 @@ class ModeSelection:
         }
 
 
+@single_blas_thread
 def select_modes(
     diagram: StabilisationDiagram,
     n_modes: int | None = None,

@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
+from .._threads import single_blas_thread
 from ..exceptions import DataError
 from ..frf import welch_spectra
 from ..prepare import prepare
@@ -273,6 +274,7 @@ def _pooled_rms(held: HeldOut, idx: list[int], kind: str = "one_step") -> float:
     return float(np.sqrt(np.mean(getattr(held, kind)[held.mask][:, idx] ** 2)))
 
 
+@single_blas_thread
 def diagnose(
     recording: Recording,
     baseline=None,
