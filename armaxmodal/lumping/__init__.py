@@ -8,8 +8,22 @@ Morlet scalograms and wavelet coherence (Eqs. 5.2-5.5), and a plain-language ver
   wavelet coherence with phase lag and red-noise significance, on pycwt.
 """
 
-from .check import LIMITS, LumpCheck, lump_check, relative_transmissibility
-from .wavelet import Scalogram, WaveletCoherence, scalogram, wavelet_coherence
+from __future__ import annotations
+
+import importlib
+
+# Loaded on first use (PEP 562): pycwt pulls in scipy.stats, 0.8 s that every CLI command
+# paid when the parser registered ``lump``.
+_HOME = {
+    "LIMITS": "check",
+    "LumpCheck": "check",
+    "lump_check": "check",
+    "relative_transmissibility": "check",
+    "Scalogram": "wavelet",
+    "WaveletCoherence": "wavelet",
+    "scalogram": "wavelet",
+    "wavelet_coherence": "wavelet",
+}
 
 __all__ = [
     "LIMITS",
@@ -21,3 +35,13 @@ __all__ = [
     "scalogram",
     "wavelet_coherence",
 ]
+
+
+def __getattr__(name: str):
+    if name not in _HOME:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(importlib.import_module(f".{_HOME[name]}", __name__), name)
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)
