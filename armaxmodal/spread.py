@@ -111,12 +111,12 @@ def apply_segment_spread(modes: pd.DataFrame, spread: pd.DataFrame, n_segments: 
     Returns ``(modes, warnings)``; ``modes`` gains the spread columns and
     ``model_error_dominates`` (bool).
     """
-    from scipy.stats import chi2, t
+    from scipy.special import chdtri, stdtrit  # chi2 and t quantiles without scipy.stats' 0.5 s import
 
     modes = pd.concat([modes.reset_index(drop=True), spread.reset_index(drop=True)], axis=1)
     flagged = []
-    crit = chi2.ppf(1 - SPREAD_ALPHA / (2 * max(1, len(modes))), n_segments - 1)
-    t_k = t.ppf(0.975, n_segments - 1)
+    crit = chdtri(n_segments - 1, SPREAD_ALPHA / (2 * max(1, len(modes))))  # upper-tail quantile
+    t_k = stdtrit(n_segments - 1, 0.975)
     dominates = np.zeros(len(modes), dtype=bool)
     for i, m in modes.iterrows():
         for value, lo, hi, sd_col, model_sd in (

@@ -3,9 +3,13 @@ selection from one missing modes, and a clear coherent peak no selected mode exp
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+from scipy.signal import find_peaks
 
 import armaxmodal as am
-from armaxmodal.frf_check import reconstruction_error, resolving_nperseg, unexplained_peaks
+from armaxmodal.frf_check import peak_prominences, reconstruction_error, resolving_nperseg, unexplained_peaks
 from armaxmodal.stabilisation import select_modes, stabilisation_diagram
 
 
@@ -67,3 +71,16 @@ def test_split_test_merges_a_fake_split_and_keeps_real_close_modes(light, fixtur
     t = am.supine_human().modes()
     assert close_pairs(t.freq_hz, t.damping) == [(0, 1), (1, 2), (2, 3)]
     assert max(split_test(sup, t.freq_hz, t.damping, k)[1] for k in range(4)) < 1e-10
+
+
+@given(
+    arrays(np.float64, st.integers(0, 80), elements=st.integers(0, 4).map(float))
+    | arrays(np.float64, st.integers(0, 80), elements=st.floats(-1e3, 1e3, allow_nan=False))
+)
+def test_peak_prominences_equal_scipy_find_peaks(x):
+    """Our peak finder (it spares every run scipy.signal's import) against scipy's, on
+    plateau-rich integer data and on arbitrary floats."""
+    peaks, props = find_peaks(x, prominence=0.0)
+    ours, prominences = peak_prominences(x)
+    np.testing.assert_array_equal(ours, peaks)
+    np.testing.assert_allclose(prominences, props["prominences"], rtol=0, atol=0)
