@@ -162,3 +162,59 @@ def test_continuous_parameters_of_slow_zero_and_real_axis_poles():
     # a real negative discrete pole given as a float is still the Nyquist-frequency pole
     lam = discrete_to_continuous(np.array([-0.5]), 100.0)
     assert lam[0] == pytest.approx(100.0 * (np.log(0.5) + 1j * np.pi))
+
+
+def _shared_problem(fixtures_dir, oe=False):
+    """Three sensors of the supine ride at (4, 5, 3, 1) with shared poles, at a start point."""
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    ys = [np.ascontiguousarray(rec.response[:1200, k]) for k in range(3)]
+    u_t = np.ascontiguousarray(rec.base[None, :1200])
+    na, nb, nc, nk = 4, 5, 0 if oe else 3, 1
+    t0, t1 = max(na, nc, nk + nb - 1), 1200
+    p_k = nb + nc
+    cols = fitmod._columns(na, nb, nc, nk, 1)
+    parts = [fitmod._hannan_rissanen(y, u_t, na, nb, 3, nk, t0, t1)[: na + p_k] for y in ys]
+    theta = fitmod._project_shared(np.concatenate([parts[0][:na]] + [p[na:] for p in parts]), na, nb, nc, 1, 3, oe)
+
+    def residuals(th):
+        return [
+            fitmod._residual_and_loss(ys[k], u_t, fitmod._local(th, k, na, p_k), na, nb, nc, nk, t0, t1, oe)
+            for k in range(3)
+        ]
+
+    variances = np.array([0.7, 1.3, 2.1]) * np.mean([np.var(y) for y in ys])
+    normal = fitmod._shared_normal_equations(ys, u_t, residuals(theta), variances, cols, na, p_k, t0, t1, oe)
+    return theta, residuals, variances, normal, (t0, t1)
+
+
+@pytest.mark.parametrize("oe", [False, True])
+def test_shared_pole_gradient_and_gauss_newton_matrix_are_exact(fixtures_dir, oe):
+    """The block-arrow normal equations of the shared-pole fit against finite differences:
+    the gradient of sum_k V_k / lambda_k, and J'WJ from the numerical Jacobian of the
+    prediction errors (a wrong Gram block, weight or sign fails this)."""
+    theta, residuals, variances, normal, (t0, t1) = _shared_problem(fixtures_dir, oe)
+    h = 1e-6
+    grad = np.zeros_like(theta)
+    jac = [np.zeros((t1 - t0, theta.size)) for _ in variances]
+    for i in range(theta.size):
+        step = np.zeros_like(theta)
+        step[i] = h
+        up, down = residuals(theta + step), residuals(theta - step)
+        grad[i] = sum((u[1] - d[1]) / (2 * h) / v for u, d, v in zip(up, down, variances, strict=True))
+        for k in range(len(variances)):
+            jac[k][:, i] = (up[k][0][t0:t1] - down[k][0][t0:t1]) / (2 * h)
+    np.testing.assert_allclose(-2 * normal.gradient, grad, rtol=0, atol=1e-5 * np.abs(grad).max())
+    gauss_newton = sum(j.T @ j / v for j, v in zip(jac, variances, strict=True))
+    np.testing.assert_allclose(normal.full(), gauss_newton, rtol=0, atol=1e-5 * np.abs(gauss_newton).max())
+
+
+def test_the_schur_solve_equals_the_dense_damped_solve(fixtures_dir):
+    """The block-arrow LM step (Schur complement on the shared A block) and its curvature
+    against the dense system with the same diagonal damping."""
+    _, _, _, normal, _ = _shared_problem(fixtures_dir)
+    dense = normal.full()
+    for damping in (0.0, 1e-3, 10.0):
+        expected = np.linalg.solve(fitmod._damped(dense, damping), normal.gradient)
+        np.testing.assert_allclose(normal.solve(damping), expected, rtol=1e-7, atol=1e-12 * np.abs(expected).max())
+    step = np.random.default_rng(2).standard_normal(dense.shape[0])
+    assert normal.curvature(step) == pytest.approx(step @ dense @ step, rel=1e-10)
