@@ -25,19 +25,13 @@ from pathlib import Path
 import numpy as np
 
 import armaxmodal as am
+from armaxmodal.datasets import five_mass_chain
 
 FS = 100.0
 
 
 def chain() -> am.Structure:
-    return am.Structure.from_chain(
-        [8.0, 10.0, 30.0, 15.0, 12.0],
-        [2e4, 1e4, 5e4, 3e4, 2e4],
-        [60.0, 40.0, 180.0, 100.0, 80.0],
-        [2e4, 3e4, 2e4, 1e4],
-        [40.0, 60.0, 40.0, 20.0],
-        ("head", "chest", "pelvis", "thighs", "legs"),
-    )
+    return five_mass_chain()
 
 
 def recording(n_samples: int) -> am.Recording:

@@ -416,14 +416,9 @@ def test_a_crawl_along_an_undetermined_valley_ends_the_fit_without_moving_the_mo
     floor-damped Gauss-Newton steps keep gaining a steady 0.004 in 2 log L and never meet the
     expected-improvement rule. The crawl rule ends the fit within a few dozen iterations, its
     modes within 0.02 standard error of a fit left to crawl to a 300-iteration cap."""
-    chain = am.Structure.from_chain(
-        [8.0, 10.0, 30.0, 15.0, 12.0],
-        [2e4, 1e4, 5e4, 3e4, 2e4],
-        [60.0, 40.0, 180.0, 100.0, 80.0],
-        [2e4, 3e4, 2e4, 1e4],
-        [40.0, 60.0, 40.0, 20.0],
-        ("head", "chest", "pelvis", "thighs", "legs"),
-    )
+    from armaxmodal.datasets import five_mass_chain
+
+    chain = five_mass_chain()
     ride = am.random_vibration(100.0, 40.0, (0.5, 40.0), seed=1)
     rec = am.simulate_recording(chain, ride, 100.0, noise=0.05, seed=2, hold="bandlimited")
     rec = am.Recording(rec.fs, rec.base - rec.base.mean(), rec.response - rec.response.mean(axis=0), rec.sensors)
