@@ -32,7 +32,7 @@ MUTANTS = [
         "root sensitivity sign (cancels in a variance: equivalent)",
     ),
     (
-        "armaxmodal/fit.py",
+        "armaxmodal/_gauss_newton.py",
         "_signals(y - eps if oe else y, uT, eps)",
         "_signals(y, uT, eps)",
         "output-error gradient of the ARMAX form",

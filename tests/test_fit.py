@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 import armaxmodal as am
+import armaxmodal._gauss_newton as gn
 from armaxmodal import fit as fitmod
 from armaxmodal._kernels import _armax_residual, _inverse_filter, _lagged_cross, _lagged_gram
 from armaxmodal.exceptions import ConvergenceWarning, DataError, OrderError
@@ -86,7 +87,7 @@ def test_inverse_filter_kernel_matches_lfilter():
 def test_lagged_gram_and_cross_match_explicit_design():
     rng = np.random.default_rng(2)
     sig = rng.standard_normal((3, 300))
-    cols = fitmod._columns(4, 5, 3, 1, 1)
+    cols = gn._columns(4, 5, 3, 1, 1)
     target = rng.standard_normal(300)
     design = naive.lagged_design(sig, *cols, 6, 300)
     np.testing.assert_allclose(_lagged_gram(sig, *cols, 6, 300), design.T @ design, rtol=KERNEL_RTOL, atol=1e-10)
@@ -107,7 +108,7 @@ def test_gradient_is_exact(nk):
     t0, t1 = max(na, nc, nk + nb - 1), y.size
     theta = fitmod._hannan_rissanen(y, u_t, na, nb, nc, nk, t0, t1)
     eps, _, c = fitmod._residual_and_loss(y, u_t, theta, na, nb, nc, nk, t0, t1)
-    _, g = fitmod._normal_equations(y, u_t, eps, c, fitmod._columns(na, nb, nc, nk, 1), t0, t1)
+    _, g = gn._normal_equations(y, u_t, eps, c, gn._columns(na, nb, nc, nk, 1), t0, t1)
     numeric = np.zeros_like(theta)
     h = 1e-7
     for i in range(theta.size):
@@ -426,12 +427,12 @@ def test_a_crawl_along_an_undetermined_valley_ends_the_fit_without_moving_the_mo
     sweep = fit_armax(rec, *orders, shared_poles=True, max_iter=30, tol=1e-5, stop="decrease", warn=False)
     stopped = fit_armax(rec, *orders, shared_poles=True, max_iter=300, start=sweep, warn=False)
     assert stopped.converged.all() and stopped.iterations[0] < 60
-    original = fitmod.CRAWL_STEPS
+    original = gn.CRAWL_STEPS
     try:
-        fitmod.CRAWL_STEPS = 10**9
+        gn.CRAWL_STEPS = 10**9
         crawled = fit_armax(rec, *orders, shared_poles=True, max_iter=300, start=sweep, warn=False)
     finally:
-        fitmod.CRAWL_STEPS = original
+        gn.CRAWL_STEPS = original
     assert crawled.iterations[0] > 3 * stopped.iterations[0]
     a, b = stopped.modes(), crawled.modes()
     a, b = a[a.damping < 0.3], b[b.damping < 0.3]

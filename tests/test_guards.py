@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 import armaxmodal as am
+import armaxmodal._gauss_newton as gn
 import armaxmodal.fit as fitmod
 from armaxmodal.frf import excited_band
 from armaxmodal.modal import discrete_modal_parameters, pole_uncertainty
@@ -57,7 +58,7 @@ def test_output_error_gradient_is_exact(fixtures_dir):
     t0, t1 = na + nb, y.size
     theta = fitmod._hannan_rissanen(y, u_t, na, nb, 2, nk, t0, t1)[: na + nb]
     eps, _, c = fitmod._residual_and_loss(y, u_t, theta, na, nb, nc, nk, t0, t1, oe=True)
-    _, g = fitmod._normal_equations(y, u_t, eps, c, fitmod._columns(na, nb, nc, nk, 1), t0, t1, oe=True)
+    _, g = gn._normal_equations(y, u_t, eps, c, gn._columns(na, nb, nc, nk, 1), t0, t1, oe=True)
     numeric = np.zeros_like(theta)
     h = 1e-7
     for i in range(theta.size):
@@ -172,7 +173,7 @@ def _shared_problem(fixtures_dir, oe=False):
     na, nb, nc, nk = 4, 5, 0 if oe else 3, 1
     t0, t1 = max(na, nc, nk + nb - 1), 1200
     p_k = nb + nc
-    cols = fitmod._columns(na, nb, nc, nk, 1)
+    cols = gn._columns(na, nb, nc, nk, 1)
     parts = [fitmod._hannan_rissanen(y, u_t, na, nb, 3, nk, t0, t1)[: na + p_k] for y in ys]
     theta = fitmod._project_shared(np.concatenate([parts[0][:na]] + [p[na:] for p in parts]), na, nb, nc, 1, 3, oe)
 
@@ -183,7 +184,7 @@ def _shared_problem(fixtures_dir, oe=False):
         ]
 
     variances = np.array([0.7, 1.3, 2.1]) * np.mean([np.var(y) for y in ys])
-    normal = fitmod._shared_normal_equations(ys, u_t, residuals(theta), variances, cols, na, p_k, t0, t1, oe)
+    normal = gn._shared_normal_equations(ys, u_t, residuals(theta), variances, cols, na, p_k, t0, t1, oe)
     return theta, residuals, variances, normal, (t0, t1)
 
 
@@ -214,7 +215,7 @@ def test_the_schur_solve_equals_the_dense_damped_solve(fixtures_dir):
     _, _, _, normal, _ = _shared_problem(fixtures_dir)
     dense = normal.full()
     for damping in (0.0, 1e-3, 10.0):
-        expected = np.linalg.solve(fitmod._damped(dense, damping), normal.gradient)
+        expected = np.linalg.solve(gn._damped(dense, damping), normal.gradient)
         np.testing.assert_allclose(normal.solve(damping), expected, rtol=1e-7, atol=1e-12 * np.abs(expected).max())
     step = np.random.default_rng(2).standard_normal(dense.shape[0])
     assert normal.curvature(step) == pytest.approx(step @ dense @ step, rel=1e-10)
