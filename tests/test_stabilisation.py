@@ -255,3 +255,53 @@ def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
     true = modes.iloc[[0, 2]].reset_index(drop=True)
     again, _, none = _justified_splits(diagram.recording, true, shapes[:, [0, 2]], None)
     assert len(again) == 2 and none == []
+
+
+def _none_if_nan(v):
+    return None if v is None or (isinstance(v, float) and np.isnan(v)) else v
+
+
+def test_the_json_report_carries_the_selection_as_computed(light_diagram):
+    """``ModeSelection.to_dict`` (the stabilise command's JSON contract) field by field
+    against the selection it reports: no value renamed, dropped, rounded or NaN."""
+    from armaxmodal.stabilisation import Tolerances
+
+    s, diagram = light_diagram
+    sel = select_modes(diagram)
+    d = sel.to_dict()
+    json.dumps(d, allow_nan=False)
+    rec, prep, m = diagram.recording, diagram.preparation, sel.modes
+    assert d["fs"] == prep.original_fs and d["analysis_fs"] == rec.fs
+    assert d["preprocessing"] == prep.to_dict()
+    assert d["warnings"] == [w.to_dict() for w in sel.warnings]
+    assert (d["input"], d["outputs"]) == (rec.input_name, list(rec.sensors))
+    assert d["nk"] == diagram.orders[0][3] and d["orders_na"] == list(range(2, 21, 2))
+    assert d["tolerances"] == {"freq": 0.01, "damping": 0.05, "shape": 0.02, "max_damping": 0.6}
+    assert Tolerances() == diagram.tolerances
+    assert d["reconstruction_error"] == sel.reconstruction_error
+    assert d["intersample_hold"] == sel.refinement.hold and d["estimator"] == sorted(set(m.estimator))
+    assert len(d["modes"]) == len(m) == 2
+    for mode, row, shape in zip(d["modes"], m.itertuples(), sel.shapes.T, strict=True):
+        values = (mode["freq_hz"], mode["damping"], mode["damped_freq_hz"])
+        assert values == (row.freq_hz, row.damping, row.damped_freq_hz)
+        assert mode["freq_ci95"] == [row.freq_ci95_lo, row.freq_ci95_hi]
+        assert mode["damping_ci95"] == [row.damping_ci95_lo, row.damping_ci95_hi]
+        assert mode["orders_supporting"] == row.count
+        assert (mode["freq_spread_hz"], mode["damping_spread"]) == (row.freq_spread, row.damping_spread)
+        assert mode["segment_spread"] == {
+            "segments_found": row.segments_found,
+            "freq_sd_hz": _none_if_nan(row.freq_segment_sd),
+            "damping_sd": _none_if_nan(row.damping_segment_sd),
+        }
+        assert mode["model_error_dominates"] is bool(row.model_error_dominates)
+        big = shape[np.argmax(np.abs(shape))]
+        for k, sensor in enumerate(rec.sensors):
+            assert mode["shape"][sensor]["mag"] == pytest.approx(abs(shape[k] / big), rel=1e-12)
+            assert mode["shape"][sensor]["supplemented"] is False
+    per_sensor = sel.per_sensor.drop(columns=["own_modal_constant"]).to_dict("records")
+    assert d["per_sensor"] == [{k: _none_if_nan(v) for k, v in r.items()} for r in per_sensor]
+    assert set(sel.per_sensor.columns) - set(d["per_sensor"][0]) == {"own_modal_constant"}
+    with pytest.raises(ValueError, match="shapes"):
+        sel.to_dict("sensor")
+    frame = diagram.to_frame()
+    assert "pole" not in frame and "vector" not in frame and len(frame) == len(diagram.poles)
