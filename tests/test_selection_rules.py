@@ -148,3 +148,104 @@ def test_refit_is_reported_unless_it_left_the_mode():
     # damping moved by more than half: the ARMAX value stays
     ref.damping = np.array([0.16, 0.05])
     assert _apply_refinement(modes, shapes, ref, 0.05, 0.5)[0].estimator[0] == "armax (refit moved too far)"
+
+
+def test_class_rules_at_their_edges():
+    # an order's unmatched pole does not stop its later poles from being classed
+    poles = _poles([("shared", 2, 5.0, 0.1, SHAPE), ("shared", 4, 9.0, 0.1, SHAPE), ("shared", 4, 5.0, 0.1, SHAPE)])
+    assert _classify(poles, Tolerances()) == ["new", "new", "f+d+v"]
+    # two sensors: the shape test is the MAC (0.5 here), not the first residue's magnitude
+    poles = _poles([("shared", 2, 5.0, 0.1, [1.0, 0.0]), ("shared", 4, 5.0, 0.1, [1.0, 1.0])])
+    assert _classify(poles, Tolerances()) == ["new", "f+d"]
+    # one sensor: the magnitude ratio for residues of any size, within 5 x 0.02 = 10 %
+    sizes = [1e-3, 1.05e-3, 1.1655e-3]
+    poles = _poles([("head", na, 5.0, 0.1, [r]) for na, r in zip((2, 4, 6), sizes, strict=True)])
+    assert _classify(poles, Tolerances()) == ["new", "f+d+v", "f+d"]  # +5 %, then +11 %
+
+
+def _band_limited(fs: float = 100.0, n: int = 6000) -> am.Recording:
+    """60 s at 100 Hz of an input band-limited to about 2-20 Hz (f_min 0.05 Hz, f_max 45 Hz)."""
+    from scipy.signal import butter, sosfiltfilt
+
+    rng = np.random.default_rng(0)
+    u = sosfiltfilt(butter(6, [2.0, 20.0], "bandpass", fs=fs, output="sos"), rng.standard_normal(n))
+    return am.Recording(fs, u, rng.standard_normal((n, 1)), ("a",))
+
+
+def test_rejection_reasons_each_at_its_threshold():
+    from armaxmodal.frf import excited_band
+    from armaxmodal.stabilisation import UNRESOLVED_DAMPING, _reject
+
+    rec = _band_limited()
+    lo, hi = excited_band(rec)
+    assert 1.0 < lo < 2.5 and 18.0 < hi < 30.0
+    rows = [  # freq, damping, damping_sd, energy, reason
+        (8.0, -0.01, 0.001, 1.0, "negative damping"),
+        (8.0, -0.001, 0.001, 1.0, UNRESOLVED_DAMPING),  # its 95 % interval reaches above zero
+        (8.0, -0.001, 0.0004, 1.0, "negative damping"),  # 1.96 sd = 0.00078 does not
+        (8.0, 0.0, 0.0, 1.0, "negative damping"),
+        (8.0, 0.61, 0.01, 1.0, "over-damped"),
+        (8.0, 0.6, 0.01, 1.0, ""),  # the ceiling itself is allowed
+        (0.04, 0.01, 0.001, 1.0, "near 0 Hz"),  # 3 / 60 s = 0.05 Hz
+        (45.5, 0.01, 0.001, 1.0, "near Nyquist"),  # 0.45 fs = 45 Hz
+        (hi * 1.05 * 1.01, 0.05, 0.001, 1.0, "no input energy"),  # beyond hi (1 + damping)
+        (hi * 1.05 * 0.99, 0.05, 0.001, 1.0, ""),  # within it
+        (lo * 0.95 * 0.99, 0.05, 0.001, 1.0, "no input energy"),
+        (lo * 0.95 * 1.01, 0.05, 0.001, 1.0, ""),
+        (8.0, 0.05, 0.001, 0.009, "negligible residue"),  # under 1 % of the order's strongest
+        (8.0, 0.05, 0.001, 0.011, ""),
+    ]
+    poles = pd.DataFrame(
+        [
+            {"source": "shared", "na": 10, "freq_hz": f, "damping": x, "damping_sd": sd, "energy": e}
+            for f, x, sd, e, _ in rows
+        ]
+    )
+    assert _reject(poles, Tolerances(), rec) == [r[4] for r in rows]
+    # a pole table without standard errors: a non-positive damping is plainly negative
+    bare = pd.DataFrame([{"source": "shared", "na": 2, "freq_hz": 8.0, "damping": -0.001, "energy": 1.0}])
+    assert _reject(bare, Tolerances(), rec) == ["negative damping"]
+    # a user's lower frequency limit replaces the 3 / T default; so does a ceiling on energy's ratio
+    low = pd.DataFrame([{"source": "shared", "na": 2, "freq_hz": 0.5, "damping": 0.05, "energy": 1.0}])
+    assert _reject(low, Tolerances(min_freq_hz=1.0), rec) == ["near 0 Hz"]
+    assert _reject(low.assign(freq_hz=0.06), Tolerances(), rec) != ["near 0 Hz"]  # 0.06 > 3 / 60 s
+
+
+def test_order_cap_message_names_the_record_the_cause_and_a_supported_range():
+    from types import SimpleNamespace
+
+    from armaxmodal.quality import QualityWarning
+
+    # 1,040 samples: (1040 // 20 - 1 - 6 - 3) // 3 = 14
+    with pytest.raises(OrderError, match=r"this record \(1040 samples at 60 Hz\) supports at most na = 14 "):
+        _check_top_order(30, _recording(1040), None)
+    with pytest.raises(OrderError, match=r"supports at most na = 2 .*e\.g\. --orders 2:2\.$"):
+        _check_top_order(30, _recording(100), None)  # never below na = 2
+    with pytest.raises(OrderError, match=r"supports at most na = 46 .*e\.g\. --orders 2:40\.$"):
+        _check_top_order(60, _recording(3000), None)  # the suggestion stays a sweep of usual size
+    prep = SimpleNamespace(
+        analysis_fs=60.0,
+        original_fs=240.0,
+        warnings=[
+            QualityWarning("offset_removed", ("a",), "means removed.", 0.1),
+            QualityWarning("narrowband_input", ("base",), "input power sits in 2.9-3.1 Hz.", 3.0),
+        ],
+    )
+    with pytest.raises(OrderError) as err:
+        _check_top_order(30, _recording(1040), prep)
+    assert str(err.value).startswith("input power sits in 2.9-3.1 Hz; check that the input excites the structure. ")
+    assert "(1040 samples at 60 Hz, resampled from 240 Hz to the input's band)" in str(err.value)
+
+
+def test_delay_edge_warning_says_the_range_and_what_to_do():
+    (w,) = _nk_edge_warning(-9, _recording(100))
+    assert "nk = -9 sits at the edge of its search range (-9 to 0)" in w.message
+    tail = "(a late input or a filter delay); look at the sensor_delay check and align the channels."
+    assert w.message.endswith(tail)
+
+
+def test_finite_or_none_keeps_numbers_and_drops_nan_and_inf():
+    from armaxmodal.stabilisation import _finite_or_none
+
+    assert _finite_or_none(np.float64(2.5)) == 2.5 and type(_finite_or_none(np.float64(2.5))) is float
+    assert _finite_or_none(float("nan")) is None and _finite_or_none(np.inf) is None

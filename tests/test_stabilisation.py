@@ -303,5 +303,12 @@ def test_the_json_report_carries_the_selection_as_computed(light_diagram):
     assert set(sel.per_sensor.columns) - set(d["per_sensor"][0]) == {"own_modal_constant"}
     with pytest.raises(ValueError, match="shapes"):
         sel.to_dict("sensor")
+    own = sel.to_dict("per_sensor")["modes"]
+    assert [set(mode["shape"]) for mode in own] == [set(rec.sensors)] * 2
+    assert all(isinstance(v["supplemented"], bool) for mode in own for v in mode["shape"].values())
+    # a record fitted as it is (prepared=True) reports its own rate and no preparation
+    bare = select_modes(stabilisation_diagram(rec, range(4, 13, 2), prepared=True, per_sensor=False), segments=0)
+    report = bare.to_dict()
+    assert report["fs"] == report["analysis_fs"] == rec.fs and report["preprocessing"] is None
     frame = diagram.to_frame()
     assert "pole" not in frame and "vector" not in frame and len(frame) == len(diagram.poles)
