@@ -219,3 +219,36 @@ def test_the_schur_solve_equals_the_dense_damped_solve(fixtures_dir):
         np.testing.assert_allclose(normal.solve(damping), expected, rtol=1e-7, atol=1e-12 * np.abs(expected).max())
     step = np.random.default_rng(2).standard_normal(dense.shape[0])
     assert normal.curvature(step) == pytest.approx(step @ dense @ step, rel=1e-10)
+
+
+def test_pole_rows_of_a_shared_and_a_single_sensor_fit(fixtures_dir):
+    """The diagram's pole rows (``_poles_of``) against the fit's own mode table: every column
+    carried over, the shared shape from each sensor's residue, the energies as defined."""
+    from armaxmodal.stabilisation import _POLE_COLUMNS, _poles_of
+
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    rec = am.Recording(rec.fs, rec.base[:2400], rec.response[:2400, :2], rec.sensors[:2])
+    shared = fitmod.fit_armax(rec, 4, 5, 4, 0, shared_poles=True)
+    table = shared.modes()
+    first = table[table.sensor == rec.sensors[0]].reset_index(drop=True)
+    rows = _poles_of(shared, "shared")
+    assert len(rows) == len(first) == 2
+    for row, (_, ref) in zip(rows, first.iterrows(), strict=True):
+        assert list(row) == _POLE_COLUMNS and row["source"] == "shared" and row["na"] == 4
+        for col in _POLE_COLUMNS[2:-3]:  # freq_hz .. damping_ci95_hi
+            assert row[col] == ref[col], col
+        assert row["pole"] == ref["pole"]
+        lam = np.log(ref.pole) * rec.fs  # Eq. 3.24 from the discrete residue R: M = -R fs / lambda^2
+        residues = [table[(table.sensor == s) & (table.pole == ref.pole)].residue.item() for s in rec.sensors]
+        own = [-r * rec.fs / lam**2 for r in residues]
+        np.testing.assert_allclose(row["vector"], own, rtol=1e-10)
+        assert row["energy"] == pytest.approx(np.linalg.norm(np.asarray(own) * ref.freq_hz), rel=1e-10)
+    single = fitmod.fit_armax(rec.select([rec.sensors[1]]), 4, 5, 4, 0)
+    ref = single.modes()
+    rows = _poles_of(single, rec.sensors[1])
+    assert len(rows) == len(ref) >= 1
+    for row, (_, r) in zip(rows, ref.iterrows(), strict=True):
+        assert row["source"] == rec.sensors[1] and row["freq_hz"] == r.freq_hz and row["damping_sd"] == r.damping_sd
+        const = -r.residue * rec.fs / (np.log(r.pole) * rec.fs) ** 2
+        np.testing.assert_allclose(row["vector"], [const], rtol=1e-10)
+        assert row["energy"] == pytest.approx(abs(const) * r.freq_hz, rel=1e-10)
