@@ -249,3 +249,86 @@ def test_finite_or_none_keeps_numbers_and_drops_nan_and_inf():
 
     assert _finite_or_none(np.float64(2.5)) == 2.5 and type(_finite_or_none(np.float64(2.5))) is float
     assert _finite_or_none(float("nan")) is None and _finite_or_none(np.inf) is None
+
+
+def test_candidates_are_shared_poles_kept_or_unresolved_inside_the_band():
+    from armaxmodal.stabilisation import UNRESOLVED_DAMPING, _candidates
+
+    poles = pd.DataFrame(
+        {
+            "source": ["shared", "shared", "shared", "head", "shared", "shared"],
+            "freq_hz": [2.0, 5.0, 8.0, 5.0, 5.0, 3.0],
+            "rejected": ["", "", "", "", "over-damped", UNRESOLVED_DAMPING],
+        }
+    )
+    assert _candidates(poles, None).index.tolist() == [0, 1, 2, 5]
+    assert _candidates(poles, (2.0, 5.0)).index.tolist() == [0, 1, 5]  # band edges included
+    assert _candidates(poles, (3.0, 8.0)).index.tolist() == [1, 2, 5]
+
+
+def test_modes_rank_their_orders_by_bic_then_order():
+    from armaxmodal.stabilisation import _ranked
+
+    poles = pd.DataFrame({"na": [4, 8, 6, 10]})
+    assert _ranked(poles, {4: 10.0, 6: -5.0, 8: 3.0, 10: -5.0}) == [6, 10, 8, 4]
+    assert _ranked(poles, {8: 1.0}) == [8, 4, 6, 10]  # orders without a BIC go last
+
+
+def test_mode_row_reports_the_representative_and_the_cluster_medoid_and_spread():
+    from armaxmodal.stabilisation import _mode_row
+
+    sub = pd.DataFrame(
+        {
+            "na": [4, 6, 8, 10],
+            "freq_hz": [5.00, 5.02, 5.20, 5.01],
+            "damping": [0.050, 0.052, 0.080, 0.049],
+            "damping_sd": [0.004, 0.004, 0.004, 0.004],
+            "energy": [1.0, 3.0, 2.0, 5.0],
+        }
+    )
+    rep = pd.Series(
+        {"na": 6, "freq_hz": 5.021, "damping": 0.0521, "damped_freq_hz": 5.01, "freq_ci95_lo": 5.0,
+         "freq_ci95_hi": 5.04, "damping_ci95_lo": 0.045, "damping_ci95_hi": 0.059}
+    )  # fmt: skip
+    row = _mode_row(rep, sub, 10)
+    assert row["freq_hz"] == 5.021 and row["damping_ci95_hi"] == 0.059 and row["na"] == 6
+    assert (row["count"], row["support"], row["energy"]) == (4, 0.4, 2.5)
+    assert row["freq_spread"] == pytest.approx(np.std(sub.freq_hz, ddof=1))
+    assert row["damping_spread"] == pytest.approx(np.std(sub.damping, ddof=1))
+    # the medoid: the least summed distance |df| / mean f + |dx| / scale (worked out by hand
+    # from that definition); with damping standard errors above the mean damping they set
+    # the scale, below it the mean does
+    wide = pd.DataFrame(
+        {"na": [2, 4, 6, 8, 10], "freq_hz": [4.79, 4.94, 5.25, 4.73, 5.19],
+         "damping": [0.047, 0.063, 0.03, 0.045, 0.033], "damping_sd": 0.066, "energy": 1.0}
+    )  # fmt: skip
+    assert _mode_row(rep, wide, 10)["medoid_freq_hz"] == 4.79
+    narrow = wide.assign(freq_hz=[5.11, 4.81, 4.94, 4.7, 4.86], damping=[0.047, 0.034, 0.055, 0.045, 0.059])
+    assert _mode_row(rep, narrow.assign(damping_sd=0.002), 10)["medoid_freq_hz"] == 4.7
+
+
+def _notes_modes(**overrides):
+    base = {"freq_hz": 4.0, "freq_ci95_lo": 3.99, "freq_ci95_hi": 4.01, "damping": 0.002,
+            "damping_ci95_lo": 0.0005, "damping_ci95_hi": 0.0035, "orders_damping_unresolved": 0}  # fmt: skip
+    base.update(overrides)
+    return pd.DataFrame([base])
+
+
+def test_unresolved_damping_notes_state_the_facts_and_the_reason():
+    from armaxmodal.stabilisation import _unresolved_damping_notes
+
+    assert _unresolved_damping_notes(_notes_modes(), 10) == []  # a resolved damping: no note
+    (note,) = _unresolved_damping_notes(_notes_modes(damping_ci95_lo=0.0), 10)  # interval reaches zero
+    assert note.code == "damping_unresolved" and note.value == 4.0 and note.channels == ()
+    assert note.message == (
+        "mode at 4.000 Hz ([3.99, 4.01] Hz): damping 0.002, 95 % interval [0, 0.0035]. the damping is below "
+        "what this record resolves: a longer record, or more excitation here, narrows it"
+    )
+    (note,) = _unresolved_damping_notes(_notes_modes(orders_damping_unresolved=2, model_error_dominates=True), 10)
+    assert note.message == (
+        "mode at 4.000 Hz ([3.99, 4.01] Hz): damping 0.002, 95 % interval [0.0005, 0.0035]; its estimate is not "
+        "positive at 2 of 10 orders. the interval is the spread of the record's thirds (model_error_dominates): "
+        "the thirds disagree about this damping; run 'armaxmodal diagnose'"
+    )
+    two = pd.concat([_notes_modes(damping_ci95_lo=-0.001), _notes_modes(freq_hz=9.0, damping_ci95_lo=0.0)])
+    assert [n.value for n in _unresolved_damping_notes(two, 10)] == [4.0, 9.0]
