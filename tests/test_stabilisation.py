@@ -312,3 +312,37 @@ def test_the_json_report_carries_the_selection_as_computed(light_diagram):
     assert report["fs"] == report["analysis_fs"] == rec.fs and report["preprocessing"] is None
     frame = diagram.to_frame()
     assert "pole" not in frame and "vector" not in frame and len(frame) == len(diagram.poles)
+
+
+def test_rescue_rules_each_decide(light_diagram):
+    """``_rescued_clusters`` on hand-made leftovers of the two-mode light ride: a group is
+    rescued only when its damping is unresolved (damping - 1.96 sd <= 0), it has support and
+    a positive estimate, and the FRF shows a coherent peak inside the band."""
+    from types import SimpleNamespace
+
+    from armaxmodal.stabilisation import _rescued_clusters
+
+    s, diagram = light_diagram
+    f1, f2 = s.modes().freq_hz
+    nas = list(range(2, 21, 2))
+    fake = SimpleNamespace(recording=diagram.recording)
+
+    def group(freq, dampings, sd):
+        return pd.DataFrame(
+            {"na": nas[: len(dampings)], "freq_hz": freq, "damping": dampings, "damping_sd": sd, "energy": 1.0}
+        )
+
+    scatter = [-0.001, 0.002, 0.004, -0.002, 0.003, 0.001, 0.0, 0.002, 0.001, 0.003]
+
+    def rescued(*groups, band=None):
+        rest = pd.concat(groups, ignore_index=True)
+        found = _rescued_clusters(fake, rest, nas, 0.05, 0.4, band)
+        return [sorted(rest.loc[c, "freq_hz"].unique().tolist()) for c in found]
+
+    assert rescued(group(f1, scatter, 0.01)) == [[f1]]  # the FRF peaks there
+    assert rescued(group(7.0, scatter, 0.01)) == []  # no peak at 7 Hz
+    assert rescued(group(f1, scatter, 0.01), band=(6.0, 20.0)) == []  # its peak lies outside the band
+    assert rescued(group(f1, [min(x, 0.0) for x in scatter], 0.01)) == []  # never positive
+    assert rescued(group(f1, scatter[:3], 0.01)) == []  # three of ten orders: no support
+    assert rescued(group(f2, [0.01] * 10, 0.004)) == []  # 0.01 - 1.96 x 0.004 > 0: resolved, not a rescue
+    assert rescued(group(f2, [0.01] * 10, 0.006)) == [[f2]]  # 0.01 - 1.96 x 0.006 < 0
