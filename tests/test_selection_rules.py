@@ -332,3 +332,57 @@ def test_unresolved_damping_notes_state_the_facts_and_the_reason():
     )
     two = pd.concat([_notes_modes(damping_ci95_lo=-0.001), _notes_modes(freq_hz=9.0, damping_ci95_lo=0.0)])
     assert [n.value for n in _unresolved_damping_notes(two, 10)] == [4.0, 9.0]
+
+
+def test_per_sensor_table_and_its_weighted_averages():
+    """Table 3.2 and Eqs. 3.35-3.36 from hand-made single-sensor poles: per sensor and mode
+    the median over orders of the strongest kept pole within 5 % (NaN where the sensor shows
+    the mode at fewer than half the orders from the mode's own up), and the |M|-weighted means."""
+    from types import SimpleNamespace
+
+    from armaxmodal.stabilisation import _per_sensor_table
+
+    def replace(ns, **kw):
+        return SimpleNamespace(**{**vars(ns), **kw})
+
+    rows = [  # source, na, freq, damping, energy, constant, rejected
+        ("a", 2, 5.01, 0.050, 1.0, 0.5 + 0.1j, ""),
+        ("a", 4, 5.02, 0.052, 1.0, 0.6 + 0.1j, ""),
+        ("a", 4, 5.20, 0.300, 0.1, 9.0 + 0.0j, ""),  # weaker pole at the same order: not taken
+        ("a", 6, 4.99, 0.049, 1.0, 0.7 + 0.1j, ""),
+        ("a", 6, 9.10, 0.020, 1.0, 0.2 + 0.0j, ""),
+        ("b", 4, 5.00, 0.050, 1.0, 0.4 + 0.0j, "over-damped"),  # rejected poles do not count
+        ("b", 4, 9.00, 0.021, 1.0, 0.3 + 0.0j, ""),
+        ("b", 6, 8.80, 0.023, 1.0, 0.3 + 0.1j, ""),
+    ]
+    poles = pd.DataFrame(
+        [
+            {"source": s, "na": na, "freq_hz": f, "damping": x, "damped_freq_hz": f * np.sqrt(1 - x**2),
+             "energy": e, "vector": np.array([c]), "rejected": r}
+            for s, na, f, x, e, c, r in rows
+        ]
+    )  # fmt: skip
+    fits = {("a", 8): None} | {(s, na): None for s in ("a", "b") for na in (2, 4, 6)}
+    diagram = SimpleNamespace(poles=poles, fits=fits, recording=SimpleNamespace(sensors=("a", "b")))
+    modes = pd.DataFrame({"freq_hz": [5.0, 9.0], "na": [4, 4]})
+    shapes = np.array([[1.0, 0.5j], [0.2, -1.5]])
+    table, weighted = _per_sensor_table(diagram, modes, shapes, 0.05)
+    t = table.set_index(["sensor", "mode"])
+    assert t.loc[("a", 1), "freq_hz"] == 5.01 and t.loc[("a", 1), "damping"] == 0.050  # medians of 3
+    damped = [5.01 * np.sqrt(1 - 0.05**2), 5.02 * np.sqrt(1 - 0.052**2), 4.99 * np.sqrt(1 - 0.049**2)]
+    assert t.loc[("a", 1), "damped_freq_hz"] == np.median(damped)
+    assert t.loc[("a", 1), "own_modal_constant"] == 0.6 + 0.1j  # at the mode's own order
+    assert np.isnan(t.loc[("b", 1), "freq_hz"])  # b keeps no pole near 5 Hz
+    assert np.isnan(t.loc[("a", 2), "freq_hz"])  # near 9 Hz at one of a's orders 4, 6, 8: under half
+    assert t.loc[("b", 2), "freq_hz"] == pytest.approx(8.9) and t.loc[("b", 2), "own_modal_constant"] == 0.3
+    assert t.residue_mag.tolist() == [1.0, 0.2, 0.5, 1.5]  # mode by mode, sensor by sensor
+    w = weighted.set_index("mode")
+    assert w.loc[1, "freq_hz"] == 5.01 and w.loc[1, "sensors"] == 1
+    assert w.loc[2, "freq_hz"] == pytest.approx(8.9) and w.loc[2, "damping"] == pytest.approx(0.022)
+    # with a's 9.1 Hz pole at two orders it shows the mode too: the means weigh by |M|
+    more = pd.concat([poles, poles.iloc[[4]].assign(na=8, freq_hz=9.12)], ignore_index=True)
+    _, weighted = _per_sensor_table(replace(diagram, poles=more), modes, shapes, 0.05)
+    w = weighted.set_index("mode")
+    assert w.loc[2, "sensors"] == 2
+    assert w.loc[2, "freq_hz"] == pytest.approx((0.5 * 9.11 + 1.5 * 8.9) / 2.0)
+    assert w.loc[2, "damping"] == pytest.approx((0.5 * 0.020 + 1.5 * 0.022) / 2.0)
