@@ -386,3 +386,54 @@ def test_per_sensor_table_and_its_weighted_averages():
     assert w.loc[2, "sensors"] == 2
     assert w.loc[2, "freq_hz"] == pytest.approx((0.5 * 9.11 + 1.5 * 8.9) / 2.0)
     assert w.loc[2, "damping"] == pytest.approx((0.5 * 0.020 + 1.5 * 0.022) / 2.0)
+
+
+def test_finished_pole_takes_the_nearest_finished_estimate_within_five_percent():
+    from types import SimpleNamespace
+
+    from armaxmodal.stabilisation import _finished_pole
+
+    def pole(freq_hz, damping, **extra):
+        mu = np.exp((-damping + 1j) * 2 * np.pi * freq_hz / 100.0)
+        return pd.Series({"na": 8, "freq_hz": freq_hz, "damping": damping, "pole": mu, **extra}, dtype=object)
+
+    finished = pd.DataFrame([pole(5.1, 0.05), pole(9.0, 0.02), pole(20.0, 0.1)])
+    diagram = SimpleNamespace()  # the cache holds order 8: nothing is fitted
+    sweep = pole(5.0, 0.06, cls="f+d", rejected="")
+    out = _finished_pole(diagram, sweep, {8: finished})
+    assert (out.freq_hz, out.damping, out.cls, out.rejected) == (5.1, 0.05, "f+d", "")
+    assert _finished_pole(diagram, pole(9.4, 0.02), {8: finished}).freq_hz == 9.0  # 4.3 % away: taken
+    assert _finished_pole(diagram, pole(8.5, 0.02), {8: finished}).freq_hz == 8.5  # 5.9 %: the sweep's stands
+    assert _finished_pole(diagram, sweep, {8: finished.iloc[:0]}).freq_hz == 5.0  # nothing finished
+
+
+def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_data(monkeypatch):
+    from types import SimpleNamespace
+
+    import armaxmodal.stabilisation as st
+    from armaxmodal.frf import excited_band
+
+    rec = _recording(2000)
+    lo, hi = excited_band(rec)
+    seen = []
+
+    def refit(recording, freq_hz, damping, band_hz):
+        seen.append(band_hz)
+        return SimpleNamespace(hold=hold)
+
+    monkeypatch.setattr(st, "refine_modes", refit)
+    modes, shapes = _modes([5.0, 9.0], [0.1, 0.05], [1.0, 1.0]), np.eye(2, dtype=complex)
+    diagram = SimpleNamespace(recording=rec)
+    hold = "zoh"
+    out, out_shapes, ref = st._refined(diagram, modes, shapes, (4.0, 12.0), 0.05, 0.5, 0.8)
+    assert seen[-1] == (max(lo, 4.0), min(hi, 12.0)) and ref.hold == "zoh"
+    assert out is modes and out_shapes is shapes  # a held input: the ARMAX values are reported
+    st._refined(diagram, modes, shapes, None, 0.05, 0.5, 0.8)
+    assert seen[-1] == (lo, hi)
+    hold = "bandlimited"
+    calls = []
+    monkeypatch.setattr(st, "_apply_refinement", lambda m, s, r, f, x: (calls.append((f, x)) or (m, s)))
+    monkeypatch.setattr(st, "_merge_duplicates", lambda m, v, mac, dur: (calls.append((len(v), mac, dur)) or [1]))
+    out, out_shapes, _ = st._refined(diagram, modes, shapes, None, 0.05, 0.5, 0.8)
+    assert calls == [(0.05, 0.5), (2, 0.8, rec.duration)]
+    assert out.freq_hz.tolist() == [9.0] and out.index.tolist() == [0] and out_shapes.tolist() == [[0.0], [1.0]]
