@@ -252,3 +252,40 @@ def test_pole_rows_of_a_shared_and_a_single_sensor_fit(fixtures_dir):
         const = -r.residue * rec.fs / (np.log(r.pole) * rec.fs) ** 2
         np.testing.assert_allclose(row["vector"], [const], rtol=1e-10)
         assert row["energy"] == pytest.approx(abs(const) * r.freq_hz, rel=1e-10)
+
+
+def test_solves_fall_back_to_least_squares_where_cholesky_fails():
+    """An indefinite or singular system (a fit broken down numerically) takes the
+    least-squares / pseudo-inverse path, and that path solves the same damped system."""
+    a = np.array([[2.0, 0.0, 1.0], [0.0, -1.0, 0.5], [1.0, 0.5, 3.0]])  # indefinite
+    g = np.array([1.0, -2.0, 0.5])
+    for damping in (0.0, 0.1):
+        expected = np.linalg.lstsq(gn._damped(a, damping), g, rcond=None)[0]
+        np.testing.assert_allclose(gn._solve(a, g, damping), expected, rtol=1e-12)
+    singular = np.array([[1.0, 1.0], [1.0, 1.0]])
+    np.testing.assert_allclose(gn._inverse(singular), np.linalg.pinv(singular), rtol=1e-12)
+    spd = np.array([[4.0, 1.0], [1.0, 3.0]])
+    np.testing.assert_allclose(gn._inverse(spd), np.linalg.inv(spd), rtol=1e-12)
+    # the block-arrow step with an indefinite sensor block equals the dense damped solve
+    arrow = gn._Arrow(
+        aa=np.array([[5.0, 0.3], [0.3, 4.0]]),
+        ab=[np.array([[0.2, 0.1, 0.0], [0.0, 0.3, 0.1]])] * 2,
+        bb=[a, np.eye(3) * 2.0],
+        ga=np.array([1.0, 0.5]),
+        gb=[g, -g],
+    )
+    for damping in (0.0, 0.1):
+        expected = np.linalg.lstsq(gn._damped(arrow.full(), damping), arrow.gradient, rcond=None)[0]
+        np.testing.assert_allclose(arrow.solve(damping), expected, rtol=1e-9, atol=1e-12)
+
+
+def test_damping_scales_by_the_diagonal_and_non_finite_systems_are_an_order_error():
+    from armaxmodal.exceptions import OrderError
+
+    g = np.array([[4.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -2.0]])
+    damped = gn._damped(g, 0.5)
+    # 0.5 x the diagonal where it is positive, 0.5 x 1 where it is not, plus a 1e-13 ridge
+    np.testing.assert_allclose(np.diag(damped), [4.0 + 2.0 + 4e-13, 0.5 + 1e-13, -2.0 + 0.5 + 1e-13], rtol=1e-15)
+    np.testing.assert_array_equal(damped - np.diag(np.diag(damped)), g - np.diag(np.diag(g)))
+    with pytest.raises(OrderError, match=r"normal equations became non-finite.*Lower the orders\.$"):
+        gn._damped(np.array([[np.nan, 0.0], [0.0, 1.0]]), 0.1)
