@@ -68,13 +68,12 @@ def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[st
     normalised shape per sensor), ``per_sensor`` (Table 3.2 rows), ``warnings``,
     ``reconstruction_error``, ``lump`` and ``figure_png`` (base64).
     """
-    from threadpoolctl import threadpool_limits
-
+    from .._threads import one_blas_thread
     from ..stabilisation import select_modes, stabilisation_diagram
 
     start = time.perf_counter()
     lo, hi = settings.orders
-    with threadpool_limits(limits=1, user_api="blas"):
+    with one_blas_thread():  # the thumbnail and the lumping check too, not only the fits
         diagram = stabilisation_diagram(
             rec.select(sensors), range(lo, hi + 1, 2), band=settings.band, detrend=settings.detrend, n_jobs=1
         )
