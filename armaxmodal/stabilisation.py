@@ -21,7 +21,7 @@ from functools import partial
 import numpy as np
 import pandas as pd
 
-from ._threads import single_blas_thread
+from ._threads import one_blas_thread
 from .exceptions import OrderError
 from .fit import ArmaxFit, fit_armax
 from .frf import excited_band
@@ -213,7 +213,6 @@ def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=Tr
     return nk, {job: fit for job, fit in reuse.items() if fit.converged.all()}
 
 
-@single_blas_thread
 def stabilisation_diagram(
     recording: Recording,
     orders=range(2, 31, 2),
@@ -265,46 +264,47 @@ def stabilisation_diagram(
     progress : bool
         Show a progress bar.
     """
-    limits = tolerances or Tolerances()
-    preparation = None
-    if not prepared:
-        preparation = prepare(recording, band=band, detrend=detrend, resample=resample, align=align)
-        recording = preparation.recording
-    _check_top_order(max(orders), recording, preparation)
-    known: dict = {}
-    if nk is None:
-        nk, known = _choose_nk(recording, NK_SEARCH, (8, 10, 12), n_jobs, tol)
-    sources = [SHARED] + (list(recording.sensors) if per_sensor else [])
-    order_list = [(na, default_nb(na, nk), default_nc(na), nk) for na in orders]
-    # single sensors cannot support high orders (their bounds are wide): stop them earlier
-    jobs = [(s, o) for o in order_list for s in sources if s == SHARED or o[0] <= per_sensor_max_order]
-    todo = [job for job in jobs if job not in known]
-    from tqdm import tqdm
+    with one_blas_thread():  # a with block, not a decorator: mutmut skips decorated functions
+        limits = tolerances or Tolerances()
+        preparation = None
+        if not prepared:
+            preparation = prepare(recording, band=band, detrend=detrend, resample=resample, align=align)
+            recording = preparation.recording
+        _check_top_order(max(orders), recording, preparation)
+        known: dict = {}
+        if nk is None:
+            nk, known = _choose_nk(recording, NK_SEARCH, (8, 10, 12), n_jobs, tol)
+        sources = [SHARED] + (list(recording.sensors) if per_sensor else [])
+        order_list = [(na, default_nb(na, nk), default_nc(na), nk) for na in orders]
+        # single sensors cannot support high orders (their bounds are wide): stop them earlier
+        jobs = [(s, o) for o in order_list for s in sources if s == SHARED or o[0] <= per_sensor_max_order]
+        todo = [job for job in jobs if job not in known]
+        from tqdm import tqdm
 
-    with tqdm(total=len(jobs), desc="stabilisation sweep", unit="fit", disable=not progress) as bar:
-        bar.update(len(jobs) - len(todo))
-        fitted = _map(
-            partial(_fit_and_poles, recording, max_iter=max_iter, tol=tol),
-            todo,
-            n_jobs,
-            bar,
-            cost=partial(_job_cost, n_sensors=len(recording.sensors)),
-        )
-    done = dict(zip(todo, fitted, strict=True))
-    done.update({job: (fit, _poles_of(fit, job[0])) for job, fit in known.items() if job in jobs})
-    rows, kept = [], {}
-    for source, o in jobs:
-        fit, fit_rows = done[(source, o)]
-        if fit is None:
-            continue
-        kept[(source, o[0])] = fit
-        rows += fit_rows
-    if not rows:
-        raise OrderError("no order in the sweep could be fitted; use lower orders or a longer record.")
-    poles = pd.DataFrame(rows)
-    poles["cls"] = _classify(poles, limits)
-    poles["rejected"] = _reject(poles, limits, recording)
-    return StabilisationDiagram(poles, order_list, limits, recording, kept, preparation)
+        with tqdm(total=len(jobs), desc="stabilisation sweep", unit="fit", disable=not progress) as bar:
+            bar.update(len(jobs) - len(todo))
+            fitted = _map(
+                partial(_fit_and_poles, recording, max_iter=max_iter, tol=tol),
+                todo,
+                n_jobs,
+                bar,
+                cost=partial(_job_cost, n_sensors=len(recording.sensors)),
+            )
+        done = dict(zip(todo, fitted, strict=True))
+        done.update({job: (fit, _poles_of(fit, job[0])) for job, fit in known.items() if job in jobs})
+        rows, kept = [], {}
+        for source, o in jobs:
+            fit, fit_rows = done[(source, o)]
+            if fit is None:
+                continue
+            kept[(source, o[0])] = fit
+            rows += fit_rows
+        if not rows:
+            raise OrderError("no order in the sweep could be fitted; use lower orders or a longer record.")
+        poles = pd.DataFrame(rows)
+        poles["cls"] = _classify(poles, limits)
+        poles["rejected"] = _reject(poles, limits, recording)
+        return StabilisationDiagram(poles, order_list, limits, recording, kept, preparation)
 
 
 def _check_top_order(na: int, recording: Recording, preparation: Preparation | None) -> None:
@@ -502,7 +502,6 @@ class ModeSelection:
         }
 
 
-@single_blas_thread
 def select_modes(
     diagram: StabilisationDiagram,
     n_modes: int | None = None,
@@ -547,44 +546,46 @@ def select_modes(
         Worker processes for the finishing and segment fits (default: all cores; 1 inside a
         process that may not start its own, e.g. a dask worker).
     """
-    if band is None and diagram.preparation is not None:
-        band = diagram.preparation.band
-    nas = sorted({o[0] for o in diagram.orders})
-    modes, vectors = _clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs)
-    if not modes.empty:
-        keep = _merge_duplicates(modes, vectors, merge_mac, diagram.recording.duration)
-        modes, vectors = modes.loc[keep].reset_index(drop=True), [vectors[i] for i in keep]
-    if modes.empty:
-        raise OrderError(
-            "no stable mode found"
-            + (f" in {band[0]:g}-{band[1]:g} Hz" if band else "")
-            + "; widen the band, extend the order range, or check that the input excites the structure."
-        )
-    order = modes.sort_values(["support", "count", "energy"], ascending=False).index
-    if n_modes is not None:
-        order = order[:n_modes]
-    order = modes.loc[order].sort_values("freq_hz").index
-    modes = modes.loc[order].reset_index(drop=True)
-    shapes = np.column_stack([vectors[i] for i in order])
-    modes["estimator"] = "armax"
-    # the segment refits are ARMAX fits: their spread is judged against the ARMAX intervals
-    modes["freq_sd_armax"] = (modes.freq_ci95_hi - modes.freq_ci95_lo) / (2 * 1.96)
-    modes["damping_sd_armax"] = (modes.damping_ci95_hi - modes.damping_ci95_lo) / (2 * 1.96)
-    refinement = None
-    if refine:
-        modes, shapes, refinement = _refined(diagram, modes, shapes, band, cluster_freq, cluster_damping, merge_mac)
-    modes, shapes, notes = _justified_splits(diagram.recording, modes, shapes, band)
-    if segments >= 2:
-        orders = {o[0]: o for o in diagram.orders}
-        spread = segment_spread(diagram.recording, modes, lambda i: orders[int(modes.at[i, "na"])], segments, n_jobs)
-        modes, spread_notes = apply_segment_spread(modes, spread, segments)
-        notes += spread_notes
-    per_sensor, weighted = _per_sensor_table(diagram, modes, shapes, cluster_freq)
-    from .frf_check import unexplained_peaks
+    with one_blas_thread():
+        if band is None and diagram.preparation is not None:
+            band = diagram.preparation.band
+        nas = sorted({o[0] for o in diagram.orders})
+        modes, vectors = _clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs)
+        if not modes.empty:
+            keep = _merge_duplicates(modes, vectors, merge_mac, diagram.recording.duration)
+            modes, vectors = modes.loc[keep].reset_index(drop=True), [vectors[i] for i in keep]
+        if modes.empty:
+            raise OrderError(
+                "no stable mode found"
+                + (f" in {band[0]:g}-{band[1]:g} Hz" if band else "")
+                + "; widen the band, extend the order range, or check that the input excites the structure."
+            )
+        order = modes.sort_values(["support", "count", "energy"], ascending=False).index
+        if n_modes is not None:
+            order = order[:n_modes]
+        order = modes.loc[order].sort_values("freq_hz").index
+        modes = modes.loc[order].reset_index(drop=True)
+        shapes = np.column_stack([vectors[i] for i in order])
+        modes["estimator"] = "armax"
+        # the segment refits are ARMAX fits: their spread is judged against the ARMAX intervals
+        modes["freq_sd_armax"] = (modes.freq_ci95_hi - modes.freq_ci95_lo) / (2 * 1.96)
+        modes["damping_sd_armax"] = (modes.damping_ci95_hi - modes.damping_ci95_lo) / (2 * 1.96)
+        refinement = None
+        if refine:
+            modes, shapes, refinement = _refined(diagram, modes, shapes, band, cluster_freq, cluster_damping, merge_mac)
+        modes, shapes, notes = _justified_splits(diagram.recording, modes, shapes, band)
+        if segments >= 2:
+            orders = {o[0]: o for o in diagram.orders}
+            orders_of = lambda i: orders[int(modes.at[i, "na"])]  # noqa: E731
+            spread = segment_spread(diagram.recording, modes, orders_of, segments, n_jobs)
+            modes, spread_notes = apply_segment_spread(modes, spread, segments)
+            notes += spread_notes
+        per_sensor, weighted = _per_sensor_table(diagram, modes, shapes, cluster_freq)
+        from .frf_check import unexplained_peaks
 
-    notes += unexplained_peaks(diagram.recording, modes.freq_hz.to_numpy(), modes.damping.to_numpy(), band)
-    notes += _unresolved_damping_notes(modes, len(nas))
-    return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement, tuple(notes))
+        notes += unexplained_peaks(diagram.recording, modes.freq_hz.to_numpy(), modes.damping.to_numpy(), band)
+        notes += _unresolved_damping_notes(modes, len(nas))
+        return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement, tuple(notes))
 
 
 def _clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs):

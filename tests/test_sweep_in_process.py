@@ -1,0 +1,175 @@
+"""The sweep and the selection run in this process (``n_jobs=1``) on a short two-mode ride.
+
+Fast (about a second each), so a mutation tool can see which test reaches the delay choice,
+the sweep's jobs, the finishing fits and the segment refits -- with worker processes it
+cannot. Every check is against the structure's exact modes, a slow reference written out
+here with :func:`fit_armax`, or the same sweep over worker processes.
+"""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import armaxmodal as am
+from armaxmodal.orders import default_nb, default_nc, information_criterion
+from armaxmodal.recording import Recording
+from armaxmodal.stabilisation import (
+    NK_SEARCH,
+    SHARED,
+    SWEEP_TOL,
+    _fit_job,
+    _job_cost,
+    choose_nk,
+    select_modes,
+    stabilisation_diagram,
+)
+
+ORDERS = range(2, 11, 2)
+PER_SENSOR_MAX = 6
+
+
+def _two_mode_ride(seconds: float = 60.0, seed: int = 3) -> tuple[am.Structure, Recording]:
+    """Two modes, 3.53 and 9.95 Hz at 5-6 % damping, a held input at 50 Hz."""
+    s = am.Structure.from_chain([10.0, 5.0], [8000.0, 0.0], [40.0, 0.0], [12000.0], [20.0], ("m1", "m2"))
+    u = am.random_vibration(50.0, seconds, (0.5, 24.0), seed=seed)
+    return s, am.simulate_recording(s, u, 50.0, noise=0.05, seed=seed + 1)
+
+
+def _late_input(rec: Recording, lag: int) -> Recording:
+    """The same ride with the input channel recorded ``lag`` samples late (outputs lead)."""
+    return Recording(rec.fs, rec.base[:-lag], rec.response[lag:], rec.sensors, rec.input_name)
+
+
+@pytest.fixture(scope="module")
+def ride():
+    return _two_mode_ride()
+
+
+@pytest.fixture(scope="module")
+def diagram(ride):
+    return stabilisation_diagram(ride[1], ORDERS, per_sensor_max_order=PER_SENSOR_MAX, n_jobs=1)
+
+
+def _reference_nk(rec: Recording, nk_values, na_values=(8, 10, 12)) -> int:
+    """The delay choice written out: the lowest BIC over every (na, nk) candidate."""
+    best = None
+    for na in na_values:
+        for nk in nk_values:
+            fit = am.fit_armax(
+                rec, na, default_nb(na, nk), default_nc(na), nk,
+                shared_poles=True, max_iter=8, tol=SWEEP_TOL, stop="decrease", warn=False,
+            )  # fmt: skip
+            score = information_criterion(fit)
+            if best is None or score < best[0]:
+                best = (score, nk)
+    return best[1]
+
+
+def test_the_delay_is_the_lowest_bic_one(ride, diagram):
+    rec = diagram.recording
+    nk = diagram.orders[0][3]
+    # the true delay is 1 (no feed-through, see below); the search starts at 0, one tap early
+    assert nk == _reference_nk(rec, NK_SEARCH) == 0
+    assert choose_nk(rec, n_jobs=1) == nk
+    assert [o for o in diagram.orders] == [(na, default_nb(na, nk), default_nc(na), nk) for na in ORDERS]
+
+
+def test_a_late_input_past_the_search_range_is_found_by_the_extension(ride):
+    """Outputs 8 samples ahead of the input: the best delay lies beyond the searched 0..-6,
+    so the search looks further, once. An absolute acceleration has no direct feed-through
+    of the base acceleration (the springs and dampers pass it on), so a held input's true
+    delay is one sample, and with the input 8 samples late it is -7."""
+    late = _late_input(ride[1], 8)
+    assert min(NK_SEARCH) > -8
+    nk = choose_nk(late, n_jobs=1)
+    assert nk == _reference_nk(late, range(min(NK_SEARCH), min(NK_SEARCH) - 4, -1)) == 1 - 8
+    # a narrower search that does not reach the edge is not extended
+    assert choose_nk(_late_input(ride[1], 2), nk_values=range(0, -5, -1), n_jobs=1) == 1 - 2
+
+
+def test_the_sweep_fits_every_source_and_order_it_should(ride, diagram):
+    rec = diagram.recording
+    expected = {(SHARED, na) for na in ORDERS} | {(s, na) for s in rec.sensors for na in ORDERS if na <= PER_SENSOR_MAX}
+    assert set(diagram.fits) == expected
+    for (source, na), fit in diagram.fits.items():
+        assert fit.orders == diagram.orders[list(ORDERS).index(na)]
+        assert fit.shared_poles == (source == SHARED)
+        assert fit.n_samples > 0 and len(fit.models) == (len(rec.sensors) if source == SHARED else 1)
+        # a fit the delay choice stopped at its 8-iteration cap must not stand in the sweep
+        assert fit.converged.all() or (fit.iterations >= 30).any(), (source, na, fit.iterations)
+    # every pole row belongs to a fit of the sweep, and every fit's poles are in the table
+    by_fit = diagram.poles.groupby(["source", "na"]).size()
+    assert set(by_fit.index) == expected
+    for (source, na), count in by_fit.items():
+        pairs = np.sum(np.imag(diagram.fits[(source, na)].models[0].poles()) > 0)
+        assert count == pairs, (source, na)
+    # the shared poles of the true modes are stable in all three and kept, from the second
+    # order that holds both modes on
+    shared = diagram.poles[(diagram.poles.source == SHARED) & (diagram.poles.na >= 6)]
+    for f in ride[0].modes().freq_hz:
+        near = shared[np.abs(shared.freq_hz / f - 1) < 0.01]
+        assert len(near) == len([na for na in ORDERS if na >= 6]), f
+        assert set(near.cls) == {"f+d+v"} and set(near.rejected) == {""}, near[["na", "cls", "rejected"]]
+
+
+def test_workers_and_this_process_give_the_same_diagram(ride, diagram):
+    forked = stabilisation_diagram(ride[1], ORDERS, per_sensor_max_order=PER_SENSOR_MAX, n_jobs=2)
+    cols = ["source", "na", "freq_hz", "damping", "cls", "rejected"]
+    pd.testing.assert_frame_equal(forked.poles[cols], diagram.poles[cols])
+
+
+def test_the_in_process_selection_gives_the_exact_modes(ride, diagram):
+    s, _ = ride
+    truth = s.modes()
+    sel = select_modes(diagram, n_jobs=1)
+    f, x = sel.modes.freq_hz.to_numpy(), sel.modes.damping.to_numpy()
+    assert len(f) == 2
+    assert np.all(np.abs(f / truth.freq_hz - 1) < 0.005), f
+    assert np.all(np.abs(x / truth.damping - 1) < 0.15), x
+    # the reported values are a converged fit's at the representative order, not the
+    # sweep's early-stopped one: a fit from scratch agrees within a tenth of an SE
+    rec = diagram.recording
+    for m in sel.modes.itertuples():
+        full = am.fit_armax(rec, *diagram.fits[(SHARED, m.na)].orders, shared_poles=True).modes()
+        full = full[full.sensor == rec.sensors[0]]
+        j = int(np.argmin(np.abs(full.freq_hz.to_numpy() - m.freq_hz)))
+        assert abs(full.freq_hz.iloc[j] - m.freq_hz) < 0.1 * full.freq_sd.iloc[j]
+        assert abs(full.damping.iloc[j] - m.damping) < 0.1 * full.damping_sd.iloc[j]
+
+
+def test_the_segment_spread_is_that_of_refits_on_thirds(diagram):
+    sel = select_modes(diagram, n_jobs=1, refine=False)
+    rec = diagram.recording
+    n = rec.n_samples // 3
+    for m in sel.modes.itertuples():
+        orders = diagram.fits[(SHARED, m.na)].orders
+        found = []
+        for k in range(3):
+            part = Recording(rec.fs, rec.base[k * n : (k + 1) * n], rec.response[k * n : (k + 1) * n], rec.sensors)
+            modes = am.fit_armax(part, *orders, shared_poles=True, max_iter=30, warn=False).modes()
+            modes = modes[(modes.sensor == rec.sensors[0]) & (modes.damping > 0)]
+            found.append(modes.iloc[int(np.argmin(np.abs(modes.freq_hz - m.freq_hz)))])
+        assert m.segments_found == 3
+        assert m.freq_segment_sd == pytest.approx(np.std([p.freq_hz for p in found], ddof=1), rel=0.02)
+        assert m.damping_segment_sd == pytest.approx(np.std([p.damping for p in found], ddof=1), rel=0.05)
+        # the model is right here: the spread does not dominate the statistical interval
+        assert not m.model_error_dominates
+
+
+def test_one_sweep_job_fits_its_own_source(diagram):
+    rec = diagram.recording
+    orders = diagram.orders[1]
+    single = _fit_job(rec, (rec.sensors[1], orders), 30, SWEEP_TOL)
+    alone = am.fit_armax(rec.select([rec.sensors[1]]), *orders, max_iter=30, tol=SWEEP_TOL, stop="decrease")
+    assert not single.shared_poles and len(single.models) == 1
+    np.testing.assert_allclose(single.models[0].a, alone.models[0].a, rtol=1e-9, atol=1e-12)
+    shared = _fit_job(rec, (SHARED, orders), 30, SWEEP_TOL)
+    assert shared.shared_poles and len(shared.models) == len(rec.sensors)
+    # orders the record cannot carry are skipped, not raised
+    assert _fit_job(rec, (SHARED, (400, 401, 400, 0)), 30, SWEEP_TOL) is None
+
+
+def test_job_cost_scales_with_order_and_sensors():
+    assert _job_cost((SHARED, (10, 11, 10, 0)), 4) == 40
+    assert _job_cost(("head", (10, 11, 10, 0)), 4) == 10
+    assert _job_cost(("head", (6, 7, 6, -2)), 4) == 6
