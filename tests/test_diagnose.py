@@ -294,3 +294,87 @@ def test_an_output_ahead_beyond_the_noncausal_taps_is_timed_by_the_cross_correla
     # within the model's reach (nk = -5) there is nothing to find, and a timed sensor is left alone
     assert all(f.p > 0.01 for f in _lead_findings(_baseline_model(clean), n_tests, set()))
     assert "legs" not in {f.channels[0] for f in _lead_findings(_baseline_model(ahead), n_tests, {"legs"})}
+
+
+def _clip_top(x: np.ndarray, k: int) -> np.ndarray:
+    """``x`` with its ``k`` largest samples set to the k-th largest: exactly k at the rail."""
+    out = x.copy()
+    top = np.argsort(out)[-k:]
+    out[top] = out[top].min()
+    return out
+
+
+def test_rail_pileup_counts_and_its_poisson_p():
+    from scipy import stats
+
+    from armaxmodal.diagnose.clipping import clipped_mask, rail_pileup
+
+    x = np.random.default_rng(5).standard_normal(5000)
+    (hi, k_hi, lam_hi, p_hi), (lo, k_lo, _, p_lo) = rail_pileup(_clip_top(x, 9))
+    assert (hi, k_hi, lo, k_lo) == (np.sort(x)[-9], 9, x.min(), 1)
+    assert lam_hi == 1.0 and p_hi == pytest.approx(stats.poisson.sf(8, 1.0), rel=1e-12) and p_lo == 1.0
+    assert clipped_mask(_clip_top(x, 9)).sum() == 9 and not clipped_mask(x).any()
+    # a coarse quantiser visits its extreme levels often: no pile-up beyond its neighbours
+    q = np.round(x * 2) / 2
+    assert all(p > 0.05 for *_, p in rail_pileup(q)) and not clipped_mask(q).any()
+
+
+def test_fill_by_prediction_leaves_zero_innovation_where_samples_are_missing(clean):
+    """Against the model's own predictor: on the filled record the prediction errors are zero
+    at the missing samples and unchanged before the first one."""
+    from armaxmodal.diagnose.clipping import fill_by_prediction
+
+    m = am.fit_armax(clean, *ORDERS, shared_poles=True, warn=False).models[1]
+    y, u = clean.response[:, 1], clean.base
+    missing = np.zeros(y.size, bool)
+    missing[[700, 701, 702, 2000, 5000]] = True
+    filled = fill_by_prediction(y, u, m, missing)
+    eps = m.prediction_errors(filled, u)
+    np.testing.assert_allclose(eps[missing], 0.0, atol=1e-9)
+    np.testing.assert_array_equal(filled[~missing], y[~missing])
+    np.testing.assert_allclose(eps[:700], m.prediction_errors(y, u)[:700], atol=1e-9)
+
+
+def test_a_clipped_sensor_is_named_filled_and_back_to_the_clean_error(clean):
+    """chest clipped at 60 % of its peak excursion (229 samples, 3 %): named first with the
+    exact count, filled, and its held-out error back to the clean ride's; nothing else named
+    (filling with the noise-free response instead once read as a quadratic spring)."""
+    rec = inject(clean, "clipping", ["chest"], fraction=0.6)
+    x = rec.response[:, 1]
+    at_rails = int(np.sum(x == x.max()) + np.sum(x == x.min()))
+    d = _run(rec)
+    effect = _first(d)
+    assert effect.finding.effect == "clipping" and effect.finding.channels == ("chest",)
+    assert effect.parameters["samples"] == at_rails > 100 and effect.finding.p < 1e-100
+    assert [e.finding.effect for e in d.effects] == ["clipping"] and d.unconfirmed == ()
+    clean_error = _pooled_chest_error(_run(clean))
+    assert effect.error_before > 1.1 * clean_error
+    assert effect.error_after == pytest.approx(clean_error, rel=0.03)
+
+
+def _pooled_chest_error(d) -> float:
+    held = d.final.held
+    return float(np.sqrt(np.mean(held.one_step[held.mask, 1] ** 2)))
+
+
+def test_clipping_near_its_threshold_and_on_the_input(clean):
+    """Three samples at a rail are what a continuous signal may show (p = 0.08 before the
+    correction): not named; twelve are (p = 1e-9): named. A clipped input is named but not
+    'fixed': no fill restores the base motion the structure felt."""
+    from armaxmodal.diagnose.evidence import run_tests
+
+    def clipping(rec):
+        return [f for f in run_tests(_baseline_model(rec))[0] if f.effect == "clipping"]
+
+    def with_head(x):
+        y = clean.response.copy()
+        y[:, 0] = x
+        return am.Recording(clean.fs, clean.base, y, clean.sensors, clean.input_name)
+
+    assert clipping(with_head(_clip_top(clean.response[:, 0], 3))) == []
+    (f,) = clipping(with_head(_clip_top(clean.response[:, 0], 12)))
+    assert f.channels == ("head",) and f.parameters["samples"] == 12
+    d = _run(inject(clean, "clipping", ["base"], fraction=0.7))
+    assert "clipping" not in {e.finding.effect for e in d.effects}
+    (u,) = [u for u in d.unconfirmed if u["effect"] == "clipping"]
+    assert u["channels"] == ["base"] and "input clipped" in u["reason"]

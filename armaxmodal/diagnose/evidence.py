@@ -20,8 +20,9 @@ from scipy.signal import lfilter
 
 from ..quality import MIN_DELAY_SAMPLES, estimate_delays
 from ..recording import Recording
+from .clipping import rail_pileup
 from .missing_mode import mode_findings
-from .model import LINE_MERGE_HZ, UNDAMPED, FittedModel, usable
+from .model import LINE_MERGE_HZ, UNDAMPED, FittedModel, counted, usable
 from .model import lagged as _lag
 from .spectral import harmonic_f_test
 
@@ -31,6 +32,7 @@ __all__ = ["Finding", "run_tests", "whiteness_p", "EFFECT_TESTS"]
 WHITENESS_LAGS = 10
 #: The tests each round runs, in the order linear/structural effects come first.
 EFFECT_TESTS = (
+    "clipping",
     "input_delay",
     "unmodelled_mode",
     "offset_drift",
@@ -126,9 +128,10 @@ def run_tests(fitted: FittedModel, alpha: float = 0.01) -> tuple[list[Finding], 
     k_count = len(fitted.signals.sensors)
     n_tests = len(EFFECT_TESTS) * k_count
     eps = fitted.one_step_errors()
-    mask = usable(fitted.signals.n, fitted.spec)
+    mask = counted(fitted)
     table = {"whiteness_p": [], "trend_p": [], "line_p": []}
-    found = _delay_findings(fitted, n_tests)
+    found = _clipping_findings(fitted, n_tests)
+    found += _delay_findings(fitted, n_tests)
     found += _lead_findings(fitted, n_tests, {c for f in found for c in f.channels})
     found += mode_findings(fitted, n_tests, table)
     found += _trend_findings(fitted, eps, mask, n_tests, table)
@@ -152,6 +155,28 @@ def _merge_per_sensor(findings: list[Finding], effects) -> list[Finding]:
             top = group[0]
             params = {**top.parameters, "per_channel": per_channel}
             out.append(Finding(effect, channels, top.statistic, top.value, top.p, params, payload=top.payload))
+    return out
+
+
+def _clipping_findings(fitted: FittedModel, n_tests: int) -> list[Finding]:
+    """A channel piled up at a rail beyond its own amplitude distribution (:mod:`.clipping`),
+    tested on the recorded values; p corrected for both rails and for sensors x tests."""
+    s = fitted.raw
+    out = []
+    for name, x in ((s.input_name, s.u), *zip(s.sensors, s.y.T, strict=True)):
+        if name in fitted.spec.clipped:
+            continue
+        rails = rail_pileup(x)
+        p = min(1.0, 2 * min(r[3] for r in rails) * n_tests)
+        clipped = [r for r in rails if r[1] > 1 and r[3] < 1e-3]
+        count = sum(r[1] for r in clipped) if clipped else max(r[1] for r in rails)
+        params = {
+            "samples": int(count),
+            "percent": 100.0 * count / x.size,
+            "rails": [r[0] for r in clipped],
+            "expected_at_rail": [r[2] for r in clipped],
+        }
+        out.append(Finding("clipping", (name,), "rail_pileup", float(count), p, params))
     return out
 
 

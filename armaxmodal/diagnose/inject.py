@@ -15,13 +15,14 @@ from .model import fractional_shift
 
 __all__ = ["inject", "INJECTABLE"]
 
-INJECTABLE = ("input_delay", "offset_drift", "periodic_disturbance", "coloured_noise")
+INJECTABLE = ("input_delay", "offset_drift", "periodic_disturbance", "coloured_noise", "clipping")
 #: Each effect's parameters: required, then optional.
 PARAMETERS = {
     "input_delay": (("samples",), ()),
     "offset_drift": ((), ("offset", "drift_per_s")),
     "periodic_disturbance": (("freq_hz", "amp"), ()),
     "coloured_noise": (("level",), ("pole", "freq_hz")),
+    "clipping": (("fraction",), ()),
 }
 
 
@@ -40,6 +41,8 @@ def check_effect(effect: str, params: dict) -> None:
         )
     if any(not np.isfinite(float(v)) for v in params.values()):
         raise DataError(f"effect {effect!r}: parameters must be finite numbers, got {params}.")
+    if effect == "clipping" and not 0 < float(params["fraction"]) <= 1:
+        raise DataError(f"effect 'clipping': fraction must be in (0, 1] (1 clips nothing), got {params['fraction']}.")
 
 
 def _channel(rec: Recording, name: str) -> int | None:
@@ -63,7 +66,9 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, **pa
         ``"periodic_disturbance"`` (``freq_hz``; ``amp``, the line's RMS as a fraction of
         each channel's RMS),
         ``"coloured_noise"`` (``level`` as a fraction of RMS; AR(1) ``pole``, or with
-        ``freq_hz`` an AR(2) resonance of radius ``pole`` there).
+        ``freq_hz`` an AR(2) resonance of radius ``pole`` there),
+        ``"clipping"`` (``fraction``: both rails at this fraction of the channel's largest
+        excursion from its median; 1 clips nothing).
     channels : sequence of str, optional
         Where: default every output (an input delay: the input).
     seed : int
@@ -88,6 +93,10 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, **pa
             x[:] = fractional_shift(x, -float(params["samples"]))
         elif effect == "offset_drift":
             x += float(params.get("offset", 0.0)) + float(params.get("drift_per_s", 0.0)) * (t - t.mean())
+        elif effect == "clipping":
+            mid = float(np.median(x))
+            rail = float(params["fraction"]) * float(np.max(np.abs(x - mid)))
+            x[:] = np.clip(x, mid - rail, mid + rail)
         elif effect == "periodic_disturbance":
             x += float(params["amp"]) * rms * np.sqrt(2) * np.sin(2 * np.pi * float(params["freq_hz"]) * t + 0.7)
         else:

@@ -50,6 +50,7 @@ EFFECTS = (
 TESTED_EFFECTS = EFFECT_TESTS
 #: Linear/structural effects first: a wrong linear part fires every later test.
 _TIER = {
+    "clipping": 0,
     "input_delay": 0,
     "unmodelled_mode": 1,
     "offset_drift": 1,
@@ -270,8 +271,10 @@ def _held_out_p(before: HeldOut, after: HeldOut, idx: list[int], kind: str = "on
     return float(stats.norm.sf(z))
 
 
-def _pooled_rms(held: HeldOut, idx: list[int], kind: str = "one_step") -> float:
-    return float(np.sqrt(np.mean(getattr(held, kind)[held.mask][:, idx] ** 2)))
+def _pooled_rms(held: HeldOut, idx: list[int], kind: str = "one_step", mask: np.ndarray | None = None) -> float:
+    """RMS held-out error of the channels ``idx`` over ``mask`` (default: the held-out mask)."""
+    mask = held.mask if mask is None else mask
+    return float(np.sqrt(np.mean(getattr(held, kind)[mask][:, idx] ** 2)))
 
 
 @single_blas_thread
@@ -348,6 +351,12 @@ def _try_fix(stage: Stage, finding: Finding, alpha: float):
     """Refit with the finding's effect; ``((Effect, Stage), "")`` if the held-out error says
     keep it, else ``(None, reason)``."""
     s = stage.model.raw
+    on_input = finding.channels == (s.input_name,)
+    if finding.effect == "clipping" and on_input:
+        return None, (
+            "the input clipped: the structure felt base motion the record does not hold, so no fix can restore "
+            "it; record with a wider range, or analyse a stretch without clipping"
+        )
     if finding.effect == "time_varying":
         change = finding.payload
         model = fit_piecewise(stage.model.spec, s, change)
@@ -355,23 +364,30 @@ def _try_fix(stage: Stage, finding: Finding, alpha: float):
     else:
         model = fit_model(add_effect(stage.model.spec, finding, stage.model), s)
         new = Stage(model, held_out(model.spec, s, model))
-    on_input = finding.channels == (s.input_name,)
     idx = list(range(len(s.sensors))) if on_input else [s.sensors.index(c) for c in finding.channels]
-    before, after = _pooled_rms(stage.held, idx), _pooled_rms(new.held, idx)
+    common = stage.held.mask & new.held.mask  # both errors on the same samples (a fix may drop some)
+    before, after = _pooled_rms(stage.held, idx, mask=common), _pooled_rms(new.held, idx, mask=common)
     kind = _CRITERION.get(finding.effect, "one_step")
     p = _held_out_p(stage.held, new.held, idx, kind)
     dbic = new.bic(kind) - stage.bic(kind)
     params = effect_parameters(finding, model)
     params["criterion"] = f"held-out {kind.replace('_', '-')} error"
     if kind == "simulation":
-        params["sim_error_before"] = _pooled_rms(stage.held, idx, kind)
-        params["sim_error_after"] = _pooled_rms(new.held, idx, kind)
+        params["sim_error_before"] = _pooled_rms(stage.held, idx, kind, common)
+        params["sim_error_after"] = _pooled_rms(new.held, idx, kind, common)
     if finding.effect == "input_delay" and finding.statistic != "residual_input_ccf_z":
         # B's taps absorb much of a delay, so the error may barely move: the phase slope names it.
         # A lead found by the cross-correlation is beyond B's reach: it must lower the error.
         if after > before * 1.01:
             return None, f"moving the channel raised the held-out error from {before:.4g} to {after:.4g}"
         note = "the model's B taps absorb part of a delay, so the error changes little; named from the phase slope"
+        return (Effect(finding, params, before, after, p, dbic, note), new), ""
+    if finding.effect == "clipping":
+        # a pile-up at the rail is a fact of the record, not a hypothesis the error must confirm;
+        # a few clipped samples barely move the error on the others, so the fix only must not hurt
+        if after > before * 1.01:
+            return None, f"filling the clipped samples raised the held-out error from {before:.4g} to {after:.4g}"
+        note = "the clipped samples are filled from the model and left out of every error"
         return (Effect(finding, params, before, after, p, dbic, note), new), ""
     if p >= alpha or dbic >= 0:
         return None, (

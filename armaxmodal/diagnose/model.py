@@ -8,7 +8,9 @@ An effect is added without touching the numba fitter:
   estimated by backfitting: ``theta`` from least squares of the output on the regressors,
   ARMAX fitted to ``y - phi theta``, ``theta`` again from the simulation residual, three
   passes (see :func:`_disturbance_ls` for why not GLS);
-* a richer noise model raises ``nc``.
+* a richer noise model raises ``nc``;
+* a clipped output's samples at its rail are filled from the model's response and refitted
+  (a few passes) and left out of every error (:mod:`.clipping`).
 
 Held-out errors (see :func:`held_out`) come from two blocked folds: a model fitted on one half
 of the record predicts the other half. Its one-step predictions there use the measured past,
@@ -23,8 +25,9 @@ import numpy as np
 from scipy.signal import lfilter
 
 from ..fit import ArmaxFit, fit_armax
+from .clipping import IMPUTE_PASSES, clipped_mask, fill_by_prediction
 
-__all__ = ["Signals", "ModelSpec", "FittedModel", "fit_model", "held_out", "HeldOut"]
+__all__ = ["Signals", "ModelSpec", "FittedModel", "fit_model", "held_out", "HeldOut", "counted"]
 
 #: Lags of a nonlinear term in its score test.
 TERM_LAGS = 3
@@ -73,6 +76,8 @@ class ModelSpec:
     terms : tuple of str
         Names of extra inputs in :attr:`Signals.extra` (a nonlinear term of the simulated
         response): each enters through the dynamics like the base input, ``B_m / A``.
+    clipped : tuple of str
+        Clipped outputs.
     """
 
     orders: tuple[int, int, int, int]
@@ -81,6 +86,8 @@ class ModelSpec:
     lines_hz: tuple[float, ...] = ()
     extra_nc: int = 0
     terms: tuple[str, ...] = ()
+    #: Outputs whose samples at a rail are filled from the model and left out of errors.
+    clipped: tuple[str, ...] = ()
 
     @property
     def n_disturbance(self) -> int:
@@ -146,6 +153,8 @@ class FittedModel:
     signals: Signals = field(repr=False)
     #: The signals before the spec's shifts (what a refit must start from).
     raw: Signals = field(default=None, repr=False)
+    #: Samples left out of every error (clipped outputs' rails and their guard), (n,) bool.
+    excluded: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def disturbance(self) -> np.ndarray:
         """The fitted disturbance on every sample, (n, K)."""
@@ -182,10 +191,75 @@ def usable(n: int, spec: ModelSpec) -> np.ndarray:
     return mask
 
 
+def clip_masks(spec: ModelSpec, signals: Signals) -> dict[int, np.ndarray]:
+    """``{column: (n,) bool}``: the rail samples of each clipped output of ``spec``."""
+    columns = [signals.sensors.index(name) for name in spec.clipped]
+    return {k: clipped_mask(signals.y[:, k]) for k in columns}
+
+
+def counted(model) -> np.ndarray:
+    """Samples whose errors count: :func:`usable` without the model's excluded ones, (n,) bool."""
+    mask = usable(model.signals.n, model.spec)
+    return mask if model.excluded is None else mask & ~model.excluded
+
+
+#: Noise SDs from a rail within which a clipped channel's predicted response leaves a sample
+#: out of every error. Near the rail only samples whose noise pulled them inside survive, so
+#: their errors are biased (truncation: a clipped ride read as a quadratic spring before this
+#: guard); choosing samples by the prediction, which the noise does not enter, is not.
+RAIL_GUARD_SD = 3.0
+
+
+def _excluded(signals: Signals, spec: ModelSpec, masks: dict, predicted: np.ndarray) -> np.ndarray:
+    """The rail samples of the clipped outputs and those predicted within the guard of a rail."""
+    out = np.zeros(signals.n, bool)
+    for k, rail in masks.items():
+        y = signals.y[:, k]
+        sd = float(np.std((y - predicted[:, k])[~rail & usable(signals.n, spec)]))
+        if rail[np.argmax(y)]:
+            out |= predicted[:, k] > y.max() - RAIL_GUARD_SD * sd
+        if rail[np.argmin(y)]:
+            out |= predicted[:, k] < y.min() + RAIL_GUARD_SD * sd
+        out |= rail
+    return out
+
+
 def fit_model(
     spec: ModelSpec, signals: Signals, window: tuple[int, int] | None = None, start: FittedModel | None = None
 ) -> FittedModel:
-    """Fit ``spec`` on ``window`` (default: the whole record) of ``signals`` (unshifted)."""
+    """Fit ``spec`` on ``window`` (default: the whole record) of ``signals`` (unshifted).
+
+    Clipped outputs: fit, fill the rail samples with the fitted response (moved back by the
+    channel's shift, as the fill applies to the recorded signal), refit; ``IMPUTE_PASSES``
+    times. The model's :attr:`FittedModel.signals` hold the filled record, ``raw`` the recorded.
+    """
+    masks = clip_masks(spec, signals)
+    model = _fit_once(spec, signals, window, start)
+    if not masks:
+        return model
+    for _ in range(IMPUTE_PASSES):
+        model = _fit_once(spec, _filled(model, signals, masks), window, model)
+    excluded = _excluded(signals, spec, masks, model.simulated() + model.disturbance())
+    return replace(model, raw=signals, excluded=excluded)
+
+
+def _filled(model: FittedModel, signals: Signals, masks: dict) -> Signals:
+    """``signals`` with each clipped channel's rail samples filled by ``model``'s one-step
+    prediction (:func:`~.clipping.fill_by_prediction`) in the model's (shifted) time frame,
+    then moved back to the recorded frame."""
+    y = signals.y.copy()
+    shifts = dict(model.spec.shifts)
+    s = model.signals
+    u, dist = s.inputs(model.spec), model.disturbance()
+    for k, rail in masks.items():
+        shift = shifts.get(signals.sensors[k], 0.0)
+        missing = fractional_shift(rail.astype(float), shift) > 0.5 if shift else rail
+        filled = fill_by_prediction(s.y[:, k] - dist[:, k], u, model.fit.models[k], missing) + dist[:, k]
+        y[rail, k] = (fractional_shift(filled, -shift) if shift else filled)[rail]
+    return replace(signals, y=y)
+
+
+def _fit_once(spec: ModelSpec, signals: Signals, window, start: FittedModel | None) -> FittedModel:
     shifted = apply_shifts(signals, spec.shifts)
     lo, hi = window or (0, signals.n)
     na, nb, nc, nk = spec.orders
@@ -321,11 +395,13 @@ def held_out(spec: ModelSpec, signals: Signals, start: FittedModel | None = None
     half = n // 2
     one = np.zeros((n, len(signals.sensors)))
     sim = np.zeros_like(one)
+    mask = np.ones(n, bool)
     for fit_window, test in (((0, half), slice(half, n)), ((half, n), slice(0, half))):
         model = fit_model(spec, signals, fit_window, start)
         one[test] = model.one_step_errors()[test]
         sim[test] = model.simulation_errors()[test]
-    return HeldOut(one, sim, usable(n, spec))
+        mask &= counted(model)
+    return HeldOut(one, sim, mask)
 
 
 @dataclass(frozen=True)
@@ -349,6 +425,11 @@ class PiecewiseModel:
     @property
     def raw(self) -> Signals:
         return self.before.raw
+
+    @property
+    def excluded(self) -> np.ndarray | None:
+        parts = [m.excluded for m in (self.before, self.after) if m.excluded is not None]
+        return np.logical_or.reduce(parts) if parts else None
 
     def _join(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         out = a.copy()
@@ -380,10 +461,12 @@ def held_out_piecewise(spec: ModelSpec, signals: Signals, change: int) -> HeldOu
     n = signals.n
     one = np.zeros((n, len(signals.sensors)))
     sim = np.zeros_like(one)
+    mask = np.ones(n, bool)
     for lo, hi in ((0, change), (change, n)):
         mid = (lo + hi) // 2
         for fit_window, test in (((lo, mid), slice(mid, hi)), ((mid, hi), slice(lo, mid))):
             model = fit_model(spec, signals, fit_window)
             one[test] = model.one_step_errors()[test]
             sim[test] = model.simulation_errors()[test]
-    return HeldOut(one, sim, usable(n, spec))
+            mask &= counted(model)
+    return HeldOut(one, sim, mask)
