@@ -23,7 +23,7 @@ import numpy as np
 
 from ._validate import check_outputs_carry_signal
 from .exceptions import DataError
-from .quality import QualityWarning, check_quality
+from .quality import QualityWarning, check_quality, estimate_delays
 from .recording import Recording
 
 __all__ = ["prepare", "Preparation", "check_band", "DETRENDS"]
@@ -159,13 +159,23 @@ def prepare(
 
 
 def _whole_sample_shifts(found: list[QualityWarning], rec: Recording) -> dict:
-    """Channel -> whole samples it lags (from ``sensor_delay`` warnings), zeros left out."""
+    """Channel -> whole samples it lags (from ``sensor_delay`` warnings), zeros left out.
+
+    A late sensor is timed against the outputs on time, not against the input: a held input
+    puts about half a sample on every output, and a sensor 3 samples late then reads 3.5-3.7
+    (aligning it by 4 would leave it a sample early against the others)."""
+    late = [w for w in found if w.code == "sensor_delay" and w.value is not None]
+    late = [w for w in late if w.channels[0] in (rec.input_name, *rec.sensors)]
+    reference_s = 0.0
+    if any(w.channels[0] != rec.input_name for w in late):
+        flagged = {w.channels[0] for w in late}
+        on_time = [e.delay_s for e in estimate_delays(rec) if e.channel not in flagged]
+        reference_s = float(np.median(on_time)) if on_time else 0.0
     shifts = {}
-    for w in found:
-        if w.code != "sensor_delay" or w.value is None:
-            continue
-        samples = int(round(w.value * 1e-3 * rec.fs))
-        if samples != 0 and w.channels[0] in (rec.input_name, *rec.sensors):
+    for w in late:
+        offset = reference_s if w.channels[0] != rec.input_name else 0.0
+        samples = int(round((w.value * 1e-3 - offset) * rec.fs))
+        if samples != 0:
             shifts[w.channels[0]] = samples
     return shifts
 

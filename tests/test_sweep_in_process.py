@@ -2,8 +2,9 @@
 
 Fast (about a second each), so a mutation tool can see which test reaches the delay choice,
 the sweep's jobs, the finishing fits and the segment refits -- with worker processes it
-cannot. Every check is against the structure's exact modes, a slow reference written out
-here with :func:`fit_armax`, or the same sweep over worker processes.
+cannot. Each test runs its own sweep (a shared fixture would credit only the first test with
+reaching the sweep). Every check is against the structure's exact modes, a slow reference
+written out here with :func:`fit_armax`, or the same sweep over worker processes.
 """
 
 import numpy as np
@@ -45,9 +46,13 @@ def ride():
     return _two_mode_ride()
 
 
-@pytest.fixture(scope="module")
+def _diagram(rec: Recording, **options):
+    return stabilisation_diagram(rec, ORDERS, per_sensor_max_order=PER_SENSOR_MAX, n_jobs=1, **options)
+
+
+@pytest.fixture
 def diagram(ride):
-    return stabilisation_diagram(ride[1], ORDERS, per_sensor_max_order=PER_SENSOR_MAX, n_jobs=1)
+    return _diagram(ride[1])
 
 
 def _reference_nk(rec: Recording, nk_values, na_values=(8, 10, 12)) -> int:
@@ -173,3 +178,102 @@ def test_job_cost_scales_with_order_and_sensors():
     assert _job_cost((SHARED, (10, 11, 10, 0)), 4) == 40
     assert _job_cost(("head", (10, 11, 10, 0)), 4) == 10
     assert _job_cost(("head", (6, 7, 6, -2)), 4) == 6
+
+
+def _late_channel(rec: Recording, k: int, lag: int) -> Recording:
+    """Output ``k`` recorded ``lag`` samples late."""
+    y = rec.response[lag:].copy()
+    y[:, k] = rec.response[:-lag, k]
+    return Recording(rec.fs, rec.base[lag:], y, rec.sensors, rec.input_name)
+
+
+def test_by_default_a_late_sensor_is_aligned_and_sensors_stop_at_order_20(ride, capsys):
+    late = _late_channel(ride[1], 1, 3)
+    d = stabilisation_diagram(late, (2, 4, 20, 21, 22), n_jobs=1, progress=True)
+    assert d.preparation.shifts == {"m2": 3}
+    aligned, want = d.recording.response[:, 1], late.response[3 : 3 + d.recording.n_samples, 1]
+    np.testing.assert_allclose(aligned - aligned.mean(), want - want.mean(), atol=1e-9)
+    assert {na for (src, na) in d.fits if src != SHARED} == {2, 4, 20}
+    assert {na for (src, na) in d.fits if src == SHARED} == {2, 4, 20, 21, 22}
+    assert max(int(f.iterations.max()) for f in d.fits.values()) <= 30
+    bar = capsys.readouterr().err
+    assert "stabilisation sweep: 100%" in bar and "11/11" in bar and "fit/s" in bar  # 5 shared + 2 x 3
+
+
+def test_a_record_sampled_far_above_its_band_is_resampled_by_default():
+    s, rec50 = _two_mode_ride(40.0)
+    u = am.random_vibration(400.0, 40.0, (0.5, 24.0), seed=3)
+    rec = am.simulate_recording(s, u, 400.0, noise=0.05, seed=4)
+    d = stabilisation_diagram(rec, ORDERS, per_sensor=False, n_jobs=1)
+    assert d.preparation.original_fs == 400.0 and d.recording.fs < 100.0
+    assert d.recording.fs == d.preparation.analysis_fs and "resampled" in {w.code for w in d.warnings}
+
+
+def test_the_band_and_the_detrend_reach_the_preparation_and_the_selection(ride):
+    s, rec = ride
+    offset = Recording(rec.fs, rec.base, rec.response + [0.5, -0.2], rec.sensors, rec.input_name)
+    d = _diagram(offset, band=(1.0, 6.0), detrend="linear")
+    assert d.preparation.band == (1.0, 6.0) and d.preparation.detrend == "linear"
+    assert "trend_removed" in {w.code for w in d.warnings}
+    sel = select_modes(d, n_jobs=1)  # the diagram's band: only the first mode, nothing unexplained
+    assert sel.modes.freq_hz.to_numpy() == pytest.approx(s.modes().freq_hz[:1], rel=0.005)
+    assert not [n for n in sel.notes if n.code == "unexplained_peak"]
+
+
+def test_a_given_delay_sweeps_as_the_chosen_one(ride, diagram):
+    given = _diagram(ride[1], nk=diagram.orders[0][3])
+    assert given.orders == diagram.orders and set(given.fits) == set(diagram.fits)
+    pd.testing.assert_frame_equal(
+        given.poles[["source", "na", "cls"]], diagram.poles[["source", "na", "cls"]], check_exact=True
+    )
+    np.testing.assert_allclose(given.poles.freq_hz, diagram.poles.freq_hz, rtol=1e-3)
+
+
+def test_the_selection_reports_what_it_should(ride, diagram):
+    s, _ = ride
+    sel = select_modes(diagram, n_jobs=1, segments=2)
+    assert "index" not in sel.modes.columns and list(sel.modes.index) == [0, 1]
+    assert set(sel.modes.estimator) == {"armax"} and sel.refinement.hold == "zoh"  # a held input
+    assert (sel.modes.segments_found == 2).all() and sel.modes.freq_segment_sd.notna().all()
+    # the ARMAX standard deviations are the converged fit's, taken from its 95 % intervals
+    rec = diagram.recording
+    for m in sel.modes.itertuples():
+        full = am.fit_armax(rec, *diagram.fits[(SHARED, m.na)].orders, shared_poles=True).modes()
+        full = full[full.sensor == rec.sensors[0]]
+        j = int(np.argmin(np.abs(full.freq_hz.to_numpy() - m.freq_hz)))
+        assert m.freq_sd_armax == pytest.approx(full.freq_sd.iloc[j], rel=0.1)
+        assert m.damping_sd_armax == pytest.approx(full.damping_sd.iloc[j], rel=0.1)
+    # Table 3.2's weighted means come with the selection (a per-sensor sweep was run)
+    assert sel.weighted is not None and len(sel.weighted) == 2
+    # the best-supported mode when only one is asked for
+    (one,) = select_modes(diagram, n_modes=1, n_jobs=1, segments=0).modes.freq_hz
+    assert one == pytest.approx(s.modes().freq_hz[0], rel=0.005)
+
+
+def test_no_mode_in_the_band_says_what_to_do(diagram):
+    from armaxmodal.exceptions import OrderError
+
+    message = (
+        "no stable mode found in 15-20 Hz; widen the band, extend the order range, "
+        "or check that the input excites the structure."
+    )
+    with pytest.raises(OrderError) as err:
+        select_modes(diagram, band=(15.0, 20.0), n_jobs=1)
+    assert str(err.value) == message
+
+
+def test_the_diagram_plots_the_selection(diagram):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    sel = select_modes(diagram, n_jobs=1, segments=0)
+    top, damping = diagram.plot(sel)
+    labels = " ".join(t.get_text() for t in top.texts)
+    for f in sel.modes.freq_hz:
+        assert f"{f:.2f} Hz" in labels
+    fig, ax = plt.subplots()
+    top2, _ = diagram.plot(ax=ax)
+    assert top2 is ax and not top2.texts  # no selection: no mode labels
+    plt.close("all")
