@@ -378,3 +378,49 @@ def test_clipping_near_its_threshold_and_on_the_input(clean):
     assert "clipping" not in {e.finding.effect for e in d.effects}
     (u,) = [u for u in d.unconfirmed if u["effect"] == "clipping"]
     assert u["channels"] == ["base"] and "input clipped" in u["reason"]
+
+
+def test_stuck_runs_and_glitches_against_planted_ones():
+    from armaxmodal.armax import ArmaxModel
+    from armaxmodal.diagnose.faults import glitches, stuck_runs
+
+    rng = np.random.default_rng(11)
+    x = rng.standard_normal(6000)
+    assert stuck_runs(x) == []
+    x[3000:3040] = x[2999]
+    ((first, stop, p),) = stuck_runs(x)
+    assert (first, stop) == (2999, 3040) and p < 1e-100
+    # a coarse quantiser on a slow signal repeats itself often: its runs are allowed
+    slow = np.round(np.sin(np.arange(6000) / 200.0), 1)
+    assert all(p > 0.01 for *_, p in stuck_runs(slow))
+    # glitches through a white-noise model (pi = 1): exactly the planted samples and sizes
+    white = ArmaxModel(np.array([1.0]), np.zeros((1, 1)), np.array([1.0]), 0, 100.0)
+    e = rng.standard_normal(6000)
+    mask = np.ones(6000, bool)
+    assert glitches(e, white, mask)[0] == []
+    at, size = [500, 2500, 4100], [9.0, -12.0, 15.0]
+    e[at] += size
+    found, sizes, largest = glitches(e, white, mask)
+    assert sorted(found) == at and largest > 14
+    # with pi = 1 a glitch's least-squares size is its sample's residual, noise included
+    np.testing.assert_allclose([w for _, w in sorted(zip(found, sizes, strict=True))], e[at], rtol=1e-9)
+
+
+def test_glitches_and_a_stuck_sensor_are_named_filled_and_back_to_the_clean_error(clean):
+    held = _run(clean).final.held
+    clean_error = float(np.sqrt(np.mean(held.one_step[held.mask, 2] ** 2)))
+    spiky = inject(clean, "sensor_fault", ["pelvis"], seed=3, spikes=10)
+    effect = _first(_run(spiky))
+    assert effect.finding.effect == "sensor_fault" and effect.finding.channels == ("pelvis",)
+    planted = np.flatnonzero(spiky.response[:, 2] != clean.response[:, 2])
+    assert list(effect.finding.payload) == list(planted) and effect.parameters["glitches"] == 10
+    assert effect.error_before > 1.05 * clean_error and effect.error_after == pytest.approx(clean_error, rel=0.03)
+    stuck = inject(clean, "sensor_fault", ["pelvis"], stuck_s=1.0)
+    d = _run(stuck)
+    effect = _first(d)
+    assert effect.finding.effect == "sensor_fault" and effect.finding.statistic == "stuck_run"
+    (run,) = effect.parameters["stuck"]
+    assert run["start_s"] == pytest.approx(0.4 * clean.duration, abs=1 / clean.fs)
+    assert run["duration_s"] == pytest.approx(1.0 + 1 / clean.fs, abs=1e-9)  # the last live sample and 60 repeats
+    assert effect.error_after == pytest.approx(clean_error, rel=0.03)
+    assert [e.finding.effect for e in d.effects] == ["sensor_fault"]

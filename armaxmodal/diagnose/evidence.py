@@ -21,6 +21,7 @@ from scipy.signal import lfilter
 from ..quality import MIN_DELAY_SAMPLES, estimate_delays
 from ..recording import Recording
 from .clipping import rail_pileup
+from .faults import FAULT_ALPHA, glitch_p, glitches, stuck_runs
 from .missing_mode import mode_findings
 from .model import LINE_MERGE_HZ, UNDAMPED, FittedModel, counted, usable
 from .model import lagged as _lag
@@ -33,6 +34,7 @@ WHITENESS_LAGS = 10
 #: The tests each round runs, in the order linear/structural effects come first.
 EFFECT_TESTS = (
     "clipping",
+    "sensor_fault",
     "input_delay",
     "unmodelled_mode",
     "offset_drift",
@@ -131,6 +133,7 @@ def run_tests(fitted: FittedModel, alpha: float = 0.01) -> tuple[list[Finding], 
     mask = counted(fitted)
     table = {"whiteness_p": [], "trend_p": [], "line_p": []}
     found = _clipping_findings(fitted, n_tests)
+    found += _fault_findings(fitted, eps, mask, n_tests)
     found += _delay_findings(fitted, n_tests)
     found += _lead_findings(fitted, n_tests, {c for f in found for c in f.channels})
     found += mode_findings(fitted, n_tests, table)
@@ -177,6 +180,40 @@ def _clipping_findings(fitted: FittedModel, n_tests: int) -> list[Finding]:
             "expected_at_rail": [r[2] for r in clipped],
         }
         out.append(Finding("clipping", (name,), "rail_pileup", float(count), p, params))
+    return out
+
+
+def _fault_findings(fitted: FittedModel, eps: np.ndarray, mask: np.ndarray, n_tests: int) -> list[Finding]:
+    """Per output, a stuck run or glitches (:mod:`.faults`); p corrected for sensors x tests.
+    The payload is the recorded samples the fault spoiled: a stuck run's repeats (its first
+    sample is the last live reading) and each glitch."""
+    raw, fs = fitted.raw, fitted.raw.fs
+    shifts = dict(fitted.spec.shifts)
+    known = {name: set(samples) for name, samples in fitted.spec.faults}
+    out = []
+    for k, name in enumerate(raw.sensors):
+        runs = [r for r in stuck_runs(raw.y[:, k]) if r[0] + 1 not in known.get(name, ())]
+        spikes, sizes, largest = glitches(eps[:, k], fitted.fit.models[k], mask)
+        lag = int(round(shifts.get(name, 0.0)))  # the residual is in the channel's shifted frame
+        spikes = [t + lag for t in spikes if 0 <= t + lag < raw.n]
+        p_stuck = min((r[2] for r in runs), default=1.0)
+        p_glitch = glitch_p(largest, int(mask.sum()))
+        p = min(1.0, min(p_stuck, p_glitch) * n_tests)
+        stuck = [r for r in runs if r[2] < FAULT_ALPHA]
+        samples = sorted({t for first, stop, _ in stuck for t in range(first + 1, stop)} | set(spikes))
+        params = {
+            "stuck": [{"start_s": first / fs, "duration_s": (stop - first) / fs, "p": q} for first, stop, q in stuck],
+            "glitches": len(spikes),
+            "glitch_times_s": [t / fs for t in spikes[:20]],
+            "glitch_sizes": sizes[:20],
+            "samples": len(samples),
+        }
+        statistic, value = (
+            ("stuck_run", float(max(r[1] - r[0] for r in runs)))
+            if p_stuck <= p_glitch
+            else ("additive_outlier_z", largest)
+        )
+        out.append(Finding("sensor_fault", (name,), statistic, value, p, params, payload=tuple(samples)))
     return out
 
 

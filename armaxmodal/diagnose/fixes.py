@@ -37,6 +37,8 @@ def add_effect(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelS
         return replace(spec, orders=(na + 2, nb + 2, nc + 2, nk))
     if finding.effect == "clipping":
         return replace(spec, clipped=tuple(sorted(set(spec.clipped) | set(finding.channels))))
+    if finding.effect == "sensor_fault":
+        return replace(spec, faults=spec.faults + ((finding.channels[0], tuple(finding.payload)),))
     if finding.effect == "stiffness_nonlinearity":
         name = f"{finding.parameters['term']}:{'-'.join(finding.parameters['between'])}#{len(spec.terms) + 1}"
         fitted.signals.extra[name] = finding.payload

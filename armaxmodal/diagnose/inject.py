@@ -15,7 +15,7 @@ from .model import fractional_shift
 
 __all__ = ["inject", "INJECTABLE"]
 
-INJECTABLE = ("input_delay", "offset_drift", "periodic_disturbance", "coloured_noise", "clipping")
+INJECTABLE = ("input_delay", "offset_drift", "periodic_disturbance", "coloured_noise", "clipping", "sensor_fault")
 #: Each effect's parameters: required, then optional.
 PARAMETERS = {
     "input_delay": (("samples",), ()),
@@ -23,6 +23,7 @@ PARAMETERS = {
     "periodic_disturbance": (("freq_hz", "amp"), ()),
     "coloured_noise": (("level",), ("pole", "freq_hz")),
     "clipping": (("fraction",), ()),
+    "sensor_fault": ((), ("spikes", "spike_size", "stuck_s")),
 }
 
 
@@ -43,6 +44,14 @@ def check_effect(effect: str, params: dict) -> None:
         raise DataError(f"effect {effect!r}: parameters must be finite numbers, got {params}.")
     if effect == "clipping" and not 0 < float(params["fraction"]) <= 1:
         raise DataError(f"effect 'clipping': fraction must be in (0, 1] (1 clips nothing), got {params['fraction']}.")
+    if effect == "sensor_fault" and not (
+        int(params.get("spikes", 0)) == params.get("spikes", 0) >= 0 <= params.get("stuck_s", 0)
+        and params.get("spikes", 0) + params.get("stuck_s", 0) > 0
+    ):
+        raise DataError(
+            f"effect 'sensor_fault': give spikes (a whole number >= 0) and/or stuck_s (seconds >= 0), "
+            f"not both zero; got {params}."
+        )
 
 
 def _channel(rec: Recording, name: str) -> int | None:
@@ -68,7 +77,10 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, **pa
         ``"coloured_noise"`` (``level`` as a fraction of RMS; AR(1) ``pole``, or with
         ``freq_hz`` an AR(2) resonance of radius ``pole`` there),
         ``"clipping"`` (``fraction``: both rails at this fraction of the channel's largest
-        excursion from its median; 1 clips nothing).
+        excursion from its median; 1 clips nothing),
+        ``"sensor_fault"`` (``spikes`` single-sample glitches of ``spike_size`` (default 8)
+        times the channel's RMS, random sign, at random samples; ``stuck_s`` seconds from 40 %
+        of the record on which the channel repeats its last value).
     channels : sequence of str, optional
         Where: default every output (an input delay: the input).
     seed : int
@@ -93,6 +105,11 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, **pa
             x[:] = fractional_shift(x, -float(params["samples"]))
         elif effect == "offset_drift":
             x += float(params.get("offset", 0.0)) + float(params.get("drift_per_s", 0.0)) * (t - t.mean())
+        elif effect == "sensor_fault":
+            at = rng.choice(np.arange(10, t.size - 10), int(params.get("spikes", 0)), replace=False)
+            x[at] += float(params.get("spike_size", 8.0)) * rms * rng.choice([-1.0, 1.0], at.size)
+            first, held = int(0.4 * t.size), int(round(float(params.get("stuck_s", 0.0)) * recording.fs))
+            x[first + 1 : first + 1 + held] = x[first]
         elif effect == "clipping":
             mid = float(np.median(x))
             rail = float(params["fraction"]) * float(np.max(np.abs(x - mid)))

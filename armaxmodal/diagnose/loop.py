@@ -51,6 +51,7 @@ TESTED_EFFECTS = EFFECT_TESTS
 #: Linear/structural effects first: a wrong linear part fires every later test.
 _TIER = {
     "clipping": 0,
+    "sensor_fault": 0,
     "input_delay": 0,
     "unmodelled_mode": 1,
     "offset_drift": 1,
@@ -382,12 +383,22 @@ def _try_fix(stage: Stage, finding: Finding, alpha: float):
             return None, f"moving the channel raised the held-out error from {before:.4g} to {after:.4g}"
         note = "the model's B taps absorb part of a delay, so the error changes little; named from the phase slope"
         return (Effect(finding, params, before, after, p, dbic, note), new), ""
-    if finding.effect == "clipping":
-        # a pile-up at the rail is a fact of the record, not a hypothesis the error must confirm;
+    if finding.effect == "sensor_fault" and finding.statistic == "additive_outlier_z":
+        # a glitch is a hypothesis (a heavy-tailed disturbance looks alike): the error must drop
+        if p >= alpha:
+            return None, (
+                f"named by its test, but filling the samples did not lower the held-out error significantly "
+                f"({before:.4g} -> {after:.4g}, p = {p:.2g})"
+            )
+        note = "the spoiled samples are filled from the model and left out of every error"
+        return (Effect(finding, params, before, after, p, dbic, note), new), ""
+    if finding.effect in ("clipping", "sensor_fault"):
+        # a pile-up at the rail or a stuck run is a fact of the record, not a hypothesis;
         # a few clipped samples barely move the error on the others, so the fix only must not hurt
         if after > before * 1.01:
-            return None, f"filling the clipped samples raised the held-out error from {before:.4g} to {after:.4g}"
-        note = "the clipped samples are filled from the model and left out of every error"
+            return None, f"filling the samples raised the held-out error from {before:.4g} to {after:.4g}"
+        kind = "clipped" if finding.effect == "clipping" else "stuck"
+        note = f"the {kind} samples are filled from the model and left out of every error"
         return (Effect(finding, params, before, after, p, dbic, note), new), ""
     if p >= alpha or dbic >= 0:
         return None, (

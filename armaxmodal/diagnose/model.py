@@ -9,8 +9,9 @@ An effect is added without touching the numba fitter:
   ARMAX fitted to ``y - phi theta``, ``theta`` again from the simulation residual, three
   passes (see :func:`_disturbance_ls` for why not GLS);
 * a richer noise model raises ``nc``;
-* a clipped output's samples at its rail are filled from the model's response and refitted
-  (a few passes) and left out of every error (:mod:`.clipping`).
+* a clipped output's samples at its rail, and a faulty sensor's stuck or glitched samples,
+  are treated as missing: filled by the model's one-step prediction and refitted (a few
+  passes), and left out of every error (:mod:`.clipping`, :mod:`.faults`).
 
 Held-out errors (see :func:`held_out`) come from two blocked folds: a model fitted on one half
 of the record predicts the other half. Its one-step predictions there use the measured past,
@@ -78,6 +79,8 @@ class ModelSpec:
         response): each enters through the dynamics like the base input, ``B_m / A``.
     clipped : tuple of str
         Clipped outputs.
+    faults : tuple of (str, tuple of int)
+        Outputs with stuck or glitched samples, and those samples.
     """
 
     orders: tuple[int, int, int, int]
@@ -88,6 +91,8 @@ class ModelSpec:
     terms: tuple[str, ...] = ()
     #: Outputs whose samples at a rail are filled from the model and left out of errors.
     clipped: tuple[str, ...] = ()
+    #: (output, sample indices) a sensor fault spoiled: filled and left out likewise.
+    faults: tuple[tuple[str, tuple[int, ...]], ...] = ()
 
     @property
     def n_disturbance(self) -> int:
@@ -229,33 +234,40 @@ def fit_model(
 ) -> FittedModel:
     """Fit ``spec`` on ``window`` (default: the whole record) of ``signals`` (unshifted).
 
-    Clipped outputs: fit, fill the rail samples with the fitted response (moved back by the
-    channel's shift, as the fill applies to the recorded signal), refit; ``IMPUTE_PASSES``
-    times. The model's :attr:`FittedModel.signals` hold the filled record, ``raw`` the recorded.
+    Missing samples (clipped outputs' rails, a fault's samples): fit, fill them with the
+    fitted one-step prediction (in the channel's shifted frame, moved back, as the fill
+    applies to the recorded signal), refit; ``IMPUTE_PASSES`` times. The model's
+    :attr:`FittedModel.signals` hold the filled record, ``raw`` the recorded.
     """
-    masks = clip_masks(spec, signals)
+    rails = clip_masks(spec, signals)
+    missing = {k: m.copy() for k, m in rails.items()}
+    for name, samples in spec.faults:
+        k = signals.sensors.index(name)
+        missing.setdefault(k, np.zeros(signals.n, bool))[list(samples)] = True
     model = _fit_once(spec, signals, window, start)
-    if not masks:
+    if not missing:
         return model
     for _ in range(IMPUTE_PASSES):
-        model = _fit_once(spec, _filled(model, signals, masks), window, model)
-    excluded = _excluded(signals, spec, masks, model.simulated() + model.disturbance())
+        model = _fit_once(spec, _filled(model, signals, missing), window, model)
+    excluded = _excluded(signals, spec, rails, model.simulated() + model.disturbance())
+    for m in missing.values():
+        excluded |= m
     return replace(model, raw=signals, excluded=excluded)
 
 
 def _filled(model: FittedModel, signals: Signals, masks: dict) -> Signals:
-    """``signals`` with each clipped channel's rail samples filled by ``model``'s one-step
+    """``signals`` with each channel's missing samples filled by ``model``'s one-step
     prediction (:func:`~.clipping.fill_by_prediction`) in the model's (shifted) time frame,
     then moved back to the recorded frame."""
     y = signals.y.copy()
     shifts = dict(model.spec.shifts)
     s = model.signals
     u, dist = s.inputs(model.spec), model.disturbance()
-    for k, rail in masks.items():
+    for k, gone in masks.items():
         shift = shifts.get(signals.sensors[k], 0.0)
-        missing = fractional_shift(rail.astype(float), shift) > 0.5 if shift else rail
+        missing = fractional_shift(gone.astype(float), shift) > 0.5 if shift else gone
         filled = fill_by_prediction(s.y[:, k] - dist[:, k], u, model.fit.models[k], missing) + dist[:, k]
-        y[rail, k] = (fractional_shift(filled, -shift) if shift else filled)[rail]
+        y[gone, k] = (fractional_shift(filled, -shift) if shift else filled)[gone]
     return replace(signals, y=y)
 
 

@@ -1,0 +1,90 @@
+"""Sensor faults: a channel stuck on one value, and isolated glitches (additive outliers).
+
+* **Stuck.** A live sensor does not repeat its last value for long. With ``r`` the channel's
+  own rate of repeating the previous sample (outside the run tested, so a coarse quantiser on
+  a slow signal is allowed its repeats), a run of ``L`` equal samples somewhere in ``n`` has
+  probability at most ``n r^(L-1)``. Runs at the channel's extremes are clipping's
+  (:mod:`.clipping`), not tested here.
+* **Glitch.** A sample off by ``w`` (a spike, a dropped sample read as zero) leaves the
+  one-step residual ``w pi`` from there on, ``pi`` the impulse response of ``A / C``. The
+  additive-outlier statistic of Chang, Tiao & Chen (1988) is that pattern's matched filter,
+  ``lambda(t) = sum_j pi_j e(t + j) / (sigma |pi|)``, about N(0, 1) without a glitch
+  (``sigma`` from the residual's median absolute deviation, robust to the glitches
+  themselves). Glitches are taken one at a time, largest first, each one's pattern removed
+  before the next (so a glitch's neighbours are not counted again), while ``|lambda|``
+  passes the Bonferroni bound over the samples.
+
+Both kinds are fixed as clipping is: the samples are treated as missing, filled by the
+model's one-step prediction and left out of every error.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.signal import fftconvolve, lfilter
+from scipy.special import ndtr, ndtri
+
+__all__ = ["stuck_runs", "glitches", "glitch_p", "FAULT_ALPHA"]
+
+#: Uncorrected level at which a run or a glitch enters a fault's mask.
+FAULT_ALPHA = 1e-3
+#: Shortest run tested (two equal samples in a row happen on any quantised channel).
+STUCK_MIN_RUN = 3
+#: Most glitches taken from one channel (a channel with more is broken, not glitching).
+MAX_GLITCHES = 200
+#: Share of the impulse response's energy kept in the matched filter.
+PI_ENERGY = 0.999
+
+
+def stuck_runs(x: np.ndarray) -> list[tuple[int, int, float]]:
+    """Runs of ``STUCK_MIN_RUN`` or more equal samples away from the extremes:
+    ``(first, stop, p)`` each, ``x[first:stop]`` equal, ``p = min(1, n r^(L-1))``."""
+    n = x.size
+    same = np.concatenate([[False], x[1:] == x[:-1]])
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], same.astype(np.int8), [0]])))
+    repeats = int(same.sum())
+    out = []
+    for start, stop in zip(edges[::2], edges[1::2], strict=True):
+        first, length = start - 1, stop - start + 1  # the run's first sample is not a repeat
+        if length < STUCK_MIN_RUN or x[first] in (x.max(), x.min()):
+            continue
+        rate = (repeats - (length - 1) + 1) / (n + 1)
+        out.append((int(first), int(stop), float(min(1.0, n * rate ** (length - 1)))))
+    return out
+
+
+def _matched_filter(model) -> np.ndarray:
+    """``pi``: the impulse response of ``A / C``, cut where it holds PI_ENERGY of its energy."""
+    pi = lfilter(model.a, model.c, np.r_[1.0, np.zeros(511)])
+    keep = int(np.searchsorted(np.cumsum(pi**2) / np.sum(pi**2), PI_ENERGY)) + 1
+    return pi[:keep]
+
+
+def glitches(eps: np.ndarray, model, mask: np.ndarray, alpha: float = FAULT_ALPHA):
+    """Additive outliers in one channel's one-step residual ``eps`` (n,), counted where
+    ``mask``: ``(samples, sizes, largest |lambda|)``; sizes in the channel's units."""
+    pi = _matched_filter(model)
+    e = np.where(mask, eps, 0.0)
+    sigma = 1.4826 * float(np.median(np.abs(eps[mask] - np.median(eps[mask]))))
+    norm = float(np.sqrt(pi @ pi))
+    n = int(mask.sum())
+    bound = float(ndtri(1 - alpha / (2 * n)))
+    found, sizes, largest = [], [], 0.0
+    for _ in range(MAX_GLITCHES):
+        lam = fftconvolve(e, pi[::-1], mode="full")[pi.size - 1 :] / (sigma * norm)
+        lam[~mask] = 0.0
+        t0 = int(np.argmax(np.abs(lam)))
+        largest = max(largest, abs(float(lam[t0])))
+        if abs(lam[t0]) < bound:
+            break
+        w = lam[t0] * sigma / norm  # least-squares size of the glitch
+        stop = min(e.size, t0 + pi.size)
+        e[t0:stop] -= w * pi[: stop - t0]
+        found.append(t0)
+        sizes.append(float(w))
+    return found, sizes, largest
+
+
+def glitch_p(largest: float, n: int) -> float:
+    """Bonferroni p of the largest ``|lambda|`` over ``n`` samples."""
+    return float(min(1.0, 2 * n * ndtr(-largest)))
