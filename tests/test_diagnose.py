@@ -424,3 +424,16 @@ def test_glitches_and_a_stuck_sensor_are_named_filled_and_back_to_the_clean_erro
     assert run["duration_s"] == pytest.approx(1.0 + 1 / clean.fs, abs=1e-9)  # the last live sample and 60 repeats
     assert effect.error_after == pytest.approx(clean_error, rel=0.03)
     assert [e.finding.effect for e in d.effects] == ["sensor_fault"]
+
+
+def test_outliers_where_the_input_is_strongest_are_not_a_sensor_fault(clean):
+    """Glitches fall anywhere; outliers gathered in the strong part of a ride are the model's."""
+    from armaxmodal.diagnose.faults import follows_excitation
+
+    u = clean.base * np.where(np.arange(clean.n_samples) < 3600, 1.0, 3.0)  # a strong second half
+    rng = np.random.default_rng(2)
+    anywhere = sorted(rng.choice(clean.n_samples, 30, replace=False))
+    strong = sorted(rng.choice(np.arange(3700, clean.n_samples), 30, replace=False))
+    assert follows_excitation(anywhere, u, clean.fs) > 0.01
+    assert follows_excitation(strong, u, clean.fs) < 1e-3
+    assert follows_excitation(strong[:2], u, clean.fs) == 1.0  # too few to judge

@@ -21,7 +21,7 @@ from scipy.signal import lfilter
 from ..quality import MIN_DELAY_SAMPLES, estimate_delays
 from ..recording import Recording
 from .clipping import rail_pileup
-from .faults import FAULT_ALPHA, glitch_p, glitches, stuck_runs
+from .faults import FAULT_ALPHA, FOLLOWS_ALPHA, follows_excitation, glitch_p, glitches, stuck_runs
 from .missing_mode import mode_findings
 from .model import LINE_MERGE_HZ, UNDAMPED, FittedModel, counted, usable
 from .model import lagged as _lag
@@ -196,6 +196,9 @@ def _fault_findings(fitted: FittedModel, eps: np.ndarray, mask: np.ndarray, n_te
         spikes, sizes, largest = glitches(eps[:, k], fitted.fit.models[k], mask)
         lag = int(round(shifts.get(name, 0.0)))  # the residual is in the channel's shifted frame
         spikes = [t + lag for t in spikes if 0 <= t + lag < raw.n]
+        p_follow = follows_excitation(spikes, raw.u, fs)
+        if p_follow < FOLLOWS_ALPHA:  # outliers of strong motion: the model's error, not the sensor's
+            spikes, sizes, largest = [], [], 0.0
         p_stuck = min((r[2] for r in runs), default=1.0)
         p_glitch = glitch_p(largest, int(mask.sum()))
         p = min(1.0, min(p_stuck, p_glitch) * n_tests)
@@ -210,7 +213,7 @@ def _fault_findings(fitted: FittedModel, eps: np.ndarray, mask: np.ndarray, n_te
         }
         statistic, value = (
             ("stuck_run", float(max(r[1] - r[0] for r in runs)))
-            if p_stuck <= p_glitch
+            if runs and p_stuck <= p_glitch
             else ("additive_outlier_z", largest)
         )
         out.append(Finding("sensor_fault", (name,), statistic, value, p, params, payload=tuple(samples)))
