@@ -375,9 +375,24 @@ def test_clipping_near_its_threshold_and_on_the_input(clean):
     (f,) = clipping(with_head(_clip_top(clean.response[:, 0], 12)))
     assert f.channels == ("head",) and f.parameters["samples"] == 12
     d = _run(inject(clean, "clipping", ["base"], fraction=0.7))
-    assert "clipping" not in {e.finding.effect for e in d.effects}
+    # nothing named: the outputs' outliers where the clipped input reaches them are not faults
+    assert d.effects == ()
     (u,) = [u for u in d.unconfirmed if u["effect"] == "clipping"]
     assert u["channels"] == ["base"] and "input clipped" in u["reason"]
+
+
+def test_input_rail_reach_spans_b_and_the_predictor_memory():
+    """A clipped input sample at s spoils the output from s + nk to s + nk + nb + len(pi) - 2
+    (white noise model: pi = 1), in the output's own shifted frame."""
+    from armaxmodal.armax import ArmaxModel
+    from armaxmodal.diagnose.faults import input_rail_reach
+
+    u = np.sin(np.arange(400) / 7.0)
+    model = ArmaxModel(np.array([1.0]), np.ones((1, 3)), np.array([1.0]), 2, 100.0)
+    assert not input_rail_reach(u, model).any()
+    u[100:112] = u.max() + 1.0  # twelve samples piled at a rail
+    assert np.flatnonzero(input_rail_reach(u, model)).tolist() == list(range(102, 116))
+    assert np.flatnonzero(input_rail_reach(u, model, lag=5)).tolist() == list(range(97, 111))
 
 
 def test_stuck_runs_and_glitches_against_planted_ones():

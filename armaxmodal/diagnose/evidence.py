@@ -21,7 +21,7 @@ from scipy.signal import lfilter
 from ..quality import MIN_DELAY_SAMPLES, estimate_delays
 from ..recording import Recording
 from .clipping import rail_pileup
-from .faults import FAULT_ALPHA, FOLLOWS_ALPHA, follows_excitation, glitch_p, glitches, stuck_runs
+from .faults import FAULT_ALPHA, FOLLOWS_ALPHA, follows_excitation, glitch_p, glitches, input_rail_reach, stuck_runs
 from .missing_mode import mode_findings
 from .model import LINE_MERGE_HZ, UNDAMPED, FittedModel, counted, usable
 from .model import lagged as _lag
@@ -193,8 +193,9 @@ def _fault_findings(fitted: FittedModel, eps: np.ndarray, mask: np.ndarray, n_te
     out = []
     for k, name in enumerate(raw.sensors):
         runs = [r for r in stuck_runs(raw.y[:, k]) if r[0] + 1 not in known.get(name, ())]
-        spikes, sizes, largest = glitches(eps[:, k], fitted.fit.models[k], mask)
         lag = int(round(shifts.get(name, 0.0)))  # the residual is in the channel's shifted frame
+        model = fitted.fit.models[k]
+        spikes, sizes, largest = glitches(eps[:, k], model, mask & ~input_rail_reach(raw.u, model, lag))
         spikes = [t + lag for t in spikes if 0 <= t + lag < raw.n]
         p_follow = follows_excitation(spikes, raw.u, fs)
         if p_follow < FOLLOWS_ALPHA:  # outliers of strong motion: the model's error, not the sensor's

@@ -18,7 +18,8 @@ A glitch is the sensor's, not the record's: it falls anywhere, whatever the base
 Outliers that gather where the input is strongest are the model's error under strong motion
 (a shake-table IMU's residual during an earthquake's strong phase matched the pattern 200
 times), so a set of glitches whose local input level ranks high (a one-sided test of the
-mean rank, ``FOLLOWS_ALPHA``) is not named.
+mean rank, ``FOLLOWS_ALPHA``) is not named, nor is a glitch a clipped input sample can reach
+(the input is named instead).
 
 Both kinds are fixed as clipping is: the samples are treated as missing, filled by the
 model's one-step prediction and left out of every error.
@@ -30,7 +31,9 @@ import numpy as np
 from scipy.signal import fftconvolve, lfilter
 from scipy.special import ndtr, ndtri
 
-__all__ = ["stuck_runs", "glitches", "glitch_p", "follows_excitation", "FAULT_ALPHA"]
+from .clipping import clipped_mask
+
+__all__ = ["stuck_runs", "glitches", "glitch_p", "follows_excitation", "input_rail_reach", "FAULT_ALPHA"]
 
 #: Uncorrected level at which a run or a glitch enters a fault's mask.
 FAULT_ALPHA = 1e-3
@@ -109,3 +112,19 @@ def follows_excitation(samples: list[int], u: np.ndarray, fs: float) -> float:
     ranks = (np.argsort(np.argsort(level)) + 0.5) / level.size
     z = (float(np.mean(ranks[samples])) - 0.5) / np.sqrt(1 / (12 * len(samples)))
     return float(ndtr(-z))
+
+
+def input_rail_reach(u: np.ndarray, model, lag: int = 0) -> np.ndarray:
+    """Samples of an output (n,) bool that a clipped input sample can spoil: an input held at
+    its rail while the base moved on spoils the output from ``nk`` to ``nk + nb`` samples later,
+    and the predictor carries that on for the length of ``A / C``'s impulse response. Residual
+    outliers there are the input's clipping (named on the input), not a fault of the sensor.
+    ``lag``: the output's shift, samples (its residual is in the shifted frame)."""
+    u = np.asarray(u, float).reshape(len(u), -1)[:, 0]
+    rails = np.flatnonzero(clipped_mask(u))
+    reach = np.zeros(u.size + 1, int)
+    first = rails + model.nk - lag
+    stop = first + model.b.shape[1] + _matched_filter(model).size - 1  # B's taps, then pi's
+    np.add.at(reach, np.clip(first, 0, u.size), 1)
+    np.add.at(reach, np.clip(stop, 0, u.size), -1)
+    return np.cumsum(reach)[:-1] > 0

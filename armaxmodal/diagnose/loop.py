@@ -322,7 +322,7 @@ def diagnose(
     spec = ModelSpec(tuple(int(v) for v in orders))
     model = fit_model(spec, signals)
     stage = first = Stage(model, held_out(spec, signals, model))
-    effects, unconfirmed, tests = [], [], {}
+    effects, unconfirmed, tests = [], {}, {}
     for round_no in range(int(max_rounds)):
         findings, tests = run_tests(stage.model, alpha)
         findings.sort(key=lambda f: (_tier(f), f.p, -f.value))
@@ -332,12 +332,15 @@ def diagnose(
             step, reason = _try_fix(stage, finding, alpha)
             if step is not None:
                 break
-            unconfirmed.append({"effect": finding.effect, "channels": list(finding.channels), "reason": reason,
-                                "evidence": finding.evidence()})  # fmt: skip
+            # one entry per effect and channels, from the latest round that tried it
+            unconfirmed[(finding.effect, finding.channels)] = {
+                "effect": finding.effect, "channels": list(finding.channels), "reason": reason,
+                "evidence": finding.evidence()}  # fmt: skip
         if step is None:
             break
         effect, stage = step
         effects.append(effect)
+        unconfirmed.pop((effect.finding.effect, effect.finding.channels), None)
         if isinstance(stage.model, PiecewiseModel):
             break  # the tests assume one model; a record split in two is reported as it is
     if effects:
@@ -345,7 +348,8 @@ def diagnose(
     clean = Signals(signals.u, signals.y - stage.model.disturbance(), signals.fs, signals.sensors, signals.input_name)
     floor = _noise_floor(clean, usable(signals.n, spec))
     tests["cross_correlation"] = cross_correlation(stage.model)
-    return Diagnosis(first, stage, tuple(effects), tuple(unconfirmed), floor, rec, recording.fs, warnings, tests)
+    unsure = tuple(unconfirmed.values())
+    return Diagnosis(first, stage, tuple(effects), unsure, floor, rec, recording.fs, warnings, tests)
 
 
 def _try_fix(stage: Stage, finding: Finding, alpha: float):
