@@ -29,6 +29,12 @@ PLANTED = {
     "drift near threshold": ("offset_drift", ["chest"], {"offset": 0.0, "drift_per_s": 0.0003}),
     "sensor late 2.4 samples": ("input_delay", ["legs"], {"samples": 2.4}),
     "sensor late 1 sample": ("input_delay", ["legs"], {"samples": 1.0}),
+    "clipping clear": ("clipping", ["chest"], {"fraction": 0.6}),
+    "clipping near threshold": ("clipping", ["chest"], {"fraction": 0.9}),
+    "glitches clear": ("sensor_fault", ["pelvis"], {"spikes": 10}),
+    "glitches near threshold": ("sensor_fault", ["pelvis"], {"spikes": 5, "spike_size": 0.3}),
+    "stuck clear": ("sensor_fault", ["pelvis"], {"stuck_s": 1.0}),
+    "stuck near threshold": ("sensor_fault", ["pelvis"], {"stuck_s": 0.05}),
 }
 
 
@@ -43,6 +49,7 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--planted", action="store_true", help="also run the planted effects (supine)")
     parser.add_argument("--planted-only", action="store_true", help="only the planted effects")
+    parser.add_argument("--only", default="", help="planted cases whose label contains this text")
     args = parser.parse_args()
     for system in () if args.planted_only else SYSTEMS:
         alarms, t0 = [], time.perf_counter()
@@ -55,9 +62,11 @@ def main() -> None:
     if not (args.planted or args.planted_only):
         return
     for label, (effect, channels, params) in PLANTED.items():
+        if args.only not in label:
+            continue
         hits = 0
         for seed in range(args.seeds):
-            d = diagnose(inject(ride("supine 60 Hz", seed), effect, channels, **params))
+            d = diagnose(inject(ride("supine 60 Hz", seed), effect, channels, seed=seed, **params))
             first = d.effects[0].finding if d.effects else None
             hits += first is not None and first.effect == effect and channels[0] in first.channels
         print(f"{label}: named first {hits}/{args.seeds}", flush=True)
