@@ -246,6 +246,9 @@ def _diagnosis_text(name: str, report: dict) -> str:
     lines = [f"{name}: {len(sensors)} sensors at {report['analysis_fs']:g} Hz; baseline orders {report['orders']}"]
     lines.append(f"{'sensor':>12} {'fit before %':>13} {'fit after %':>12} {'resid RMS':>10} {'H1 floor':>12}")
     for k, s in enumerate(sensors):
+        if final["fit_val_pct"][k] is None:
+            lines.append(f"{s:>12} {base['fit_val_pct'][k]:13.1f}   now an input (a second excitation)")
+            continue
         lines.append(
             f"{s:>12} {base['fit_val_pct'][k]:13.1f} {final['fit_val_pct'][k]:12.1f} "
             f"{final['sim_resid_rms'][k]:10.4g} {final['noise_floor_rms'][k]:12.4g}"
@@ -263,7 +266,8 @@ def _diagnosis_text(name: str, report: dict) -> str:
             lines.append(f"  note: {e['note']}")
     for u in report["unconfirmed"]:
         lines.append(f"unconfirmed {u['effect']} on {', '.join(u['channels'])}: {u['reason']}")
-    lines.append("not tested by this version: " + ", ".join(report["not_tested"]))
+    if report["not_tested"]:
+        lines.append("not tested by this version: " + ", ".join(report["not_tested"]))
     lines.append("verdict: " + report["verdict"])
     return "\n".join(lines)
 
@@ -463,7 +467,7 @@ def _cmd_simulate(args) -> int:
     for effect, channels, params in effects:
         from .diagnose.inject import inject
 
-        rec = inject(rec, effect, channels, seed=args.seed, **params)
+        rec = inject(rec, effect, channels, seed=args.seed, structure=structure, **params)
     write_recording_csv(rec, args.out)
     if not args.quiet:
         print(f"wrote {args.out}: {rec.n_samples} samples, outputs {', '.join(rec.sensors)}")

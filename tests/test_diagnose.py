@@ -452,3 +452,86 @@ def test_outliers_where_the_input_is_strongest_are_not_a_sensor_fault(clean):
     assert follows_excitation(anywhere, u, clean.fs) > 0.01
     assert follows_excitation(strong, u, clean.fs) < 1e-3
     assert follows_excitation(strong[:2], u, clean.fs) == 1.0  # too few to judge
+
+
+def _with_force(clean, level, at="chest"):
+    return inject(clean, "second_input", [at], seed=3, structure=am.supine_human(), level=level)
+
+
+def test_a_second_input_is_named_taken_out_of_the_outputs_and_its_share_measured(clean):
+    """A force on chest's mass from its own random source, recorded as a column 'force' that
+    nothing declares an input: named first, moved to the inputs, every output's held-out error
+    back to the clean ride's, and chest's share of the force response the planted one."""
+    rec = _with_force(clean, 0.3)
+    assert rec.sensors == (*clean.sensors, "force")
+    d = _run(rec)
+    effect = _first(d)
+    assert effect.finding.effect == "second_input" and effect.finding.channels == ("force",)
+    assert set(effect.parameters["explains"]) == set(clean.sensors) and effect.parameters["base_coherence"] < 0.2
+    planted = 0.3 * np.std(clean.response[:, 1]) / np.std(rec.response[:, 1])
+    assert effect.parameters["rms_share_of_output"]["chest"] == pytest.approx(planted, rel=0.02)
+    held = _run(clean).final.held
+    clean_error = float(np.sqrt(np.mean(held.one_step[held.mask] ** 2)))
+    assert effect.error_before > 2 * clean_error and effect.error_after == pytest.approx(clean_error, rel=0.02)
+    js = d.to_dict()
+    assert js["final"]["inputs_added"] == ["force"] and js["final"]["fit_val_pct"][4] is None
+    assert js["baseline"]["fit_val_pct"][1] < 75 < 94 < js["final"]["fit_val_pct"][1]
+    assert json.loads(json.dumps(js, allow_nan=False)) == js
+
+
+def test_a_second_input_near_its_threshold_and_an_unrelated_channel(clean):
+    """0.5 % of chest's RMS is named (the force is recorded without noise), 0.2 % is not; a
+    recorded channel that is random but acts on nothing is not an input."""
+    from dataclasses import replace
+
+    (weak,) = _run(_with_force(clean, 0.005)).effects
+    assert weak.finding.effect == "second_input" and weak.error_after < weak.error_before
+    assert "second_input" not in {e.finding.effect for e in _run(_with_force(clean, 0.002)).effects}
+    spare = am.random_vibration(clean.fs, clean.n_samples / clean.fs, seed=99)
+    rec = replace(clean, response=np.column_stack([clean.response, spare]), sensors=(*clean.sensors, "spare"))
+    d = _run(rec)
+    assert d.tests["base_coherence"][4] < 0.1 < 0.5 < min(d.tests["base_coherence"][:4])
+    assert "second_input" not in {e.finding.effect for e in d.effects} | {u["effect"] for u in d.unconfirmed}
+
+
+def test_a_second_input_on_another_structure_and_rate():
+    """The Chapter 2 system at 100 Hz, a force on its last mass at 10 %: named first (orders by
+    BIC), the error lower after."""
+    system = am.chapter2_system()
+    u = am.random_vibration(100.0, 60.0, band=(0.5, 40.0), seed=4)
+    rec = am.simulate_recording(system, u, 100.0, noise=0.05, seed=4)
+    forced = inject(rec, "second_input", ["m4"], seed=1, structure=system, level=0.1)
+    effect = _first(diagnose(forced))
+    assert effect.finding.effect == "second_input" and effect.finding.channels == ("force",)
+    assert effect.error_after < 0.8 * effect.error_before
+
+
+def test_widened_start_predicts_as_the_model_it_widens(clean):
+    """A start for a spec with a new input is the old model with zero B for it: the same
+    one-step errors, without the output that became an input."""
+    from armaxmodal.diagnose.model import ModelSpec, Signals, fit_model, widened_start
+
+    rec = _with_force(clean, 0.3)
+    signals = Signals(rec.base, rec.response, rec.fs, rec.sensors, rec.input_name)
+    model = fit_model(ModelSpec(ORDERS), signals)
+    spec = ModelSpec(ORDERS, terms=("force",), inputs_from=("force",))
+    start = widened_start(model, spec)
+    u = np.column_stack([rec.base, rec.response[:, 4]])
+    for k in range(4):
+        np.testing.assert_allclose(
+            start.fit.models[k].prediction_errors(rec.response[:, k], u),
+            model.fit.models[k].prediction_errors(rec.response[:, k], rec.base[:, None]),
+            rtol=1e-12,
+            atol=1e-12,
+        )
+    assert len(start.fit.models) == 4 and start.spec == spec
+    assert widened_start(model, ModelSpec((12, 16, 10, -5), terms=("force",))) is None
+
+
+def test_second_input_injection_refuses_what_it_cannot_plant(clean):
+    with pytest.raises(DataError, match="structure"):
+        inject(clean, "second_input", ["chest"], level=0.1)
+    with pytest.raises(DataError, match="not on the input"):
+        inject(clean, "second_input", ["base"], structure=am.supine_human(), level=0.1)
+    with pytest.raises(DataError, match="level must be > 0"):
+        inject(clean, "second_input", ["chest"], structure=am.supine_human(), level=-1)

@@ -39,6 +39,9 @@ def add_effect(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelS
         return replace(spec, clipped=tuple(sorted(set(spec.clipped) | set(finding.channels))))
     if finding.effect == "sensor_fault":
         return replace(spec, faults=spec.faults + ((finding.channels[0], tuple(finding.payload)),))
+    if finding.effect == "second_input":
+        name = finding.channels[0]
+        return replace(spec, terms=spec.terms + (name,), inputs_from=spec.inputs_from + (name,))
     if finding.effect == "stiffness_nonlinearity":
         name = f"{finding.parameters['term']}:{'-'.join(finding.parameters['between'])}#{len(spec.terms) + 1}"
         fitted.signals.extra[name] = finding.payload
@@ -111,6 +114,16 @@ def effect_parameters(finding: Finding, fitted) -> dict:
             name: float(np.std(fitted.fit.models[k].simulate(u)) / np.std(s.y[:, k]))
             for k, name in enumerate(s.sensors)
             if name in finding.channels
+        }
+        return {**finding.parameters, "rms_share_of_output": share}
+    if finding.effect == "second_input":
+        # each explained channel's share of the response to the new input
+        u = np.zeros((s.n, 1 + len(spec.terms)))
+        u[:, 1 + spec.terms.index(finding.channels[0])] = s.extra[finding.channels[0]]
+        share = {
+            name: float(np.std(fitted.fit.models[k].simulate(u)) / np.std(s.y[:, k]))
+            for k, name in enumerate(s.sensors)
+            if name in finding.parameters["explains"]
         }
         return {**finding.parameters, "rms_share_of_output": share}
     if finding.effect == "unmodelled_mode":

@@ -13,9 +13,17 @@ from ..exceptions import DataError
 from ..recording import Recording
 from .model import fractional_shift
 
-__all__ = ["inject", "INJECTABLE"]
+__all__ = ["inject", "INJECTABLE", "add_second_input"]
 
-INJECTABLE = ("input_delay", "offset_drift", "periodic_disturbance", "coloured_noise", "clipping", "sensor_fault")
+INJECTABLE = (
+    "input_delay",
+    "offset_drift",
+    "periodic_disturbance",
+    "coloured_noise",
+    "clipping",
+    "sensor_fault",
+    "second_input",
+)
 #: Each effect's parameters: required, then optional.
 PARAMETERS = {
     "input_delay": (("samples",), ()),
@@ -24,6 +32,7 @@ PARAMETERS = {
     "coloured_noise": (("level",), ("pole", "freq_hz")),
     "clipping": (("fraction",), ()),
     "sensor_fault": ((), ("spikes", "spike_size", "stuck_s")),
+    "second_input": (("level",), ()),
 }
 
 
@@ -42,6 +51,8 @@ def check_effect(effect: str, params: dict) -> None:
         )
     if any(not np.isfinite(float(v)) for v in params.values()):
         raise DataError(f"effect {effect!r}: parameters must be finite numbers, got {params}.")
+    if effect == "second_input" and not float(params["level"]) > 0:
+        raise DataError(f"effect 'second_input': level must be > 0, got {params['level']}.")
     if effect == "clipping" and not 0 < float(params["fraction"]) <= 1:
         raise DataError(f"effect 'clipping': fraction must be in (0, 1] (1 clips nothing), got {params['fraction']}.")
     if effect == "sensor_fault" and not (
@@ -63,7 +74,7 @@ def _channel(rec: Recording, name: str) -> int | None:
     return rec.sensors.index(name)
 
 
-def inject(recording: Recording, effect: str, channels=None, seed: int = 0, **params) -> Recording:
+def inject(recording: Recording, effect: str, channels=None, seed: int = 0, structure=None, **params) -> Recording:
     """A copy of ``recording`` with one effect planted.
 
     Parameters
@@ -80,11 +91,15 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, **pa
         excursion from its median; 1 clips nothing),
         ``"sensor_fault"`` (``spikes`` single-sample glitches of ``spike_size`` (default 8)
         times the channel's RMS, random sign, at random samples; ``stuck_s`` seconds from 40 %
-        of the record on which the channel repeats its last value).
+        of the record on which the channel repeats its last value),
+        ``"second_input"`` (``level``; see :func:`add_second_input`: needs ``structure``).
     channels : sequence of str, optional
-        Where: default every output (an input delay: the input).
+        Where: default every output (an input delay: the input; a second input: the first
+        sensor).
     seed : int
         Random seed of a noise effect.
+    structure : Structure, optional
+        The structure recorded (a second input's force acts on it).
 
     Returns
     -------
@@ -92,6 +107,13 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, **pa
         With ``meta["injected"]`` recording what was planted.
     """
     check_effect(effect, params)
+    if effect == "second_input":
+        if structure is None:
+            raise DataError("effect 'second_input' needs the structure the force acts on: pass structure=.")
+        names = list(channels) if channels is not None else [recording.sensors[0]]
+        if len(names) != 1:
+            raise DataError(f"effect 'second_input': one channel (where the force acts), got {names}.")
+        return add_second_input(recording, structure, names[0], float(params["level"]), seed)
     default = [recording.input_name] if effect == "input_delay" else list(recording.sensors)
     names = list(channels) if channels is not None else default
     base, y = recording.base.copy(), np.array(recording.response, dtype=float)
@@ -204,3 +226,41 @@ def _rk4_cubic(m_inv, c, k, fine, h, i, j, k3):
         z = z + h / 6 * (k1z + 2 * k2z + 2 * k3z + k4z)
         v = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)
     return out
+
+
+def add_second_input(recording: Recording, structure, at: str, level: float, seed: int = 0) -> Recording:
+    """``recording`` with a second excitation: a force on the mass of sensor ``at``, recorded
+    as an extra column ``"force"`` that nothing declares an input (the truth for
+    ``second_input``).
+
+    The force is Gaussian random vibration over the base input's default band with its own
+    seed, held between samples (a DAC-driven exciter); its response -- absolute accelerations
+    of the structure on a base held still, ``M z'' + C z' + K z = e_at f`` discretised exactly
+    for that hold -- is added to every output, scaled so that at ``at`` its RMS is ``level``
+    times that channel's RMS before. Superposition makes this the ride under both inputs.
+    """
+    from scipy.signal import cont2discrete, dlsim
+
+    from ..simulate import random_vibration
+
+    k_at = _channel(recording, at)
+    if k_at is None:
+        raise DataError("effect 'second_input': the force acts on a sensor's mass, not on the input.")
+    m, c, k = (np.asarray(x, float) for x in (structure.M, structure.C, structure.K))
+    dof = m.shape[0]
+    if recording.response.shape[1] != dof:
+        raise DataError(f"effect 'second_input': the recording has {recording.response.shape[1]} outputs, "
+                        f"the structure {dof} masses.")  # fmt: skip
+    m_inv = np.linalg.inv(m)
+    a = np.block([[np.zeros((dof, dof)), np.eye(dof)], [-m_inv @ k, -m_inv @ c]])
+    b = np.r_[np.zeros(dof), m_inv[:, k_at]][:, None]
+    cc, d = a[dof:], b[dof:]
+    n, fs = recording.n_samples, recording.fs
+    force = random_vibration(fs, n / fs, band=(0.5, min(28.0, 0.47 * fs)), seed=seed + 7919)[:n]
+    ad, bd, cd, dd, _ = cont2discrete((a, b, cc, d), 1.0 / fs, method="zoh")
+    _, response, _ = dlsim((ad, bd, cd, dd, 1.0 / fs), force)
+    scale = level * float(np.std(recording.response[:, k_at])) / float(np.std(response[:, k_at]))
+    y = np.column_stack([recording.response + scale * response, scale * force])
+    meta = dict(recording.meta, injected={"effect": "second_input", "channels": ["force"], "at": at,
+                                         "level": level, "force_scale": scale})  # fmt: skip
+    return replace(recording, response=y, sensors=(*recording.sensors, "force"), meta=meta)

@@ -29,6 +29,7 @@ from .model import (
     held_out,
     held_out_piecewise,
     usable,
+    widened_start,
 )
 
 __all__ = ["diagnose", "Diagnosis", "EFFECTS", "TESTED_EFFECTS"]
@@ -59,6 +60,7 @@ _TIER = {
     "coloured_noise": 2,
     "time_varying": 3,
     "stiffness_nonlinearity": 3,
+    "second_input": 1,
 }
 #: A disturbance on the output is judged on the simulation error: a one-step predictor can
 #: carry a line or an offset in its noise model (an undamped pole, A(1)) while the
@@ -81,11 +83,13 @@ class Stage:
     model: FittedModel
     held: HeldOut
 
-    def bic(self, kind: str = "one_step") -> float:
-        """BIC of the in-sample one-step (or simulation) errors: ``N sum log V_k + p log(N K)``."""
-        mask = usable(self.model.signals.n, self.model.spec)
+    def bic(self, kind: str = "one_step", channels=None) -> float:
+        """BIC of the in-sample one-step (or simulation) errors: ``N sum log V_k + p log(N K)``,
+        over ``channels`` (default all: two models compare on the outputs they share)."""
+        s = self.model.signals
+        mask = usable(s.n, self.model.spec)
         errors = self.model.one_step_errors() if kind == "one_step" else self.model.simulation_errors()
-        e = errors[mask]
+        e = errors[mask][:, [s.sensors.index(c) for c in (s.sensors if channels is None else channels)]]
         n, k = e.shape
         pieces = 2 if isinstance(self.model, PiecewiseModel) else 1
         p = pieces * self.model.spec.n_parameters(k) + len(self.model.spec.shifts)
@@ -168,7 +172,7 @@ class Diagnosis:
         def modes(stage):
             return [{k: float(v) for k, v in row.items()} for row in self.modes(stage).to_dict("records")]
 
-        final = self.final.summary(self.noise_floor)
+        final = _per_output(self.final.summary(self.noise_floor), self.final.model.signals.sensors, self.sensors)
         final.update(modes_before=modes(self.baseline), modes_after=modes(self.final))
         return {
             "verdict": _verdict(self, final["whiteness_p"]),
@@ -188,6 +192,17 @@ class Diagnosis:
         }
 
 
+def _per_output(summary: dict, sensors, outputs) -> dict:
+    """``summary``'s per-sensor lists over ``outputs`` (the recording's), ``None`` where an
+    output became an input (a second input); ``inputs_added`` names those."""
+    out = {}
+    for key, values in summary.items():
+        by_name = dict(zip(sensors, values, strict=True))
+        out[key] = [by_name.get(name) for name in outputs]
+    out["inputs_added"] = [name for name in outputs if name not in sensors]
+    return out
+
+
 def _tier(finding: Finding) -> int:
     """The finding's place in a round. A lead found by the residual-input cross-correlation
     waits for the disturbances and missing modes (tier 1): their misfit also correlates with
@@ -199,7 +214,7 @@ def _tier(finding: Finding) -> int:
 
 def _verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float = 0.01) -> str:
     """One sentence a person can act on, unsure where the data leave doubt."""
-    coloured = [s for s, p in zip(diagnosis.sensors, whiteness, strict=True) if p < alpha]
+    coloured = [s for s, p in zip(diagnosis.sensors, whiteness, strict=True) if p is not None and p < alpha]
     if coloured:
         return (
             f"unsure: the residual of {', '.join(coloured)} is still not white after the fixes; an effect the "
@@ -244,6 +259,18 @@ def _baseline_orders(rec: Recording, baseline) -> tuple[int, int, int, int]:
     return fit.orders
 
 
+def _extra_input_response(model) -> np.ndarray | float:
+    """The response to the model's extra inputs (a second input, a nonlinear term), (n, K):
+    what the noise floor, a coherence with the base alone, must not count as noise."""
+    if isinstance(model, PiecewiseModel):
+        return model._join(*(_extra_input_response(m) for m in (model.before, model.after)))
+    if not model.spec.terms:
+        return np.zeros_like(model.signals.y)
+    u = model.signals.inputs(model.spec).copy()
+    u[:, 0] = 0.0
+    return np.column_stack([m.simulate(u) for m in model.fit.models])
+
+
 def _noise_floor(s: Signals, mask: np.ndarray) -> np.ndarray:
     """RMS of the output part not coherent with the input (Welch H1): what a perfect linear
     model of this input would still leave in its simulation error."""
@@ -255,11 +282,13 @@ def _noise_floor(s: Signals, mask: np.ndarray) -> np.ndarray:
     return np.sqrt(np.sum((1 - coh) * pyy, axis=0) * df)
 
 
-def _held_out_p(before: HeldOut, after: HeldOut, idx: list[int], kind: str = "one_step") -> float:
+def _held_out_p(before: HeldOut, after: HeldOut, idx: list[int], kind: str = "one_step", idx_after=None) -> float:
     """Diebold-Mariano test that the fix lowers the held-out squared one-step (or simulation)
-    error of the channels ``idx`` (one-sided; Newey-West variance of the loss difference)."""
+    error of the channels ``idx`` (``idx_after`` in ``after`` when a fix took an output out;
+    one-sided; Newey-West variance of the loss difference)."""
     mask = before.mask & after.mask
-    e0, e1 = (getattr(before, kind)[mask][:, idx], getattr(after, kind)[mask][:, idx])
+    idx_after = idx if idx_after is None else idx_after
+    e0, e1 = (getattr(before, kind)[mask][:, idx], getattr(after, kind)[mask][:, idx_after])
     scale = np.mean(e0**2, axis=0)
     d = np.sum((e0**2 - e1**2) / scale, axis=1)
     n = d.size
@@ -345,11 +374,23 @@ def diagnose(
             break  # the tests assume one model; a record split in two is reported as it is
     if effects:
         tests = run_tests(stage.model, alpha)[1]
-    clean = Signals(signals.u, signals.y - stage.model.disturbance(), signals.fs, signals.sensors, signals.input_name)
+    raw = stage.model.raw  # without an output a second input took
+    own = raw.y - stage.model.disturbance() - _extra_input_response(stage.model)
+    clean = Signals(raw.u, own, raw.fs, raw.sensors, raw.input_name)
     floor = _noise_floor(clean, usable(signals.n, spec))
     tests["cross_correlation"] = cross_correlation(stage.model)
     unsure = tuple(unconfirmed.values())
     return Diagnosis(first, stage, tuple(effects), unsure, floor, rec, recording.fs, warnings, tests)
+
+
+def _affected(finding: Finding, s: Signals) -> list[str]:
+    """The outputs whose error judges a fix: every output for an input's effect, the channels
+    a second input explains, else the finding's channels."""
+    if finding.channels == (s.input_name,):
+        return list(s.sensors)
+    if finding.effect == "second_input":
+        return list(finding.parameters["explains"])
+    return list(finding.channels)
 
 
 def _try_fix(stage: Stage, finding: Finding, alpha: float):
@@ -364,22 +405,26 @@ def _try_fix(stage: Stage, finding: Finding, alpha: float):
         )
     if finding.effect == "time_varying":
         change = finding.payload
-        model = fit_piecewise(stage.model.spec, s, change)
-        new = Stage(model, held_out_piecewise(model.spec, s, change))
+        model = fit_piecewise(stage.model.spec, s, change, start=stage.model)
+        new = Stage(model, held_out_piecewise(model.spec, s, change, stage.model))
     else:
-        model = fit_model(add_effect(stage.model.spec, finding, stage.model), s)
+        spec = add_effect(stage.model.spec, finding, stage.model)
+        model = fit_model(spec, s, start=widened_start(stage.model, spec))
         new = Stage(model, held_out(model.spec, s, model))
-    idx = list(range(len(s.sensors))) if on_input else [s.sensors.index(c) for c in finding.channels]
+    affected = _affected(finding, s)
+    idx = [s.sensors.index(c) for c in affected]
+    idx_new = [new.model.signals.sensors.index(c) for c in affected]  # a second input leaves the outputs
     common = stage.held.mask & new.held.mask  # both errors on the same samples (a fix may drop some)
-    before, after = _pooled_rms(stage.held, idx, mask=common), _pooled_rms(new.held, idx, mask=common)
+    before, after = _pooled_rms(stage.held, idx, mask=common), _pooled_rms(new.held, idx_new, mask=common)
     kind = _CRITERION.get(finding.effect, "one_step")
-    p = _held_out_p(stage.held, new.held, idx, kind)
-    dbic = new.bic(kind) - stage.bic(kind)
+    p = _held_out_p(stage.held, new.held, idx, kind, idx_new)
+    shared = new.model.signals.sensors
+    dbic = new.bic(kind, shared) - stage.bic(kind, shared)
     params = effect_parameters(finding, model)
     params["criterion"] = f"held-out {kind.replace('_', '-')} error"
     if kind == "simulation":
         params["sim_error_before"] = _pooled_rms(stage.held, idx, kind, common)
-        params["sim_error_after"] = _pooled_rms(new.held, idx, kind, common)
+        params["sim_error_after"] = _pooled_rms(new.held, idx_new, kind, common)
     if finding.effect == "input_delay" and finding.statistic != "residual_input_ccf_z":
         # B's taps absorb much of a delay, so the error may barely move: the phase slope names it.
         # A lead found by the cross-correlation is beyond B's reach: it must lower the error.

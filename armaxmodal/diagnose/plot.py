@@ -64,8 +64,10 @@ def _psd(x, fs):
 
 def _spectra(ax, diagnosis, mask):
     fs = diagnosis.final.model.signals.fs
+    outputs = diagnosis.final.model.signals.sensors  # both over the outputs left (a second input leaves)
     for stage, style, label in ((diagnosis.baseline, "-", "before"), (diagnosis.final, "--", "after")):
-        f, p = _psd(stage.model.simulation_errors()[mask], fs)
+        columns = [stage.model.signals.sensors.index(name) for name in outputs]
+        f, p = _psd(stage.model.simulation_errors()[mask][:, columns], fs)
         ax.semilogy(f, p.mean(axis=1), style, label=f"simulation residual, {label} (mean over sensors)")
     for e in diagnosis.effects:
         if e.finding.effect == "periodic_disturbance":
@@ -91,7 +93,13 @@ def _frf(ax, diagnosis):
 
 def _traces(ax, diagnosis):
     s = diagnosis.final.model.signals
-    affected = [c for e in diagnosis.effects for c in e.finding.channels if c in s.sensors]
+
+    def driven(e):  # a second input's channel is no output: the outputs it drives, hardest first
+        share = e.parameters.get("rms_share_of_output", {})
+        return sorted(share, key=lambda name: -share[name])
+
+    named = [c for e in diagnosis.effects for c in (*e.finding.channels, *driven(e))]
+    affected = [c for c in named if c in s.sensors]
     k = s.sensors.index(affected[0]) if affected else 0
     n_show = min(s.n // 2, int(10 * s.fs))
     start = s.n // 2 + n_show // 4  # inside the second half, predicted by the first half's model
@@ -110,8 +118,10 @@ def _summary(ax, diagnosis):
         lines.append(f"  {e.finding.effect} {where}: one-step {e.error_before:.4g} -> {e.error_after:.4g}")
     for u in diagnosis.unconfirmed:
         lines.append(f"unconfirmed: {u['effect']} {', '.join(u['channels'])}")
-    y = diagnosis.baseline.model.signals.y
-    base, final = diagnosis.baseline.held.fit_percent(y), diagnosis.final.held.fit_percent(y)
-    pairs = [f"{a:.1f} -> {b:.1f}" for a, b in zip(base, final, strict=True)]
+    before, after = (stage.model.signals for stage in (diagnosis.baseline, diagnosis.final))
+    base = dict(zip(before.sensors, diagnosis.baseline.held.fit_percent(before.y), strict=True))
+    final = dict(zip(after.sensors, diagnosis.final.held.fit_percent(after.y), strict=True))
+    # an output a second input took has no fit after
+    pairs = [f"{base[name]:.1f} -> " + (f"{final[name]:.1f}" if name in final else "input") for name in base]
     lines.append("held-out simulation fit %:\n  " + ", ".join(pairs))
     ax.text(0, 1, "\n".join(lines), va="top", family="monospace", fontsize=8, wrap=True)
