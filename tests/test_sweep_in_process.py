@@ -79,6 +79,29 @@ def test_the_delay_is_the_lowest_bic_one(ride, diagram):
     assert [o for o in diagram.orders] == [(na, default_nb(na, nk), default_nc(na), nk) for na in ORDERS]
 
 
+def test_the_delay_choice_hands_the_sweep_its_converged_fits_at_that_delay(ride):
+    """The fits the sweep may reuse are exactly the delay choice's converged fits at the
+    chosen delay, each equal to the same fit written out."""
+    from armaxmodal.stabilisation import _choose_nk
+
+    rec = ride[1]
+    nk, reuse = _choose_nk(rec, NK_SEARCH, (4, 6), 1)
+    assert nk == 0 and reuse
+    for (source, (na, nb, nc, k)), fit in reuse.items():
+        assert source == SHARED and k == nk and (nb, nc) == (default_nb(na, nk), default_nc(na))
+        ref = am.fit_armax(
+            rec, na, nb, nc, nk, shared_poles=True, max_iter=8, tol=SWEEP_TOL, stop="decrease", warn=False
+        )
+        assert fit.converged.all() and ref.converged.all()
+        np.testing.assert_allclose(fit.models[0].a, ref.models[0].a, rtol=1e-9, atol=1e-12)
+    converged = [
+        na for na in (4, 6)
+        if am.fit_armax(rec, na, default_nb(na, nk), default_nc(na), nk, shared_poles=True, max_iter=8,
+                        tol=SWEEP_TOL, stop="decrease", warn=False).converged.all()
+    ]  # fmt: skip
+    assert sorted(orders[0] for _, orders in reuse) == converged
+
+
 def test_a_late_input_past_the_search_range_is_found_by_the_extension(ride):
     """Outputs 8 samples ahead of the input: the best delay lies beyond the searched 0..-6,
     so the search looks further, once. An absolute acceleration has no direct feed-through
@@ -88,6 +111,8 @@ def test_a_late_input_past_the_search_range_is_found_by_the_extension(ride):
     assert min(NK_SEARCH) > -8
     nk = choose_nk(late, n_jobs=1)
     assert nk == _reference_nk(late, range(min(NK_SEARCH), min(NK_SEARCH) - 4, -1)) == 1 - 8
+    # the extension reaches NK_EXTENSION = 3 beyond the edge: -9
+    assert choose_nk(_late_input(ride[1], 10), n_jobs=1) == min(NK_SEARCH) - 3 == 1 - 10
     # a narrower search that does not reach the edge is not extended
     assert choose_nk(_late_input(ride[1], 2), nk_values=range(0, -5, -1), n_jobs=1) == 1 - 2
 

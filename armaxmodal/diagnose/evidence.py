@@ -601,8 +601,9 @@ def _second_input_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
     (coherence below ``SECOND_INPUT_COHERENCE``, :func:`base_coherence`) and, entering the other channels through
     the dynamics as a second input ``B_2 / A``, it explains their one-step residual: the score
     test of its lags ``nk .. nk+nb-1`` filtered by ``1/C`` (the gradient in ``B_2``), with a
-    constant among the regressors so an offset is not read as an input. p per explained
-    channel, Bonferroni over candidates x sensors x tests."""
+    constant among the regressors so an offset is not read as an input. Only outputs the
+    base drives (coherent) are tested. p per explained channel, Bonferroni over candidates x
+    sensors x tests."""
     s = fitted.signals
     k_count = len(s.sensors)
     y = s.y - fitted.disturbance()
@@ -615,7 +616,8 @@ def _second_input_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
     out = []
     for c in candidates:
         f_sum, ps = 0.0, {}
-        for k in (k for k in range(k_count) if k != c):
+        # outputs the base drives: where no channel is a response, nothing tells an input
+        for k in (k for k in range(k_count) if coherence[k] >= SECOND_INPUT_COHERENCE):
             m = fitted.fit.models[k]
             if k not in psi:
                 grad = gradient_columns(m, y[:, k], u, eps[:, k])[mask]
