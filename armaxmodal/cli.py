@@ -251,7 +251,7 @@ def _diagnosis_text(name: str, report: dict) -> str:
             continue
         lines.append(
             f"{s:>12} {base['fit_val_pct'][k]:13.1f} {final['fit_val_pct'][k]:12.1f} "
-            f"{final['sim_resid_rms'][k]:10.4g} {final['noise_floor_rms'][k]:12.4g}"
+            f"{final['sim_resid_rms'][k]:10.4g} {_or_unresolved(final['noise_floor_rms'][k]):>12}"
         )
     if not report["effects"]:
         lines.append("no effect kept (the tests' p-values are in the JSON's 'tests').")
@@ -270,6 +270,11 @@ def _diagnosis_text(name: str, report: dict) -> str:
         lines.append("not tested by this version: " + ", ".join(report["not_tested"]))
     lines.append("verdict: " + report["verdict"])
     return "\n".join(lines)
+
+
+def _or_unresolved(value) -> str:
+    """A noise floor, or why there is none (the record cannot resolve its lightest mode)."""
+    return "unresolved" if value is None else f"{value:.4g}"
 
 
 def _short(params: dict) -> str:

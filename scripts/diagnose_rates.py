@@ -35,6 +35,8 @@ PLANTED = {
     "glitches near threshold": ("sensor_fault", ["pelvis"], {"spikes": 5, "spike_size": 0.3}),
     "stuck clear": ("sensor_fault", ["pelvis"], {"stuck_s": 1.0}),
     "stuck near threshold": ("sensor_fault", ["pelvis"], {"stuck_s": 0.05}),
+    "second input clear": ("second_input", ["chest"], {"level": 0.1}),
+    "second input near threshold": ("second_input", ["chest"], {"level": 0.004}),
 }
 
 
@@ -66,9 +68,11 @@ def main() -> None:
             continue
         hits = 0
         for seed in range(args.seeds):
-            d = diagnose(inject(ride("supine 60 Hz", seed), effect, channels, seed=seed, **params))
+            rec = inject(ride("supine 60 Hz", seed), effect, channels, seed=seed, structure=am.supine_human(), **params)
+            d = diagnose(rec)
             first = d.effects[0].finding if d.effects else None
-            hits += first is not None and first.effect == effect and channels[0] in first.channels
+            named = "force" if effect == "second_input" else channels[0]  # the recorded force, not where it acts
+            hits += first is not None and first.effect == effect and named in first.channels
         print(f"{label}: named first {hits}/{args.seeds}", flush=True)
 
 

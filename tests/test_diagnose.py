@@ -535,3 +535,27 @@ def test_second_input_injection_refuses_what_it_cannot_plant(clean):
         inject(clean, "second_input", ["base"], structure=am.supine_human(), level=0.1)
     with pytest.raises(DataError, match="level must be > 0"):
         inject(clean, "second_input", ["chest"], structure=am.supine_human(), level=-1)
+
+
+def test_the_noise_floor_is_the_sensor_noise_and_none_where_the_record_cannot_resolve_it():
+    """The supine ride's floor is its 5 % sensor noise; a 0.3 %-damped two-mode ride of 60 s
+    smears its peaks at every segment the record allows (its 'floor' lies above the linear
+    baseline's own held-out error): no floor rather than a wrong one."""
+    from armaxmodal.diagnose.loop import _noise_floor
+    from armaxmodal.diagnose.model import Signals
+
+    def floor(rec):
+        s = Signals(rec.base, rec.response, rec.fs, rec.sensors, rec.input_name)
+        return _noise_floor(s, np.ones(s.n, bool))
+
+    u = am.random_vibration(60.0, 120.0, band=(0.5, 28.0), seed=8)
+    exact = am.simulate(am.supine_human(), u, 60.0, hold="bandlimited")
+    noisy = am.simulate_recording(am.supine_human(), u, 60.0, noise=0.05, seed=9, hold="bandlimited")
+    got = floor(noisy)
+    for k, name in enumerate(noisy.sensors):
+        assert got[name] == pytest.approx(0.05 * np.sqrt(np.mean(exact[:, k] ** 2)), rel=0.1)
+    light = am.Structure.from_chain([10.0, 5.0], [8000.0, 0.0], [1.0, 0.0], [12000.0], [0.5], ("m1", "m2"))
+    v = am.random_vibration(50.0, 60.0, (0.5, 24.0), seed=3)
+    d = diagnose(am.simulate_recording(light, v, 50.0, noise=0.05, seed=4))
+    assert d.noise_floor == {"m1": None, "m2": None}
+    assert d.to_dict()["final"]["noise_floor_rms"] == [None, None]
