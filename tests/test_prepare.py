@@ -223,3 +223,31 @@ def test_f16_torsion_mode_softens_and_damps_with_force(realdata_dir):
     assert 0.003 < found[1].damping < 0.008
     assert found[7].freq_hz == pytest.approx(7.18, rel=0.01)
     assert found[7].damping > 2.5 * found[1].damping
+
+
+def test_outputs_that_do_not_respond_to_the_input_are_named(clean):
+    """Independent noise in place of a sensor reads a coherence with the input near the
+    estimate's bias (0.07); the clean ride's sensors read 0.78-1.00 and give no warning. When
+    no output responds, the message says the modes found are not the structure's (a record of
+    pure noise once gave two 'modes' with intervals and no warning)."""
+    from armaxmodal.quality import INCOHERENT, input_coherence
+
+    assert [w for w in check_quality(clean) if w.code == "incoherent_output"] == []
+    coherence = input_coherence(clean.base, clean.response, clean.fs)
+    assert coherence.min() > 0.75 > INCOHERENT
+    rng = np.random.default_rng(1)
+    y = clean.response.copy()
+    y[:, 2] = rng.standard_normal(clean.n_samples)
+    (w,) = [w for w in check_quality(_with(clean, response=y)) if w.code == "incoherent_output"]
+    assert w.channels == ("pelvis",) and w.value < 0.1 and "pelvis 0.0" in w.message
+    assert "do not respond" in w.message
+    noise = rng.standard_normal(clean.response.shape)
+    (w,) = [w for w in check_quality(_with(clean, response=noise)) if w.code == "incoherent_output"]
+    assert w.channels == clean.sensors and "not the structure's" in w.message
+    # the weighting is the input's spectrum: a response sensor's coherence, computed by scipy
+    from scipy.signal import coherence as scipy_coherence
+    from scipy.signal import welch
+
+    f, c = scipy_coherence(clean.base, clean.response[:, 0], clean.fs, nperseg=clean.n_samples // 8)
+    _, puu = welch(clean.base, clean.fs, nperseg=clean.n_samples // 8)
+    assert coherence[0] == pytest.approx(float(puu @ c / puu.sum()), rel=1e-6)

@@ -243,6 +243,11 @@ def test_the_band_and_the_detrend_reach_the_preparation_and_the_selection(ride):
     sel = select_modes(d, n_jobs=1)  # the diagram's band: only the first mode, nothing unexplained
     assert sel.modes.freq_hz.to_numpy() == pytest.approx(s.modes().freq_hz[:1], rel=0.005)
     assert not [n for n in sel.notes if n.code == "unexplained_peak"]
+    # a band the rate need not change for: the selection still keeps to it
+    upper = _diagram(rec, band=(6.0, 20.0))
+    assert upper.recording.fs == rec.fs
+    sel = select_modes(upper, n_jobs=1)
+    assert sel.modes.freq_hz.to_numpy() == pytest.approx(s.modes().freq_hz[1:], rel=0.005)
 
 
 def test_a_given_delay_sweeps_as_the_chosen_one(ride, diagram):
@@ -285,6 +290,16 @@ def test_no_mode_in_the_band_says_what_to_do(diagram):
     with pytest.raises(OrderError) as err:
         select_modes(diagram, band=(15.0, 20.0), n_jobs=1)
     assert str(err.value) == message
+
+
+def test_a_record_of_noise_is_flagged_before_its_poles_are_read(ride):
+    """Outputs that are independent noise still give poles a selection may keep; the diagram
+    says first that no output responds to the input."""
+    rec = ride[1]
+    noise = np.random.default_rng(5).standard_normal(rec.response.shape)
+    d = _diagram(Recording(rec.fs, rec.base, noise, rec.sensors, rec.input_name))
+    (w,) = [w for w in d.warnings if w.code == "incoherent_output"]
+    assert w.channels == rec.sensors and "not the structure's" in w.message
 
 
 def test_the_diagram_plots_the_selection(diagram):

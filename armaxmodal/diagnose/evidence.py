@@ -18,7 +18,7 @@ import numpy as np
 from scipy import stats
 from scipy.signal import lfilter
 
-from ..quality import MIN_DELAY_SAMPLES, estimate_delays
+from ..quality import MIN_DELAY_SAMPLES, estimate_delays, input_coherence
 from ..recording import Recording
 from .clipping import rail_pileup
 from .faults import FAULT_ALPHA, FOLLOWS_ALPHA, follows_excitation, glitch_p, glitches, input_rail_reach, stuck_runs
@@ -46,7 +46,7 @@ EFFECT_TESTS = (
 )
 #: A recorded channel whose coherence with the base, averaged over the base's spectrum, is
 #: below this is a candidate input: a response sensor on a structure the base drives is far
-#: more coherent (H1 coherence 0.94 and more on the measured records). Coherence, not the
+#: more coherent (0.63-1.00 on the measured records, :data:`~armaxmodal.quality.INCOHERENT`). Coherence, not the
 #: simulation fit: an offset or a drift the diagnosis has not yet removed ruins the fit of a
 #: response sensor (-180 % with 0.3 on chest) and once made it a "second input".
 SECOND_INPUT_COHERENCE = 0.5
@@ -598,16 +598,17 @@ def _time_findings(fitted, mask, n_tests, table) -> list[Finding]:
 
 def _second_input_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
     """A recorded channel that is an input, not a response: the base explains little of it
-    (coherence below ``SECOND_INPUT_COHERENCE``, :func:`base_coherence`) and, entering the other channels through
-    the dynamics as a second input ``B_2 / A``, it explains their one-step residual: the score
-    test of its lags ``nk .. nk+nb-1`` filtered by ``1/C`` (the gradient in ``B_2``), with a
-    constant among the regressors so an offset is not read as an input. Only outputs the
-    base drives (coherent) are tested. p per explained channel, Bonferroni over candidates x
-    sensors x tests."""
+    (coherence below ``SECOND_INPUT_COHERENCE``, :func:`~armaxmodal.quality.input_coherence`)
+    and, entering the other channels through the dynamics as a second input ``B_2 / A``, it
+    explains their one-step residual: the score test of its lags ``nk .. nk+nb-1`` filtered by
+    ``1/C`` (the gradient in ``B_2``), with a constant among the regressors so an offset is not
+    read as an input. Only outputs the base drives (coherent) are tested. p per explained
+    channel, Bonferroni over candidates x sensors x tests."""
     s = fitted.signals
     k_count = len(s.sensors)
     y = s.y - fitted.disturbance()
-    coherence = base_coherence(s.u, y, s.fs, mask)
+    lo, hi = np.flatnonzero(mask)[[0, -1]]
+    coherence = input_coherence(s.u[lo : hi + 1], y[lo : hi + 1], s.fs)
     table["base_coherence"] = coherence.tolist()
     candidates = [c for c in range(k_count) if coherence[c] < SECOND_INPUT_COHERENCE] if k_count > 1 else []
     _, nb, _, nk = fitted.fit.orders
@@ -632,16 +633,3 @@ def _second_input_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
             out.append(Finding("second_input", (s.sensors[c],), "score_F", f_sum, min(ps.values()), params))
     return out
 
-
-def base_coherence(u: np.ndarray, y: np.ndarray, fs: float, mask: np.ndarray) -> np.ndarray:
-    """Each output's magnitude-squared coherence with the base (Welch, 10 s segments at most),
-    averaged with the base's power as weight: the share of the output, at the frequencies the
-    base drives, that a linear response to the base explains, (K,)."""
-    from ..frf import welch_spectra
-
-    lo, hi = np.flatnonzero(mask)[[0, -1]]
-    uu, yy = u[lo : hi + 1], y[lo : hi + 1]
-    nperseg = int(min(uu.size // 8, 2 ** int(np.ceil(np.log2(fs * 10)))))
-    _, puu, puy, pyy = welch_spectra(uu, yy, fs, nperseg)
-    coh = np.abs(puy) ** 2 / np.maximum(puu[:, None] * pyy, 1e-300)
-    return puu @ coh / max(float(puu.sum()), 1e-300)
