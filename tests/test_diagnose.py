@@ -559,3 +559,24 @@ def test_the_noise_floor_is_the_sensor_noise_and_none_where_the_record_cannot_re
     d = diagnose(am.simulate_recording(light, v, 50.0, noise=0.05, seed=4))
     assert d.noise_floor == {"m1": None, "m2": None}
     assert d.to_dict()["final"]["noise_floor_rms"] == [None, None]
+
+
+def test_outliers_other_sensors_share_are_not_one_sensors_glitches():
+    """Ten outliers that two other sensors also show within a sample or two (an impact felt
+    by the structure) against ten that no other sensor shows (a sensor's glitch): the binomial
+    test of coincidences against their rate at random moments."""
+    from scipy.stats import binom
+
+    from armaxmodal.diagnose.faults import SHARED_LEVEL, shared_by_others
+
+    rng = np.random.default_rng(2)
+    n = 6000
+    others = np.abs(rng.standard_normal((n, 2)))
+    at = sorted(rng.choice(np.arange(50, n - 50), 10, replace=False).tolist())
+    alone = shared_by_others(at, others)
+    assert alone > 0.05
+    shared = others.copy()
+    shared[np.array(at) + 2, 1] = SHARED_LEVEL + 1.0
+    rate = float(np.mean(np.convolve(shared.max(axis=1) > SHARED_LEVEL, np.ones(7), mode="same") > 0))
+    assert shared_by_others(at, shared) == pytest.approx(binom.sf(9, 10, rate), rel=1e-9) and rate < 0.1
+    assert shared_by_others(at[:2], shared) == 1.0 and shared_by_others(at, np.zeros((n, 0))) == 1.0

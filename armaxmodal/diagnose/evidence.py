@@ -21,7 +21,17 @@ from scipy.signal import lfilter
 from ..quality import MIN_DELAY_SAMPLES, estimate_delays, input_coherence
 from ..recording import Recording
 from .clipping import rail_pileup
-from .faults import FAULT_ALPHA, FOLLOWS_ALPHA, follows_excitation, glitch_p, glitches, input_rail_reach, stuck_runs
+from .faults import (
+    FAULT_ALPHA,
+    FOLLOWS_ALPHA,
+    follows_excitation,
+    glitch_p,
+    glitches,
+    input_rail_reach,
+    outlier_scores,
+    shared_by_others,
+    stuck_runs,
+)
 from .missing_mode import mode_findings
 from .model import LINE_MERGE_HZ, UNDAMPED, FittedModel, counted, usable
 from .model import lagged as _lag
@@ -199,6 +209,7 @@ def _fault_findings(fitted: FittedModel, eps: np.ndarray, mask: np.ndarray, n_te
     shifts = dict(fitted.spec.shifts)
     known = {name: set(samples) for name, samples in fitted.spec.faults}
     out = []
+    scores = np.column_stack([outlier_scores(eps[:, k], m, mask) for k, m in enumerate(fitted.fit.models)])
     for k, name in enumerate(raw.sensors):
         runs = [r for r in stuck_runs(raw.y[:, k]) if r[0] + 1 not in known.get(name, ())]
         lag = int(round(shifts.get(name, 0.0)))  # the residual is in the channel's shifted frame
@@ -206,7 +217,8 @@ def _fault_findings(fitted: FittedModel, eps: np.ndarray, mask: np.ndarray, n_te
         spikes, sizes, largest = glitches(eps[:, k], model, mask & ~input_rail_reach(raw.u, model, lag))
         spikes = [t + lag for t in spikes if 0 <= t + lag < raw.n]
         p_follow = follows_excitation(spikes, raw.u, fs)
-        if p_follow < FOLLOWS_ALPHA:  # outliers of strong motion: the model's error, not the sensor's
+        p_shared = shared_by_others([t - lag for t in spikes], np.delete(scores, k, axis=1))
+        if min(p_follow, p_shared) < FOLLOWS_ALPHA:  # strong motion or impacts: the structure's, not the sensor's
             spikes, sizes, largest = [], [], 0.0
         p_stuck = min((r[2] for r in runs), default=1.0)
         p_glitch = glitch_p(largest, int(mask.sum()))

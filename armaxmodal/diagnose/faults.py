@@ -19,7 +19,10 @@ Outliers that gather where the input is strongest are the model's error under st
 (a shake-table IMU's residual during an earthquake's strong phase matched the pattern 200
 times), so a set of glitches whose local input level ranks high (a one-sided test of the
 mean rank, ``FOLLOWS_ALPHA``) is not named, nor is a glitch a clipped input sample can reach
-(the input is named instead).
+(the input is named instead). A glitch is also one sensor's alone: outliers that other
+sensors show at the same moment (within ``SHARED_WINDOW`` samples, ``|lambda| > SHARED_LEVEL``)
+more often than at random moments (binomial test, ``FOLLOWS_ALPHA``) are the structure's --
+the impacts of a joint with clearance, which the F-16's wing-payload joint has -- not a fault.
 
 Both kinds are fixed as clipping is: the samples are treated as missing, filled by the
 model's one-step prediction and left out of every error.
@@ -33,7 +36,16 @@ from scipy.special import ndtr, ndtri
 
 from .clipping import clipped_mask
 
-__all__ = ["stuck_runs", "glitches", "glitch_p", "follows_excitation", "input_rail_reach", "FAULT_ALPHA"]
+__all__ = [
+    "stuck_runs",
+    "glitches",
+    "glitch_p",
+    "follows_excitation",
+    "shared_by_others",
+    "outlier_scores",
+    "input_rail_reach",
+    "FAULT_ALPHA",
+]
 
 #: Uncorrected level at which a run or a glitch enters a fault's mask.
 FAULT_ALPHA = 1e-3
@@ -45,6 +57,10 @@ MAX_GLITCHES = 200
 FOLLOWS_ALPHA = 0.01
 #: Share of the impulse response's energy kept in the matched filter.
 PI_ENERGY = 0.999
+#: Another sensor's outlier within this many samples of a glitch counts as the same event.
+SHARED_WINDOW = 3
+#: |lambda| above which another sensor's residual counts as an outlier there.
+SHARED_LEVEL = 3.0
 
 
 def stuck_runs(x: np.ndarray) -> list[tuple[int, int, float]]:
@@ -69,6 +85,31 @@ def _matched_filter(model) -> np.ndarray:
     pi = lfilter(model.a, model.c, np.r_[1.0, np.zeros(511)])
     keep = int(np.searchsorted(np.cumsum(pi**2) / np.sum(pi**2), PI_ENERGY)) + 1
     return pi[:keep]
+
+
+def outlier_scores(eps: np.ndarray, model, mask: np.ndarray) -> np.ndarray:
+    """``|lambda(t)|`` of one channel's one-step residual ``eps`` (n,), zero outside ``mask``."""
+    pi = _matched_filter(model)
+    e = np.where(mask, eps, 0.0)
+    sigma = 1.4826 * float(np.median(np.abs(eps[mask] - np.median(eps[mask]))))
+    lam = fftconvolve(e, pi[::-1], mode="full")[pi.size - 1 :] / (sigma * float(np.sqrt(pi @ pi)))
+    return np.where(mask, np.abs(lam), 0.0)
+
+
+def shared_by_others(samples: list[int], others: np.ndarray) -> float:
+    """p that ``samples`` meet another sensor's outlier no more often than random moments do:
+    ``others`` (n, K-1) are the other sensors' :func:`outlier_scores`; a hit is any of them
+    above ``SHARED_LEVEL`` within ``SHARED_WINDOW`` samples. One-sided binomial test against
+    the hit rate over all samples; 1 for fewer than three samples or no other sensor."""
+    from scipy.ndimage import maximum_filter1d
+    from scipy.stats import binom
+
+    if len(samples) < 3 or others.size == 0:
+        return 1.0
+    near = maximum_filter1d(others.max(axis=1), 2 * SHARED_WINDOW + 1) > SHARED_LEVEL
+    rate = float(np.mean(near))
+    hits = int(np.count_nonzero(near[samples]))
+    return float(binom.sf(hits - 1, len(samples), rate)) if hits else 1.0
 
 
 def glitches(eps: np.ndarray, model, mask: np.ndarray, alpha: float = FAULT_ALPHA):
