@@ -81,6 +81,12 @@ def welch_spectra(u: np.ndarray, y: np.ndarray, fs: float, nperseg: int):
     return np.fft.rfftfreq(nperseg, 1.0 / fs), puu, puy, pyy
 
 
+def coherence(puu: np.ndarray, puy: np.ndarray, pyy: np.ndarray) -> np.ndarray:
+    """Magnitude-squared coherence ``|Puy|^2 / (Puu Pyy)`` of :func:`welch_spectra`'s output,
+    (n_freq, K); zero where a spectrum vanishes."""
+    return np.abs(puy) ** 2 / np.maximum(puu[:, None] * pyy, 1e-300)
+
+
 def measured_frf(recording, nperseg: int | None = None):
     """H1 estimate of each output over the input and the coherence.
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .frf import excited_band, modal_frf, welch_spectra
+from .frf import coherence, excited_band, modal_frf, welch_spectra
 from .quality import QualityWarning
 from .recording import Recording
 
@@ -31,7 +31,7 @@ def resolving_nperseg(recording: Recording, freq_hz, damping) -> int:
 
 def _measured(recording: Recording, nperseg: int):
     f, puu, puy, pyy = welch_spectra(recording.base, recording.response, recording.fs, nperseg)
-    return f, puy / puu[:, None], np.abs(puy) ** 2 / np.maximum(puu[:, None] * pyy, 1e-300)
+    return f, puy / puu[:, None], coherence(puu, puy, pyy)
 
 
 def reconstruction_error(recording: Recording, freq_hz, damping, shapes, band=None) -> tuple[float, int]:

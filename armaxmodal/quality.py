@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .frf import welch_spectra
+from .frf import coherence, welch_spectra
 from .recording import Recording
 
 __all__ = ["QualityWarning", "WARNING_CODES", "check_quality", "estimate_delays", "DelayEstimate"]
@@ -131,7 +131,7 @@ def input_coherence(u: np.ndarray, y: np.ndarray, fs: float) -> np.ndarray:
     y = np.asarray(y, float).reshape(len(u), -1)
     nperseg = int(min(len(u) // 8, 2 ** int(np.ceil(np.log2(fs * 10)))))
     _, puu, puy, pyy = welch_spectra(u, y, fs, nperseg)
-    coh = np.abs(puy) ** 2 / np.maximum(puu[:, None] * pyy, 1e-300)
+    coh = coherence(puu, puy, pyy)
     return puu @ coh / max(float(puu.sum()), 1e-300)
 
 
@@ -139,8 +139,8 @@ def incoherent_outputs(recording: Recording) -> list[QualityWarning]:
     """Outputs whose coherence with the input (:func:`input_coherence`) is below ``INCOHERENT``."""
     if recording.n_samples < 128:
         return []
-    coherence = input_coherence(recording.base, recording.response, recording.fs)
-    low = [(name, float(c)) for name, c in zip(recording.sensors, coherence, strict=True) if c < INCOHERENT]
+    levels = input_coherence(recording.base, recording.response, recording.fs)
+    low = [(name, float(c)) for name, c in zip(recording.sensors, levels, strict=True) if c < INCOHERENT]
     if not low:
         return []
     every = len(low) == len(recording.sensors)

@@ -11,7 +11,7 @@ from scipy import stats
 
 from .._threads import single_blas_thread
 from ..exceptions import DataError
-from ..frf import welch_spectra
+from ..frf import coherence, welch_spectra
 from ..prepare import prepare
 from ..recording import Recording
 from .evidence import EFFECT_TESTS, Finding, cross_correlation, run_tests, whiteness_p
@@ -313,7 +313,7 @@ FLOOR_SETTLED = 0.2
 
 def _welch_floor(u: np.ndarray, y: np.ndarray, fs: float, nperseg: int) -> np.ndarray:
     f, puu, puy, pyy = welch_spectra(u, y, fs, nperseg)
-    coh = np.abs(puy) ** 2 / np.maximum(puu[:, None] * pyy, 1e-300)
+    coh = coherence(puu, puy, pyy)
     return np.sqrt(np.sum((1 - coh) * pyy, axis=0) * (f[1] - f[0]))
 
 

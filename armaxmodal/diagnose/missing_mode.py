@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..frf import h1_relative_error, welch_spectra
+from ..frf import coherence, h1_relative_error, welch_spectra
 from .model import FittedModel, usable
 
 __all__ = ["mode_findings", "added_modes", "MODEL_CLASS_FLOOR"]
@@ -27,7 +27,7 @@ def _misfit(fitted: FittedModel):
     nperseg = int(min(u.size // 8, 2 ** int(np.ceil(np.log2(s.fs * 10)))))
     f, puu, puy, pyy = welch_spectra(u, y, s.fs, nperseg)
     h1 = puy / puu[:, None]
-    coh = np.abs(puy) ** 2 / np.maximum(puu[:, None] * pyy, 1e-300)
+    coh = coherence(puu, puy, pyy)
     sigma = h1_relative_error(coh, u.size, nperseg)
     model = np.column_stack([m.frf(f)[:, 0] for m in fitted.fit.models])
     rel = np.abs(model - h1) / np.maximum(np.abs(h1), 1e-300)
