@@ -58,6 +58,39 @@ def _hold_recursion(phi, gam, u_pad, n_steps, stride):
 
 
 @njit(**_JIT)
+def _divide_by_c(x, c, out):
+    """``out = x / C(q)`` for one signal: ``out[t] = x[t] - sum_i c[i] out[t-i]``, zero start.
+
+    The sum runs in four accumulators: one accumulator makes every step wait on the
+    previous add's latency, so the recursion ran at half the speed (measured at nc = 10-30,
+    n = 20,000; the rounding differs from a single sum in the last bits).
+    """
+    n = x.size
+    nc = c.size - 1
+    for t in range(min(nc, n)):
+        acc = 0.0
+        for i in range(1, t + 1):
+            acc += c[i] * out[t - i]
+        out[t] = x[t] - acc
+    for t in range(nc, n):
+        a0 = 0.0
+        a1 = 0.0
+        a2 = 0.0
+        a3 = 0.0
+        i = 1
+        while i + 3 <= nc:
+            a0 += c[i] * out[t - i]
+            a1 += c[i + 1] * out[t - i - 1]
+            a2 += c[i + 2] * out[t - i - 2]
+            a3 += c[i + 3] * out[t - i - 3]
+            i += 4
+        while i <= nc:
+            a0 += c[i] * out[t - i]
+            i += 1
+        out[t] = x[t] - ((a0 + a1) + (a2 + a3))
+
+
+@njit(**_JIT)
 def _inverse_filter(x, c):
     """``x_f = x / C(q)`` with zero initial state: ``x_f[t] = x[t] - sum_i c[i] x_f[t-i]``.
 
@@ -67,15 +100,28 @@ def _inverse_filter(x, c):
     n_sig, n = x.shape
     nc = c.size - 1
     out = np.empty_like(x)
-    # Time outermost: the signals' recursions are independent, so interleaving them keeps
-    # the pipeline busy where one recursion alone waits on its previous output.
-    for t in range(n):
-        top = min(nc, t)
-        for s in range(n_sig):
-            acc = x[s, t]
-            for i in range(1, top + 1):
-                acc -= c[i] * out[s, t - i]
-            out[s, t] = acc
+    # Four signals at a time, time-major: their four independent sums share each load of
+    # c[i] and keep the pipeline busy (1.3-2.4x faster than one signal after another).
+    buf = np.empty((n, 4))  # every entry is written before it is read
+    for s0 in range(0, n_sig, 4):
+        k = min(4, n_sig - s0)
+        for t in range(n):
+            a0 = 0.0
+            a1 = 0.0
+            a2 = 0.0
+            a3 = 0.0
+            for i in range(1, min(nc, t) + 1):
+                ci = c[i]
+                a0 += ci * buf[t - i, 0]
+                a1 += ci * buf[t - i, 1]
+                a2 += ci * buf[t - i, 2]
+                a3 += ci * buf[t - i, 3]
+            buf[t, 0] = x[s0, t] - a0
+            buf[t, 1] = x[s0 + 1, t] - a1 if k > 1 else 0.0
+            buf[t, 2] = x[s0 + 2, t] - a2 if k > 2 else 0.0
+            buf[t, 3] = x[s0 + 3, t] - a3 if k > 3 else 0.0
+        for j in range(k):
+            out[s0 + j, :] = buf[:, j]
     return out
 
 
@@ -98,33 +144,22 @@ def _armax_residual(y, u, a, b, nk, c):
     """
     n = y.size
     n_in, nb = b.shape
-    na = a.size - 1
-    nc = c.size - 1
+    # A y - q^-nk B u one lag at a time over slices: the time loop has no recursion and no
+    # index arithmetic, so it runs in vector registers (4x faster than per-sample sums).
+    w = y.copy()
+    for i in range(1, a.size):
+        ai, w_i, y_i = a[i], w[i:], y[: n - i]
+        for t in range(n - i):
+            w_i[t] += ai * y_i[t]
+    for m in range(n_in):
+        for j in range(nb):
+            lag = nk + j
+            lo, hi = max(lag, 0), min(n, n + lag)
+            bj, w_j, u_j = b[m, j], w[lo:hi], u[m, lo - lag : hi - lag]
+            for t in range(hi - lo):
+                w_j[t] -= bj * u_j[t]
     eps = np.empty(n)
-    # Interior samples have every regressor inside the record: no bounds checks there.
-    lo = max(na, nc, nk + nb - 1, 0)
-    hi = n - max(0, -nk)
-    for t in range(n):
-        w = y[t]
-        if lo <= t < hi:
-            for i in range(1, na + 1):
-                w += a[i] * y[t - i]
-            for m in range(n_in):
-                for j in range(nb):
-                    w -= b[m, j] * u[m, t - nk - j]
-            for i in range(1, nc + 1):
-                w -= c[i] * eps[t - i]
-        else:
-            for i in range(1, min(na, t) + 1):
-                w += a[i] * y[t - i]
-            for m in range(n_in):
-                for j in range(nb):
-                    k = t - nk - j
-                    if 0 <= k < n:
-                        w -= b[m, j] * u[m, k]
-            for i in range(1, min(nc, t) + 1):
-                w -= c[i] * eps[t - i]
-        eps[t] = w
+    _divide_by_c(w, c, eps)
     return eps
 
 

@@ -27,9 +27,9 @@ def armax_residual(y, u, a, b, nk, c):
         for j in range(b.shape[1]):
             lag = nk + j
             shifted = np.zeros(n)
-            if lag >= 0:
+            if 0 <= lag < n:
                 shifted[lag:] = u[m, : n - lag]
-            else:
+            elif -n < lag < 0:
                 shifted[: n + lag] = u[m, -lag:]
             w -= b[m, j] * shifted
     return scipy.signal.lfilter([1.0], c, w)

@@ -84,6 +84,26 @@ def test_inverse_filter_kernel_matches_lfilter():
     np.testing.assert_allclose(_inverse_filter(x, c), naive.inverse_filter(x, c), rtol=KERNEL_RTOL, atol=1e-12)
 
 
+def test_kernels_match_references_at_sweep_orders_and_short_records():
+    """Orders of the sweep (the four-accumulator sums and their remainders, four-signal
+    groups with a partial last group) and records shorter than the filter."""
+    rng = np.random.default_rng(3)
+    for n, order, n_sig in ((600, 11, 3), (600, 30, 6), (600, 4, 5), (7, 9, 2)):
+        c = np.concatenate([[1.0], 0.4 * rng.standard_normal(order) / order])
+        a = np.concatenate([[1.0], 0.4 * rng.standard_normal(order + 2) / order])
+        x = rng.standard_normal((n_sig, n))
+        np.testing.assert_allclose(_inverse_filter(x, c), naive.inverse_filter(x, c), rtol=KERNEL_RTOL, atol=1e-12)
+        y, u = rng.standard_normal(n), rng.standard_normal((2, n))
+        for nk in (-4, 0, 2):
+            b = rng.standard_normal((2, order + 1 - min(nk, 0)))
+            np.testing.assert_allclose(
+                _armax_residual(y, u, a, b, nk, c),
+                naive.armax_residual(y, u, a, b, nk, c),
+                rtol=KERNEL_RTOL,
+                atol=1e-12,
+            )
+
+
 def test_lagged_gram_and_cross_match_explicit_design():
     rng = np.random.default_rng(2)
     sig = rng.standard_normal((3, 300))
