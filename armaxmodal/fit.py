@@ -475,11 +475,15 @@ def _steiglitz_mcbride(ys, uT, a0, na, nb, nk, t0, t1, iterations=6):
     a = _stable_a(a0)
     weights = np.ones(n_out)
     bs = [np.zeros(p_k)] * n_out
+    zeros = np.zeros(uT.shape[1])
     for _ in range(iterations):
         g_mat = np.zeros((na + n_out * p_k,) * 2)
         g_vec = np.zeros(na + n_out * p_k)
-        for k, yk in enumerate(ys):
-            sig = _inverse_filter(_signals(yk, uT, np.zeros(yk.size)), a)
+        # every output and the input through the shared 1/A in one pass (u / A once, not
+        # once per sensor)
+        filtered = _inverse_filter(np.ascontiguousarray(np.vstack([np.vstack(ys), uT])), a)
+        for k in range(n_out):
+            sig = _signals(filtered[k], filtered[n_out:], zeros)
             idx = np.concatenate([np.arange(na), na + k * p_k + np.arange(p_k)])
             g_mat[np.ix_(idx, idx)] += weights[k] * _lagged_gram(sig, *cols, t0, t1)
             g_vec[idx] += weights[k] * _lagged_cross(sig, *cols, sig[0], t0, t1)
