@@ -113,8 +113,11 @@ def pole_uncertainty(a, mu, cov_a, fs: float) -> tuple[np.ndarray, np.ndarray]:
 def mode_record(row, shape: np.ndarray, sensors, supplemented=None) -> dict:
     """One mode of the JSON contract: frequency, damping, 95 % intervals and the shape
     (normalised to a unit largest component on the positive real axis) per sensor."""
-    big = shape[np.argmax(np.abs(shape))]
-    shape = shape / big if abs(big) > 0 else shape
+    i_big = int(np.argmax(np.abs(shape)))
+    big = shape[i_big]
+    if abs(big) > 0:
+        shape = shape / big
+        shape[i_big] = 1.0  # complex z / z can round to 0.9999999999999999 or a phase of 1e-15 deg
     flags = np.zeros(len(sensors), dtype=bool) if supplemented is None else supplemented
     return {
         "freq_hz": float(row.freq_hz),
