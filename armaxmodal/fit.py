@@ -461,6 +461,18 @@ def _stable_a(a):
     return np.real(np.poly(r))
 
 
+def _lagged_sum(uT, b, nk):
+    """``sum_m sum_j b[m, j] u_m[t - nk - j]`` for t in [0, n), zero outside the record."""
+    n = uT.shape[1]
+    out = np.zeros(n)
+    for u_m, b_m in zip(uT, b, strict=True):
+        full = np.convolve(u_m, b_m)  # full[i] = sum_j b_m[j] u_m[i - j]
+        lo, hi = max(nk, 0), min(n, full.size + nk)
+        if hi > lo:
+            out[lo:hi] += full[lo - nk : hi - nk]
+    return out
+
+
 def _steiglitz_mcbride(ys, uT, a0, na, nb, nk, t0, t1, iterations=6):
     """Output-error start: shared A and per-sensor B by iterated prefiltering with 1/A.
 
@@ -476,12 +488,19 @@ def _steiglitz_mcbride(ys, uT, a0, na, nb, nk, t0, t1, iterations=6):
     weights = np.ones(n_out)
     bs = [np.zeros(p_k)] * n_out
     zeros = np.zeros(uT.shape[1])
-    for _ in range(iterations):
+    for it in range(iterations):
         g_mat = np.zeros((na + n_out * p_k,) * 2)
         g_vec = np.zeros(na + n_out * p_k)
         # every output and the input through the shared 1/A in one pass (u / A once, not
         # once per sensor)
         filtered = _inverse_filter(np.ascontiguousarray(np.vstack([np.vstack(ys), uT])), a)
+        if it > 0:
+            # reweight by each sensor's output-error residual variance under the previous
+            # pass's (A, B_k): y_k - B_k (u / A), which is (A y_k - B_k u) / A without a
+            # recursion per sensor
+            for k, yk in enumerate(ys):
+                e = yk - _lagged_sum(filtered[n_out:], bs[k].reshape(n_in, -1), nk)
+                weights[k] = 1.0 / max(float(np.var(e[t0:t1])), 1e-300)
         for k in range(n_out):
             sig = _signals(filtered[k], filtered[n_out:], zeros)
             idx = np.concatenate([np.arange(na), na + k * p_k + np.arange(p_k)])
@@ -490,10 +509,6 @@ def _steiglitz_mcbride(ys, uT, a0, na, nb, nk, t0, t1, iterations=6):
         theta = _solve(g_mat, g_vec)
         a_new = _stable_a(np.concatenate([[1.0], theta[:na]]))
         bs = [theta[na + k * p_k : na + (k + 1) * p_k] for k in range(n_out)]
-        # reweight by each sensor's output-error residual variance
-        for k, yk in enumerate(ys):
-            e = _armax_residual(yk, uT, a_new, bs[k].reshape(n_in, -1), nk, a_new)
-            weights[k] = 1.0 / max(float(np.var(e[t0:t1])), 1e-300)
         done = np.max(np.abs(a_new - a)) < 1e-4  # a start only: PEM does the rest
         a = a_new
         if done:

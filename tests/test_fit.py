@@ -104,6 +104,18 @@ def test_kernels_match_references_at_sweep_orders_and_short_records():
             )
 
 
+def test_lagged_input_sum_matches_the_residual_reference():
+    """The Steiglitz-McBride reweighting's ``B u`` (every delay sign, lags past the record)."""
+    from armaxmodal.fit import _lagged_sum
+
+    rng = np.random.default_rng(4)
+    one = np.array([1.0])
+    for n, nb, nk in ((50, 5, -3), (50, 5, 0), (50, 5, 4), (6, 9, -2), (6, 9, 8), (6, 3, -8)):
+        u, b, y = rng.standard_normal((2, n)), rng.standard_normal((2, nb)), rng.standard_normal(n)
+        expected = y - naive.armax_residual(y, u, one, b, nk, one)
+        np.testing.assert_allclose(_lagged_sum(u, b, nk), expected, rtol=KERNEL_RTOL, atol=1e-12)
+
+
 def test_lagged_gram_and_cross_match_explicit_design():
     rng = np.random.default_rng(2)
     sig = rng.standard_normal((3, 300))
