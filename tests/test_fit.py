@@ -62,19 +62,18 @@ def _physical(modes, band):
 
 
 # -- kernels against slow references -----------------------------------------------------
+def _assert_residual_matches_reference(y, u, a, b, nk, c):
+    expected = naive.armax_residual(y, u, a, b, nk, c)
+    np.testing.assert_allclose(_armax_residual(y, u, a, b, nk, c), expected, rtol=KERNEL_RTOL, atol=1e-12)
+
+
 def test_residual_kernel_matches_lfilter():
     rng = np.random.default_rng(0)
     y, u = rng.standard_normal(500), rng.standard_normal((2, 500))
     a = np.array([1.0, -1.2, 0.5])
     c = np.array([1.0, 0.3, -0.2])
     for nk in (-2, 0, 3):
-        b = rng.standard_normal((2, 4))
-        np.testing.assert_allclose(
-            _armax_residual(y, u, a, b, nk, c),
-            naive.armax_residual(y, u, a, b, nk, c),
-            rtol=KERNEL_RTOL,
-            atol=1e-12,
-        )
+        _assert_residual_matches_reference(y, u, a, rng.standard_normal((2, 4)), nk, c)
 
 
 def test_inverse_filter_kernel_matches_lfilter():
@@ -95,13 +94,7 @@ def test_kernels_match_references_at_sweep_orders_and_short_records():
         np.testing.assert_allclose(_inverse_filter(x, c), naive.inverse_filter(x, c), rtol=KERNEL_RTOL, atol=1e-12)
         y, u = rng.standard_normal(n), rng.standard_normal((2, n))
         for nk in (-4, 0, 2):
-            b = rng.standard_normal((2, order + 1 - min(nk, 0)))
-            np.testing.assert_allclose(
-                _armax_residual(y, u, a, b, nk, c),
-                naive.armax_residual(y, u, a, b, nk, c),
-                rtol=KERNEL_RTOL,
-                atol=1e-12,
-            )
+            _assert_residual_matches_reference(y, u, a, rng.standard_normal((2, order + 1 - min(nk, 0))), nk, c)
 
 
 def test_lagged_input_sum_matches_the_residual_reference():
