@@ -6,7 +6,9 @@ In this order, every step stated in the result (and in the JSON):
 2. :func:`armaxmodal.quality.check_quality` on the raw record;
 3. outputs that duplicate another channel are left out (a copy adds no information and,
    pooled with its original, gives zero-width intervals);
-4. channels found late or early by whole samples are aligned (a sensor with its own clock);
+4. an output in other units than the rest whose quasi-static ratio matches a unit conversion
+   (:mod:`armaxmodal.units`) is converted by that exact factor; channels found late or early
+   by whole samples are aligned (a sensor with its own clock);
 5. each channel's mean (default) or linear trend is removed, so gravity on an accelerometer
    and sensor offsets do not bias the modes (MATLAB's ``detrend``);
 6. a record sampled far above its band is resampled to about ``fs = band_hi / 0.4`` with
@@ -141,6 +143,7 @@ def prepare(
             f"every output duplicates another channel ({', '.join(dropped)}); nothing independent is left to fit."
         )
     rec = recording.select(keep) if dropped else recording
+    rec, found = _convert_units(rec, found)
     shifts = _whole_sample_shifts(found, rec) if align else {}
     if shifts:
         rec = _align(rec, shifts)
@@ -156,6 +159,22 @@ def prepare(
     meta = dict(rec.meta, preprocessing={"detrend": detrend, "analysis_fs": analysis_fs})
     rec = replace(rec, meta=meta)
     return Preparation(rec, recording.fs, analysis_fs, band, detrend, dropped, shifts, tuple(found))
+
+
+def _convert_units(rec: Recording, found: list[QualityWarning]) -> tuple[Recording, list[QualityWarning]]:
+    """Divide each ``unit_mismatch`` output whose ratio matches a unit conversion by that
+    exact factor, and say so in its warning."""
+    from .units import unit_conversion
+
+    response, notes = rec.response.copy(), []
+    for w in found:
+        match = unit_conversion(w.value) if w.code == "unit_mismatch" and w.channels[0] in rec.sensors else None
+        if match is not None:
+            response[:, rec.sensors.index(w.channels[0])] /= match[0]
+            note = f" Divided by {match[0]:.5g} before fitting; shapes are in the others' units."
+            w = replace(w, message=w.message + note)
+        notes.append(w)
+    return replace(rec, response=response), notes
 
 
 def _whole_sample_shifts(found: list[QualityWarning], rec: Recording) -> dict:

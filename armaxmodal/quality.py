@@ -22,6 +22,7 @@ recording:
   input's spectrum, is below ``INCOHERENT``: it is not a response to this input (a wrong
   column, a dead sensor, a second excitation), and its poles are not the structure's. A
   record of pure noise once gave two "modes" with intervals and no warning.
+* ``unit_mismatch`` -- an output in other units than the rest (:mod:`armaxmodal.units`).
 """
 
 from __future__ import annotations
@@ -53,6 +54,7 @@ WARNING_CODES = (
     "split_merged",
     "no_modes",
     "incoherent_output",
+    "unit_mismatch",
 )
 #: An output less coherent with the input than this (averaged over the input's spectrum) is
 #: not its response: response sensors read 0.63-1.00 on the measured records (the F-16, the
@@ -121,6 +123,9 @@ def check_quality(recording: Recording) -> list[QualityWarning]:
     found += narrowband_input(recording)
     found += clipped_channels(recording)
     found += incoherent_outputs(recording)
+    from .units import unit_mismatch  # units.py builds on this module's constants
+
+    found += unit_mismatch(recording)
     return found
 
 

@@ -251,3 +251,64 @@ def test_outputs_that_do_not_respond_to_the_input_are_named(clean):
     f, c = scipy_coherence(clean.base, clean.response[:, 0], clean.fs, nperseg=clean.n_samples // 8)
     _, puu = welch(clean.base, clean.fs, nperseg=clean.n_samples // 8)
     assert coherence[0] == pytest.approx(float(puu @ c / puu.sum()), rel=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("channel", "factor", "exact"),
+    [(1, 1 / 9.80665, True), (2, 1000.0, True), (0, 1000 / 9.80665, False), (3, 100.0, False)],
+)
+def test_an_output_in_other_units_is_measured_named_and_converted(clean, channel, factor, exact):
+    """Chest in g, pelvis 1000x, head in mg, legs in Gal among m/s²: the quasi-static ratio is
+    the unit factor (within 5 %) and the channel is converted: by the exact factor where one
+    unit conversion is that near (the prepared record is then the clean one), by the measured
+    ratio where two are (mg 101.97 and Gal 100), which leaves the channel within the ratio's
+    scatter (2 %) of the clean one."""
+    from armaxmodal.units import UNIT_MATCH, unit_conversion
+
+    y = clean.response.copy()
+    y[:, channel] *= factor
+    rec = _with(clean, response=y)
+    found = [w for w in check_quality(rec) if w.code == "unit_mismatch"]
+    assert [w.channels for w in found] == [(clean.sensors[channel],)]
+    assert found[0].value == pytest.approx(factor, rel=UNIT_MATCH)
+    divisor = unit_conversion(found[0].value)[0]
+    assert (divisor == pytest.approx(factor, rel=1e-12)) == exact
+    prepared = prepare(rec)
+    reference = prepare(clean).recording.response[:, channel]
+    assert "Divided by" in prepared.warnings[0].message
+    np.testing.assert_allclose(
+        prepared.recording.response[:, channel], reference * factor / divisor, rtol=1e-9, atol=1e-12
+    )
+    gain = np.std(prepared.recording.response[:, channel]) / np.std(reference)
+    assert gain == pytest.approx(1.0, abs=1e-9 if exact else 0.02)
+
+
+@pytest.mark.parametrize("factor", [7.0, 0.2])
+def test_a_scale_that_matches_no_unit_is_named_and_left(clean, factor):
+    y = clean.response.copy()
+    y[:, 2] *= factor
+    rec = _with(clean, response=y)
+    prepared = prepare(rec)
+    found = [w for w in prepared.warnings if w.code == "unit_mismatch"]
+    assert [w.channels for w in found] == [("pelvis",)] and found[0].value == pytest.approx(factor, rel=0.05)
+    assert "Convert it and rerun" in found[0].message
+    np.testing.assert_allclose(prepared.recording.response[:, 2], prepare(clean).recording.response[:, 2] * factor)
+
+
+def test_a_record_without_a_quasi_static_band_or_with_one_output_is_not_tested(clean):
+    """A force input (|T| not near 1 on any output) and a single output say nothing."""
+    force_like = _with(clean, response=clean.response * np.array([30.0, 45.0, 60.0, 3000.0]))
+    assert not [w for w in check_quality(force_like) if w.code == "unit_mismatch"]
+    single = clean.select(["head"])
+    single = _with(single, response=single.response * 102.0, sensors=("head",))
+    assert not [w for w in check_quality(single) if w.code == "unit_mismatch"]
+
+
+def test_the_head_in_mg_no_longer_loses_modes(clean):
+    """Before the check, the head in mg dominated every shape comparison and two of the four
+    modes were merged away with no warning; converted, the selection is the clean one's."""
+    y = clean.response.copy()
+    y[:, 0] *= 1000 / 9.80665
+    found = select_modes(stabilisation_diagram(_with(clean, response=y), n_jobs=1), segments=0)
+    truth = am.supine_human().modes()
+    np.testing.assert_allclose(found.modes.freq_hz, truth.freq_hz, rtol=FREQ_RTOL)
