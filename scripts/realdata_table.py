@@ -45,6 +45,9 @@ def _damaged(tmp: Path) -> dict:
     inv = d.copy()
     inv["chest"] = -inv["chest"]
     save("chest inverted", inv)
+    mg = d.copy()
+    mg["head"] *= 1000 / 9.80665
+    save("head in mg", mg)
     drift = d.copy()
     drift[outs] += 0.05 * np.arange(len(d))[:, None] / 60.0
     save("drift 0.05 m per s^3", drift)
