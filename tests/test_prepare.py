@@ -283,8 +283,9 @@ def test_an_output_in_other_units_is_measured_named_and_converted(clean, channel
     assert gain == pytest.approx(1.0, abs=1e-9 if exact else 0.02)
 
 
-@pytest.mark.parametrize("factor", [7.0, 0.2])
+@pytest.mark.parametrize("factor", [7.0, 0.2, 9.0])
 def test_a_scale_that_matches_no_unit_is_named_and_left(clean, factor):
+    """x7 and x0.2 are no unit; x9 is 8 % from g's 9.81, beyond the 5 % a match allows."""
     y = clean.response.copy()
     y[:, 2] *= factor
     rec = _with(clean, response=y)
@@ -297,11 +298,23 @@ def test_a_scale_that_matches_no_unit_is_named_and_left(clean, factor):
 
 def test_a_record_without_a_quasi_static_band_or_with_one_output_is_not_tested(clean):
     """A force input (|T| not near 1 on any output) and a single output say nothing."""
-    force_like = _with(clean, response=clean.response * np.array([30.0, 45.0, 60.0, 3000.0]))
-    assert not [w for w in check_quality(force_like) if w.code == "unit_mismatch"]
+    for gains in ([30.0, 45.0, 60.0, 3000.0], [1.0, 30.0, 45.0, 60.0]):  # one output near 1 is no majority
+        force_like = _with(clean, response=clean.response * np.array(gains))
+        assert not [w for w in check_quality(force_like) if w.code == "unit_mismatch"]
     single = clean.select(["head"])
     single = _with(single, response=single.response * 102.0, sensors=("head",))
     assert not [w for w in check_quality(single) if w.code == "unit_mismatch"]
+
+
+def test_the_ratio_is_taken_against_the_other_outputs(clean):
+    """A base sensor 15 % off in sensitivity (every output reads 1.15) with the chest in g:
+    against the others the chest reads 1/9.81 and is converted exactly; against the input it
+    would read 0.117 and match nothing."""
+    y = clean.response * 1.15
+    y[:, 1] /= 9.80665
+    found = [w for w in check_quality(_with(clean, response=y)) if w.code == "unit_mismatch"]
+    assert [w.channels for w in found] == [("chest",)]
+    assert found[0].value == pytest.approx(1 / 9.80665, rel=0.02)
 
 
 def test_the_head_in_mg_no_longer_loses_modes(clean):
