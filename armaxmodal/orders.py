@@ -99,12 +99,28 @@ def _map(func, items, n_jobs, bar=None, cost=None, min_items: int = 4):
     order = sorted(range(len(items)), key=lambda i: -cost(items[i])) if cost else list(range(len(items)))
     out = [None] * len(items)
     ctx = multiprocessing.get_context("fork")
-    with ProcessPoolExecutor(n_jobs, mp_context=ctx, initializer=_single_blas_thread) as pool:
-        for i, result in zip(order, pool.map(func, [items[i] for i in order]), strict=True):
+    # each worker is forked with the task already in its memory (fork passes initargs
+    # without pickling): only the items cross the pipe, not the recording bound into
+    # ``func`` (a megabyte pickled per item)
+    with ProcessPoolExecutor(n_jobs, mp_context=ctx, initializer=_start_worker, initargs=(func,)) as pool:
+        for i, result in zip(order, pool.map(_run_task, [items[i] for i in order]), strict=True):
             out[i] = result
             if bar is not None:
                 bar.update()
     return out
+
+
+_WORKER_TASK = None
+
+
+def _start_worker(func) -> None:
+    global _WORKER_TASK
+    _WORKER_TASK = func
+    _single_blas_thread()
+
+
+def _run_task(item):
+    return _WORKER_TASK(item)
 
 
 def choose_orders(
