@@ -20,7 +20,7 @@ import pandas as pd
 from .quality import QualityWarning
 from .recording import Recording
 
-__all__ = ["segment_spread", "apply_segment_spread", "N_SEGMENTS"]
+__all__ = ["segment_spread", "apply_segment_spread", "segment_jobs", "segment_poles", "split_segments", "N_SEGMENTS"]
 
 N_SEGMENTS = 3
 #: family-wise false-alarm rate of the spread test over all modes and both parameters
@@ -29,7 +29,8 @@ SPREAD_ALPHA = 0.01
 MATCH_FREQ = 0.05
 
 
-def _segments(recording: Recording, k: int) -> list[Recording]:
+def split_segments(recording: Recording, k: int = N_SEGMENTS) -> list[Recording]:
+    """The record cut into ``k`` disjoint, equal parts (the remainder dropped)."""
     n = recording.n_samples // k
     return [
         Recording(recording.fs, recording.base[i * n : (i + 1) * n], recording.response[i * n : (i + 1) * n],
@@ -39,7 +40,12 @@ def _segments(recording: Recording, k: int) -> list[Recording]:
 
 
 def segment_spread(
-    recording: Recording, modes: pd.DataFrame, orders_of, n_segments: int = N_SEGMENTS, n_jobs: int | None = None
+    recording: Recording,
+    modes: pd.DataFrame,
+    orders_of,
+    n_segments: int = N_SEGMENTS,
+    n_jobs: int | None = None,
+    fitted: dict | None = None,
 ):
     """Between-segment standard deviation of each mode's frequency and damping.
 
@@ -54,6 +60,9 @@ def segment_spread(
     n_segments : int
     n_jobs : int, optional
         Worker processes for the segment fits (default: all cores).
+    fitted : dict, optional
+        Segment poles already computed, ``{(orders, k): poles}`` (:func:`segment_poles`);
+        the jobs not in it are fitted here.
 
     Returns
     -------
@@ -63,14 +72,18 @@ def segment_spread(
     """
     from .orders import _map
 
-    parts = _segments(recording, n_segments)
     wanted = sorted({tuple(orders_of(i)) for i in range(len(modes))})
-    jobs = [(orders, k) for orders in wanted for k in range(n_segments)]
-    # every segment refit of every representative order at once, over the worker processes
-    found = _map(partial(_segment_poles, parts), jobs, n_jobs, cost=lambda job: job[0][0], min_items=2)
+    jobs = segment_jobs(wanted, n_segments)
+    fitted = dict(fitted or {})
+    todo = [job for job in jobs if job not in fitted]
+    if todo:
+        # every segment refit of every representative order at once, over the worker processes
+        parts = split_segments(recording, n_segments)
+        found = _map(partial(segment_poles, parts), todo, n_jobs, cost=lambda job: job[0][0], min_items=2)
+        fitted.update(zip(todo, found, strict=True))
     poles_by_orders: dict = {orders: [] for orders in wanted}
-    for (orders, _), poles in zip(jobs, found, strict=True):
-        poles_by_orders[orders].append(poles)
+    for orders, k in jobs:
+        poles_by_orders[orders].append(fitted[(orders, k)])
     rows = []
     for i, mode in enumerate(modes.itertuples(index=False)):
         orders = tuple(orders_of(i))
@@ -95,7 +108,12 @@ def segment_spread(
     return pd.DataFrame(rows)
 
 
-def _segment_poles(parts: list[Recording], job) -> pd.DataFrame | None:
+def segment_jobs(orders: list, n_segments: int = N_SEGMENTS) -> list:
+    """The refits :func:`segment_spread` needs: ``(orders, segment)`` for each set of orders."""
+    return [(tuple(o), k) for o in orders for k in range(n_segments)]
+
+
+def segment_poles(parts: list[Recording], job) -> pd.DataFrame | None:
     """The shared-pole poles of one segment's refit at the given orders (None: not fitted)."""
     from .orders import _fit_or_none
     from .stabilisation import SHARED, _poles_of

@@ -32,7 +32,7 @@ from .prepare import Preparation, prepare
 from .quality import QualityWarning
 from .recording import Recording
 from .refine import ModalRefinement, refine_modes
-from .spread import N_SEGMENTS, apply_segment_spread, segment_spread
+from .spread import N_SEGMENTS, apply_segment_spread, segment_jobs, segment_poles, segment_spread, split_segments
 
 __all__ = ["stabilisation_diagram", "StabilisationDiagram", "select_modes", "ModeSelection", "Tolerances"]
 
@@ -571,13 +571,15 @@ def select_modes(
         modes["freq_sd_armax"] = (modes.freq_ci95_hi - modes.freq_ci95_lo) / (2 * 1.96)
         modes["damping_sd_armax"] = (modes.damping_ci95_hi - modes.damping_ci95_lo) / (2 * 1.96)
         refinement = None
+        orders = {o[0]: o for o in diagram.orders}
+        fitted = _refit_and_segment_fits(diagram, modes, band, refine, segments, orders, n_jobs)
         if refine:
-            modes, shapes, refinement = _refined(diagram, modes, shapes, band, cluster_freq, cluster_damping, merge_mac)
+            modes, shapes, refinement = _refined(diagram, modes, shapes, fitted.pop("refit"), cluster_freq,
+                                                 cluster_damping, merge_mac)  # fmt: skip
         modes, shapes, notes = _justified_splits(diagram.recording, modes, shapes, band)
         if segments >= 2:
-            orders = {o[0]: o for o in diagram.orders}
             orders_of = lambda i: orders[int(modes.at[i, "na"])]  # noqa: E731
-            spread = segment_spread(diagram.recording, modes, orders_of, segments, n_jobs)
+            spread = segment_spread(diagram.recording, modes, orders_of, segments, n_jobs, fitted)
             modes, spread_notes = apply_segment_spread(modes, spread, segments)
             notes += spread_notes
         per_sensor, weighted = _per_sensor_table(diagram, modes, shapes, cluster_freq)
@@ -640,16 +642,41 @@ def _finished_poles(recording: Recording, fit: ArmaxFit) -> pd.DataFrame:
     return pd.DataFrame(_poles_of(done, SHARED))
 
 
-def _refined(diagram, modes, shapes, band, cluster_freq, cluster_damping, merge_mac):
-    """The frequency-domain refit (:func:`armaxmodal.refine.refine_modes`), reported for a
-    band-limited record; ``(modes, shapes, refinement or None)``."""
-    lo, hi = excited_band(diagram.recording)
-    if band is not None:  # modes outside the user's band are not in the refit: fit only inside it
-        lo, hi = max(lo, band[0]), min(hi, band[1])
+def _refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, orders: dict, n_jobs) -> dict:
+    """The frequency-domain refit (key ``"refit"``) and the segment refits of every mode's
+    representative orders (keys ``(orders, k)``), run together over the worker processes:
+    the refit ran alone in this process before, while the workers waited."""
+    jobs: list = [("refit", _refit_band(diagram.recording, band))] if refine else []
+    if segments >= 2:
+        jobs += [("segment", job) for job in segment_jobs(sorted({orders[int(na)] for na in modes.na}), segments)]
+    task = partial(_selection_job, diagram.recording, split_segments(diagram.recording, max(segments, 1)), modes)
+    # the refit first: it is the longest job (a frequency-domain fit of every mode)
+    done = _map(task, jobs, n_jobs, cost=lambda job: np.inf if job[0] == "refit" else job[1][0][0], min_items=2)
+    return {("refit" if kind == "refit" else job): result for (kind, job), result in zip(jobs, done, strict=True)}
+
+
+def _refit_band(recording: Recording, band) -> tuple[float, float]:
+    """Where the refit fits: the input's excited band, inside the user's band if given (modes
+    outside it are not in the refit)."""
+    lo, hi = excited_band(recording)
+    return (lo, hi) if band is None else (max(lo, band[0]), min(hi, band[1]))
+
+
+def _selection_job(recording: Recording, parts: list, modes: pd.DataFrame, job):
+    kind, what = job
+    if kind == "segment":
+        return segment_poles(parts, what)
     try:
-        refinement = refine_modes(diagram.recording, modes.freq_hz, modes.damping, band_hz=(lo, hi))
+        return refine_modes(recording, modes.freq_hz, modes.damping, band_hz=what)
     except (OrderError, np.linalg.LinAlgError):
-        return modes, shapes, None  # too few lines or a degenerate basis: the ARMAX values stand
+        return None  # too few lines or a degenerate basis: the ARMAX values stand
+
+
+def _refined(diagram, modes, shapes, refinement, cluster_freq, cluster_damping, merge_mac):
+    """The frequency-domain refit (:func:`armaxmodal.refine.refine_modes`, or None when it
+    could not be made), reported for a band-limited record; ``(modes, shapes, refinement)``."""
+    if refinement is None:
+        return modes, shapes, None
     if refinement.hold == "bandlimited":
         modes, shapes = _apply_refinement(modes, shapes, refinement, cluster_freq, cluster_damping)
         # two modes the refit brought together are one peak

@@ -424,16 +424,26 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     monkeypatch.setattr(st, "refine_modes", refit)
     modes, shapes = _modes([5.0, 9.0], [0.1, 0.05], [1.0, 1.0]), np.eye(2, dtype=complex)
     diagram = SimpleNamespace(recording=rec)
+    assert st._refit_band(rec, (4.0, 12.0)) == (max(lo, 4.0), min(hi, 12.0))
+    assert st._refit_band(rec, None) == (lo, hi)
     hold = "zoh"
-    out, out_shapes, ref = st._refined(diagram, modes, shapes, (4.0, 12.0), 0.05, 0.5, 0.8)
-    assert seen[-1] == (max(lo, 4.0), min(hi, 12.0)) and ref.hold == "zoh"
-    assert out is modes and out_shapes is shapes  # a held input: the ARMAX values are reported
-    st._refined(diagram, modes, shapes, None, 0.05, 0.5, 0.8)
-    assert seen[-1] == (lo, hi)
+    ref = st._selection_job(rec, [], modes, ("refit", (4.0, 12.0)))
+    assert seen[-1] == (4.0, 12.0) and ref.hold == "zoh"
+    out, out_shapes, kept = st._refined(diagram, modes, shapes, ref, 0.05, 0.5, 0.8)
+    assert kept is ref and out is modes and out_shapes is shapes  # a held input: the ARMAX values are reported
+
+    def failing(recording, freq_hz, damping, band_hz):
+        raise OrderError("too few lines")
+
+    monkeypatch.setattr(st, "refine_modes", failing)
+    assert st._selection_job(rec, [], modes, ("refit", (lo, hi))) is None  # the ARMAX values stand
+    out, out_shapes, kept = st._refined(diagram, modes, shapes, None, 0.05, 0.5, 0.8)
+    assert kept is None and out is modes and out_shapes is shapes
+    monkeypatch.setattr(st, "refine_modes", refit)
     hold = "bandlimited"
     calls = []
     monkeypatch.setattr(st, "_apply_refinement", lambda m, s, r, f, x: (calls.append((f, x)) or (m, s)))
     monkeypatch.setattr(st, "_merge_duplicates", lambda m, v, mac, dur: (calls.append((len(v), mac, dur)) or [1]))
-    out, out_shapes, _ = st._refined(diagram, modes, shapes, None, 0.05, 0.5, 0.8)
+    out, out_shapes, _ = st._refined(diagram, modes, shapes, SimpleNamespace(hold=hold), 0.05, 0.5, 0.8)
     assert calls == [(0.05, 0.5), (2, 0.8, rec.duration)]
     assert out.freq_hz.tolist() == [9.0] and out.index.tolist() == [0] and out_shapes.tolist() == [[0.0], [1.0]]
