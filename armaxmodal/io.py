@@ -208,7 +208,13 @@ def _read_csv(path: Path):
     _check_csv_layout(path)
     info = _csv_comments(path)
     try:
-        frame = pd.read_csv(path, comment="#", skipinitialspace=True, dtype=str, keep_default_na=False)
+        # every cell a number, the common case, is parsed in C; anything else (text, empty or
+        # missing cells) is read again as text below, to say which cell is wrong (the same
+        # doubles either way: checked on the fixtures and a 20,000-row record)
+        frame = pd.read_csv(path, comment="#", skipinitialspace=True, keep_default_na=False)
+        numeric = all(dtype.kind in "iuf" for dtype in frame.dtypes)
+        if not numeric:
+            frame = pd.read_csv(path, comment="#", skipinitialspace=True, dtype=str, keep_default_na=False)
     except pd.errors.EmptyDataError as exc:
         raise DataError(f"{path.name}: the file is empty; expected a header row and data.") from exc
     except (pd.errors.ParserError, UnicodeDecodeError, OSError, EOFError) as exc:
@@ -216,6 +222,24 @@ def _read_csv(path: Path):
     if frame.shape[0] == 0:
         raise DataError(f"{path.name}: header only, no data rows.")
     frame.columns = [str(c).strip() for c in frame.columns]
+    if numeric:
+        channels = {col: frame[col].to_numpy(dtype=float) for col in frame.columns}
+    else:
+        channels = _text_channels(frame, path)
+    file_fs = None
+    time_col = next((c for c in channels if c.lower() in _TIME_NAMES), None)
+    if time_col is not None:
+        t = channels.pop(time_col)
+        if not np.all(np.isfinite(t)):
+            raise DataError(f"{path.name}: the time column contains NaN or empty cells.")
+        file_fs = _fs_from_time(t, path)
+    return channels, file_fs, info
+
+
+def _text_channels(frame: pd.DataFrame, path: Path) -> dict[str, np.ndarray]:
+    """Channels of a CSV read as text: numbers parsed, text columns skipped, an all-missing
+    column kept as NaN (refused by name if used), any other missing or non-numeric cell an
+    error that names it."""
     channels: dict[str, np.ndarray] = {}
     for col in frame.columns:
         text = frame[col].str.strip()
@@ -238,14 +262,7 @@ def _read_csv(path: Path):
                 "not a number; fix or remove that cell."
             )
         channels[col] = values
-    file_fs = None
-    time_col = next((c for c in channels if c.lower() in _TIME_NAMES), None)
-    if time_col is not None:
-        t = channels.pop(time_col)
-        if not np.all(np.isfinite(t)):
-            raise DataError(f"{path.name}: the time column contains NaN or empty cells.")
-        file_fs = _fs_from_time(t, path)
-    return channels, file_fs, info
+    return channels
 
 
 def _csv_comments(path: Path) -> dict:

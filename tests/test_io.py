@@ -184,3 +184,23 @@ def test_json_is_strict_nan_and_infinity_become_null(tmp_path):
     )
     data = json.loads(path.read_text(), parse_constant=lambda c: pytest.fail(f"bare {c} written"))
     assert data == {"a": None, "b": [1.5, None], "c": [None, 2]}
+
+
+def test_an_all_numeric_csv_reads_the_same_doubles_as_the_cell_by_cell_path(fixtures_dir, tmp_path):
+    """The C parser's fast path against the text path that checks every cell, on a fixture
+    and on awkward but valid numbers (exponents, integers, signs, spaces after commas)."""
+    import pandas as pd
+
+    from armaxmodal.io import _read_csv, _text_channels
+
+    awkward = tmp_path / "awkward.csv"
+    awkward.write_text("time, base, a\n0, 1e-3, -2\n0.01, -4.5E+2, 3\n0.02, 0.1, +7.25\n0.03, 12, 1e300\n")
+    for path in (fixtures_dir / "supine_random.csv", awkward):
+        fast, _, _ = _read_csv(path)
+        text = pd.read_csv(path, comment="#", skipinitialspace=True, dtype=str, keep_default_na=False)
+        text.columns = [c.strip() for c in text.columns]
+        slow = _text_channels(text, path)
+        slow.pop("time")
+        assert fast.keys() == slow.keys()
+        for name in fast:
+            np.testing.assert_array_equal(fast[name], slow[name])
