@@ -293,7 +293,8 @@ def fit_armax(
     valid = np.array(
         [np.all(np.abs(m.poles()) < 1.0) and np.isfinite(v) for m, v in zip(models, info["loss"], strict=True)]
     )
-    info["converged"] = np.asarray(info["converged"]) & valid
+    stopped = np.asarray(info["converged"])
+    info["converged"] = stopped & valid
     result = ArmaxFit(
         models=tuple(models),
         shared_poles=shared_poles,
@@ -309,15 +310,29 @@ def fit_armax(
         fs=fs,
     )
     if warn and not np.all(result.converged):
-        bad = [s for s, ok in zip(sensors, result.converged, strict=True) if not ok]
-        warnings.warn(
-            f"PEM did not converge in {max_iter} iterations for {bad} (orders {na},{nb},{nc},{nk}); "
-            "the estimate is flagged converged=False. Try a larger max_iter, lower orders, or check "
-            "the data for drift and outliers.",
-            ConvergenceWarning,
-            stacklevel=2,
-        )
+        _warn_not_converged(sensors, stopped, valid, max_iter, (na, nb, nc, nk))
     return result
+
+
+def _warn_not_converged(sensors, stopped, valid, max_iter, orders) -> None:
+    """Say why a fit is flagged converged=False: the iteration cap, or a model that is not
+    valid (a pole on or outside the unit circle, a non-finite loss) -- the reasons differ,
+    and so do the remedies."""
+    capped = [s for s, ok in zip(sensors, stopped, strict=True) if not ok]
+    invalid = [s for s, ok, v in zip(sensors, stopped, valid, strict=True) if ok and not v]
+    reasons, remedies = [], []
+    if capped:
+        reasons.append(f"did not converge in {max_iter} iterations for {capped}")
+        remedies.append("a larger max_iter or lower orders")
+    if invalid:
+        reasons.append(f"ended at a pole on or outside the unit circle (its simulation diverges) for {invalid}")
+        remedies.append("lower orders or removing a drift (detrend='linear'), which such a pole usually fits")
+    warnings.warn(
+        f"PEM {' and '.join(reasons)} (orders {','.join(map(str, orders))}); the estimate is flagged "
+        f"converged=False. Try {' or '.join(remedies)}.",
+        ConvergenceWarning,
+        stacklevel=3,
+    )
 
 
 @functools.cache

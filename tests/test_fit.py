@@ -464,3 +464,27 @@ def test_a_crawl_along_an_undetermined_valley_ends_the_fit_without_moving_the_mo
     assert len(a) == len(b) >= 4
     assert np.all(np.abs(a.freq_hz.to_numpy() - b.freq_hz.to_numpy()) < 0.02 * b.freq_sd.to_numpy())
     assert np.all(np.abs(a.damping.to_numpy() - b.damping.to_numpy()) < 0.02 * b.damping_sd.to_numpy())
+
+
+@pytest.mark.parametrize(
+    ("stopped", "valid", "said", "not_said"),
+    [
+        ([False, True], [True, True], "did not converge in 100 iterations for ['a'] (orders", "unit circle"),
+        ([True, True], [True, False], "ended at a pole on or outside the unit circle (its simulation diverges) "
+         "for ['b'] (orders 8,9,4,0); the estimate is flagged converged=False. Try lower orders or removing a "
+         "drift (detrend='linear')", "did not converge"),
+        ([False, True], [True, False], "did not converge in 100 iterations for ['a'] and ended at a pole on or "
+         "outside the unit circle (its simulation diverges) for ['b']", "nothing else"),
+    ],
+)  # fmt: skip
+def test_a_fit_flagged_not_converged_says_why(stopped, valid, said, not_said):
+    """The iteration cap and an invalid model are different failures with different remedies:
+    the supine chest alone at 8,9,4,0 ends at a pole at 1.003 after 14 iterations, and was
+    reported as 'did not converge in 100 iterations'."""
+    from armaxmodal.exceptions import ConvergenceWarning
+    from armaxmodal.fit import _warn_not_converged
+
+    with pytest.warns(ConvergenceWarning) as record:
+        _warn_not_converged(["a", "b"], np.array(stopped), np.array(valid), 100, (8, 9, 4, 0))
+    message = str(record[0].message)
+    assert said in message and not_said not in message
