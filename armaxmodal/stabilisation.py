@@ -574,8 +574,8 @@ def select_modes(
         orders = {o[0]: o for o in diagram.orders}
         fitted = _refit_and_segment_fits(diagram, modes, band, refine, segments, orders, n_jobs)
         if refine:
-            modes, shapes, refinement = _refined(diagram, modes, shapes, fitted.pop("refit"), cluster_freq,
-                                                 cluster_damping, merge_mac)  # fmt: skip
+            refit, limits = fitted.pop("refit"), (cluster_freq, cluster_damping, merge_mac)
+            modes, shapes, refinement = _refined(diagram, modes, shapes, refit, *limits)
         modes, shapes, notes = _justified_splits(diagram.recording, modes, shapes, band)
         if segments >= 2:
             orders_of = lambda i: orders[int(modes.at[i, "na"])]  # noqa: E731
@@ -649,7 +649,8 @@ def _refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, o
     jobs: list = [("refit", _refit_band(diagram.recording, band))] if refine else []
     if segments >= 2:
         jobs += [("segment", job) for job in segment_jobs(sorted({orders[int(na)] for na in modes.na}), segments)]
-    task = partial(_selection_job, diagram.recording, split_segments(diagram.recording, max(segments, 1)), modes)
+    parts = split_segments(diagram.recording, segments) if segments >= 2 else []
+    task = partial(_selection_job, diagram.recording, parts, modes)
     # the refit first: it is the longest job (a frequency-domain fit of every mode)
     done = _map(task, jobs, n_jobs, cost=lambda job: np.inf if job[0] == "refit" else job[1][0][0], min_items=2)
     return {("refit" if kind == "refit" else job): result for (kind, job), result in zip(jobs, done, strict=True)}
