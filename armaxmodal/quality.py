@@ -202,18 +202,27 @@ def duplicate_channels(recording: Recording) -> list[QualityWarning]:
     return found
 
 
-def estimate_delays(recording: Recording) -> list[DelayEstimate]:
-    """Per output: time offset and sign from the quasi-static transmissibility (empty for an
-    output without a quasi-static band, e.g. a force input)."""
+def transmissibility_spectra(recording: Recording):
+    """H1 transmissibility of every output and its coherence for the quasi-static checks
+    (Welch, 20 s segments at most an eighth of the record): ``(f, h, coh, excited,
+    n_segments)``, ``h`` and ``coh`` (n_freq, K), ``excited`` the lines with input power within
+    30 dB of its peak; None for a record too short."""
     n = recording.n_samples
     nperseg = int(min(n // 8, 2 ** int(np.ceil(np.log2(recording.fs * 20)))))
     if nperseg < 16:
-        return []
+        return None
     f, puu, puy, pyy = welch_spectra(recording.base, recording.response, recording.fs, nperseg)
-    h = puy / puu[:, None]
-    coh = np.abs(puy) ** 2 / (puu[:, None] * pyy)
     n_segments = max(1, (n - nperseg) // (nperseg // 2) + 1)
-    excited = puu >= puu.max() * 1e-3
+    return f, puy / puu[:, None], coherence(puu, puy, pyy), puu >= puu.max() * 1e-3, n_segments
+
+
+def estimate_delays(recording: Recording) -> list[DelayEstimate]:
+    """Per output: time offset and sign from the quasi-static transmissibility (empty for an
+    output without a quasi-static band, e.g. a force input)."""
+    spectra = transmissibility_spectra(recording)
+    if spectra is None:
+        return []
+    f, h, coh, excited, n_segments = spectra
     out = []
     for k, name in enumerate(recording.sensors):
         est = _quasi_static_fit(f, h[:, k], coh[:, k], excited, n_segments)

@@ -21,8 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .frf import coherence, welch_spectra
-from .quality import MIN_COHERENCE, QUASI_STATIC_MAGNITUDE, QualityWarning
+from .quality import MIN_COHERENCE, QUASI_STATIC_MAGNITUDE, QualityWarning, transmissibility_spectra
 from .recording import Recording
 
 __all__ = ["unit_mismatch", "unit_conversion", "UNIT_CONVERSIONS"]
@@ -66,17 +65,14 @@ def unit_conversion(ratio: float) -> tuple[float, str] | None:
 def _quasi_static_gains(recording: Recording) -> np.ndarray | None:
     """Each output's median ``|T|`` over the lowest excited lines coherent on most outputs,
     (K,), or None when the record has too few such lines."""
-    n = recording.n_samples
-    nperseg = int(min(n // 8, 2 ** int(np.ceil(np.log2(recording.fs * 20)))))
-    if nperseg < 16:
+    spectra = transmissibility_spectra(recording)
+    if spectra is None:
         return None
-    f, puu, puy, pyy = welch_spectra(recording.base, recording.response, recording.fs, nperseg)
-    excited = (puu >= puu.max() * 1e-3) & (f > 0)
-    lines = np.flatnonzero(excited & (np.median(coherence(puu, puy, pyy), axis=1) >= MIN_COHERENCE))
+    f, h, coh, excited, _ = spectra
+    lines = np.flatnonzero(excited & (f > 0) & (np.median(coh, axis=1) >= MIN_COHERENCE))
     if lines.size < QUASI_STATIC_LINES:
         return None
-    lines = lines[:QUASI_STATIC_LINES]
-    return np.median(np.abs(puy[lines] / puu[lines, None]), axis=0)
+    return np.median(np.abs(h[lines[:QUASI_STATIC_LINES]]), axis=0)
 
 
 def unit_mismatch(recording: Recording) -> list[QualityWarning]:
