@@ -85,9 +85,10 @@ def test_inverse_filter_kernel_matches_lfilter():
 
 def test_kernels_match_references_at_sweep_orders_and_short_records():
     """Orders of the sweep (the four-accumulator sums and their remainders, four-signal
-    groups with a partial last group) and records shorter than the filter."""
+    groups with a partial last group), records shorter than the filter, and records over
+    several of the residual's time tiles (a partial last tile, lags across tile edges)."""
     rng = np.random.default_rng(3)
-    for n, order, n_sig in ((600, 11, 3), (600, 30, 6), (600, 4, 5), (7, 9, 2)):
+    for n, order, n_sig in ((600, 11, 3), (600, 30, 6), (600, 4, 5), (7, 9, 2), (2500, 12, 3), (1030, 30, 1)):
         c = np.concatenate([[1.0], 0.4 * rng.standard_normal(order) / order])
         a = np.concatenate([[1.0], 0.4 * rng.standard_normal(order + 2) / order])
         x = rng.standard_normal((n_sig, n))
