@@ -165,7 +165,21 @@ def _shared_normal_equations(ys, uT, state, variances, cols, na, p_k, t0, t1, oe
     return _Arrow(aa, ab, bb, ga, gb)
 
 
-def _levenberg_marquardt(theta, state, evaluate, linearise, project, max_iter, tol, stop="expected", unit=None):
+@dataclass(frozen=True)
+class _Progress:
+    """Where a Levenberg-Marquardt run stood when its iteration cap stopped it: the
+    damping, its growth factor, the crawl count and the iterations done. Passed back in,
+    the run continues exactly as if the cap had been higher."""
+
+    damping: float = 1e-4
+    grow: float = 2.0
+    crawling: int = 0
+    iterations: int = 0
+
+
+def _levenberg_marquardt(
+    theta, state, evaluate, linearise, project, max_iter, tol, stop="expected", unit=None, progress=None
+):
     """Levenberg-Marquardt on a Gauss-Newton model, shared by every fit.
 
     ``evaluate(theta) -> (state, objective)``; ``linearise(state)`` gives the normal
@@ -181,16 +195,19 @@ def _levenberg_marquardt(theta, state, evaluate, linearise, project, max_iter, t
     Both also stop when no step at any damping lowers the objective: a minimum to numerical
     precision, or on the stability boundary kept for C. ``unit`` (the objective change that
     is one unit of 2 log-likelihood) adds the crawl rule: CRAWL_STEPS floor-damped steps in
-    a row each worth less than CRAWL_LOGLIK units end the fit as converged. Returns
-    ``(theta, state, iterations, converged)``.
+    a row each worth less than CRAWL_LOGLIK units end the fit as converged. ``progress``
+    (a :class:`_Progress` this function returned at its cap, with the ``theta`` and ``state``
+    it returned) continues that run; ``max_iter`` then counts its iterations too. Returns
+    ``(theta, state, iterations, converged, progress)``; ``progress`` is None unless the cap
+    stopped the run.
     """
     objective = evaluate(theta)[1]
-    lm, grow = 1e-4, 2.0
-    crawling = 0
-    for it in range(1, max_iter + 1):
+    start = progress or _Progress()
+    lm, grow, crawling = start.damping, start.grow, start.crawling
+    for it in range(start.iterations + 1, max_iter + 1):
         normal = linearise(state)
         if stop == "expected" and normal.solve(0.0) @ normal.gradient < tol * objective:
-            return theta, state, it, True
+            return theta, state, it, True, None
         while lm < 1e10:
             step = normal.solve(lm)
             trial = project(theta + step)
@@ -199,7 +216,7 @@ def _levenberg_marquardt(theta, state, evaluate, linearise, project, max_iter, t
                 break
             lm, grow = lm * grow, grow * 2.0
         else:
-            return theta, state, it, True
+            return theta, state, it, True, None
         gauss_newton = lm <= 10.0 * _LM_FLOOR
         predicted = 2.0 * step @ normal.gradient - normal.curvature(step)
         gain = (objective - objective_t) / predicted if predicted > 0 else 0.0
@@ -209,5 +226,6 @@ def _levenberg_marquardt(theta, state, evaluate, linearise, project, max_iter, t
         crawling = crawling + 1 if small else 0
         theta, state, objective = trial, state_t, objective_t
         if (stop == "decrease" and decrease < tol) or crawling >= CRAWL_STEPS:
-            return theta, state, it, True
-    return theta, state, max_iter, False
+            return theta, state, it, True, None
+    done = max(max_iter, start.iterations)
+    return theta, state, done, False, _Progress(lm, grow, crawling, done)

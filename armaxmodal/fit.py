@@ -36,6 +36,7 @@ from ._gauss_newton import (
     _inverse,
     _levenberg_marquardt,
     _normal_equations,
+    _Progress,
     _shared_normal_equations,
     _signals,
     _solve,
@@ -223,6 +224,20 @@ def fit_armax(
     -------
     ArmaxFit
     """
+    return _fit(
+        data, (na, nb, nc, nk), fs=fs, shared_poles=shared_poles, output_error=output_error, max_iter=max_iter,
+        tol=tol, stop=stop, warn=warn, start=start,
+    )[0]  # fmt: skip
+
+
+def _fit(
+    data, orders, *, fs=None, shared_poles=False, output_error=False, max_iter=100, tol=1e-6, stop="expected",
+    warn=True, start=None, resume=None, covariance=True,
+):  # fmt: skip
+    """:func:`fit_armax`'s work, returning ``(fit, checkpoint)``. Shared-pole fits only:
+    ``resume`` (the ``checkpoint`` of an earlier fit of the same data, orders and form)
+    continues that fit, and ``covariance=False`` leaves the covariances out (empty) for a
+    fit judged by its criterion alone; ``checkpoint`` is None for per-sensor fits."""
     if stop not in ("expected", "decrease"):
         raise ValueError(f"stop: expected 'expected' or 'decrease', got {stop!r}.")
     if isinstance(max_iter, bool) or not float(max_iter).is_integer() or max_iter < 1:
@@ -230,7 +245,7 @@ def fit_armax(
     if not (np.isfinite(tol) and tol > 0):
         raise OrderError(f"tol: expected a finite number > 0, got {tol!r}.")
     u, y, fs, sensors, inputs = _unpack(data, fs)
-    na, nb, nc, nk = _check_orders(na, nb, 0 if output_error else nc, nk)
+    na, nb, nc, nk = _check_orders(orders[0], orders[1], 0 if output_error else orders[2], orders[3])
     if abs(nk) > y.shape[0] // 4:
         raise OrderError(
             f"nk = {nk} moves the input by {abs(nk)} of the record's {y.shape[0]} samples ({abs(nk) / fs:g} s): "
@@ -242,49 +257,55 @@ def fit_armax(
     # Filtering by 1/C from rest commutes with delays, not with advances, so this keeps the
     # prediction errors and their gradient exact.
     lead = max(0, -nk)
-    y_fit, u_fit, nk_fit = y[: y.shape[0] - lead], u[lead:], nk + lead
-    n = y_fit.shape[0]
-    t0 = max(na, nc, nk_fit + nb - 1, 0)
-    t1 = n
-    n_in = u.shape[1]
+    y_fit, uT, nk_fit = y[: y.shape[0] - lead], np.ascontiguousarray(u[lead:].T), nk + lead
+    t0, t1 = max(na, nc, nk_fit + nb - 1, 0), y_fit.shape[0]
+    _check_record_supports(y_fit.shape[0], t1 - t0, (na, nb, nc, nk), u.shape[1], y.shape[1], shared_poles)
+    thetas0 = None if start is None else _start_parameters(start, (na, nb, nc, nk), shared_poles, sensors)
+    window = (na, nb, nc, nk_fit, t0, t1)
+    checkpoint = None
+    if shared_poles:
+        theta0 = None if thetas0 is None else np.concatenate([thetas0[0][:na]] + [th[na:] for th in thetas0])
+        thetas, info, checkpoint = _fit_shared(y_fit, uT, *window, max_iter, tol, output_error, theta0, stop, resume)
+        if covariance:
+            _shared_covariance(y_fit, uT, *window, info, output_error)
+        else:
+            del info["state"]
+            info["covariance"] = []
+    else:
+        thetas, info = [], []
+        for k in range(y.shape[1]):
+            th, inf = _fit_single(
+                np.ascontiguousarray(y_fit[:, k]), uT, *window, max_iter, tol, output_error,
+                None if thetas0 is None else thetas0[k], stop,
+            )  # fmt: skip
+            thetas.append(th)
+            info.append(inf)
+        info = _merge_single_info(info)
+    orders = (na, nb, nc, nk)
+    fit, valid = _assemble(thetas, info, orders, output_error, u, y, fs, sensors, inputs, t0, lead, shared_poles)
+    if warn and not np.all(fit.converged):
+        _warn_not_converged(sensors, np.asarray(info["converged"]), valid, max_iter, orders)
+    return fit, checkpoint
+
+
+def _check_record_supports(n, n_eff, orders, n_in, n_out, shared_poles) -> None:
+    na, nb, nc, nk = orders
     p_single = na + n_in * nb + nc
-    p_needed = p_single if not shared_poles else na + y.shape[1] * (n_in * nb + nc)
-    n_eff = t1 - t0
-    if n_eff * (y.shape[1] if shared_poles else 1) < _MIN_SAMPLES_PER_PARAMETER * p_needed or n_eff < 2 * p_single:
+    p_needed = p_single if not shared_poles else na + n_out * (n_in * nb + nc)
+    if n_eff * (n_out if shared_poles else 1) < _MIN_SAMPLES_PER_PARAMETER * p_needed or n_eff < 2 * p_single:
         raise OrderError(
             f"orders na={na}, nb={nb}, nc={nc}, nk={nk} give {p_needed} parameters; the record has "
             f"{n} samples ({n_eff} usable), too few (need about "
             f"{_MIN_SAMPLES_PER_PARAMETER * p_single} per sensor). Lower the orders or use a longer record."
         )
-    uT = np.ascontiguousarray(u_fit.T)
-    thetas0 = None if start is None else _start_parameters(start, (na, nb, nc, nk), shared_poles, sensors)
-    if shared_poles:
-        theta0 = None if thetas0 is None else np.concatenate([thetas0[0][:na]] + [th[na:] for th in thetas0])
-        thetas, info = _fit_shared(y_fit, uT, na, nb, nc, nk_fit, t0, t1, max_iter, tol, output_error, theta0, stop)
-    else:
-        thetas, info = [], []
-        for k in range(y.shape[1]):
-            th, inf = _fit_single(
-                np.ascontiguousarray(y_fit[:, k]),
-                uT,
-                na,
-                nb,
-                nc,
-                nk_fit,
-                t0,
-                t1,
-                max_iter,
-                tol,
-                output_error,
-                None if thetas0 is None else thetas0[k],
-                stop,
-            )
-            thetas.append(th)
-            info.append(inf)
-        info = _merge_single_info(info)
+
+
+def _assemble(thetas, info, orders, output_error, u, y, fs, sensors, inputs, t0, lead, shared_poles):
+    """The :class:`ArmaxFit` of fitted parameter vectors, and which of its models are valid."""
+    na, nb, nc, nk = orders
     models = []
     for k, theta in enumerate(thetas):
-        a, b, c = _unpack_theta(theta, na, nb, nc, n_in)
+        a, b, c = _unpack_theta(theta, na, nb, nc, u.shape[1])
         c = a.copy() if output_error else c
         models.append(ArmaxModel(a, b, c, nk, fs, float(info["noise_variance"][k]), sensors[k], inputs))
     fit_pct = np.array([_nrmse_fit(y[:, k], m.simulate(u), t0, y.shape[0] - lead) for k, m in enumerate(models)])
@@ -293,25 +314,21 @@ def fit_armax(
     valid = np.array(
         [np.all(np.abs(m.poles()) < 1.0) and np.isfinite(v) for m, v in zip(models, info["loss"], strict=True)]
     )
-    stopped = np.asarray(info["converged"])
-    info["converged"] = stopped & valid
-    result = ArmaxFit(
+    fit = ArmaxFit(
         models=tuple(models),
         shared_poles=shared_poles,
-        orders=(na, nb, nc, nk),
+        orders=orders,
         loss=info["loss"],
         noise_variance=info["noise_variance"],
         fit_percent=fit_pct,
         iterations=info["iterations"],
-        converged=info["converged"],
+        converged=np.asarray(info["converged"]) & valid,
         covariance=tuple(info["covariance"]),
         joint_covariance=info.get("joint_covariance"),
-        n_samples=n_eff,
+        n_samples=y.shape[0] - lead - t0,
         fs=fs,
     )
-    if warn and not np.all(result.converged):
-        _warn_not_converged(sensors, stopped, valid, max_iter, (na, nb, nc, nk))
-    return result
+    return fit, valid
 
 
 def _warn_not_converged(sensors, stopped, valid, max_iter, orders) -> None:
@@ -612,7 +629,7 @@ def _fit_single(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=N
 
     state, _ = evaluate(theta)
     unit = state[1] / (t1 - t0)  # 2 log L = -N log V: a unit is a change of V by V / N
-    theta, state, it, converged = _levenberg_marquardt(
+    theta, state, it, converged, _ = _levenberg_marquardt(
         theta, state, evaluate, linearise, lambda th: _project(th, na, nb, nc, n_in, oe), max_iter, tol, stop, unit
     )
     eps, loss, c = state
@@ -684,14 +701,29 @@ def _shared_start(ys, uT, na, nb, nc, nk, t0, t1, oe, evaluate):
     return theta, state, losses
 
 
-def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=None, stop="expected"):
+@dataclass(frozen=True)
+class _Checkpoint:
+    """Where a shared-pole fit stopped: enough to continue it bit for bit as if its
+    iteration cap had been higher (``_fit(..., resume=)``). The sweep continues the delay
+    choice's short fits instead of starting them again."""
+
+    theta: np.ndarray
+    variances: np.ndarray  # the noise variances weighting the next iterations
+    iterations: int  # done before the Levenberg-Marquardt run in progress
+    progress: _Progress | None  # that run's state; None between runs
+    converged: bool  # stopped by the rule: nothing is left to do
+
+
+def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=None, stop="expected", resume=None):
     """Joint maximum likelihood with per-sensor noise variances.
 
     Alternates a weighted least-squares Levenberg-Marquardt solve at fixed variances
     (a true Gauss-Newton problem, so it converges fast) with the variance update
     ``lambda_k = V_k / N``; at the fixed point this maximises the concentrated likelihood
     ``-N/2 sum_k log V_k``. Gauss-Newton on ``sum_k log V_k`` directly would drop a Hessian
-    term that does not vanish at the optimum and crawl.
+    term that does not vanish at the optimum and crawl. ``resume`` (a :class:`_Checkpoint`)
+    continues a fit instead of starting one. Returns ``(thetas, info, checkpoint)``; ``info``
+    lacks the covariances, which :func:`_shared_covariance` adds.
     """
     n_out = y.shape[1]
     n_in = uT.shape[0]
@@ -704,15 +736,19 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=N
         out = [_residual_and_loss(ys[k], uT, _local(th, k, na, p_k), na, nb, nc, nk, t0, t1, oe) for k in range(n_out)]
         return out, np.array([o[1] for o in out])
 
-    if theta0 is not None:
-        theta = _project_shared(theta0, na, nb, nc, n_in, n_out, oe)
+    if resume is not None:
+        theta, variances, total_iterations = resume.theta, resume.variances, resume.iterations
+        progress, converged = resume.progress, resume.converged
         state, losses = evaluate(theta)
     else:
-        theta, state, losses = _shared_start(ys, uT, na, nb, nc, nk, t0, t1, oe, evaluate)
-    variances = losses / n_eff
-    total_iterations = 0
-    converged = False
-    while total_iterations < max_iter:
+        if theta0 is not None:
+            theta = _project_shared(theta0, na, nb, nc, n_in, n_out, oe)
+            state, losses = evaluate(theta)
+        else:
+            theta, state, losses = _shared_start(ys, uT, na, nb, nc, nk, t0, t1, oe, evaluate)
+        variances, total_iterations, progress, converged = losses / n_eff, 0, None, False
+    paused = None
+    while not converged and total_iterations < max_iter:
         weights = 1.0 / variances
 
         def weighted(th, weights=weights):
@@ -722,7 +758,7 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=N
         def linearise(st, variances=variances):
             return _shared_normal_equations(ys, uT, st[0], variances, cols, na, p_k, t0, t1, oe)
 
-        theta, (state, losses), used, inner_converged = _levenberg_marquardt(
+        theta, (state, losses), used, inner_converged, progress = _levenberg_marquardt(
             theta,
             (state, losses),
             weighted,
@@ -732,27 +768,36 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=N
             tol,
             stop,
             1.0,  # the objective sum_k V_k / lambda_k changes with 2 log L one for one
+            progress,
         )
+        if progress is not None:  # the cap stopped this run mid-way: continue it from here
+            paused = _Checkpoint(theta, variances, total_iterations, progress, False)
+            progress = None
         total_iterations += used
         new_variances = losses / n_eff
         settled = np.max(np.abs(new_variances / variances - 1.0)) < 1e-3
         variances = new_variances
-        if inner_converged and settled:
-            converged = True
-            break
-    lam = losses / max(n_eff - (na / n_out + p_k), 1)
-    joint = _inverse(_shared_normal_equations(ys, uT, state, lam, cols, na, p_k, t0, t1, oe).full())
-    covs = [joint[np.ix_(_shared_index(k, na, p_k), _shared_index(k, na, p_k))] for k in range(n_out)]
-    thetas = [_local(theta, k, na, p_k) for k in range(n_out)]
+        converged = inner_converged and settled
+    checkpoint = paused or _Checkpoint(theta, variances, total_iterations, None, converged)
     info = {
         "loss": losses / n_eff,
-        "noise_variance": lam,
+        "noise_variance": losses / max(n_eff - (na / n_out + p_k), 1),
         "iterations": np.full(n_out, total_iterations),
         "converged": np.full(n_out, converged),
-        "covariance": covs,
-        "joint_covariance": joint,
+        "state": state,
     }
-    return thetas, info
+    return [_local(theta, k, na, p_k) for k in range(n_out)], info, checkpoint
+
+
+def _shared_covariance(y, uT, na, nb, nc, nk, t0, t1, info, oe=False):
+    """Add the joint and per-sensor covariances to a shared fit's ``info`` (in place)."""
+    n_out, p_k = y.shape[1], uT.shape[0] * nb + nc
+    ys = [np.ascontiguousarray(y[:, k]) for k in range(n_out)]
+    cols = _columns(na, nb, nc, nk, uT.shape[0])
+    lam = info["noise_variance"]
+    joint = _inverse(_shared_normal_equations(ys, uT, info.pop("state"), lam, cols, na, p_k, t0, t1, oe).full())
+    info["covariance"] = [joint[np.ix_(_shared_index(k, na, p_k), _shared_index(k, na, p_k))] for k in range(n_out)]
+    info["joint_covariance"] = joint
 
 
 def _project_shared(theta, na, nb, nc, n_in, n_out, oe=False):

@@ -23,11 +23,11 @@ import pandas as pd
 
 from ._threads import one_blas_thread
 from .exceptions import OrderError
-from .fit import ArmaxFit, fit_armax
+from .fit import ArmaxFit, _fit, fit_armax
 from .frf import excited_band
 from .frf_check import peak_support
 from .modal import mode_record
-from .orders import _fit_or_none, _map, default_nb, default_nc, information_criterion
+from .orders import _map, default_nb, default_nc, information_criterion
 from .prepare import Preparation, prepare
 from .quality import QualityWarning
 from .recording import Recording
@@ -52,6 +52,8 @@ FINISHED_MAX_SHIFT = 0.05
 NK_SEARCH = range(0, -7, -1)
 #: when the best delay is the most non-causal searched, this many more are tried once
 NK_EXTENSION = 3
+#: iteration cap of the delay choice's fits; the sweep continues those of the chosen delay
+DELAY_CHOICE_ITERATIONS = 8
 #: samples the record must hold per parameter of one sensor's model (about 3 na + 1 - nk) at
 #: the sweep's highest order: fewer, and the fits describe the noise (and take minutes each)
 SAMPLES_PER_PARAMETER = 20
@@ -163,22 +165,31 @@ def _row(source, fit, r, shape, energy):
     }
 
 
-def _fit_job(recording: Recording, job, max_iter: int, tol: float):
-    source, orders = job
+def _fit_job(recording: Recording, job, max_iter: int, tol: float, covariance: bool = True):
+    """``(fit, checkpoint)`` of a sweep job ``(source, orders[, checkpoint])``: the shared
+    fit continues the checkpoint when there is one; ``(None, None)`` when the record cannot
+    support the orders."""
+    source, orders = job[:2]
     rec = recording if source == SHARED else recording.select([source])
-    return _fit_or_none(rec, orders, shared_poles=source == SHARED, max_iter=max_iter, tol=tol, stop="decrease")
+    try:
+        return _fit(
+            rec, orders, shared_poles=source == SHARED, max_iter=max_iter, tol=tol, stop="decrease", warn=False,
+            resume=job[2] if len(job) > 2 else None, covariance=covariance,
+        )  # fmt: skip
+    except OrderError:
+        return None, None
 
 
 def _fit_and_poles(recording: Recording, job, max_iter: int, tol: float):
     """A sweep job run in a worker: the fit and its pole rows (computing the rows there
     keeps the parent's serial share small)."""
-    fit = _fit_job(recording, job, max_iter, tol)
+    fit = _fit_job(recording, job, max_iter, tol)[0]
     return fit, ([] if fit is None else _poles_of(fit, job[0]))
 
 
 def _job_cost(job, n_sensors: int) -> float:
     """Relative run time of a sweep fit: about linear in na and in the number of sensors."""
-    source, orders = job
+    source, orders = job[:2]
     return orders[0] * (n_sensors if source == SHARED else 1)
 
 
@@ -192,25 +203,24 @@ def choose_nk(recording: Recording, nk_values=range(0, -7, -1), na_values=(8, 10
 
 
 def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=True):
-    """``(nk, {(SHARED, orders): fit})`` -- the fits of the chosen delay are reused by the sweep."""
+    """``(nk, {(SHARED, orders): checkpoint})``: the chosen delay and where its fits stopped,
+    which the sweep continues instead of fitting those orders again."""
     jobs = [(SHARED, (na, default_nb(na, nk), default_nc(na), nk)) for na in na_values for nk in nk_values]
     # BIC differences between delays are large; 8 iterations settle the choice (checked on
-    # every fixture, a lightly damped structure and the real recordings against 20 and 50)
+    # every fixture, a lightly damped structure and the real recordings against 20 and 50).
+    # Only the criterion is needed here: no covariances.
     fits = _map(
-        partial(_fit_job, recording, max_iter=8, tol=tol),
+        partial(_fit_job, recording, max_iter=DELAY_CHOICE_ITERATIONS, tol=tol, covariance=False),
         jobs,
         n_jobs,
         cost=partial(_job_cost, n_sensors=len(recording.sensors)),
     )
-    scores = [information_criterion(f) if f is not None else np.inf for f in fits]
+    scores = [information_criterion(f) if f is not None else np.inf for f, _ in fits]
     nk = int(jobs[int(np.argmin(scores))][1][3])
     if extend and nk == min(nk_values):
         # the best delay is the most non-causal one searched: look NK_EXTENSION further, once
         return _choose_nk(recording, range(nk, nk - NK_EXTENSION - 1, -1), na_values, n_jobs, tol, extend=False)
-    # only fits that stopped on the sweep's rule, not at this stage's 8-iteration cap, may
-    # stand in the sweep
-    reuse = {job: fit for job, fit in zip(jobs, fits, strict=True) if job[1][3] == nk and fit is not None}
-    return nk, {job: fit for job, fit in reuse.items() if fit.converged.all()}
+    return nk, {job: ck for job, (_, ck) in zip(jobs, fits, strict=True) if job[1][3] == nk and ck is not None}
 
 
 def stabilisation_diagram(
@@ -278,11 +288,14 @@ def stabilisation_diagram(
         order_list = [(na, default_nb(na, nk), default_nc(na), nk) for na in orders]
         # single sensors cannot support high orders (their bounds are wide): stop them earlier
         jobs = [(s, o) for o in order_list for s in sources if s == SHARED or o[0] <= per_sensor_max_order]
-        todo = [job for job in jobs if job not in known]
+        # the delay choice's fits of these orders continue from where they stopped, exactly
+        # as if fitted here from the start (unless this sweep's cap is below theirs)
+        if max_iter < DELAY_CHOICE_ITERATIONS:
+            known = {}
+        todo = [job + ((known[job],) if job in known else ()) for job in jobs]
         from tqdm import tqdm
 
         with tqdm(total=len(jobs), desc="stabilisation sweep", unit="fit", disable=not progress) as bar:
-            bar.update(len(jobs) - len(todo))
             fitted = _map(
                 partial(_fit_and_poles, recording, max_iter=max_iter, tol=tol),
                 todo,
@@ -290,8 +303,7 @@ def stabilisation_diagram(
                 bar,
                 cost=partial(_job_cost, n_sensors=len(recording.sensors)),
             )
-        done = dict(zip(todo, fitted, strict=True))
-        done.update({job: (fit, _poles_of(fit, job[0])) for job, fit in known.items() if job in jobs})
+        done = dict(zip(jobs, fitted, strict=True))
         rows, kept = [], {}
         for source, o in jobs:
             fit, fit_rows = done[(source, o)]

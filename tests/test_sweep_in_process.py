@@ -79,27 +79,57 @@ def test_the_delay_is_the_lowest_bic_one(ride, diagram):
     assert [o for o in diagram.orders] == [(na, default_nb(na, nk), default_nc(na), nk) for na in ORDERS]
 
 
-def test_the_delay_choice_hands_the_sweep_its_converged_fits_at_that_delay(ride):
-    """The fits the sweep may reuse are exactly the delay choice's converged fits at the
-    chosen delay, each equal to the same fit written out."""
+def _same_fit(a, b) -> bool:
+    """Bit for bit: every coefficient, loss, count and covariance."""
+    models = zip(a.models, b.models, strict=True)
+    fields = ("loss", "iterations", "converged", "joint_covariance")
+    return all(np.array_equal(getattr(ma, k), getattr(mb, k)) for ma, mb in models for k in "abc") and all(
+        np.array_equal(getattr(a, k), getattr(b, k)) for k in fields
+    )
+
+
+def test_the_sweep_continues_the_delay_choice_fits_exactly(ride):
+    """The delay choice hands the sweep where each of its fits at the chosen delay stopped
+    (after at most 8 iterations); continued in the sweep, each is bit for bit the fit the
+    sweep would have made from the start."""
+    from armaxmodal._threads import one_blas_thread
     from armaxmodal.stabilisation import _choose_nk
 
     rec = ride[1]
-    nk, reuse = _choose_nk(rec, NK_SEARCH, (4, 6), 1)
-    assert nk == 0 and reuse
-    for (source, (na, nb, nc, k)), fit in reuse.items():
-        assert source == SHARED and k == nk and (nb, nc) == (default_nb(na, nk), default_nc(na))
-        ref = am.fit_armax(
-            rec, na, nb, nc, nk, shared_poles=True, max_iter=8, tol=SWEEP_TOL, stop="decrease", warn=False
-        )
-        assert fit.converged.all() and ref.converged.all()
-        np.testing.assert_allclose(fit.models[0].a, ref.models[0].a, rtol=1e-9, atol=1e-12)
-    converged = [
-        na for na in (4, 6)
-        if am.fit_armax(rec, na, default_nb(na, nk), default_nc(na), nk, shared_poles=True, max_iter=8,
-                        tol=SWEEP_TOL, stop="decrease", warn=False).converged.all()
-    ]  # fmt: skip
-    assert sorted(orders[0] for _, orders in reuse) == converged
+    with one_blas_thread():
+        nk, checkpoints = _choose_nk(rec, NK_SEARCH, (4, 6), 1)
+        assert nk == 0
+        assert sorted(checkpoints) == [(SHARED, (na, default_nb(na, nk), default_nc(na), nk)) for na in (4, 6)]
+        for job, checkpoint in checkpoints.items():
+            continued = _fit_job(rec, job + (checkpoint,), 30, SWEEP_TOL)[0]
+            fresh = am.fit_armax(
+                rec, *job[1], shared_poles=True, max_iter=30, tol=SWEEP_TOL, stop="decrease", warn=False
+            )
+            assert _same_fit(continued, fresh)
+
+
+@pytest.mark.parametrize(
+    ("na", "cap", "where"), [(6, 3, "mid-run"), (8, 8, "mid-run"), (4, 5, "between runs"), (4, 8, "converged")]
+)
+def test_a_fit_stopped_by_its_cap_continues_exactly(ride, na, cap, where):
+    """Stopped after ``cap`` iterations -- mid-way through a Levenberg-Marquardt run, between
+    two runs of the noise-variance alternation, or converged -- and continued to 30, a
+    shared-pole fit equals the fit capped at 30 from the start, bit for bit: the damping,
+    its growth, the crawl count and the variances weighting the run are all carried over."""
+    from armaxmodal._threads import one_blas_thread
+    from armaxmodal.fit import _fit
+
+    rec = ride[1]
+    options = {"shared_poles": True, "tol": SWEEP_TOL, "stop": "decrease", "warn": False}
+    orders = (na, default_nb(na, -1), default_nc(na), -1)
+    with one_blas_thread():
+        short, checkpoint = _fit(rec, orders, max_iter=cap, covariance=False, **options)
+        fresh = _fit(rec, orders, max_iter=30, **options)[0]
+        continued = _fit(rec, orders, max_iter=30, resume=checkpoint, **options)[0]
+    kind = "converged" if checkpoint.converged else "mid-run" if checkpoint.progress else "between runs"
+    assert kind == where and short.covariance == ()
+    assert fresh.iterations[0] > cap or kind == "converged"
+    assert _same_fit(continued, fresh)
 
 
 def test_a_late_input_past_the_search_range_is_found_by_the_extension(ride):
@@ -189,20 +219,24 @@ def test_the_segment_spread_is_that_of_refits_on_thirds(diagram):
 def test_one_sweep_job_fits_its_own_source(diagram):
     rec = diagram.recording
     orders = diagram.orders[1]
-    single = _fit_job(rec, (rec.sensors[1], orders), 30, SWEEP_TOL)
+    single, no_checkpoint = _fit_job(rec, (rec.sensors[1], orders), 30, SWEEP_TOL)
+    assert no_checkpoint is None  # only shared-pole fits are continued
     alone = am.fit_armax(rec.select([rec.sensors[1]]), *orders, max_iter=30, tol=SWEEP_TOL, stop="decrease")
     assert not single.shared_poles and len(single.models) == 1
     np.testing.assert_allclose(single.models[0].a, alone.models[0].a, rtol=1e-9, atol=1e-12)
-    shared = _fit_job(rec, (SHARED, orders), 30, SWEEP_TOL)
+    shared, checkpoint = _fit_job(rec, (SHARED, orders), 30, SWEEP_TOL)
     assert shared.shared_poles and len(shared.models) == len(rec.sensors)
+    assert checkpoint.iterations <= shared.iterations[0]
+    assert np.array_equal(checkpoint.theta[: orders[0]], shared.models[0].a[1:])
     # orders the record cannot carry are skipped, not raised
-    assert _fit_job(rec, (SHARED, (400, 401, 400, 0)), 30, SWEEP_TOL) is None
+    assert _fit_job(rec, (SHARED, (400, 401, 400, 0)), 30, SWEEP_TOL) == (None, None)
 
 
 def test_job_cost_scales_with_order_and_sensors():
     assert _job_cost((SHARED, (10, 11, 10, 0)), 4) == 40
     assert _job_cost(("head", (10, 11, 10, 0)), 4) == 10
     assert _job_cost(("head", (6, 7, 6, -2)), 4) == 6
+    assert _job_cost((SHARED, (10, 11, 10, 0), None), 4) == 40  # a continued fit
 
 
 def _late_channel(rec: Recording, k: int, lag: int) -> Recording:
@@ -317,3 +351,14 @@ def test_the_diagram_plots_the_selection(diagram):
     top2, _ = diagram.plot(ax=ax)
     assert top2 is ax and not top2.texts  # no selection: no mode labels
     plt.close("all")
+
+
+def test_a_sweep_capped_below_the_delay_choice_fits_its_orders_afresh(ride):
+    """The delay choice's fits ran DELAY_CHOICE_ITERATIONS iterations; a sweep capped lower
+    must not take them over (they would exceed its cap): every fit respects the sweep's cap."""
+    from armaxmodal.stabilisation import DELAY_CHOICE_ITERATIONS
+
+    cap = 2
+    assert cap < DELAY_CHOICE_ITERATIONS
+    diagram = stabilisation_diagram(ride[1], range(4, 9, 2), per_sensor=False, max_iter=cap, n_jobs=1)
+    assert max(int(fit.iterations.max()) for fit in diagram.fits.values()) == cap
