@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .frf import measured_frf, modal_frf
+from .frf_check import MIN_COHERENCE as COHERENT
 
 __all__ = ["plot_stabilisation", "plot_prediction"]
 
@@ -15,6 +16,7 @@ _STYLE = {
     "f+d": ("s", "#ff7f0e", "stable f, ξ"),
     "f+d+v": ("*", "#d62728", "stable f, ξ, shape"),
 }
+_LOW_COHERENCE = "#fff3b0"  # shading of the bands where some sensor's coherence is low
 
 
 def plot_stabilisation(diagram, selection=None, ax=None):
@@ -64,9 +66,9 @@ def plot_stabilisation(diagram, selection=None, ax=None):
     ax_f = ax.twinx()
     for k, s in enumerate(rec.sensors):
         ax_f.semilogy(f, np.abs(h[:, k]), lw=1.0, alpha=0.7, label=f"|H1| {s}")
-    low = np.min(coh, axis=1) < 0.8
+    low = np.min(coh, axis=1) < COHERENT
     for lo, hi in _runs(f, low):
-        ax.axvspan(lo, hi, color="#fff3b0", alpha=0.5, zorder=0, lw=0)
+        ax.axvspan(lo, hi, color=_LOW_COHERENCE, alpha=0.5, zorder=0, lw=0)
     if selection is not None:
         rebuilt = modal_frf(f, selection.modes.freq_hz, selection.modes.damping, selection.shapes)
         for k in range(len(rec.sensors)):
@@ -95,12 +97,16 @@ def plot_stabilisation(diagram, selection=None, ax=None):
         )
     lo, hi = _frequency_span(diagram)
     ax.set_xlim(lo, hi)
-    _limit_frf_axis(ax_f, f, h, lo, hi)
+    _limit_frf_axis(ax_f, f, h, coh, lo, hi)
     if selection is not None:
         _label_modes(ax, selection.modes)
     ax_f.set_ylabel("|FRF| (output / base acceleration)")
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = ax_f.get_legend_handles_labels()
+    if low.any():  # say what the shading is
+        from matplotlib.patches import Patch
+
+        h2, l2 = h2 + [Patch(color=_LOW_COHERENCE, alpha=0.5)], l2 + [f"coherence < {COHERENT:g}"]
     fig.legend(h1 + h2, l1 + l2, fontsize=7, loc="outside lower center", ncol=5, frameon=False)
     ax_d.set_ylabel("damping ratio")
     ax_d.set_xlabel("frequency (Hz)")
@@ -121,11 +127,15 @@ def _frequency_span(diagram) -> tuple[float, float]:
     return 0.0, min(f_hi, 1.1 * excited_band(rec)[1])
 
 
-def _limit_frf_axis(ax_f, f, h, lo, hi, decades: float = 4.0) -> None:
-    """Log FRF axis over the curves inside the span, at most ``decades`` below the largest
-    (a near-zero channel, e.g. a signal-generator reference, would stretch it)."""
+def _limit_frf_axis(ax_f, f, h, coh, lo, hi, decades: float = 4.0) -> None:
+    """Log FRF axis over the curves inside the span where they are coherent (``coh`` >=
+    COHERENT, when any is), at most ``decades`` below the largest. Outside the input's band
+    an H1 is noise over noise and rose two decades above the structure's response on the
+    size benchmark's ride; a near-zero channel (a signal-generator reference) would stretch
+    the axis down."""
     inside = (f >= lo) & (f <= hi) & (f > 0)
-    mags = np.abs(h[inside])
+    mags, coherent = np.abs(h[inside]), coh[inside] >= COHERENT
+    mags = mags[coherent] if coherent.any() else mags.ravel()
     mags = mags[np.isfinite(mags) & (mags > 0)]
     if mags.size == 0:
         return

@@ -347,9 +347,36 @@ def test_the_diagram_plots_the_selection(diagram):
     labels = " ".join(t.get_text() for t in top.texts)
     for f in sel.modes.freq_hz:
         assert f"{f:.2f} Hz" in labels
+    legend = [t.get_text() for t in top.figure.legends[0].get_texts()]
+    assert ("coherence < 0.8" in legend) == bool(top.patches)  # the shading is explained
     fig, ax = plt.subplots()
     top2, _ = diagram.plot(ax=ax)
     assert top2 is ax and not top2.texts  # no selection: no mode labels
+    plt.close("all")
+
+
+def test_the_frf_axis_spans_the_coherent_curves():
+    """An H1 outside the input's band (noise over noise, incoherent) may rise decades above
+    the structure's response; a near-zero channel may fall decades below: neither sets the
+    axis."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from armaxmodal.plot import _limit_frf_axis
+
+    f = np.linspace(0, 50, 201)
+    h = np.column_stack([1 + 9 * np.exp(-((f - 10) ** 2)), np.full(f.size, 1e-9)])
+    coh = np.column_stack([np.where(f < 40, 0.95, 0.1), np.full(f.size, 0.9)])
+    h[f >= 40, 0] = 1e3  # incoherent junk above the band
+    _, ax = plt.subplots()
+    _limit_frf_axis(ax, f, h, coh, 0.0, 45.0)
+    lo, hi = ax.get_ylim()
+    assert hi == pytest.approx(2 * h[f < 40, 0].max()) and lo == pytest.approx(hi * 1e-4)
+    # nothing coherent: every curve inside the span counts
+    _limit_frf_axis(ax, f, h, np.zeros_like(coh), 0.0, 45.0)
+    assert ax.get_ylim()[1] == pytest.approx(2e3)
     plt.close("all")
 
 
