@@ -355,28 +355,31 @@ def test_the_diagram_plots_the_selection(diagram):
     plt.close("all")
 
 
-def test_the_frf_axis_spans_the_coherent_curves():
-    """An H1 outside the input's band (noise over noise, incoherent) may rise decades above
-    the structure's response; a near-zero channel may fall decades below: neither sets the
-    axis."""
+def test_the_frf_axis_spans_the_curves_inside_the_input_band():
+    """Beyond the input's excited band an H1 is noise over noise and may rise far above the
+    structure's response: the axis is set by the curves inside the band (twice their peak),
+    and a near-zero channel stretches it at most four decades down."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from armaxmodal.frf import excited_band, measured_frf
     from armaxmodal.plot import _limit_frf_axis
 
-    f = np.linspace(0, 50, 201)
-    h = np.column_stack([1 + 9 * np.exp(-((f - 10) ** 2)), np.full(f.size, 1e-9)])
-    coh = np.column_stack([np.where(f < 40, 0.95, 0.1), np.full(f.size, 0.9)])
-    h[f >= 40, 0] = 1e3  # incoherent junk above the band
+    s, _ = _two_mode_ride(30.0)
+    ride = am.simulate_recording(s, am.random_vibration(50.0, 30.0, (0.5, 16.0), seed=3), 50.0, noise=0.05, seed=4)
+    diagram = _diagram(ride)
+    rec = diagram.recording
+    f, h, _ = measured_frf(rec)
+    top, _ = diagram.plot(select_modes(diagram, n_jobs=1, segments=0))
+    (frf_axis,) = [a for a in top.figure.axes if a.get_yscale() == "log"]
+    inside = (f > 0) & (f <= excited_band(rec)[1])
+    assert top.get_xlim()[1] > excited_band(rec)[1]  # the span reaches past the band ...
+    assert frf_axis.get_ylim()[1] == pytest.approx(2 * np.abs(h[inside]).max())  # ... its curves do not count
     _, ax = plt.subplots()
-    _limit_frf_axis(ax, f, h, coh, 0.0, 45.0)
-    lo, hi = ax.get_ylim()
-    assert hi == pytest.approx(2 * h[f < 40, 0].max()) and lo == pytest.approx(hi * 1e-4)
-    # nothing coherent: every curve inside the span counts
-    _limit_frf_axis(ax, f, h, np.zeros_like(coh), 0.0, 45.0)
-    assert ax.get_ylim()[1] == pytest.approx(2e3)
+    _limit_frf_axis(ax, f, np.column_stack([np.abs(h[:, 0]), np.full(f.size, 1e-12)]), 0.0, 50.0)
+    assert ax.get_ylim()[0] == pytest.approx(ax.get_ylim()[1] * 1e-4)
     plt.close("all")
 
 
