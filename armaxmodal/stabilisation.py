@@ -22,6 +22,7 @@ import numpy as np
 import pandas as pd
 
 from ._threads import one_blas_thread
+from .disturbance import disturbance_lines
 from .exceptions import OrderError
 from .fit import ArmaxFit, _fit, fit_armax
 from .frf import excited_band
@@ -104,7 +105,8 @@ class StabilisationDiagram:
     def warnings(self) -> list[QualityWarning]:
         """Data-quality findings of the preparation and of the sweep itself."""
         found = list(self.preparation.warnings) if self.preparation is not None else []
-        return found + _nk_edge_warning(self.orders[0][3], self.recording)
+        found += _nk_edge_warning(self.orders[0][3], self.recording)
+        return found + disturbance_lines(self.poles, self.tolerances.min_energy, self.recording, SHARED)
 
     def to_frame(self) -> pd.DataFrame:
         """The tidy pole table without the complex columns (for CSV)."""

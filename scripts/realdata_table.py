@@ -48,6 +48,9 @@ def _damaged(tmp: Path) -> dict:
     mg = d.copy()
     mg["head"] *= 1000 / 9.80665
     save("head in mg", mg)
+    hum = d.copy()
+    hum["legs"] += 0.3 * np.sin(2 * np.pi * 12.5 * hum["time"])
+    save("hum 0.3 m s⁻² at 12.5 Hz on legs", hum)
     drift = d.copy()
     drift[outs] += 0.05 * np.arange(len(d))[:, None] / 60.0
     save("drift 0.05 m per s^3", drift)

@@ -392,3 +392,39 @@ def test_a_sweep_capped_below_the_delay_choice_fits_its_orders_afresh(ride):
     assert cap < DELAY_CHOICE_ITERATIONS
     diagram = stabilisation_diagram(ride[1], range(4, 9, 2), per_sensor=False, max_iter=cap, n_jobs=1)
     assert max(int(fit.iterations.max()) for fit in diagram.fits.values()) == cap
+
+
+def _with_line(rec: Recording, channels: list[str], freq_hz: float, amp: float, on_input: bool = False) -> Recording:
+    """A sinusoid added to some outputs (and to the input)."""
+    line = amp * np.sin(2 * np.pi * freq_hz * rec.time)
+    y = rec.response.copy()
+    for name in channels:
+        y[:, rec.sensors.index(name)] += line
+    return Recording(rec.fs, rec.base + line if on_input else rec.base, y, rec.sensors, rec.input_name)
+
+
+def test_a_line_the_input_does_not_drive_is_named_as_a_periodic_disturbance(ride, diagram):
+    """A hum the base does not cause is an undamped pole of negligible residue at every order:
+    named with its frequency and the sensor whose own sweep shows it, never on the clean ride;
+    picked up on every channel, the input's own line is stated with its prominence."""
+    assert not [w for w in diagram.warnings if w.code == "periodic_disturbance"]
+    name = ride[1].sensors[1]
+    (w,) = [w for w in _diagram(_with_line(ride[1], [name], 7.3, 0.2)).warnings if w.code == "periodic_disturbance"]
+    assert w.value == pytest.approx(7.3, abs=0.005) and w.channels == (name,)
+    assert "in the outputs" in w.message and "armaxmodal diagnose" in w.message
+    everywhere = _with_line(ride[1], list(ride[1].sensors), 7.3, 0.6, on_input=True)
+    (w,) = [w for w in _diagram(everywhere).warnings if w.code == "periodic_disturbance"]
+    assert w.value == pytest.approx(7.3, abs=0.005) and "the input carries the line too (" in w.message
+
+
+def test_a_structure_damped_below_the_line_threshold_is_not_a_disturbance():
+    """Modes at 0.066 % and 0.089 % damping are as undamped as a hum, but the input drives
+    them (residues 11 % and 100 % of the strongest): modes, never a periodic disturbance."""
+    from armaxmodal.disturbance import UNDAMPED_LINE
+
+    s = am.Structure.from_chain([10.0, 5.0], [8000.0, 0.0], [0.5, 0.0], [12000.0], [0.3], ("m1", "m2"))
+    assert max(s.modes().damping) < UNDAMPED_LINE
+    rec = am.simulate_recording(s, am.random_vibration(50.0, 60.0, (0.5, 24.0), seed=3), 50.0, noise=0.05, seed=4)
+    diagram = _diagram(rec)
+    assert (diagram.poles.damping.abs() < UNDAMPED_LINE).sum() >= 8  # the sweep does see them undamped
+    assert not [w for w in diagram.warnings if w.code == "periodic_disturbance"]
