@@ -94,6 +94,25 @@ MUTANTS = [
         "out[s0 + j, :] = buf[j::4][::-1]",
         "filter lanes unpacked backwards (perf)",
     ),
+    # periodic disturbances seen by the sweep
+    (
+        "armaxmodal/disturbance.py",
+        "(pooled.damping.abs() < UNDAMPED_LINE) & (pooled.energy < min_energy * strongest)",
+        "(pooled.damping.abs() < UNDAMPED_LINE)",
+        "a driven lightly damped mode called a disturbance (line)",
+    ),
+    (
+        "armaxmodal/disturbance.py",
+        "if prominence >= INPUT_LINE_RATIO:",
+        "if prominence < INPUT_LINE_RATIO:",
+        "input's own line stated backwards (line)",
+    ),
+    (
+        "armaxmodal/diagnose/evidence.py",
+        "INPUT_LINE_P = 1e-6",
+        "INPUT_LINE_P = 1e-3",
+        "a chance input p vetoes a hum (line)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/test_guards.py",
