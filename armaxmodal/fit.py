@@ -753,7 +753,8 @@ def _fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=N
 
         def weighted(th, weights=weights):
             per_sensor, losses_t = evaluate(th)
-            return (per_sensor, losses_t), float(weights @ losses_t)
+            with np.errstate(invalid="ignore", over="ignore"):  # an unstable trial (inf loss) is rejected
+                return (per_sensor, losses_t), float(weights @ losses_t)
 
         def linearise(st, variances=variances):
             return _shared_normal_equations(ys, uT, st[0], variances, cols, na, p_k, t0, t1, oe)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import struct
 import tempfile
 from collections.abc import Callable, Sequence
@@ -28,6 +29,20 @@ __all__ = [
 ]
 
 _TIME_NAMES = ("time", "t", "time_s")
+# A time column named with its unit, as exports write it: "time (s)", "Time [ms]", "t_ms",
+# "timestamp_us"; the unit sets the scale to seconds.
+_TIME_UNIT = re.compile(
+    r"^(?:t|time|timestamp)(?:\s*[\(\[]\s*(s|sec|ms|us|µs)\s*[\)\]]|[_\s]+(s|sec|ms|us|µs))$", re.IGNORECASE
+)
+_TO_SECONDS = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
+
+
+def _time_scale(name: str) -> float | None:
+    """Seconds per unit of a time column called ``name``, or None if it is not one."""
+    if name.strip().lower() in _TIME_NAMES:
+        return 1.0
+    match = _TIME_UNIT.match(name.strip())
+    return _TO_SECONDS[(match.group(1) or match.group(2)).lower()] if match else None
 # Relative jitter allowed in a time column before it counts as non-uniform (device clocks
 # quantise to a microsecond: 1e-4 of a 120 Hz step).
 _TIME_JITTER = 1e-3
@@ -182,14 +197,9 @@ def _check_csv_layout(path: Path) -> None:
     ]
     if not lines:
         return
+    _check_separator(path, lines[:200])
     commas = [ln.count(",") for ln in lines[:200]]
     if max(commas) == 0:
-        for sep, name in ((";", "semicolons"), ("\t", "tabs")):
-            if sum(sep in ln for ln in lines[:200]) > 0.8 * len(lines[:200]):
-                raise DataError(
-                    f"{path.name}: the columns are separated by {name}, not commas; re-export as comma-separated "
-                    "CSV (with a '.' decimal point)."
-                )
         return
     fields = max(set(commas), key=commas.count)
     leading = next((i for i, c in enumerate(commas) if c == fields), 0)
@@ -198,6 +208,28 @@ def _check_csv_layout(path: Path) -> None:
             f"{path.name}: {leading} line(s) before the header have fewer fields than the data (first: "
             f"{lines[0][:40]!r}): metadata lines. Put '#' before each (they are then read as comments) or "
             "delete them. Xsens DOT exports are read as they are when you pass one file per sensor."
+        )
+
+
+def _check_separator(path: Path, lines: list[str]) -> None:
+    """Refuse semicolon- or tab-separated files by name: most lines hold the same number of
+    the separator. Such exports often write decimal commas too (a European spreadsheet),
+    which once read as 'metadata lines before the header'."""
+    import re
+
+    for sep, name in ((";", "semicolons"), ("\t", "tabs")):
+        counts = [ln.count(sep) for ln in lines]
+        fields = max(set(counts), key=counts.count)
+        if fields == 0 or counts.count(fields) < 0.8 * len(counts):
+            continue
+        leading = next(i for i, c in enumerate(counts) if c == fields)
+        decimal = any(re.search(r"\d,\d", ln) for ln in lines[leading + 1 :])
+        raise DataError(
+            f"{path.name}: the columns are separated by {name}, not commas"
+            + (", and the numbers use decimal commas" if decimal else "")
+            + (f", after {leading} metadata line(s) before the header" if leading else "")
+            + "; re-export as comma-separated CSV with a '.' decimal point"
+            + (" (and '#' before each metadata line)." if leading else ".")
         )
 
 
@@ -227,12 +259,12 @@ def _read_csv(path: Path):
     else:
         channels = _text_channels(frame, path)
     file_fs = None
-    time_col = next((c for c in channels if c.lower() in _TIME_NAMES), None)
+    time_col = next((c for c in channels if _time_scale(c) is not None), None)
     if time_col is not None:
         t = channels.pop(time_col)
         if not np.all(np.isfinite(t)):
             raise DataError(f"{path.name}: the time column contains NaN or empty cells.")
-        file_fs = _fs_from_time(t, path)
+        file_fs = _fs_from_time(t * _time_scale(time_col), path)
     return channels, file_fs, info
 
 
@@ -315,9 +347,9 @@ def _read_mat(path: Path):
         if key in numeric and numeric[key].size == 1:
             file_fs = float(numeric.pop(key))
             break
-    time_key = next((k for k in numeric if k.lower() in _TIME_NAMES), None)
+    time_key = next((k for k in numeric if _time_scale(k) is not None), None)
     if time_key is not None:
-        t = numeric.pop(time_key).ravel().astype(float)
+        t = numeric.pop(time_key).ravel().astype(float) * _time_scale(time_key)
         t_fs = _fs_from_time(t, path)
         file_fs = file_fs if file_fs is not None else t_fs
     sensor_names = None

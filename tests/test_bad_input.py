@@ -118,8 +118,12 @@ def test_an_unstable_fit_is_never_converged(fixtures_dir):
     ("make", "words"),
     [
         (lambda text: "Exported by ShakerLab v2\nOperator: A\n" + text, "metadata lines"),
-        (lambda text: text.replace(",", ";"), "semicolons"),
-        (lambda text: text.replace(",", "\t"), "tabs"),
+        (lambda text: text.replace(",", ";"), "semicolons, not commas;"),
+        (lambda text: text.replace(",", "\t"), "tabs, not commas;"),
+        # a European spreadsheet: decimal commas as well (read as 'metadata lines' before)
+        (lambda text: text.replace(",", ";").replace(".", ","), "semicolons, not commas, and the numbers use decimal"),
+        (lambda text: text.replace(",", "\t").replace(".", ","), "tabs, not commas, and the numbers use decimal"),
+        (lambda text: "Device: rig 3\n" + text.replace(",", ";").replace(".", ","), "after 1 metadata line(s)"),
     ],
 )
 def test_csv_export_mistakes_are_named(tmp_path, fixtures_dir, capsys, make, words):
@@ -129,7 +133,8 @@ def test_csv_export_mistakes_are_named(tmp_path, fixtures_dir, capsys, make, wor
     data = tmp_path / "ride.csv"
     data.write_text(make(plain))
     assert main(["info", str(data)]) == 2
-    assert words in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert words in err and ("metadata" in err) == ("metadata" in words)
 
 
 def test_a_gzip_file_named_csv_is_named(tmp_path, fixtures_dir, capsys):

@@ -2,6 +2,7 @@ import gzip
 import hashlib
 
 import numpy as np
+import pandas as pd
 import pytest
 import scipy.io
 
@@ -40,6 +41,23 @@ def test_csv_gz_and_fs_without_time(tmp_path):
     r = am.read_recording(p, input="plat", fs=100.0)
     assert r.fs == 100.0 and r.sensors == ("a", "b")
     np.testing.assert_array_equal(r.base, [1, 2, 0])
+
+
+@pytest.mark.parametrize(
+    ("name", "scale"),
+    [("time (s)", 1), ("Time [s]", 1), ("time_ms", 1e3), ("Time (ms)", 1e3), ("t_us", 1e6), ("timestamp [µs]", 1e6)],
+)
+def test_a_time_column_named_with_its_unit_is_the_time_base(tmp_path, rec, name, scale):
+    """Exports name the time column with its unit; one in ms read as a sensor gave a ramp
+    'output' (and, without --fs, no sampling rate)."""
+    path = am.write_recording_csv(rec, tmp_path / "r.csv")
+    frame = pd.read_csv(path, comment="#")
+    frame.insert(0, name, frame.pop("time") * scale)
+    frame.to_csv(tmp_path / "u.csv", index=False)
+    back = am.read_recording(tmp_path / "u.csv")
+    assert back.fs == pytest.approx(60.0, rel=1e-9) and back.sensors == rec.sensors
+    scipy.io.savemat(tmp_path / "u.mat", {"time_ms": rec.time * 1e3, "base": rec.base, "head": rec.response[:, 0]})
+    assert am.read_recording(tmp_path / "u.mat").fs == pytest.approx(60.0, rel=1e-9)
 
 
 def test_csv_output_selection(tmp_path):
