@@ -56,6 +56,7 @@ WARNING_CODES = (
     "incoherent_output",
     "unit_mismatch",
     "periodic_disturbance",
+    "stuck_samples",
 )
 #: An output less coherent with the input than this (averaged over the input's spectrum) is
 #: not its response: response sensors read 0.63-1.00 on the measured records (the F-16, the
@@ -69,6 +70,10 @@ DUPLICATE_TOLERANCE = 1e-6
 #: quasi-static band: |T| within these bounds of 1 and coherence at least MIN_COHERENCE
 QUASI_STATIC_MAGNITUDE = (0.8, 1.25)
 MIN_COHERENCE = 0.9
+#: Shortest run of equal samples tested (two in a row happen on any quantised channel).
+STUCK_MIN_RUN = 3
+#: family-wise level of the stuck-samples warning over the channels
+STUCK_ALPHA = 0.01
 #: a delay is reported when it exceeds this fraction of a sample and is significant at
 #: DELAY_ALPHA after Bonferroni correction over the channels; a held (zero-order-hold)
 #: input alone shows half a sample on every output, which is the hold, not a defect
@@ -123,6 +128,7 @@ def check_quality(recording: Recording) -> list[QualityWarning]:
     found += delay_and_inversion(recording)
     found += narrowband_input(recording)
     found += clipped_channels(recording)
+    found += stuck_channels(recording)
     found += incoherent_outputs(recording)
     from .units import unit_mismatch  # units.py builds on this module's constants
 
@@ -363,4 +369,51 @@ def clipped_channels(recording: Recording) -> list[QualityWarning]:
                     100 * stuck / x.size,
                 )
             )
+    return found
+
+
+def stuck_runs(x: np.ndarray) -> list[tuple[int, int, float]]:
+    """Runs of ``STUCK_MIN_RUN`` or more equal samples away from the extremes:
+    ``(first, stop, p)`` each, ``x[first:stop]`` equal, ``p = min(1, n r^(L-1))``."""
+    n = x.size
+    same = np.concatenate([[False], x[1:] == x[:-1]])
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], same.astype(np.int8), [0]])))
+    repeats = int(same.sum())
+    out = []
+    for start, stop in zip(edges[::2], edges[1::2], strict=True):
+        first, length = start - 1, stop - start + 1  # the run's first sample is not a repeat
+        if length < STUCK_MIN_RUN or x[first] in (x.max(), x.min()):
+            continue
+        rate = (repeats - (length - 1) + 1) / (n + 1)
+        out.append((int(first), int(stop), float(min(1.0, n * rate ** (length - 1)))))
+    return out
+
+
+def stuck_channels(recording: Recording) -> list[QualityWarning]:
+    """``stuck_samples``: runs of equal samples away from the channel's extremes (those are
+    :func:`clipped_channels`'), longer than the channel's own rate of repeated samples makes
+    likely (:func:`stuck_runs`, family-wise STUCK_ALPHA over the channels): a sensor or a
+    recorder that stopped updating."""
+    names = (recording.input_name, *recording.sensors)
+    data = np.column_stack([recording.base, recording.response])
+    found = []
+    for k, name in enumerate(names):
+        runs = [r for r in stuck_runs(data[:, k]) if r[2] < STUCK_ALPHA / len(names)]
+        if not runs:
+            continue
+        first, stop, p = max(runs, key=lambda r: r[1] - r[0])
+        total = sum(b - a for a, b, _ in runs)
+        repeats = float(np.mean(data[1:, k] == data[:-1, k]))
+        more = f"; {len(runs)} such runs, {total} samples in all" if len(runs) > 1 else ""
+        found.append(
+            QualityWarning(
+                "stuck_samples",
+                (name,),
+                f"'{name}' holds {data[first, k]:.6g} for {stop - first} samples in a row from "
+                f"{first / recording.fs:.3f} s (p = {p:.1e} against its rate of repeated samples, "
+                f"{100 * repeats:.2g} %){more}: the sensor or its recorder stopped updating. The fit takes those "
+                "samples as measured; 'armaxmodal diagnose' fills them by prediction.",
+                float(total),
+            )
+        )
     return found

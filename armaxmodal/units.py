@@ -62,9 +62,9 @@ def unit_conversion(ratio: float) -> tuple[float, str] | None:
     return None
 
 
-def _quasi_static_gains(recording: Recording) -> np.ndarray | None:
-    """Each output's median ``|T|`` over the lowest excited lines coherent on most outputs,
-    (K,), or None when the record has too few such lines."""
+def _quasi_static_lines(recording: Recording) -> np.ndarray | None:
+    """Each output's ``|T|`` on the lowest excited lines coherent on most outputs,
+    (QUASI_STATIC_LINES, K), or None when the record has too few such lines."""
     spectra = transmissibility_spectra(recording)
     if spectra is None:
         return None
@@ -72,18 +72,23 @@ def _quasi_static_gains(recording: Recording) -> np.ndarray | None:
     lines = np.flatnonzero(excited & (f > 0) & (np.median(coh, axis=1) >= MIN_COHERENCE))
     if lines.size < QUASI_STATIC_LINES:
         return None
-    return np.median(np.abs(h[lines[:QUASI_STATIC_LINES]]), axis=0)
+    return np.abs(h[lines[:QUASI_STATIC_LINES]])
 
 
 def unit_mismatch(recording: Recording) -> list[QualityWarning]:
     """``unit_mismatch`` warnings: outputs whose quasi-static transmissibility is
     :data:`MISMATCH_RATIO` times or more away from that of the other outputs, which read 1
-    (see the module docstring). ``value`` is the measured ratio."""
-    gains = None if len(recording.sensors) < 2 else _quasi_static_gains(recording)
-    if gains is None:
+    (see the module docstring), or the input when every output reads the same flat
+    multiple of it that a unit conversion explains (:func:`_input_in_other_units`).
+    ``value`` is the measured ratio."""
+    lines = _quasi_static_lines(recording)
+    if lines is None:
         return []
+    gains = np.median(lines, axis=0)
+    found = _input_in_other_units(recording, lines, gains)
+    if found or len(recording.sensors) < 2:
+        return found
     lo, hi = QUASI_STATIC_MAGNITUDE
-    found = []
     for k, name in enumerate(recording.sensors):
         others = np.delete(gains, k)
         static = others[(others >= lo) & (others <= hi)]
@@ -110,3 +115,39 @@ def unit_mismatch(recording: Recording) -> list[QualityWarning]:
             )
         )
     return found
+
+
+#: every output's quasi-static |T| within this factor over the lines (a base-excited
+#: structure: 1.02-1.05 on the fixtures and the shake-table frames; a force input's
+#: acceleration grows as the frequency squared: 1.2-4.0 on the F-16)
+FLAT = 1.1
+
+
+def _input_in_other_units(recording: Recording, lines: np.ndarray, gains: np.ndarray) -> list[QualityWarning]:
+    """A ``unit_mismatch`` warning on the input when every output reads the same flat
+    quasi-static multiple of it (outputs within QUASI_STATIC_MAGNITUDE's spread of each
+    other, each flat within FLAT), at least MISMATCH_RATIO away from 1 and within
+    UNIT_MATCH of a unit conversion: the input and the outputs are in different units.
+    Frequencies and damping do not depend on it; residues, and the masses the inverse
+    problem draws from them, are off by that factor. Reported, not converted."""
+    lo, hi = QUASI_STATIC_MAGNITUDE
+    ratio = float(np.median(gains))
+    agree = gains.max() / gains.min() <= hi / lo and np.all(lines.max(axis=0) <= FLAT * lines.min(axis=0))
+    if not agree or 1.0 / MISMATCH_RATIO < ratio < MISMATCH_RATIO:
+        return []
+    near = [(factor, meaning) for factor, meaning in UNIT_CONVERSIONS.items() if abs(ratio / factor - 1) <= UNIT_MATCH]
+    if not near:
+        return []
+    named = [m.replace("the others are", "the input is").replace("the others'", "the input's") for _, m in near]
+    meaning = " or ".join(m + (f" ({f:.5g})" if len(near) > 1 else "") for (f, _), m in zip(near, named, strict=True))
+    return [
+        QualityWarning(
+            "unit_mismatch",
+            (recording.input_name,),
+            f"every output reads {ratio:.4g} times the input '{recording.input_name}' below the first mode "
+            f"({gains.min():.4g}-{gains.max():.4g}), where a base-excited structure moves with its base: the "
+            f"outputs are in {meaning}. Frequencies, damping and shapes do not change; residues and the masses "
+            "drawn from them are off by that factor. Convert one side and rerun.",
+            ratio,
+        )
+    ]

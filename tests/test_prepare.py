@@ -32,8 +32,10 @@ def _with(rec, base=None, response=None, sensors=None):
 
 
 def _late(x, samples):
-    """``x`` recorded ``samples`` late: each value appears that many samples later."""
-    return np.concatenate([np.full(samples, x[0]), x[:-samples]])
+    """``x`` recorded ``samples`` late: each value appears that many samples later. The
+    unknown first samples are the record's next ones mirrored (a constant pad would be a
+    run of equal samples, which the stuck-samples check rightly names)."""
+    return np.concatenate([x[samples:0:-1], x[:-samples]])
 
 
 def _codes(warnings):
@@ -296,14 +298,31 @@ def test_a_scale_that_matches_no_unit_is_named_and_left(clean, factor):
     np.testing.assert_allclose(prepared.recording.response[:, 2], prepare(clean).recording.response[:, 2] * factor)
 
 
-def test_a_record_without_a_quasi_static_band_or_with_one_output_is_not_tested(clean):
-    """A force input (|T| not near 1 on any output) and a single output say nothing."""
+def test_a_record_without_a_quasi_static_band_is_not_tested_and_one_output_only_against_the_input(clean):
+    """Outputs at unrelated scales (no quasi-static band they share) say nothing; a single
+    output 102 times its input is compared with the input alone: mg or Gal, both named."""
     for gains in ([30.0, 45.0, 60.0, 3000.0], [1.0, 30.0, 45.0, 60.0]):  # one output near 1 is no majority
         force_like = _with(clean, response=clean.response * np.array(gains))
         assert not [w for w in check_quality(force_like) if w.code == "unit_mismatch"]
     single = clean.select(["head"])
     single = _with(single, response=single.response * 102.0, sensors=("head",))
-    assert not [w for w in check_quality(single) if w.code == "unit_mismatch"]
+    (w,) = [w for w in check_quality(single) if w.code == "unit_mismatch"]
+    assert w.channels == ("base",) and "mg where the input is in m/s² (101.97)" in w.message and "(100)" in w.message
+
+
+@pytest.mark.parametrize(("scale", "words"), [(1 / 9.80665, "g where the input is in m/s²"), (9.80665, "m/s² where")])
+def test_every_output_in_other_units_than_the_input_is_named_on_the_input(clean, scale, words):
+    """Outputs in g with the base in m/s² (or the base in g): every output reads the same
+    flat multiple of the input; named on the input, nothing converted (modes do not depend
+    on it); a force input, whose |T| grows as f^2 (the F-16: 1.2-4x over the same lines), never."""
+    rec = _with(clean, response=clean.response * scale)
+    found = [w for w in check_quality(rec) if w.code == "unit_mismatch"]
+    assert [w.channels for w in found] == [("base",)] and words in found[0].message
+    assert found[0].value == pytest.approx(scale, rel=0.03)
+    np.testing.assert_allclose(prepare(rec).recording.response, prepare(clean).recording.response * scale, rtol=1e-12)
+    f = np.fft.rfftfreq(clean.n_samples, 1 / clean.fs)
+    force = np.fft.irfft(np.fft.rfft(clean.response, axis=0) * (f[:, None] / 2.0) ** 2 * scale, clean.n_samples, axis=0)
+    assert not [w for w in check_quality(_with(clean, response=force)) if w.code == "unit_mismatch"]
 
 
 def test_the_ratio_is_taken_against_the_other_outputs(clean):
@@ -325,3 +344,18 @@ def test_the_head_in_mg_no_longer_loses_modes(clean):
     found = select_modes(stabilisation_diagram(_with(clean, response=y), n_jobs=1), segments=0)
     truth = am.supine_human().modes()
     np.testing.assert_allclose(found.modes.freq_hz, truth.freq_hz, rtol=FREQ_RTOL)
+
+
+def test_a_sensor_that_stopped_updating_is_named_with_its_run(clean):
+    """52 equal samples on pelvis from 50 s (a dropout) are named with their start and
+    length; the clean record and a coarsely quantised one (a step of 0.3 on a unit RMS: equal
+    neighbours on 15 % of its samples) are not: the test weighs a run against the channel's
+    own rate of repeats. (At a step of half the RMS, 2 bits, it takes runs of 13 for stuck.)"""
+    assert not [w for w in check_quality(clean) if w.code == "stuck_samples"]
+    y = clean.response.copy()
+    y[3000:3052, 2] = y[2999, 2]
+    (w,) = [w for w in check_quality(_with(clean, response=y)) if w.code == "stuck_samples"]
+    assert w.channels == ("pelvis",) and "for 53 samples in a row from 49.983 s" in w.message and w.value == 53
+    coarse = np.round(clean.response / 0.3) * 0.3
+    assert np.mean(coarse[1:] == coarse[:-1]) > 0.1
+    assert not [w for w in check_quality(_with(clean, response=coarse)) if w.code == "stuck_samples"]

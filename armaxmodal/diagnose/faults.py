@@ -34,6 +34,7 @@ import numpy as np
 from scipy.signal import fftconvolve, lfilter
 from scipy.special import ndtr, ndtri
 
+from ..quality import STUCK_MIN_RUN, stuck_runs  # noqa: F401  (shared with the pre-fit check)
 from .clipping import clipped_mask
 
 __all__ = [
@@ -49,8 +50,6 @@ __all__ = [
 
 #: Uncorrected level at which a run or a glitch enters a fault's mask.
 FAULT_ALPHA = 1e-3
-#: Shortest run tested (two equal samples in a row happen on any quantised channel).
-STUCK_MIN_RUN = 3
 #: Most glitches taken from one channel (a channel with more is broken, not glitching).
 MAX_GLITCHES = 200
 #: Level of the test that glitches gather where the input is strongest.
@@ -61,23 +60,6 @@ PI_ENERGY = 0.999
 SHARED_WINDOW = 3
 #: |lambda| above which another sensor's residual counts as an outlier there.
 SHARED_LEVEL = 3.0
-
-
-def stuck_runs(x: np.ndarray) -> list[tuple[int, int, float]]:
-    """Runs of ``STUCK_MIN_RUN`` or more equal samples away from the extremes:
-    ``(first, stop, p)`` each, ``x[first:stop]`` equal, ``p = min(1, n r^(L-1))``."""
-    n = x.size
-    same = np.concatenate([[False], x[1:] == x[:-1]])
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], same.astype(np.int8), [0]])))
-    repeats = int(same.sum())
-    out = []
-    for start, stop in zip(edges[::2], edges[1::2], strict=True):
-        first, length = start - 1, stop - start + 1  # the run's first sample is not a repeat
-        if length < STUCK_MIN_RUN or x[first] in (x.max(), x.min()):
-            continue
-        rate = (repeats - (length - 1) + 1) / (n + 1)
-        out.append((int(first), int(stop), float(min(1.0, n * rate ** (length - 1)))))
-    return out
 
 
 def _matched_filter(model) -> np.ndarray:
