@@ -29,15 +29,17 @@ def _damaged(tmp: Path) -> dict:
 
     def save(name, frame):
         path = tmp / f"{name}.csv"
-        frame.to_csv(path, index=False)
+        # a shifted channel's unknown first samples are dropped, not filled: a filled run of
+        # equal samples is a (true) stuck_samples finding the damage did not intend
+        frame.dropna().to_csv(path, index=False)
         cases[name] = [str(path)]
 
     g = d.copy()
     g[outs] += 9.81
-    g["head"] = g["head"].shift(2).bfill()
+    g["head"] = g["head"].shift(2)  # the first two rows, unknown, are dropped below
     save("gravity + head 2 samples late", g)
     late = d.copy()
-    late["base"] = late["base"].shift(3).bfill()
+    late["base"] = late["base"].shift(3)
     save("input 3 samples late", late)
     dup = d.copy()
     dup["head_copy"] = dup["head"]
@@ -48,6 +50,12 @@ def _damaged(tmp: Path) -> dict:
     mg = d.copy()
     mg["head"] *= 1000 / 9.80665
     save("head in mg", mg)
+    g_base = d.copy()
+    g_base["base"] /= 9.80665
+    save("base in g", g_base)
+    stuck = d.copy()
+    stuck.loc[3000:3051, "pelvis"] = stuck.loc[2999, "pelvis"]
+    save("pelvis stuck for 53 samples", stuck)
     hum = d.copy()
     hum["legs"] += 0.3 * np.sin(2 * np.pi * 12.5 * hum["time"])
     save("hum 0.3 m s⁻² at 12.5 Hz on legs", hum)
