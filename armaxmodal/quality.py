@@ -74,6 +74,9 @@ MIN_COHERENCE = 0.9
 STUCK_MIN_RUN = 3
 #: family-wise level of the stuck-samples warning over the channels
 STUCK_ALPHA = 0.01
+#: a run at the record's first or last sample shorter than this is padding (a channel
+#: shifted into alignment repeats its first value a few times), not a dropout: not reported
+STUCK_EDGE_MIN = 10
 #: a delay is reported when it exceeds this fraction of a sample and is significant at
 #: DELAY_ALPHA after Bonferroni correction over the channels; a held (zero-order-hold)
 #: input alone shows half a sample on every output, which is the hold, not a defect
@@ -398,7 +401,10 @@ def stuck_channels(recording: Recording) -> list[QualityWarning]:
     data = np.column_stack([recording.base, recording.response])
     found = []
     for k, name in enumerate(names):
-        runs = [r for r in stuck_runs(data[:, k]) if r[2] < STUCK_ALPHA / len(names)]
+        runs = [
+            r for r in stuck_runs(data[:, k])
+            if r[2] < STUCK_ALPHA / len(names) and (0 < r[0] and r[1] < len(data) or r[1] - r[0] >= STUCK_EDGE_MIN)
+        ]  # fmt: skip
         if not runs:
             continue
         first, stop, p = max(runs, key=lambda r: r[1] - r[0])

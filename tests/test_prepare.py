@@ -359,3 +359,18 @@ def test_a_sensor_that_stopped_updating_is_named_with_its_run(clean):
     coarse = np.round(clean.response / 0.3) * 0.3
     assert np.mean(coarse[1:] == coarse[:-1]) > 0.1
     assert not [w for w in check_quality(_with(clean, response=coarse)) if w.code == "stuck_samples"]
+
+
+def test_a_few_padded_samples_at_the_edges_are_not_a_dropout_but_a_long_dead_end_is(clean):
+    """A channel shifted into alignment repeats its first value a few times: padding, not
+    reported; the last 60 samples (1 s) frozen are a dead sensor: reported."""
+    from armaxmodal.quality import STUCK_EDGE_MIN
+
+    y = clean.response.copy()
+    y[:3, 0] = y[3, 0]
+    assert 3 < STUCK_EDGE_MIN
+    assert not [w for w in check_quality(_with(clean, response=y)) if w.code == "stuck_samples"]
+    y = y.copy()  # the recording froze the first copy
+    y[-60:, 1] = y[-61, 1]
+    (w,) = [w for w in check_quality(_with(clean, response=y)) if w.code == "stuck_samples"]
+    assert w.channels == ("chest",) and "for 61 samples" in w.message
