@@ -348,7 +348,7 @@ def _warn_not_converged(sensors, stopped, valid, max_iter, orders) -> None:
         f"PEM {' and '.join(reasons)} (orders {','.join(map(str, orders))}); the estimate is flagged "
         f"converged=False. Try {' or '.join(remedies)}.",
         ConvergenceWarning,
-        stacklevel=3,
+        stacklevel=5,  # the caller of fit_armax: _warn, _fit, fit_armax, its BLAS-thread wrapper
     )
 
 

@@ -286,9 +286,10 @@ def test_constant_input_and_bad_arrays():
 
 
 def test_non_convergence_is_flagged_and_warned(supine_zoh):
-    with pytest.warns(ConvergenceWarning, match="did not converge"):
+    with pytest.warns(ConvergenceWarning, match="did not converge") as record:
         fit = fit_armax(supine_zoh, 8, 9, 8, 0, max_iter=1)
     assert not fit.converged.all() and fit.iterations.tolist() == [1] * 4
+    assert record[0].filename == __file__  # the warning points at the caller's line, not inside armaxmodal
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         fit_armax(supine_zoh, 8, 9, 8, 0, max_iter=1, warn=False)
