@@ -240,6 +240,8 @@ def _fit(
     fit judged by its criterion alone; ``checkpoint`` is None for per-sensor fits."""
     if stop not in ("expected", "decrease"):
         raise ValueError(f"stop: expected 'expected' or 'decrease', got {stop!r}.")
+    if not shared_poles and (resume is not None or not covariance):
+        raise ValueError("resume= and covariance=False apply to shared-pole fits only.")
     if isinstance(max_iter, bool) or not float(max_iter).is_integer() or max_iter < 1:
         raise OrderError(f"max_iter: expected a whole number >= 1, got {max_iter!r}.")
     if not (np.isfinite(tol) and tol > 0):
