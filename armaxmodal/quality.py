@@ -18,11 +18,16 @@ recording:
 * ``narrowband_input`` -- the input's power sits in a narrow band (a sine ride): modes
   outside it are not identifiable.
 * ``clipping`` -- runs of samples stuck at a channel's extreme value (the sensor's rail).
+* ``stuck_samples`` -- a run of equal samples elsewhere, longer than the channel's own rate
+  of repeated samples makes likely: a sensor or a recorder that stopped updating.
 * ``incoherent_output`` -- an output whose coherence with the input, averaged over the
   input's spectrum, is below ``INCOHERENT``: it is not a response to this input (a wrong
   column, a dead sensor, a second excitation), and its poles are not the structure's. A
   record of pure noise once gave two "modes" with intervals and no warning.
-* ``unit_mismatch`` -- an output in other units than the rest (:mod:`armaxmodal.units`).
+* ``unit_mismatch`` -- an output in other units than the rest, or every output in other
+  units than the input (:mod:`armaxmodal.units`).
+
+The sweep adds ``periodic_disturbance`` (:mod:`armaxmodal.disturbance`).
 """
 
 from __future__ import annotations
