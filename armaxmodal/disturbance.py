@@ -108,6 +108,8 @@ def _input_prominence(recording: Recording, freq: float) -> float:
     i = int(np.argmin(np.abs(f - freq)))
     around = np.r_[puu[max(i - 12, 0) : max(i - 2, 0)], puu[i + 3 : i + 13]]
     peak = float(puu[max(i - 1, 0) : i + 2].max())
+    if peak <= 0:  # no input at all there (a synthetic band-limited ride outside its band)
+        return 0.0
     return peak / float(np.median(around)) if around.size and np.median(around) > 0 else np.inf
 
 
