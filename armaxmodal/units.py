@@ -53,13 +53,18 @@ def unit_conversion(ratio: float) -> tuple[float, str] | None:
     why: the unit conversion within :data:`UNIT_MATCH` of it, or the measured ratio itself
     when several are (mg and Gal differ by 2 %, within the ratio's own scatter of 1-2 %);
     None when no conversion is near."""
-    near = [(factor, meaning) for factor, meaning in UNIT_CONVERSIONS.items() if abs(ratio / factor - 1) <= UNIT_MATCH]
+    near = _near_conversions(ratio)
     if len(near) == 1:
         return near[0]
     if near:
         options = " or ".join(f"{meaning} ({factor:.5g})" for factor, meaning in near)
         return ratio, f"{options}: the record cannot tell these apart, so the measured ratio is used"
     return None
+
+
+def _near_conversions(ratio: float) -> list[tuple[float, str]]:
+    """The unit conversions within UNIT_MATCH of ``ratio``: ``(factor, meaning)`` each."""
+    return [(factor, meaning) for factor, meaning in UNIT_CONVERSIONS.items() if abs(ratio / factor - 1) <= UNIT_MATCH]
 
 
 def _quasi_static_lines(recording: Recording) -> np.ndarray | None:
@@ -135,7 +140,7 @@ def _input_in_other_units(recording: Recording, lines: np.ndarray, gains: np.nda
     agree = gains.max() / gains.min() <= hi / lo and np.all(lines.max(axis=0) <= FLAT * lines.min(axis=0))
     if not agree or 1.0 / MISMATCH_RATIO < ratio < MISMATCH_RATIO:
         return []
-    near = [(factor, meaning) for factor, meaning in UNIT_CONVERSIONS.items() if abs(ratio / factor - 1) <= UNIT_MATCH]
+    near = _near_conversions(ratio)
     if not near:
         return []
     named = [m.replace("the others are", "the input is").replace("the others'", "the input's") for _, m in near]
