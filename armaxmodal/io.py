@@ -215,8 +215,6 @@ def _check_separator(path: Path, lines: list[str]) -> None:
     """Refuse semicolon- or tab-separated files by name: most lines hold the same number of
     the separator. Such exports often write decimal commas too (a European spreadsheet),
     which once read as 'metadata lines before the header'."""
-    import re
-
     for sep, name in ((";", "semicolons"), ("\t", "tabs")):
         counts = [ln.count(sep) for ln in lines]
         fields = max(set(counts), key=counts.count)
