@@ -204,6 +204,22 @@ def test_a_record_sampled_far_above_its_band_is_resampled_and_its_modes_found():
     np.testing.assert_allclose(selection.modes.damping, truth.damping, rtol=DAMPING_RTOL)
 
 
+@pytest.mark.parametrize(("n", "factor"), [(74000, 10), (1000, 2), (1001, 3), (999, 7), (5003, 4), (400, 5)])
+def test_decimate_equals_scipy_resample_poly_on_the_samples_kept(n, factor):
+    """prepare's own decimator (no scipy.signal import) against scipy's polyphase resampler,
+    on a drifting random walk whose ends differ: the kept samples never see scipy's padding."""
+    from scipy.signal import resample_poly
+
+    from armaxmodal.prepare import RESAMPLE_EDGE, decimate
+
+    rng = np.random.default_rng(n)
+    x = rng.standard_normal((n, 3)).cumsum(axis=0) + np.linspace(0.0, 50.0, n)[:, None]
+    expected = resample_poly(x, 1, factor, axis=0, padtype="line")[RESAMPLE_EDGE:-RESAMPLE_EDGE]
+    got = decimate(x, factor)
+    assert got.shape == expected.shape
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
+
+
 def test_f16_torsion_mode_softens_and_damps_with_force(realdata_dir):
     """F-16 GVT benchmark (Noël & Schoukens): at 400 Hz with its modes in 2-15 Hz. The
     benchmark note's check gives the wing-torsion mode at 7.32 Hz, about 0.5 %, at level 1
