@@ -113,6 +113,11 @@ MUTANTS = [
         "INPUT_LINE_P = 1e-3",
         "a chance input p vetoes a hum (line)",
     ),
+    ("armaxmodal/prepare.py", "[::factor][:n_out]", "[1::factor][:n_out]", "decimated one sample late (decimate)"),
+    ("armaxmodal/prepare.py", "np.kaiser(2 * half + 1, 5.0)", "np.kaiser(2 * half + 1, 6.0)", "window (decimate)"),
+    ("armaxmodal/prepare.py", "np.sinc(taps / factor)", "np.sinc(taps / (factor + 1))", "cut-off too low (decimate)"),
+    ("armaxmodal/prepare.py", "half = 10 * factor", "half = 8 * factor", "a shorter filter (decimate)"),
+    ("armaxmodal/prepare.py", "h /= h.sum()", "h /= h.max()", "gain not one at 0 Hz (decimate)"),
 ]
 DEFAULT_TESTS = [
     "tests/test_guards.py",
