@@ -497,7 +497,10 @@ def _parse_effect(text: str):
     return effect, channels, params
 
 
-_DETREND_HELP = "remove each channel's mean (default) or least-squares line before fitting"
+_DETREND_HELP = (
+    "remove each channel's mean (default) or least-squares line before fitting, and any level shift "
+    "(a sensor offset jumping mid-record); 'none' only reports them"
+)
 
 
 def build_parser() -> argparse.ArgumentParser:

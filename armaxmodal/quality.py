@@ -27,7 +27,9 @@ recording:
 * ``unit_mismatch`` -- an output in other units than the rest, or every output in other
   units than the input (:mod:`armaxmodal.units`).
 
-The sweep adds ``periodic_disturbance`` (:mod:`armaxmodal.disturbance`).
+The sweep adds ``periodic_disturbance`` (:mod:`armaxmodal.disturbance`); preparation
+(:mod:`armaxmodal.prepare`) adds ``offset_removed``, ``offset_step``, ``drift``,
+``trend_removed`` and ``resampled``.
 """
 
 from __future__ import annotations
@@ -49,6 +51,7 @@ WARNING_CODES = (
     "clipping",
     "dropped_packet",
     "offset_removed",
+    "offset_step",
     "drift",
     "trend_removed",
     "resampled",

@@ -1,5 +1,7 @@
 """Quality checks and preparation against defects planted with known size in the fixtures."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -139,6 +141,62 @@ def test_offsets_and_drift_are_removed_and_reported(clean):
     assert [w.code for w in linear.warnings] == ["offset_removed", "trend_removed"]
     assert "+0.02/s" in linear.warnings[1].message
     np.testing.assert_allclose(linear.recording.response, clean.response - clean.response.mean(0), atol=0.05)
+
+
+def test_a_sensor_offset_jumping_mid_record_is_found_removed_and_the_modes_kept(clean):
+    """+0.8 on the pelvis from t = 60 s on (a sensor re-zeroing, a cable knock): before, it
+    moved the third mode from 13.7 to 14.7 Hz, outside its interval, with only a drift
+    warning whose advice (--detrend linear) left it at 14.6 Hz."""
+    y = clean.response.copy()
+    at = clean.n_samples // 2
+    y[at:, 2] += 0.8
+    prepared = prepare(_with(clean, response=y))
+    (step,) = [w for w in prepared.warnings if w.code == "offset_step"]
+    assert step.channels == ("pelvis",) and "drift" not in [w.code for w in prepared.warnings]
+    found = re.search(r"pelvis ([+-][0-9.]+) \(.*\) at t = ([0-9.]+) s", step.message)
+    assert float(found[1]) == pytest.approx(0.8, abs=0.03) and float(found[2]) == pytest.approx(at / clean.fs, abs=0.1)
+    # removed: the prepared pelvis is the clean one, centred, up to the estimated size of the
+    # shift and the few samples by which its place may be missed
+    expected = clean.response[:, 2] - clean.response[:, 2].mean()
+    error = np.abs(prepared.recording.response[:, 2] - expected)
+    assert np.median(error) < 0.01 and np.sum(error > 0.05) <= 6
+    selection = select_modes(stabilisation_diagram(_with(clean, response=y), per_sensor=False))
+    truth = am.supine_human().modes()
+    assert len(selection.modes) == 4
+    np.testing.assert_allclose(selection.modes.freq_hz, truth.freq_hz, rtol=FREQ_RTOL)
+
+
+@pytest.mark.parametrize("where", [0.1, 0.5, 0.9])
+def test_level_shifts_are_located_and_sized_a_drift_is_not_one(clean, where):
+    from armaxmodal.prepare import level_shifts
+
+    x = clean.response[:, 1].copy()
+    at = int(where * x.size)
+    shifted = x.copy()
+    shifted[at:] += 0.5
+    # located to a few samples: the oscillation about the shift blurs where it happened
+    (found,) = level_shifts(shifted)
+    assert abs(found[0] - at) <= 6 and found[1] == pytest.approx(0.5, abs=0.03)
+    # down at 40 s and up again at 80 s: both, each with its size
+    pulse = x.copy()
+    pulse[2400:4800] -= 0.6
+    (k1, j1), (k2, j2) = level_shifts(pulse)
+    assert abs(k1 - 2400) <= 30 and abs(k2 - 4800) <= 30
+    assert j1 == pytest.approx(-0.6, abs=0.05) and j2 == pytest.approx(0.6, abs=0.05)
+    # a bare step: its exact sample and size
+    assert level_shifts(np.r_[np.zeros(500), np.ones(700)]) == [(500, 1.0)]
+    # a drift of the same size, a clean channel: none
+    assert level_shifts(x + 0.5 * np.linspace(0.0, 1.0, x.size)) == []
+    assert level_shifts(x) == []
+
+
+def test_a_level_shift_is_reported_not_removed_without_detrending(clean):
+    y = clean.response.copy()
+    y[3000:, 0] -= 0.5
+    prepared = prepare(_with(clean, response=y), detrend="none")
+    (step,) = prepared.warnings
+    assert step.code == "offset_step" and step.channels == ("head",) and "not removed" in step.message
+    np.testing.assert_array_equal(prepared.recording.response, y)
 
 
 @pytest.mark.parametrize(
