@@ -245,7 +245,7 @@ def _signals(recording: Recording, band) -> tuple[Signals, Recording, tuple]:
             f"diagnose: the record has {rec.n_samples} samples at {rec.fs:g} Hz; holding out half of it for "
             f"validation needs at least {2 * MIN_SAMPLES}. Use a longer recording."
         )
-    kept = ("duplicate_channel", "resampled", "clipping", "narrowband_input", "incoherent_output")
+    kept = ("duplicate_channel", "resampled", "clipping", "narrowband_input", "incoherent_output", "offset_step")
     keep = tuple(w for w in prep.warnings if w.code in kept)
     return Signals(rec.base, rec.response, rec.fs, rec.sensors, rec.input_name), rec, keep
 
