@@ -59,6 +59,9 @@ def _damaged(tmp: Path) -> dict:
     hum = d.copy()
     hum["legs"] += 0.3 * np.sin(2 * np.pi * 12.5 * hum["time"])
     save("hum 0.3 m s⁻² at 12.5 Hz on legs", hum)
+    jump = d.copy()
+    jump.loc[len(d) // 2 :, "pelvis"] += 0.8
+    save("pelvis offset jumps +0.8 at 60 s", jump)
     drift = d.copy()
     drift[outs] += 0.05 * np.arange(len(d))[:, None] / 60.0
     save("drift 0.05 m per s^3", drift)
