@@ -118,12 +118,12 @@ MUTANTS = [
     ("armaxmodal/prepare.py", "np.sinc(taps / factor)", "np.sinc(taps / (factor + 1))", "cut-off too low (decimate)"),
     ("armaxmodal/prepare.py", "half = 10 * factor", "half = 8 * factor", "a shorter filter (decimate)"),
     ("armaxmodal/prepare.py", "h /= h.sum()", "h /= h.max()", "gain not one at 0 Hz (decimate)"),
-    ("armaxmodal/prepare.py", "or explained[best] <= line:", "or explained[best] <= 0:", "drift as a shift (step)"),
     ("armaxmodal/prepare.py", "<= STEP_FRACTION * total", "<= 10 * STEP_FRACTION * total", "shifts missed (step)"),
     ("armaxmodal/prepare.py", "col[k:] -= jump", "col[k:] += jump", "shift doubled (step)"),
     ("armaxmodal/prepare.py", "levels[k] - levels[k - 1]", "levels[k - 1] - levels[k]", "jump sign (step)"),
     ("armaxmodal/prepare.py", "(candidates * (n - candidates))", "candidates", "unnormalised breakpoint score (step)"),
     ("armaxmodal/prepare.py", "np.cumsum(rest)[candidates - 1]", "np.cumsum(rest)[candidates]", "off by one (step)"),
+    ("armaxmodal/prepare.py", "abs(local) >= STEP_Z * spread", "abs(local) >= 0 * spread", "wander as a shift (step)"),
 ]
 DEFAULT_TESTS = [
     "tests/test_guards.py",
