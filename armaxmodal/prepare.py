@@ -14,9 +14,9 @@ In this order, every step stated in the result (and in the JSON):
    where a sensor's offset jumps mid-record (:func:`level_shifts`; MATLAB's ``detrend`` with
    breakpoints, the breakpoints found);
 6. a record sampled far above its band is resampled to about ``fs = band_hi / 0.4`` with
-   scipy's polyphase filter (a Kaiser-windowed anti-alias FIR of zero phase, :func:`decimate`): high orders
-   would otherwise be spent on the empty spectrum above the band, and one low order no
-   longer resolves close modes at 400 Hz that it resolves at 50 Hz.
+   scipy's polyphase filter (a Kaiser-windowed anti-alias FIR of zero phase, written out in
+   :func:`decimate`): high orders would otherwise be spent on the empty spectrum above the
+   band, and one low order no longer resolves close modes at 400 Hz that it resolves at 50 Hz.
 """
 
 from __future__ import annotations
@@ -48,11 +48,11 @@ OFFSET_FRACTION = 0.05
 STEP_FRACTION = 0.01
 #: ... and is sudden: the means of the STEP_EDGE-long windows either side of it differ by at
 #: least STEP_Z times the spread of such differences along the channel (robust SD), or it is
-#: slow wander such as a velocity channel's: the 20 channels of the four fixtures integrated to velocity read 1.1-3.6 at
-#: their best breakpoints; a shift planted on the supine ride reads 3.4-3.8 at 0.2 x RMS
-#: (missed: the modes moved by under 0.2 %), 4.8-5.0 at 0.3 x RMS (which lost the 13.5 Hz
-#: mode), 7.6-8.0 at 0.5, 12 at 0.8; a drift, spreading its change over the record, reads
-#: 0.9-2.5 (the supine ride's outputs with 0.5 or 6 m/s^2 of drift over the record)
+#: slow wander such as a velocity channel's. The 20 channels of the four fixtures integrated
+#: to velocity read 1.1-3.6 at their best breakpoints; a drift, spreading its change over the
+#: record, 0.9-2.5 (the supine ride's outputs with 0.5 or 6 m/s^2 of drift over the record);
+#: a shift planted on that ride 3.4-3.8 at 0.2 x RMS (missed: the modes moved by under
+#: 0.2 %), 4.8-5.0 at 0.3 x RMS (which lost the 13.5 Hz mode), 7.6-8.0 at 0.5, 12 at 0.8
 STEP_Z = 4.0
 #: breakpoints are searched this share of the record away from either end (a start transient
 #: is not a level shift), at most MAX_STEPS per channel
@@ -366,8 +366,8 @@ def _step_notes(names, steps, data, fs: float, removed: bool) -> list[QualityWar
         QualityWarning(
             "offset_step",
             tuple(channels),
-            f"level shifts (a sensor's offset jumping mid-record, explaining more of its variance than a drift "
-            f"would): {'; '.join(listed)}; {action}.",
+            f"level shifts (a sensor's offset jumping mid-record, at once: not a drift): {'; '.join(listed)}; "
+            f"{action}.",
             worst,
         )
     ]
