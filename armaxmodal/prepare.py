@@ -30,7 +30,7 @@ from .exceptions import DataError
 from .quality import QualityWarning, check_quality, estimate_delays
 from .recording import Recording
 
-__all__ = ["prepare", "Preparation", "check_band", "decimate", "DETRENDS"]
+__all__ = ["prepare", "Preparation", "check_band", "decimate", "level_shifts", "DETRENDS"]
 
 DETRENDS = ("mean", "linear", "none")
 #: the band's upper edge sits at this fraction of the analysis rate (0.8 of its Nyquist),
