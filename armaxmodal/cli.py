@@ -104,7 +104,12 @@ def _load(args):
         args.data = " + ".join(args.data)
         return rec if outputs is None else rec.select(outputs)
     args.data = args.data[0]
-    return read_recording(args.data, input=args.input, fs=args.fs, outputs=outputs)
+    rec = read_recording(args.data, input=args.input, fs=args.fs, outputs=outputs)
+    skipped = rec.meta.get("counter_columns", ())
+    if skipped and not getattr(args, "quiet", False):
+        named = ", ".join(f"'{c}'" for c in skipped)
+        print(f"{args.data}: column(s) {named} count the rows (a row index): not used as outputs")
+    return rec
 
 
 def _cmd_info(args) -> int:

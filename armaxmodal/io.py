@@ -46,6 +46,8 @@ def _time_scale(name: str) -> float | None:
 # Relative jitter allowed in a time column before it counts as non-uniform (device clocks
 # quantise to a microsecond: 1e-4 of a 120 Hz step).
 _TIME_JITTER = 1e-3
+# A time base slower than this (Hz) is a time column in ms or us read as seconds.
+_SLOWEST_FS = 1.0
 
 
 def read_recording(
@@ -59,6 +61,10 @@ def read_recording(
     mass_kg: float | None = None,
 ) -> Recording:
     """Read a recording: one input column, the other numeric columns as outputs.
+
+    A column of consecutive whole numbers (a row index, as pandas writes by default, or a
+    sample counter) is not taken as an output unless ``outputs`` names it; the recording's
+    ``meta["counter_columns"]`` lists those left out.
 
     Parameters
     ----------
@@ -96,7 +102,10 @@ def read_recording(
             f"{path.name}: input channel '{input}' not found; channels are {list(channels)}. "
             "Name the input column with input=... (CLI: --input)."
         )
-    names = list(outputs) if outputs is not None else [c for c in channels if c != input]
+    # a row index or sample counter (pandas writes its index as an unnamed first column) is
+    # not a sensor: taken as an output it was a ramp that lost modes and raised 'drift'
+    counters = [c for c in channels if c != input and _is_counter(channels[c])]
+    names = list(outputs) if outputs is not None else [c for c in channels if c != input and c not in counters]
     missing = [c for c in names if c not in channels]
     if missing:
         raise DataError(f"{path.name}: unknown output channel(s) {missing}; channels are {list(channels)}.")
@@ -111,7 +120,9 @@ def read_recording(
     lengths = {c: channels[c].size for c in [input, *names]}
     if len(set(lengths.values())) > 1:
         raise DataError(f"{path.name}: channels differ in length {lengths}; trim them to a common length.")
-    meta = {"source": str(path), "format": kind}
+    meta = {"source": str(path), "format": kind, "counter_columns": tuple(c for c in counters if c not in names)}
+    if "units" in info:  # a CSV's row of units under the header
+        meta["units"] = info["units"]
     return Recording(
         fs,
         channels[input],
@@ -124,6 +135,14 @@ def read_recording(
     )
 
 
+def _is_counter(values: np.ndarray) -> bool:
+    """Consecutive whole numbers (``k, k + 1, ...``): a row index or packet counter."""
+    return bool(
+        values.size > 0 and np.isfinite(values[0]) and values[0] == np.round(values[0])
+        and np.array_equal(values, values[0] + np.arange(values.size))
+    )  # fmt: skip
+
+
 def _guess_format(path: Path) -> str:
     suffixes = [s.lower() for s in path.suffixes]
     if suffixes and suffixes[-1] == ".gz":
@@ -133,18 +152,31 @@ def _guess_format(path: Path) -> str:
 
 
 def _resolve_fs(file_fs: float | None, user_fs: float | None, path: Path) -> float:
+    """The sampling rate: the user's, checked against the file's time base, or the file's.
+
+    A time column in milliseconds (or microseconds) under a plain name reads as a rate 1,000
+    (1,000,000) times too low: below 1 Hz it is refused, naming the fix, and a user's rate
+    exactly that multiple of it is taken as saying so."""
     if file_fs is None and user_fs is None:
         raise DataError(
             f"{path.name}: no time column or sample step in the file; give the sampling rate with fs=... (CLI: --fs)."
         )
-    if file_fs is not None and user_fs is not None:
-        if abs(file_fs - user_fs) > _TIME_JITTER * user_fs:
+    if user_fs is None:
+        if file_fs < _SLOWEST_FS:
             raise DataError(
-                f"{path.name}: the file's time column gives fs = {file_fs:.6g} Hz but fs = "
-                f"{user_fs:.6g} Hz was passed; drop one of them."
+                f"{path.name}: the time column, read in seconds, steps by {1 / file_fs:.4g} s ({file_fs:.4g} Hz "
+                f"sampling), far too slow for a vibration record: if it is in milliseconds, name the column "
+                f"'time_ms' or 'time [ms]' (or give its unit in a row under the header), or give the sampling "
+                "rate with fs=... (CLI: --fs)."
             )
-        return float(user_fs)
-    return float(user_fs if user_fs is not None else file_fs)
+        return float(file_fs)
+    in_a_unit = (abs(file_fs * unit - user_fs) <= _TIME_JITTER * user_fs for unit in (1, 1e3, 1e6))
+    if file_fs is not None and not any(in_a_unit):
+        raise DataError(
+            f"{path.name}: the file's time column gives fs = {file_fs:.6g} Hz but fs = "
+            f"{user_fs:.6g} Hz was passed; drop one of them."
+        )
+    return float(user_fs)
 
 
 def _fs_from_time(t: np.ndarray, path: Path) -> float:
@@ -252,6 +284,10 @@ def _read_csv(path: Path):
     if frame.shape[0] == 0:
         raise DataError(f"{path.name}: header only, no data rows.")
     frame.columns = [str(c).strip() for c in frame.columns]
+    units = {} if numeric else _units_row(frame)
+    if units:
+        frame = frame.iloc[1:].reset_index(drop=True)
+        info["units"] = units
     if numeric:
         channels = {col: frame[col].to_numpy(dtype=float) for col in frame.columns}
     else:
@@ -262,8 +298,21 @@ def _read_csv(path: Path):
         t = channels.pop(time_col)
         if not np.all(np.isfinite(t)):
             raise DataError(f"{path.name}: the time column contains NaN or empty cells.")
-        file_fs = _fs_from_time(t * _time_scale(time_col), path)
+        scale = _TO_SECONDS.get(units.get(time_col, "").strip("()[] ").lower()) or _time_scale(time_col)
+        file_fs = _fs_from_time(t * scale, path)
     return channels, file_fs, info
+
+
+def _units_row(frame: pd.DataFrame) -> dict[str, str]:
+    """``{column: unit}`` when the first row under the header is a row of units (every cell
+    text, such as ``s, m/s^2``, above rows of numbers), as many exports write; else empty."""
+    if len(frame) < 2:
+        return {}
+    first = frame.iloc[0].str.strip()
+    if pd.to_numeric(first, errors="coerce").notna().any():  # a blank unit is allowed
+        return {}
+    second = pd.to_numeric(frame.iloc[1].str.strip(), errors="coerce")
+    return dict(zip(frame.columns, first, strict=True)) if second.notna().all() else {}
 
 
 def _text_channels(frame: pd.DataFrame, path: Path) -> dict[str, np.ndarray]:

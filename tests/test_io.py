@@ -1,5 +1,6 @@
 import gzip
 import hashlib
+import re
 
 import numpy as np
 import pandas as pd
@@ -58,6 +59,77 @@ def test_a_time_column_named_with_its_unit_is_the_time_base(tmp_path, rec, name,
     assert back.fs == pytest.approx(60.0, rel=1e-9) and back.sensors == rec.sensors
     scipy.io.savemat(tmp_path / "u.mat", {"time_ms": rec.time * 1e3, "base": rec.base, "head": rec.response[:, 0]})
     assert am.read_recording(tmp_path / "u.mat").fs == pytest.approx(60.0, rel=1e-9)
+
+
+def test_a_row_index_column_is_not_an_output(tmp_path, rec):
+    """pandas writes its index as an unnamed first column by default; read as an output it
+    was a ramp that cost the supine ride two of its four modes. A column of consecutive whole
+    numbers is left out (and listed), unless the user names it."""
+    path = am.write_recording_csv(rec, tmp_path / "r.csv")
+    frame = pd.read_csv(path, comment="#")
+    frame.to_csv(tmp_path / "indexed.csv")  # index=True: a first column "", 0..n-1
+    frame.insert(1, "sample", np.arange(1, len(frame) + 1))
+    frame.to_csv(tmp_path / "counted.csv", index=False)
+    for name, counter in (("indexed.csv", "Unnamed: 0"), ("counted.csv", "sample")):
+        back = am.read_recording(tmp_path / name)
+        assert back.sensors == rec.sensors and back.meta["counter_columns"] == (counter,)
+        np.testing.assert_allclose(back.response, rec.response, rtol=1e-8)
+    named = am.read_recording(tmp_path / "counted.csv", outputs=["head", "sample"])
+    assert named.sensors == ("head", "sample") and named.meta["counter_columns"] == ()
+    # one skipped count, or a fractional start, is data, not a counter
+    for column in (np.r_[0, np.arange(2, len(frame) + 1)], np.arange(len(frame)) + 0.5):
+        frame["sample"] = column
+        frame.to_csv(tmp_path / "near.csv", index=False)
+        assert am.read_recording(tmp_path / "near.csv").sensors == ("sample", *rec.sensors)
+
+
+@pytest.mark.parametrize(("time_unit", "scale"), [("s", 1.0), ("(ms)", 1e3), ("[us]", 1e6)])
+def test_a_row_of_units_under_the_header_is_read_as_units(tmp_path, rec, time_unit, scale):
+    """Exports often put a row of units under the names ('s, m/s^2'): it was refused as a
+    non-numeric cell. Its time unit sets the time base."""
+    path = am.write_recording_csv(rec, tmp_path / "r.csv")
+    frame = pd.read_csv(path, comment="#")
+    frame["time"] *= scale
+    units = [time_unit] + ["m/s^2"] * (frame.shape[1] - 1)
+    with open(tmp_path / "u.csv", "w") as fh:
+        fh.write(",".join(frame.columns) + "\n" + ",".join(units) + "\n")
+        frame.to_csv(fh, header=False, index=False)
+    back = am.read_recording(tmp_path / "u.csv")
+    assert back.fs == pytest.approx(60.0, rel=1e-9) and back.sensors == rec.sensors
+    assert back.meta["units"]["head"] == "m/s^2" and back.n_samples == rec.n_samples
+    np.testing.assert_allclose(back.response, rec.response, rtol=1e-8)
+    # a text cell in the first data row alone is still a bad cell, named
+    with open(tmp_path / "bad.csv", "w") as fh:
+        fh.write(",".join(frame.columns) + "\n" + ",".join(["0"] + units[1:]) + "\n")
+        frame.to_csv(fh, header=False, index=False)
+    with pytest.raises(DataError, match="data row 1: 'm/s\\^2' is not a number"):
+        am.read_recording(tmp_path / "bad.csv")
+    # two text rows: not a row of units over numbers; the first wrong cell is named
+    with open(tmp_path / "two.csv", "w") as fh:
+        fh.write(",".join(frame.columns) + "\n" + ",".join(units) + "\n" + ",".join(["x"] * len(units)) + "\n")
+        frame.to_csv(fh, header=False, index=False)
+    with pytest.raises(DataError, match=f"data row 1: '{re.escape(time_unit)}' is not a number"):
+        am.read_recording(tmp_path / "two.csv")
+
+
+def test_a_plain_time_column_in_milliseconds_is_named_and_fs_settles_it(tmp_path, rec):
+    """A column called 'time' holding milliseconds read as seconds gave 0.06 Hz and a
+    failure deep in the spectra ('nperseg ... got 1'): refused at reading with the fix; a
+    --fs 1,000 times the file's rate says the column is in ms and is taken."""
+    path = am.write_recording_csv(rec, tmp_path / "r.csv")
+    frame = pd.read_csv(path, comment="#")
+    frame["time"] *= 1e3
+    frame.to_csv(tmp_path / "ms.csv", index=False)
+    with pytest.raises(DataError, match="steps by 16.67 s .*'time_ms'.*--fs"):
+        am.read_recording(tmp_path / "ms.csv")
+    back = am.read_recording(tmp_path / "ms.csv", fs=60.0)
+    assert back.fs == 60.0 and back.sensors == rec.sensors
+    np.testing.assert_allclose(back.response, rec.response, rtol=1e-8)
+    frame["time"] *= 1e3  # microseconds
+    frame.to_csv(tmp_path / "us.csv", index=False)
+    assert am.read_recording(tmp_path / "us.csv", fs=60.0).fs == 60.0
+    with pytest.raises(DataError, match="fs = 6e-05 Hz but fs = 61 Hz was passed"):
+        am.read_recording(tmp_path / "us.csv", fs=61.0)
 
 
 def test_csv_output_selection(tmp_path):
