@@ -105,10 +105,10 @@ def _load(args):
         return rec if outputs is None else rec.select(outputs)
     args.data = args.data[0]
     rec = read_recording(args.data, input=args.input, fs=args.fs, outputs=outputs)
-    skipped = rec.meta.get("counter_columns", ())
+    skipped = rec.meta.get("axis_columns", ())
     if skipped and not getattr(args, "quiet", False):
         named = ", ".join(f"'{c}'" for c in skipped)
-        print(f"{args.data}: column(s) {named} count the rows (a row index): not used as outputs")
+        print(f"{args.data}: column(s) {named} increase in equal steps (a row index or time axis): not outputs")
     return rec
 
 

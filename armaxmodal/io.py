@@ -62,9 +62,9 @@ def read_recording(
 ) -> Recording:
     """Read a recording: one input column, the other numeric columns as outputs.
 
-    A column of consecutive whole numbers (a row index, as pandas writes by default, or a
-    sample counter) is not taken as an output unless ``outputs`` names it; the recording's
-    ``meta["counter_columns"]`` lists those left out.
+    A column that increases in equal steps (a row index, as pandas writes by default, a
+    sample counter, a time column under another name) is not taken as an output unless
+    ``outputs`` names it; the recording's ``meta["axis_columns"]`` lists those left out.
 
     Parameters
     ----------
@@ -96,16 +96,23 @@ def read_recording(
     channels, file_fs, info = readers[kind](path)
     if not channels:
         raise DataError(f"{path.name}: no numeric channels found.")
+    # a row index, sample counter or time column under another name (pandas writes its index
+    # as an unnamed first column) is not a sensor: taken as an output it was a ramp that lost
+    # modes and raised 'drift'
+    axes = [c for c in channels if c != input and _is_axis(channels[c])]
+    if file_fs is None and fs is None and axes:
+        raise DataError(
+            f"{path.name}: no time column found, but column(s) {axes} increase in equal steps: if one is the "
+            "time, name it 'time' (seconds) or 'time_ms' (milliseconds); else give the sampling rate with "
+            "fs=... (CLI: --fs)."
+        )
     fs = _resolve_fs(file_fs, fs, path)
     if input not in channels:
         raise DataError(
             f"{path.name}: input channel '{input}' not found; channels are {list(channels)}. "
             "Name the input column with input=... (CLI: --input)."
         )
-    # a row index or sample counter (pandas writes its index as an unnamed first column) is
-    # not a sensor: taken as an output it was a ramp that lost modes and raised 'drift'
-    counters = [c for c in channels if c != input and _is_counter(channels[c])]
-    names = list(outputs) if outputs is not None else [c for c in channels if c != input and c not in counters]
+    names = list(outputs) if outputs is not None else [c for c in channels if c != input and c not in axes]
     missing = [c for c in names if c not in channels]
     if missing:
         raise DataError(f"{path.name}: unknown output channel(s) {missing}; channels are {list(channels)}.")
@@ -120,7 +127,7 @@ def read_recording(
     lengths = {c: channels[c].size for c in [input, *names]}
     if len(set(lengths.values())) > 1:
         raise DataError(f"{path.name}: channels differ in length {lengths}; trim them to a common length.")
-    meta = {"source": str(path), "format": kind, "counter_columns": tuple(c for c in counters if c not in names)}
+    meta = {"source": str(path), "format": kind, "axis_columns": tuple(c for c in axes if c not in names)}
     if "units" in info:  # a CSV's row of units under the header
         meta["units"] = info["units"]
     return Recording(
@@ -135,12 +142,14 @@ def read_recording(
     )
 
 
-def _is_counter(values: np.ndarray) -> bool:
-    """Consecutive whole numbers (``k, k + 1, ...``): a row index or packet counter."""
-    return bool(
-        values.size > 0 and np.isfinite(values[0]) and values[0] == np.round(values[0])
-        and np.array_equal(values, values[0] + np.arange(values.size))
-    )  # fmt: skip
+def _is_axis(values: np.ndarray) -> bool:
+    """Increasing in equal steps (within the time column's jitter): a row index, a sample
+    counter or a time axis. No sensor records a ramp that exact."""
+    steps = np.diff(values)
+    if steps.size < 2 or not np.all(np.isfinite(steps)):
+        return False
+    step = float(np.median(steps))
+    return bool(step > 0 and np.all(np.abs(steps - step) <= _TIME_JITTER * step))
 
 
 def _guess_format(path: Path) -> str:

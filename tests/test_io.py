@@ -61,26 +61,38 @@ def test_a_time_column_named_with_its_unit_is_the_time_base(tmp_path, rec, name,
     assert am.read_recording(tmp_path / "u.mat").fs == pytest.approx(60.0, rel=1e-9)
 
 
-def test_a_row_index_column_is_not_an_output(tmp_path, rec):
+def test_a_row_index_or_unnamed_time_axis_is_not_an_output(tmp_path, rec):
     """pandas writes its index as an unnamed first column by default; read as an output it
-    was a ramp that cost the supine ride two of its four modes. A column of consecutive whole
-    numbers is left out (and listed), unless the user names it."""
+    was a ramp that cost the supine ride two of its four modes, and so was a time column
+    under a name not known as one ('elapsed_s'). A column increasing in equal steps is left
+    out (and listed) unless the user names it; with no time base it is named in the error."""
     path = am.write_recording_csv(rec, tmp_path / "r.csv")
     frame = pd.read_csv(path, comment="#")
     frame.to_csv(tmp_path / "indexed.csv")  # index=True: a first column "", 0..n-1
     frame.insert(1, "sample", np.arange(1, len(frame) + 1))
     frame.to_csv(tmp_path / "counted.csv", index=False)
-    for name, counter in (("indexed.csv", "Unnamed: 0"), ("counted.csv", "sample")):
+    for name, axis in (("indexed.csv", "Unnamed: 0"), ("counted.csv", "sample")):
         back = am.read_recording(tmp_path / name)
-        assert back.sensors == rec.sensors and back.meta["counter_columns"] == (counter,)
+        assert back.sensors == rec.sensors and back.meta["axis_columns"] == (axis,)
         np.testing.assert_allclose(back.response, rec.response, rtol=1e-8)
     named = am.read_recording(tmp_path / "counted.csv", outputs=["head", "sample"])
-    assert named.sensors == ("head", "sample") and named.meta["counter_columns"] == ()
-    # one skipped count, or a fractional start, is data, not a counter
-    for column in (np.r_[0, np.arange(2, len(frame) + 1)], np.arange(len(frame)) + 0.5):
+    assert named.sensors == ("head", "sample") and named.meta["axis_columns"] == ()
+    frame.pop("sample")
+    elapsed = frame.rename(columns={"time": "elapsed_s"})
+    elapsed.to_csv(tmp_path / "elapsed.csv", index=False)
+    back = am.read_recording(tmp_path / "elapsed.csv", fs=60.0)
+    assert back.sensors == rec.sensors and back.meta["axis_columns"] == ("elapsed_s",)
+    with pytest.raises(DataError, match=r"\['elapsed_s'\] increase in equal steps: if one is the time, name it"):
+        am.read_recording(tmp_path / "elapsed.csv")
+    # a constant column is a dead sensor (refused by name before a fit), not an axis left out
+    frame["sample"] = 1.0
+    frame.to_csv(tmp_path / "flat.csv", index=False)
+    assert am.read_recording(tmp_path / "flat.csv").sensors == (*rec.sensors, "sample")
+    # one step twice as long, or a step back, is data, not an axis
+    for column in (np.r_[0, np.arange(2, len(frame) + 1)], np.r_[np.arange(len(frame) - 1), 0]):
         frame["sample"] = column
         frame.to_csv(tmp_path / "near.csv", index=False)
-        assert am.read_recording(tmp_path / "near.csv").sensors == ("sample", *rec.sensors)
+        assert am.read_recording(tmp_path / "near.csv").sensors == (*rec.sensors, "sample")
 
 
 @pytest.mark.parametrize(("time_unit", "scale"), [("s", 1.0), ("(ms)", 1e3), ("[us]", 1e6)])
