@@ -5,7 +5,8 @@ In this order, every step stated in the result (and in the JSON):
 1. the band is validated (finite, ``0 <= lo < hi <=`` Nyquist) before any work;
 2. :func:`armaxmodal.quality.check_quality` on the raw record;
 3. outputs that duplicate another channel are left out (a copy adds no information and,
-   pooled with its original, gives zero-width intervals);
+   pooled with its original, gives zero-width intervals), and so are outputs that do not
+   respond to the input while another does (pooled, they bend the shared poles);
 4. an output in other units than the rest whose quasi-static ratio matches a unit conversion
    (:mod:`armaxmodal.units`) is converted by that exact factor; channels found late or early
    by whole samples are aligned (a sensor with its own clock);
@@ -77,7 +78,8 @@ class Preparation:
     detrend : str
         ``"mean"``, ``"linear"`` or ``"none"``.
     dropped : tuple of str
-        Outputs left out as duplicates.
+        Outputs left out: duplicates, and outputs that do not respond to the input
+        (``incoherent_output``) while another output does.
     shifts : dict
         Channel -> samples it was moved earlier at the original rate (positive: it lagged).
     warnings : tuple of QualityWarning
@@ -130,6 +132,7 @@ def prepare(
     detrend: str = "mean",
     resample: bool = True,
     align: bool = True,
+    drop_incoherent: bool = True,
 ) -> Preparation:
     """Check and prepare ``recording`` for identification (see the module docstring).
 
@@ -144,6 +147,9 @@ def prepare(
         Resample to a rate suited to the band when the record is sampled far above it.
     align : bool
         Move channels found late or early by whole samples into line.
+    drop_incoherent : bool
+        Leave out outputs that do not respond to the input while another does (the
+        diagnosis keeps them: such a channel may be a second input it names).
 
     Returns
     -------
@@ -160,6 +166,16 @@ def prepare(
         raise DataError(
             f"every output duplicates another channel ({', '.join(dropped)}); nothing independent is left to fit."
         )
+    # an output that does not respond to the input, pooled with those that do, bends the
+    # shared poles to its own spectrum (a temperature channel moved the supine ride's
+    # 13.7 Hz mode to 15.0 Hz): left out while a responding output remains
+    incoherent = {c for w in found if w.code == "incoherent_output" for c in w.channels}
+    if drop_incoherent and any(s not in incoherent for s in keep):
+        dropped += tuple(s for s in keep if s in incoherent)
+        keep = [s for s in keep if s not in incoherent]
+        # the scale of a channel left out matters to nothing fitted (its advice would mislead)
+        found = [w for w in found if not (w.code == "unit_mismatch" and w.channels[0] in dropped)]
+        found = [_left_out(w) if w.code == "incoherent_output" else w for w in found]
     rec = recording.select(keep) if dropped else recording
     rec, found = _convert_units(rec, found)
     shifts = _whole_sample_shifts(found, rec) if align else {}
@@ -177,6 +193,10 @@ def prepare(
     meta = dict(rec.meta, preprocessing={"detrend": detrend, "analysis_fs": analysis_fs})
     rec = replace(rec, meta=meta)
     return Preparation(rec, recording.fs, analysis_fs, band, detrend, dropped, shifts, tuple(found))
+
+
+def _left_out(w: QualityWarning) -> QualityWarning:
+    return replace(w, message=w.message.rstrip(".") + "; they were left out of the fit.")
 
 
 def _convert_units(rec: Recording, found: list[QualityWarning]) -> tuple[Recording, list[QualityWarning]]:

@@ -333,6 +333,24 @@ def test_outputs_that_do_not_respond_to_the_input_are_named(clean):
     assert coherence[0] == pytest.approx(float(puu @ c / puu.sum()), rel=1e-6)
 
 
+def test_an_output_that_does_not_respond_is_left_out_of_the_fit(clean):
+    """A temperature channel exported beside the accelerometers, pooled with them, moved the
+    supine ride's 13.7 Hz mode to 15.0 Hz: it is left out as a duplicate is, and the record
+    fitted is the clean one, sample for sample. When no output responds there is nothing to
+    keep instead, and every output stays (the warning says the modes are not the structure's)."""
+    t = clean.time
+    temperature = 20 + t / t[-1] + 0.01 * np.random.default_rng(0).standard_normal(clean.n_samples)
+    extra = _with(clean, response=np.column_stack([clean.response, temperature]), sensors=(*clean.sensors, "temp"))
+    prep, ref = prepare(extra), prepare(clean)
+    assert prep.dropped == ("temp",) and prep.recording.sensors == clean.sensors
+    np.testing.assert_array_equal(prep.recording.response, ref.recording.response)
+    (w,) = [w for w in prep.warnings if w.code == "incoherent_output"]
+    assert w.channels == ("temp",) and "left out of the fit" in w.message
+    assert not [w for w in prep.warnings if w.code == "unit_mismatch"]  # its scale no longer matters
+    noise = np.random.default_rng(2).standard_normal(clean.response.shape)
+    assert prepare(_with(clean, response=noise)).dropped == ()
+
+
 @pytest.mark.parametrize(
     ("channel", "factor", "exact"),
     [(1, 1 / 9.80665, True), (2, 1000.0, True), (0, 1000 / 9.80665, False), (3, 100.0, False)],

@@ -238,7 +238,7 @@ def _verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float = 0.01) 
 def _signals(recording: Recording, band) -> tuple[Signals, Recording, tuple]:
     """The record as recorded (no detrend, no alignment: those are what is tested), resampled
     to the band when it is sampled far above it."""
-    prep = prepare(recording, band=band, detrend="none", align=False)
+    prep = prepare(recording, band=band, detrend="none", align=False, drop_incoherent=False)
     rec = prep.recording
     if rec.n_samples < 2 * MIN_SAMPLES:
         raise DataError(
@@ -255,7 +255,7 @@ def _baseline_orders(rec: Recording, baseline) -> tuple[int, int, int, int]:
     from ..orders import choose_orders
 
     if baseline is None:
-        centred = prepare(rec, detrend="mean", align=False, resample=False).recording
+        centred = prepare(rec, detrend="mean", align=False, resample=False, drop_incoherent=False).recording
         return choose_orders(centred).orders
     fit = baseline.fit if isinstance(baseline, Identification) else baseline
     if tuple(fit.sensors) != tuple(rec.sensors) or not np.isclose(fit.fs, rec.fs):
