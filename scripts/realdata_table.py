@@ -65,6 +65,13 @@ def _damaged(tmp: Path) -> dict:
     drift = d.copy()
     drift[outs] += 0.05 * np.arange(len(d))[:, None] / 60.0
     save("drift 0.05 m per s^3", drift)
+    temperature = d.copy()
+    noise = np.random.default_rng(0).standard_normal(len(d))
+    temperature["temperature"] = 20 + d["time"] / d["time"].iloc[-1] + 0.01 * noise
+    save("a temperature channel beside the sensors", temperature)
+    path = tmp / "pandas index column.csv"
+    d.to_csv(path)  # pandas' default: the row index as an unnamed first column
+    cases["exported with pandas' index column"] = [str(path)]
     return cases
 
 
