@@ -65,6 +65,7 @@ WARNING_CODES = (
     "unit_mismatch",
     "periodic_disturbance",
     "stuck_samples",
+    "oversampled",
 )
 #: An output less coherent with the input than this (averaged over the input's spectrum) is
 #: not its response: response sensors read 0.63-1.00 on the measured records (the F-16, the

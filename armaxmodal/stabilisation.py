@@ -29,7 +29,7 @@ from .frf import excited_band
 from .frf_check import peak_support
 from .modal import mode_record
 from .orders import _map, default_nb, default_nc, information_criterion
-from .prepare import Preparation, prepare
+from .prepare import Preparation, oversampling_note, prepare
 from .quality import QualityWarning
 from .recording import Recording
 from .refine import ModalRefinement, refine_modes
@@ -330,7 +330,10 @@ def _check_top_order(na: int, recording: Recording, preparation: Preparation | N
     narrow = [w for w in (preparation.warnings if preparation else ()) if w.code == "narrowband_input"]
     resampled = preparation is not None and preparation.analysis_fs != preparation.original_fs
     record = f"{recording.n_samples} samples at {recording.fs:g} Hz" + (
-        f", resampled from {preparation.original_fs:g} Hz to the input's band" if resampled else ""
+        f", resampled from {preparation.original_fs:g} Hz to the "
+        + ("band" if preparation.band is not None else "input's band")
+        if resampled
+        else ""
     )
     lead = f"{narrow[0].message.rstrip('.')}; check that the input excites the structure. " if narrow else ""
     raise OrderError(
@@ -600,6 +603,7 @@ def select_modes(
         from .frf_check import unexplained_peaks
 
         notes += unexplained_peaks(diagram.recording, modes.freq_hz.to_numpy(), modes.damping.to_numpy(), band)
+        notes += oversampling_note(modes.freq_hz.to_numpy(), diagram.recording.fs)
         notes += _unresolved_damping_notes(modes, len(nas))
         return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement, tuple(notes))
 

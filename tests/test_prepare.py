@@ -470,3 +470,28 @@ def test_a_few_padded_samples_at_the_edges_are_not_a_dropout_but_a_long_dead_end
     y[-60:, 1] = y[-61, 1]
     (w,) = [w for w in check_quality(_with(clean, response=y)) if w.code == "stuck_samples"]
     assert w.channels == ("chest",) and "for 61 samples" in w.message
+
+
+def test_a_record_sampled_far_above_its_structure_says_so_and_its_advice_finds_the_modes():
+    """The supine model at 1 kHz under a 0.5-400 Hz ride: the input excites far above the
+    structure, so the rate is kept, and the sweep found one of the four modes with nothing
+    said. Every mode found lies below 10 % of the Nyquist frequency: 'oversampled' names it
+    and the band to use; with that band all four modes are found, within 1.5 %."""
+    from armaxmodal.prepare import oversampling_note
+
+    system = am.supine_human()
+    ride = am.random_vibration(1000.0, 15.0, (0.5, 400.0), seed=1)
+    rec = am.simulate_recording(system, ride, 1000.0, noise=0.05, seed=2, hold="bandlimited")
+    first = select_modes(stabilisation_diagram(rec), segments=0)
+    (w,) = [w for w in first.warnings if w.code == "oversampled"]
+    top = first.modes.freq_hz.max()
+    assert len(first.modes) < 4 and w.value == pytest.approx(top / 500.0)
+    hi = float(np.ceil(2.5 * top))
+    assert f"band=(0, {hi:g}) (CLI: --band 0:{hi:g}), which resamples to {1000 / (400 // hi):.4g} Hz" in w.message
+    second = select_modes(stabilisation_diagram(rec, range(2, 25, 2), band=(0.0, hi)), segments=0)
+    exact = system.modes().freq_hz
+    assert len(second.modes) == 4 and not [w for w in second.warnings if w.code == "oversampled"]
+    np.testing.assert_allclose(second.modes.freq_hz, exact, rtol=0.015)
+    # the threshold: the highest mode at 10 % of the Nyquist frequency is not oversampled
+    assert oversampling_note(np.array([3.0, 50.0]), 1000.0) == [] and oversampling_note(np.array([]), 1000.0) == []
+    assert oversampling_note(np.array([49.9]), 1000.0)[0].value == pytest.approx(0.0998)
