@@ -396,7 +396,7 @@ def _read_mat(path: Path):
         UnicodeDecodeError, OverflowError, MemoryError,
     ) as exc:  # fmt: skip  -- what scipy raises on random bytes (tests/test_fuzz.py)
         raise DataError(f"{path.name}: not a readable MAT file ({type(exc).__name__}: {exc}).") from exc
-    arrays = {k: v for k, v in data.items() if not k.startswith("__") and isinstance(v, np.ndarray)}
+    arrays = _struct_fields({k: v for k, v in data.items() if not k.startswith("__") and isinstance(v, np.ndarray)})
     numeric = {k: np.squeeze(v) for k, v in arrays.items() if v.dtype.kind in "fiu" and v.size > 0}
     file_fs = None
     for key in ("fs", "Fs", "FS"):
@@ -431,6 +431,21 @@ def _read_mat(path: Path):
 
 
 # -- UFF ------------------------------------------------------------------------------
+def _struct_fields(arrays: dict) -> dict:
+    """A MATLAB struct's fields as variables of their own (``data.head`` -> ``head``, or
+    ``data.head`` when a variable of that name exists): labs often save a record as one
+    struct, which read as 'no numeric channels'. One struct level; struct arrays are skipped."""
+    out = {k: v for k, v in arrays.items() if v.dtype.names is None}
+    for name, record in arrays.items():
+        if record.dtype.names is None or record.size != 1:
+            continue
+        for field in record.dtype.names:
+            value = record.flat[0][field]
+            if isinstance(value, np.ndarray):
+                out[field if field not in arrays and field not in out else f"{name}.{field}"] = value
+    return out
+
+
 def _read_uff(path: Path):
     import pyuff
 

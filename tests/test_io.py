@@ -144,6 +144,22 @@ def test_a_plain_time_column_in_milliseconds_is_named_and_fs_settles_it(tmp_path
         am.read_recording(tmp_path / "us.csv", fs=61.0)
 
 
+def test_a_mat_struct_is_read_field_by_field(tmp_path, rec):
+    """A record saved as one MATLAB struct read as 'no numeric channels found'. Its fields
+    are the variables; a field named as a top-level variable keeps the struct's prefix."""
+    fields = {"time": rec.time, "base": rec.base, **{s: rec.response[:, k] for k, s in enumerate(rec.sensors)}}
+    scipy.io.savemat(tmp_path / "s.mat", {"data": fields})
+    back = am.read_recording(tmp_path / "s.mat")
+    assert back.fs == pytest.approx(60.0, rel=1e-9) and back.sensors == rec.sensors
+    np.testing.assert_array_equal(back.response, rec.response)
+    trials = np.empty((2,), dtype=[("x", "O")])  # a struct array: which element is the record?
+    trials[0]["x"], trials[1]["x"] = 3 * rec.base, 4 * rec.base
+    scipy.io.savemat(tmp_path / "c.mat", {"data": fields, "head": 2 * rec.response[:, 0], "trials": trials})
+    both = am.read_recording(tmp_path / "c.mat")
+    assert set(both.sensors) == {*rec.sensors, "data.head"}
+    np.testing.assert_array_equal(both.response[:, both.sensors.index("head")], 2 * rec.response[:, 0])
+
+
 def test_csv_output_selection(tmp_path):
     p = _write(tmp_path, "r.csv", "time,base,a,b,c\n0,1,2,3,4\n0.5,2,3,4,5\n1.0,0,1,1,1\n")
     r = am.read_recording(p, outputs=["c", "a"])
