@@ -226,6 +226,7 @@ def test_order_cap_message_names_the_record_the_cause_and_a_supported_range():
     prep = SimpleNamespace(
         analysis_fs=60.0,
         original_fs=240.0,
+        band=None,
         warnings=[
             QualityWarning("offset_removed", ("a",), "means removed.", 0.1),
             QualityWarning("narrowband_input", ("base",), "input power sits in 2.9-3.1 Hz.", 3.0),
@@ -235,6 +236,8 @@ def test_order_cap_message_names_the_record_the_cause_and_a_supported_range():
         _check_top_order(30, _recording(1040), prep)
     assert str(err.value).startswith("input power sits in 2.9-3.1 Hz; check that the input excites the structure. ")
     assert "(1040 samples at 60 Hz, resampled from 240 Hz to the input's band)" in str(err.value)
+    with pytest.raises(OrderError, match=r"resampled from 240 Hz to the band\)"):  # the user's band
+        _check_top_order(30, _recording(1040), SimpleNamespace(**{**vars(prep), "band": (0.0, 24.0)}))
 
 
 def test_delay_edge_warning_says_the_range_and_what_to_do():
