@@ -430,7 +430,6 @@ def _read_mat(path: Path):
     return channels, file_fs, {}
 
 
-# -- UFF ------------------------------------------------------------------------------
 def _struct_fields(arrays: dict) -> dict:
     """A MATLAB struct's fields as variables of their own (``data.head`` -> ``head``, or
     ``data.head`` when a variable of that name exists): labs often save a record as one
@@ -446,6 +445,7 @@ def _struct_fields(arrays: dict) -> dict:
     return out
 
 
+# -- UFF ------------------------------------------------------------------------------
 def _read_uff(path: Path):
     import pyuff
 
