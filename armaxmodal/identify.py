@@ -18,7 +18,7 @@ from ._threads import single_blas_thread
 from .fit import ArmaxFit, fit_armax
 from .modal import mode_record
 from .orders import OrderChoice, choose_orders
-from .prepare import Preparation, prepare
+from .prepare import Preparation, oversampling_note, prepare
 from .recording import Recording
 from .stabilisation import _POLE_COLUMNS, SHARED, Tolerances, _poles_of, _reject
 
@@ -56,8 +56,10 @@ class Identification:
 
     @property
     def warnings(self) -> tuple:
-        """Data-quality warnings found while preparing the record."""
-        return () if self.preparation is None else self.preparation.warnings
+        """Data-quality warnings found while preparing the record, and ``oversampled`` when
+        every mode lies below a tenth of the Nyquist frequency (:func:`oversampling_note`)."""
+        found = () if self.preparation is None else self.preparation.warnings
+        return (*found, *oversampling_note(self.modes.freq_hz.to_numpy(), self.recording.fs))
 
     def to_dict(self) -> dict:
         """The JSON contract: fs, input, outputs, modes (with shapes) and per_sensor rows."""

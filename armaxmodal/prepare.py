@@ -480,7 +480,7 @@ def oversampling_note(mode_freqs: np.ndarray, fs: float) -> list[QualityWarning]
             (),
             f"every mode found lies below {100 * share:.1f} % of the Nyquist frequency (the highest at "
             f"{top:.3g} Hz of {fs / 2:g} Hz): the input excites far above the structure, so the rate was kept, "
-            "and at this rate the poles crowd z = 1 where the swept orders resolve them poorly; modes may be "
+            "and at this rate the poles crowd z = 1 where ARMAX models resolve them poorly; modes may be "
             f"missed or biased. Rerun with band=(0, {hi:g}) (CLI: --band 0:{hi:g}), which resamples to "
             f"{new_fs:.4g} Hz.",
             share,
