@@ -179,8 +179,7 @@ def _resolve_fs(file_fs: float | None, user_fs: float | None, path: Path) -> flo
                 "rate with fs=... (CLI: --fs)."
             )
         return float(file_fs)
-    in_a_unit = (abs(file_fs * unit - user_fs) <= _TIME_JITTER * user_fs for unit in (1, 1e3, 1e6))
-    if file_fs is not None and not any(in_a_unit):
+    if file_fs is not None and min(abs(file_fs * unit - user_fs) for unit in (1, 1e3, 1e6)) > _TIME_JITTER * user_fs:
         raise DataError(
             f"{path.name}: the file's time column gives fs = {file_fs:.6g} Hz but fs = "
             f"{user_fs:.6g} Hz was passed; drop one of them."
