@@ -16,7 +16,7 @@ deterministic: the same data gives the same modes.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import partial
+from functools import cached_property, partial
 
 import numpy as np
 import pandas as pd
@@ -446,11 +446,13 @@ class ModeSelection:
     refinement: ModalRefinement | None = None
     notes: tuple[QualityWarning, ...] = ()
 
-    @property
+    @cached_property
     def reconstruction_error(self) -> float:
         """Relative RMS difference between the FRF rebuilt from the selected modes (with a
         constant residual per sensor) and the measured H1, over coherent lines of the band,
-        at a resolution that resolves the narrowest mode (:mod:`armaxmodal.frf_check`)."""
+        at a resolution that resolves the narrowest mode (:mod:`armaxmodal.frf_check`).
+        Computed once: the CLI, the figure and the JSON report the same number (recomputed,
+        its last digit can differ with memory alignment on some CPUs)."""
         from .frf_check import reconstruction_error
 
         prep = self.diagram.preparation

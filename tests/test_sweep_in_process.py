@@ -80,18 +80,30 @@ def test_the_delay_is_the_lowest_bic_one(ride, diagram):
 
 
 def _same_fit(a, b) -> bool:
-    """Bit for bit: every coefficient, loss, count and covariance."""
-    models = zip(a.models, b.models, strict=True)
-    fields = ("loss", "iterations", "converged", "joint_covariance")
-    return all(np.array_equal(getattr(ma, k), getattr(mb, k)) for ma, mb in models for k in "abc") and all(
-        np.array_equal(getattr(a, k), getattr(b, k)) for k in fields
-    )
+    """The same fit up to rounding: the same iteration count and stop, every coefficient and
+    loss to 1e-7 and the joint covariance to 1e-4 of its largest entry. Not bit for bit: a
+    continued fit computes on arrays allocated elsewhere, and on some CPUs the BLAS and SIMD
+    reductions round differently with alignment (seen in CI: coefficients 1e-8 apart, a
+    covariance the ill-conditioned inverse moved by 1e-5). A continuation that loses any of
+    its state (the damping, its growth, the crawl count, the variances) lands 1e-4 or more
+    away or stops at another iteration."""
+    if not all(np.array_equal(getattr(a, k), getattr(b, k)) for k in ("iterations", "converged")):
+        return False
+    for ma, mb in zip(a.models, b.models, strict=True):
+        for k in "abc":
+            x, y = getattr(ma, k), getattr(mb, k)
+            if not np.allclose(x, y, rtol=1e-7, atol=1e-7 * np.max(np.abs(y))):
+                return False
+    if not np.allclose(a.loss, b.loss, rtol=1e-7, atol=0):
+        return False
+    ca, cb = np.asarray(a.joint_covariance), np.asarray(b.joint_covariance)
+    return ca.shape == cb.shape and np.allclose(ca, cb, rtol=0, atol=1e-4 * max(np.max(np.abs(cb), initial=0), 1e-300))
 
 
 def test_the_sweep_continues_the_delay_choice_fits_exactly(ride):
     """The delay choice hands the sweep where each of its fits at the chosen delay stopped
-    (after at most 8 iterations); continued in the sweep, each is bit for bit the fit the
-    sweep would have made from the start."""
+    (after at most 8 iterations); continued in the sweep, each is the fit the sweep would
+    have made from the start (to rounding, :func:`_same_fit`)."""
     from armaxmodal._threads import one_blas_thread
     from armaxmodal.stabilisation import _choose_nk
 
@@ -109,24 +121,35 @@ def test_the_sweep_continues_the_delay_choice_fits_exactly(ride):
 
 
 @pytest.mark.parametrize(
-    ("na", "cap", "where"), [(6, 3, "mid-run"), (8, 8, "mid-run"), (4, 5, "between runs"), (4, 8, "converged")]
+    ("na", "cap", "stop", "where"),
+    [
+        (6, 3, "decrease", "mid-run"),
+        (8, 8, "decrease", "mid-run"),
+        (4, 5, "decrease", "between runs"),
+        (4, 8, "decrease", "converged"),
+        (10, 25, "expected", "crawling"),  # two floor-damped small steps counted, of the three that stop it
+    ],
 )
-def test_a_fit_stopped_by_its_cap_continues_exactly(ride, na, cap, where):
-    """Stopped after ``cap`` iterations -- mid-way through a Levenberg-Marquardt run, between
-    two runs of the noise-variance alternation, or converged -- and continued to 30, a
-    shared-pole fit equals the fit capped at 30 from the start, bit for bit: the damping,
-    its growth, the crawl count and the variances weighting the run are all carried over."""
+def test_a_fit_stopped_by_its_cap_continues_exactly(ride, na, cap, stop, where):
+    """Stopped after ``cap`` iterations -- mid-way through a Levenberg-Marquardt run, while
+    crawling, between two runs of the noise-variance alternation, or converged -- and
+    continued to 30, a shared-pole fit equals the fit capped at 30 from the start
+    (:func:`_same_fit`): the damping, the crawl count and the variances weighting the run
+    are all carried over."""
     from armaxmodal._threads import one_blas_thread
     from armaxmodal.fit import _fit
 
     rec = ride[1]
-    options = {"shared_poles": True, "tol": SWEEP_TOL, "stop": "decrease", "warn": False}
+    options = {"shared_poles": True, "tol": SWEEP_TOL if stop == "decrease" else 1e-9, "stop": stop, "warn": False}
     orders = (na, default_nb(na, -1), default_nc(na), -1)
     with one_blas_thread():
         short, checkpoint = _fit(rec, orders, max_iter=cap, covariance=False, **options)
         fresh = _fit(rec, orders, max_iter=30, **options)[0]
         continued = _fit(rec, orders, max_iter=30, resume=checkpoint, **options)[0]
-    kind = "converged" if checkpoint.converged else "mid-run" if checkpoint.progress else "between runs"
+    progress = checkpoint.progress
+    kind = "converged" if checkpoint.converged else "between runs" if progress is None else "mid-run"
+    if progress is not None and progress.crawling:
+        kind = "crawling"
     assert kind == where and short.covariance == ()
     assert fresh.iterations[0] > cap or kind == "converged"
     assert _same_fit(continued, fresh)
