@@ -120,6 +120,44 @@ def test_a_clipped_channel_is_named(clean):
     assert found[0].value == pytest.approx(100 * stuck / y.shape[0], rel=0.2)
 
 
+def test_clipped_peaks_that_never_dwell_are_named_by_their_pile_up(clean):
+    """Sampled a few times per period, a clipped peak is one sample at the rail, never two in
+    a row; the pile-up at the rail (43 samples where the values just inside occur once each)
+    names it. The channel under a coarse quantiser (every level visited often, its extreme
+    ones two in a row) is not clipped, nor is one with 4 samples at the rail."""
+    y = clean.response.copy()
+    head = clean.response[:, 0]
+    rail = np.sort(head)[-40]
+    y[:, 0] = np.minimum(head, rail)
+    at = y[:, 0] == rail
+    assert not np.any(at[1:] & at[:-1])  # the dwell test alone would miss it
+    (w,) = check_quality(_with(clean, response=y))
+    assert (w.code, w.channels) == ("clipping", ("head",))
+    assert w.value == pytest.approx(100 * (40 + 1) / y.shape[0])
+    assert "40 on one, where the values just inside it occur about 1.0 times each" in w.message
+    quantised, legs = clean.response.copy(), clean.response[:, 3]
+    quantised[:, 3] = np.round(legs / np.std(legs)) * np.std(legs)  # a 1-sigma step
+    top = quantised[:, 3] == quantised[:, 3].max()
+    assert np.count_nonzero(top) > 40 and np.any(top[1:] & top[:-1])  # the dwell test alone flagged it
+    assert not [w for w in check_quality(_with(clean, response=quantised)) if w.code == "clipping"]
+    held = clean.response.copy()
+    held[:, 0] = np.minimum(head, np.sort(head)[-6])
+    peak = int(np.argmax(head))
+    held[peak + 1, 0] = held[peak, 0]  # 7 at the rail, two in a row: p ~ 1e-4, named as a dwell
+    (w,) = [w for w in check_quality(_with(clean, response=held)) if w.code == "clipping"]
+    assert w.channels == ("head",) and "some in a row" in w.message
+    for k in (4, 6):  # below CLIP_MIN_SAMPLES; six apart (p 6e-4) as likely as a peak visited twice
+        few = clean.response.copy()
+        few[:, 0] = np.minimum(head, np.sort(head)[-k])
+        apart = few[:, 0] == few[:, 0].max()
+        assert not np.any(apart[1:] & apart[:-1])
+        assert not [w for w in check_quality(_with(clean, response=few)) if w.code == "clipping"]
+    floor = clean.response.copy()
+    floor[:, 0] = np.maximum(head, np.sort(head)[7])  # 8 at the minimum, apart: p 1e-5
+    (w,) = [w for w in check_quality(_with(clean, response=floor)) if w.code == "clipping"]
+    assert "8 on one" in w.message and "p = 1.0e-05" in w.message
+
+
 def test_a_sine_ride_is_narrowband(clean):
     t = clean.time
     base = np.sin(2 * np.pi * 3.0 * t) + 0.01 * clean.base

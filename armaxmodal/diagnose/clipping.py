@@ -13,44 +13,24 @@ just inside it (once each for continuous data, a few times for a coarse quantise
 or recorder that saturates piles every sample beyond its range onto one value. The test
 counts the samples at each rail and compares them with the mean count of the
 ``NEIGHBOUR_LEVELS`` distinct values just inside it: Poisson, so the p-value is
-``P(N >= k | lambda)``. The quality check (:func:`armaxmodal.quality.clipped_channels`)
-warns on any dwell at the rail; this test names clipping only when the pile-up is beyond
-what the channel's own amplitude distribution allows.
+``P(N >= k | lambda)`` (:func:`armaxmodal.quality.rail_pileup`, which the pre-fit warning
+uses too, at a stricter p: it is one test of many, this one is corrected for them).
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
-from scipy.special import pdtrc
 
 from .._kernels import _JIT
+from ..quality import NEIGHBOUR_LEVELS, rail_pileup
 
-__all__ = ["rail_pileup", "clipped_mask", "fill_by_prediction", "IMPUTE_PASSES"]
+__all__ = ["rail_pileup", "clipped_mask", "fill_by_prediction", "IMPUTE_PASSES", "NEIGHBOUR_LEVELS"]
 
-#: Distinct values inside the rail whose counts give the expected count at the rail.
-NEIGHBOUR_LEVELS = 5
 #: Uncorrected p below which a rail's samples are treated as clipped by the fix.
 RAIL_ALPHA = 1e-3
 #: Refit-and-fill passes of the fix (the filled values settle in two or three).
 IMPUTE_PASSES = 3
-
-
-def rail_pileup(x: np.ndarray) -> list[tuple[float, int, float, float]]:
-    """Each rail's ``(value, count, expected count, p)`` for the maximum and the minimum of ``x``.
-
-    ``expected`` is the mean count of the ``NEIGHBOUR_LEVELS`` distinct values next inside the
-    rail; ``p = P(N >= count)`` for ``N`` Poisson with that mean.
-    """
-    out = []
-    for sign in (1.0, -1.0):
-        values, counts = np.unique(-sign * x, return_counts=True)  # the rail first
-        count = int(counts[0])
-        inner = counts[1 : 1 + NEIGHBOUR_LEVELS]
-        expected = float(np.mean(inner)) if inner.size else 1.0
-        p = float(pdtrc(count - 1, expected)) if count > 1 else 1.0  # P(N >= count)
-        out.append((float(-sign * values[0]), count, expected, p))
-    return out
 
 
 def clipped_mask(x: np.ndarray, alpha: float = RAIL_ALPHA) -> np.ndarray:
