@@ -12,6 +12,7 @@ import re
 import struct
 import tempfile
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -48,6 +49,8 @@ def _time_scale(name: str) -> float | None:
 _TIME_JITTER = 1e-3
 # A time base slower than this (Hz) is a time column in ms or us read as seconds.
 _SLOWEST_FS = 1.0
+#: rows missing from a CSV's time column bridged by interpolation; a longer gap is an error
+MAX_BRIDGED_SAMPLES = 3
 
 
 def read_recording(
@@ -130,6 +133,10 @@ def read_recording(
     meta = {"source": str(path), "format": kind, "axis_columns": tuple(c for c in axes if c not in names)}
     if "units" in info:  # a CSV's row of units under the header
         meta["units"] = info["units"]
+    if info.get("read_warnings"):  # rows a logger dropped, bridged
+        kept = (input, *names)
+        notes = info["read_warnings"]
+        meta["read_warnings"] = [replace(w, channels=tuple(c for c in w.channels if c in kept)) for w in notes]
     return Recording(
         fs,
         channels[input],
@@ -185,6 +192,45 @@ def _resolve_fs(file_fs: float | None, user_fs: float | None, path: Path) -> flo
             f"{user_fs:.6g} Hz was passed; drop one of them."
         )
     return float(user_fs)
+
+
+def _bridge_dropped_rows(t: np.ndarray, channels: dict, path: Path) -> tuple[np.ndarray, dict, list]:
+    """Rows missing from a uniform time column -- steps of 2 to ``MAX_BRIDGED_SAMPLES + 1``
+    whole sample steps, a logger's dropped packet -- filled by linear interpolation in every
+    channel, each gap a ``dropped_packet`` warning; a longer gap is refused (filling it would
+    invent data), as :func:`armaxmodal.xsens.read_xsens` does. Other steps are left to
+    :func:`_fs_from_time`, which refuses a time column that is not uniform."""
+    from .quality import QualityWarning
+
+    steps = np.diff(t)
+    dt = float(np.median(steps)) if steps.size else 0.0
+    if not dt > 0:
+        return t, channels, []
+    ratio = steps / dt
+    whole = np.rint(ratio)
+    gaps = np.flatnonzero((whole >= 2) & (np.abs(ratio - whole) <= _TIME_JITTER * whole))
+    notes, inserted = [], []
+    for i in gaps:
+        n = int(whole[i]) - 1
+        if n > MAX_BRIDGED_SAMPLES:
+            raise DataError(
+                f"{path.name}: {n} samples missing after row {i} ({t[i] - t[0]:.3f} s), more than the "
+                f"{MAX_BRIDGED_SAMPLES} that can be bridged honestly; cut the record there and analyse the parts apart."
+            )
+        inserted.append(t[i] + steps[i] * np.arange(1, n + 1) / (n + 1))
+        notes.append(
+            QualityWarning(
+                "dropped_packet",
+                tuple(channels),
+                f"{n} sample(s) missing at {t[i] - t[0]:.3f} s (the time column steps {steps[i]:.6g} s there, "
+                f"{n + 1} samples); bridged by linear interpolation.",
+                float(n),
+            )
+        )
+    if not notes:
+        return t, channels, []
+    grid = np.sort(np.concatenate([t, *inserted]))
+    return grid, {name: np.interp(grid, t, x) for name, x in channels.items()}, notes
 
 
 def _fs_from_time(t: np.ndarray, path: Path) -> float:
@@ -307,7 +353,8 @@ def _read_csv(path: Path):
         if not np.all(np.isfinite(t)):
             raise DataError(f"{path.name}: the time column contains NaN or empty cells.")
         scale = _TO_SECONDS.get(units.get(time_col, "").strip("()[] ").lower()) or _time_scale(time_col)
-        file_fs = _fs_from_time(t * scale, path)
+        t, channels, info["read_warnings"] = _bridge_dropped_rows(t * scale, channels, path)
+        file_fs = _fs_from_time(t, path)
     return channels, file_fs, info
 
 

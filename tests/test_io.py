@@ -174,7 +174,8 @@ def test_csv_output_selection(tmp_path):
         ("time,plat,a\n0,1,2\n1,2,3\n2,0,1\n", {}, "input channel 'base' not found.*--input"),
         ("base,a\n1,2\n2,3\n", {}, "fs=.*--fs"),
         ("time,base,a\n0,1,2\n1,2,x3\n2,0,1\n", {}, "column 'a', data row 2: 'x3' is not a number"),
-        ("time,base,a\n0,1,2\n1,2,3\n3,0,1\n4,1,1\n", {}, "not uniformly spaced"),
+        ("time,base,a\n0,1,2\n1,2,3\n2.5,0,1\n3.5,1,1\n", {}, "not uniformly spaced"),
+        ("time,base,a\n0,1,2\n1,2,3\n6,0,1\n7,1,1\n8,0,2\n", {}, "4 samples missing after row 1 .*cut the record"),
         ("time,base,a\n0,1,2\n1,2,\n2,0,1\n", {}, "data row 2 is empty"),
         ("time,base,a\n0,1,2\n1,2,nan\n2,0,1\n", {}, "channel 'a' has 1 NaN"),
         ("time,base,a\n0,1,2\n1,2,3\n2,0,1\n", {"fs": 50.0}, "fs = 1 Hz but fs = 50 Hz"),
@@ -188,6 +189,35 @@ def test_bad_csv_gets_a_clear_error(tmp_path, text, kwargs, message):
     p = _write(tmp_path, "bad.csv", text)
     with pytest.raises(DataError, match=message):
         am.read_recording(p, **kwargs)
+
+
+@pytest.mark.parametrize("lost", [1, 2, 3])
+def test_a_dropped_row_is_bridged_and_named(tmp_path, fixtures_dir, lost):
+    """A logger that dropped 1-3 rows from row 3000 of the supine ride: the time column steps
+    that many samples more there. The rows are filled by linear interpolation in every
+    channel, every other sample is the file's, and the gap is a ``dropped_packet`` warning
+    with its time."""
+    from armaxmodal.prepare import prepare
+
+    frame = pd.read_csv(fixtures_dir / "supine_random.csv", comment="#")
+    path = tmp_path / "gap.csv"
+    gone = list(range(3000, 3000 + lost))
+    frame.drop(index=gone).to_csv(path, index=False)
+    rec, full = am.read_recording(path), am.read_recording(fixtures_dir / "supine_random.csv")
+    assert rec.n_samples == full.n_samples and rec.fs == pytest.approx(full.fs, rel=1e-9)
+    kept = np.ones(full.n_samples, bool)
+    kept[gone] = False
+    np.testing.assert_array_equal(rec.response[kept], full.response[kept])
+    np.testing.assert_array_equal(rec.base[kept], full.base[kept])
+    after = 3000 + lost
+    step = (full.response[after] - full.response[2999]) / (lost + 1)
+    line = full.response[2999] + np.outer(np.arange(1, lost + 1), step)
+    np.testing.assert_allclose(rec.response[gone], line, rtol=1e-12, atol=1e-12)
+    (note,) = rec.meta["read_warnings"]
+    assert (note.code, note.value, note.channels) == ("dropped_packet", float(lost), ("base", *full.sensors))
+    assert f"{lost} sample(s) missing at 49.983 s" in note.message
+    assert "dropped_packet" in [w.code for w in prepare(rec).warnings]
+    assert am.read_recording(path, outputs=["chest"]).meta["read_warnings"][0].channels == ("base", "chest")
 
 
 def test_missing_file():
