@@ -306,7 +306,19 @@ def delay_and_inversion(recording: Recording) -> list[QualityWarning]:
     estimates = estimate_delays(recording)
     found = []
     inverted = [e.channel for e in estimates if e.sign < 0]
-    if inverted:
+    if len(inverted) > 1 and len(inverted) == len(recording.sensors):
+        # every output reads -1: one sign flip on the input explains it, not one per sensor
+        found.append(
+            QualityWarning(
+                "inverted_sensor",
+                (recording.input_name,),
+                f"every output's low-frequency transmissibility is near -1 where a base-excited structure moves "
+                f"with its base (+1): the input '{recording.input_name}' is mounted or exported upside down "
+                "(or every output is). Shapes keep the measured sign.",
+                -1.0,
+            )
+        )
+    elif inverted:
         found.append(
             QualityWarning(
                 "inverted_sensor",

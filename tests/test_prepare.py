@@ -91,6 +91,16 @@ def test_an_inverted_sensor_is_named(clean):
     assert _codes(found) == [("inverted_sensor", ("chest",))]
 
 
+def test_an_inverted_input_is_named_not_every_output(clean):
+    """The base channel's sign flipped: every output reads -1, which one flip on the input
+    explains. Two outputs flipped of four are two sensors."""
+    found = check_quality(_with(clean, base=-clean.base))
+    assert _codes(found) == [("inverted_sensor", ("base",))] and "the input 'base'" in found[0].message
+    y = clean.response.copy()
+    y[:, :2] *= -1
+    assert _codes(check_quality(_with(clean, response=y))) == [("inverted_sensor", ("head", "chest"))]
+
+
 @pytest.mark.parametrize("scale", [1.0, -2.5, 9.81])
 def test_a_duplicated_channel_is_named_and_left_out(clean, scale):
     y = np.column_stack([clean.response, scale * clean.response[:, 0] + 0.3])
