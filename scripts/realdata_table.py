@@ -69,6 +69,15 @@ def _damaged(tmp: Path) -> dict:
     noise = np.random.default_rng(0).standard_normal(len(d))
     temperature["temperature"] = 20 + d["time"] / d["time"].iloc[-1] + 0.01 * noise
     save("a temperature channel beside the sensors", temperature)
+    clipped = d.copy()
+    clipped["head"] = clipped["head"].clip(upper=np.sort(clipped["head"])[-40])  # peaks clipped in single samples
+    save("head clipped at its 40th-largest sample", clipped)
+    flipped = d.copy()
+    flipped["base"] = -flipped["base"]
+    save("base inverted", flipped)
+    gap = tmp / "rows 3000-3001 dropped.csv"
+    d.drop(index=[3000, 3001]).to_csv(gap, index=False)
+    cases["rows 3000-3001 dropped by the logger"] = [str(gap)]
     path = tmp / "pandas index column.csv"
     d.to_csv(path)  # pandas' default: the row index as an unnamed first column
     cases["exported with pandas' index column"] = [str(path)]
