@@ -17,8 +17,8 @@ recording:
   quasi-static band) are not tested, and the check says nothing.
 * ``narrowband_input`` -- the input's power sits in a narrow band (a sine ride): modes
   outside it are not identifiable.
-* ``clipping`` -- samples piled up at a channel's extreme value (the sensor's rail): two in
-  a row, or more than the values just inside it occur (Poisson).
+* ``clipping`` -- samples piled up at a channel's extreme value (the sensor's rail): more
+  than the values just inside it occur (Poisson; a looser p when two are in a row).
 * ``stuck_samples`` -- a run of equal samples elsewhere, longer than the channel's own rate
   of repeated samples makes likely: a sensor or a recorder that stopped updating.
 * ``incoherent_output`` -- an output whose coherence with the input, averaged over the
