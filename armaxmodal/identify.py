@@ -10,6 +10,7 @@ residue), within ``band``; selection across orders lives in the stabilisation mo
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import pandas as pd
@@ -54,12 +55,23 @@ class Identification:
     order_table: pd.DataFrame | None = None
     preparation: Preparation | None = None
 
-    @property
+    @cached_property
     def warnings(self) -> tuple:
-        """Data-quality warnings found while preparing the record, and ``oversampled`` when
-        every mode lies below a tenth of the Nyquist frequency (:func:`oversampling_note`)."""
+        """Data-quality warnings found while preparing the record; ``unexplained_peak`` for
+        each clear, coherent FRF peak no reported mode explains (as :func:`select_modes`
+        gives: a fixed or BIC-chosen order can leave a mode out); and ``oversampled`` when
+        every mode lies below a tenth of the Nyquist frequency (:func:`oversampling_note`).
+        Computed once (the peak check takes spectra)."""
+        from .frf_check import unexplained_peaks
+
         found = () if self.preparation is None else self.preparation.warnings
-        return (*found, *oversampling_note(self.modes.freq_hz.to_numpy(), self.recording.fs))
+        band = None if self.preparation is None else self.preparation.band
+        freq, damping = self.modes.freq_hz.to_numpy(), self.modes.damping.to_numpy()
+        return (
+            *found,
+            *unexplained_peaks(self.recording, freq, damping, band),
+            *oversampling_note(freq, self.recording.fs),
+        )
 
     def to_dict(self) -> dict:
         """The JSON contract: fs, input, outputs, modes (with shapes) and per_sensor rows."""

@@ -451,3 +451,20 @@ def test_a_structure_damped_below_the_line_threshold_is_not_a_disturbance():
     diagram = _diagram(rec)
     assert (diagram.poles.damping.abs() < UNDAMPED_LINE).sum() >= 8  # the sweep does see them undamped
     assert not [w for w in diagram.warnings if w.code == "periodic_disturbance"]
+
+
+def test_identify_names_the_peak_its_order_leaves_out(ride):
+    """``identify`` at one order reports what that order holds: at na = 2 only the 3.53 Hz
+    mode, and the 9.95 Hz mode's clear, coherent FRF peak is named (``unexplained_peak``, on
+    both sensors, as :func:`select_modes` names it); at na = 4 both modes are found and
+    nothing is left unexplained."""
+    s, rec = ride
+    exact = s.modes().freq_hz
+    short = am.identify(rec, (2, 3, 2, 0))
+    assert short.modes.freq_hz.to_numpy() == pytest.approx(exact[:1], rel=0.005)
+    (w,) = [w for w in short.warnings if w.code == "unexplained_peak"]
+    assert w.channels == ("m1", "m2") and w.value == pytest.approx(exact[1], rel=0.05)
+    assert [d["code"] for d in short.to_dict()["warnings"]].count("unexplained_peak") == 1
+    full = am.identify(rec, (4, 5, 4, 0))
+    assert full.modes.freq_hz.to_numpy() == pytest.approx(exact, rel=0.005)
+    assert not [w for w in full.warnings if w.code == "unexplained_peak"]
