@@ -194,41 +194,50 @@ def _resolve_fs(file_fs: float | None, user_fs: float | None, path: Path) -> flo
     return float(user_fs)
 
 
+def whole_step_gaps(t: np.ndarray, step: float, max_gap: int, unit: str, source: str) -> list[tuple[int, int]]:
+    """``(i, n)`` for each step of ``t`` (seconds) after sample ``i`` that spans ``n + 1``
+    whole steps of ``step`` (within the time jitter): ``n`` samples or packets a logger
+    dropped there. More than ``max_gap`` at once is refused: bridging them would invent data.
+    Shared by the CSV reader and :func:`armaxmodal.xsens.read_xsens`."""
+    ratio = np.diff(t) / step
+    whole = np.rint(ratio)
+    gaps = []
+    for i in np.flatnonzero((whole >= 2) & (np.abs(ratio - whole) <= _TIME_JITTER * whole)):
+        n = int(whole[i]) - 1
+        if n > max_gap:
+            raise DataError(
+                f"{source}: {n} {unit} missing after row {i} ({t[i] - t[0]:.3f} s), more than the {max_gap} "
+                "that can be bridged honestly; cut the record there and analyse the parts apart."
+            )
+        gaps.append((int(i), n))
+    return gaps
+
+
 def _bridge_dropped_rows(t: np.ndarray, channels: dict, path: Path) -> tuple[np.ndarray, dict, list]:
-    """Rows missing from a uniform time column -- steps of 2 to ``MAX_BRIDGED_SAMPLES + 1``
-    whole sample steps, a logger's dropped packet -- filled by linear interpolation in every
-    channel, each gap a ``dropped_packet`` warning; a longer gap is refused (filling it would
-    invent data), as :func:`armaxmodal.xsens.read_xsens` does. Other steps are left to
-    :func:`_fs_from_time`, which refuses a time column that is not uniform."""
+    """Rows missing from a uniform time column (:func:`whole_step_gaps`, at most
+    ``MAX_BRIDGED_SAMPLES`` at once) filled by linear interpolation in every channel, each
+    gap a ``dropped_packet`` warning. Other uneven steps are left to :func:`_fs_from_time`,
+    which refuses them."""
     from .quality import QualityWarning
 
     steps = np.diff(t)
     dt = float(np.median(steps)) if steps.size else 0.0
     if not dt > 0:
         return t, channels, []
-    ratio = steps / dt
-    whole = np.rint(ratio)
-    gaps = np.flatnonzero((whole >= 2) & (np.abs(ratio - whole) <= _TIME_JITTER * whole))
-    notes, inserted = [], []
-    for i in gaps:
-        n = int(whole[i]) - 1
-        if n > MAX_BRIDGED_SAMPLES:
-            raise DataError(
-                f"{path.name}: {n} samples missing after row {i} ({t[i] - t[0]:.3f} s), more than the "
-                f"{MAX_BRIDGED_SAMPLES} that can be bridged honestly; cut the record there and analyse the parts apart."
-            )
-        inserted.append(t[i] + steps[i] * np.arange(1, n + 1) / (n + 1))
-        notes.append(
-            QualityWarning(
-                "dropped_packet",
-                tuple(channels),
-                f"{n} sample(s) missing at {t[i] - t[0]:.3f} s (the time column steps {steps[i]:.6g} s there, "
-                f"{n + 1} samples); bridged by linear interpolation.",
-                float(n),
-            )
-        )
-    if not notes:
+    gaps = whole_step_gaps(t, dt, MAX_BRIDGED_SAMPLES, "samples", path.name)
+    if not gaps:
         return t, channels, []
+    notes = [
+        QualityWarning(
+            "dropped_packet",
+            tuple(channels),
+            f"{n} sample(s) missing at {t[i] - t[0]:.3f} s (the time column steps {steps[i]:.6g} s there, "
+            f"{n + 1} samples); bridged by linear interpolation.",
+            float(n),
+        )
+        for i, n in gaps
+    ]
+    inserted = [t[i] + steps[i] * np.arange(1, n + 1) / (n + 1) for i, n in gaps]
     grid = np.sort(np.concatenate([t, *inserted]))
     return grid, {name: np.interp(grid, t, x) for name, x in channels.items()}, notes
 

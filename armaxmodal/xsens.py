@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from .exceptions import DataError
+from .io import whole_step_gaps
 from .quality import QualityWarning
 from .recording import Recording
 
@@ -147,19 +148,12 @@ def _read_one(path: Path, axis: str, max_gap: int):
     step = float(np.median(steps))
     if step <= 0:
         raise DataError(f"{path.name}: SampleTimeFine does not increase.")
-    missing_packets = np.rint(steps / step).astype(int) - 1
-    gaps = []
-    for i in np.flatnonzero(missing_packets != 0):
-        n = int(missing_packets[i])
-        at = (stamps[i] - stamps[0]) * 1e-6
-        if n < 0:
-            raise DataError(f"{path.name}: a repeated or out-of-order time stamp at {at:.3f} s; clean the export.")
-        if n > max_gap:
-            raise DataError(
-                f"{path.name}: {n} packets missing at {at:.3f} s, more than the {max_gap} that can be bridged "
-                "honestly; cut the record there and analyse the parts apart."
-            )
-        gaps.append((n, at))
+    early = np.flatnonzero(np.rint(steps / step) < 1)
+    if early.size:
+        at = (stamps[early[0]] - stamps[0]) * 1e-6
+        raise DataError(f"{path.name}: a repeated or out-of-order time stamp at {at:.3f} s; clean the export.")
+    seconds = (stamps - stamps[0]) * 1e-6
+    gaps = [(n, seconds[i]) for i, n in whole_step_gaps(seconds, step * 1e-6, max_gap, "packets", path.name)]
     return stamps.astype(float), values[axis].to_numpy(float), gaps
 
 
