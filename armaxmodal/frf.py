@@ -17,7 +17,7 @@ from .exceptions import DataError
 if TYPE_CHECKING:
     from .recording import Recording
 
-__all__ = ["excited_band", "measured_frf", "modal_frf", "welch_spectra"]
+__all__ = ["excited_band", "measured_frf", "modal_frf", "welch_segments", "welch_spectra"]
 
 
 def default_nperseg(recording) -> int:
@@ -56,6 +56,27 @@ def welch_spectra(u: np.ndarray, y: np.ndarray, fs: float, nperseg: int):
     pyy : (n_freq, k) ndarray
         Output PSDs.
     """
+    f, uf, yf, scale = welch_segments(u, y, fs, nperseg)
+    puu = scale * np.mean(np.abs(uf) ** 2, axis=0)
+    puy = scale[:, None] * np.mean(np.conj(uf)[:, :, None] * yf, axis=0)
+    pyy = scale[:, None] * np.mean(np.abs(yf) ** 2, axis=0)
+    return f, puu, puy, pyy
+
+
+def welch_segments(u: np.ndarray, y: np.ndarray, fs: float, nperseg: int):
+    """The windowed segment spectra :func:`welch_spectra` averages, for statistics that need
+    them one by one (a jackknife over segments).
+
+    Returns
+    -------
+    freq_hz : (n_freq,) ndarray
+    uf : (n_segments, n_freq) complex ndarray
+        Input segment DFTs (periodic Hann window, 50 % overlap, each segment's mean removed).
+    yf : (n_segments, n_freq, k) complex ndarray
+        Output segment DFTs.
+    scale : (n_freq,) ndarray
+        Factor turning ``|DFT|^2`` into a one-sided density, unit^2/Hz.
+    """
     n = u.shape[0]
     if not 2 <= int(nperseg) <= n:
         raise DataError(f"nperseg: expected a segment length between 2 and the {n} samples, got {nperseg}.")
@@ -70,15 +91,11 @@ def welch_spectra(u: np.ndarray, y: np.ndarray, fs: float, nperseg: int):
         seg = seg - seg.mean(axis=1, keepdims=True)
         return np.fft.rfft(seg * (window if x.ndim == 1 else window[:, None]), axis=1)
 
-    uf, yf = segments_fft(u), segments_fft(y)
     scale = np.full(nperseg // 2 + 1, 2.0 / (fs * np.sum(window**2)))
     scale[0] /= 2
     if nperseg % 2 == 0:
         scale[-1] /= 2
-    puu = scale * np.mean(np.abs(uf) ** 2, axis=0)
-    puy = scale[:, None] * np.mean(np.conj(uf)[:, :, None] * yf, axis=0)
-    pyy = scale[:, None] * np.mean(np.abs(yf) ** 2, axis=0)
-    return np.fft.rfftfreq(nperseg, 1.0 / fs), puu, puy, pyy
+    return np.fft.rfftfreq(nperseg, 1.0 / fs), segments_fft(u), segments_fft(y), scale
 
 
 def coherence(puu: np.ndarray, puy: np.ndarray, pyy: np.ndarray) -> np.ndarray:

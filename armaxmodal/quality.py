@@ -39,7 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .frf import coherence, welch_spectra
+from .frf import coherence, welch_segments, welch_spectra
 from .recording import Recording
 
 __all__ = ["QualityWarning", "WARNING_CODES", "check_quality", "estimate_delays", "DelayEstimate"]
@@ -135,7 +135,9 @@ class DelayEstimate:
     """Time offset of one output against the input from the low-frequency transmissibility.
 
     ``delay_s`` is positive when the output lags; ``sign`` is the low-frequency
-    transmissibility's sign (-1: inverted); ``n_lines`` quasi-static lines were used."""
+    transmissibility's sign (-1: inverted); ``n_lines`` quasi-static lines were used;
+    ``delay_sd_s`` is estimated with ``dof`` degrees of freedom (a Student-t quantile, not a
+    normal one, makes its interval: there are only a few)."""
 
     channel: str
     delay_s: float
@@ -143,6 +145,13 @@ class DelayEstimate:
     sign: int
     n_lines: int
     max_freq_hz: float
+    dof: int = 1
+
+    def quantile(self, probability: float) -> float:
+        """The Student-t quantile with this estimate's degrees of freedom."""
+        from scipy.special import stdtrit  # scipy.stats' quantile without its 0.5 s import
+
+        return float(stdtrit(max(self.dof, 1), probability))
 
 
 def check_quality(recording: Recording) -> list[QualityWarning]:
@@ -248,17 +257,44 @@ def transmissibility_spectra(recording: Recording):
 
 def estimate_delays(recording: Recording) -> list[DelayEstimate]:
     """Per output: time offset and sign from the quasi-static transmissibility (empty for an
-    output without a quasi-static band, e.g. a force input)."""
-    spectra = transmissibility_spectra(recording)
-    if spectra is None:
+    output without a quasi-static band, e.g. a force input).
+
+    The standard deviation is the larger of the fit's and a delete-a-block jackknife's over
+    the Welch segments (blocks of two: a segment overlaps only its neighbours). The fit's
+    alone treats the lines as independent; Hann-windowed lines are not, and over 20 seeds of
+    a clean two-sensor ride the delays scattered 1.5-1.6x wider than it said (0.13 and 0.16
+    samples against 0.08 and 0.11): the warning's 95 % interval was too narrow."""
+    n = recording.n_samples
+    nperseg = int(min(n // 8, 2 ** int(np.ceil(np.log2(recording.fs * 20)))))
+    if nperseg < 16:
         return []
-    f, h, coh, excited, n_segments = spectra
+    f, uf, yf, _ = welch_segments(recording.base, recording.response, recording.fs, nperseg)
+    puu, puy, pyy = np.abs(uf) ** 2, np.conj(uf)[:, :, None] * yf, np.abs(yf) ** 2
+    n_seg = uf.shape[0]
+    blocks = [np.arange(n_seg)] + [np.setdiff1d(np.arange(n_seg), [i, i + 1]) for i in range(0, n_seg, 2)]
     out = []
     for k, name in enumerate(recording.sensors):
-        est = _quasi_static_fit(f, h[:, k], coh[:, k], excited, n_segments)
-        if est is not None:
-            out.append(DelayEstimate(name, *est))
+        fits = [_fit_segments(f, puu[keep], puy[keep, :, k], pyy[keep, :, k]) for keep in blocks]
+        if fits[0] is None:
+            continue
+        delay, sd, sign, n_lines, f_max = fits[0]
+        dof = n_lines - 2
+        left_out = np.array([fit[0] for fit in fits[1:] if fit is not None])
+        if left_out.size >= 3:
+            jackknife = np.sqrt((left_out.size - 1) / left_out.size * np.sum((left_out - left_out.mean()) ** 2))
+            if jackknife > sd:
+                sd, dof = float(jackknife), left_out.size - 1
+        out.append(DelayEstimate(name, delay, sd, sign, n_lines, f_max, dof))
     return out
+
+
+def _fit_segments(f, puu, puy, pyy):
+    """:func:`_quasi_static_fit` on the mean of the given segments' spectra."""
+    mean_uu, mean_uy, mean_yy = puu.mean(axis=0), puy.mean(axis=0), pyy.mean(axis=0)
+    coh = np.abs(mean_uy) ** 2 / np.maximum(mean_uu * mean_yy, 1e-300)
+    excited = mean_uu >= mean_uu.max() * 1e-3
+    n_segments = max(1, puu.shape[0])
+    return _quasi_static_fit(f, mean_uy / np.maximum(mean_uu, 1e-300), coh, excited, n_segments)
 
 
 def _quasi_static_fit(f, h, coh, excited, n_segments):
@@ -301,8 +337,6 @@ def _quasi_static_fit(f, h, coh, excited, n_segments):
 
 def delay_and_inversion(recording: Recording) -> list[QualityWarning]:
     """``inverted_sensor`` and ``sensor_delay`` warnings from :func:`estimate_delays`."""
-    from scipy.special import ndtri  # scipy.stats' quantile without its 0.5 s import
-
     estimates = estimate_delays(recording)
     found = []
     inverted = [e.channel for e in estimates if e.sign < 0]
@@ -329,9 +363,9 @@ def delay_and_inversion(recording: Recording) -> list[QualityWarning]:
                 -1.0,
             )
         )
-    z = ndtri(1 - DELAY_ALPHA / (2 * max(1, len(recording.sensors))))
+    level = 1 - DELAY_ALPHA / (2 * max(1, len(recording.sensors)))
     dt = 1.0 / recording.fs
-    late = [e for e in estimates if abs(e.delay_s) > max(z * e.delay_sd_s, MIN_DELAY_SAMPLES * dt)]
+    late = [e for e in estimates if abs(e.delay_s) > max(e.quantile(level) * e.delay_sd_s, MIN_DELAY_SAMPLES * dt)]
     if late and len(late) == len(recording.sensors) and len(late) > 1 and all(e.delay_s < 0 for e in late):
         lead = float(np.median([-e.delay_s for e in late]))
         found.append(
@@ -345,7 +379,8 @@ def delay_and_inversion(recording: Recording) -> list[QualityWarning]:
         )
         return found
     for e in late:
-        lo, hi = e.delay_s - 1.96 * e.delay_sd_s, e.delay_s + 1.96 * e.delay_sd_s
+        half = e.quantile(0.975) * e.delay_sd_s
+        lo, hi = e.delay_s - half, e.delay_s + half
         verb = "lags" if e.delay_s > 0 else "leads"
         found.append(
             QualityWarning(

@@ -255,7 +255,7 @@ def _delay_findings(fitted: FittedModel, n_tests: int) -> list[Finding]:
     late = []
     for e in estimates:
         z = abs(e.delay_s) / max(e.delay_sd_s, 1e-300)
-        p = min(1.0, 2 * stats.norm.sf(z) * n_tests)
+        p = min(1.0, 2 * stats.t.sf(z, max(e.dof, 1)) * n_tests)  # the sd has few degrees of freedom
         if abs(e.delay_s) * s.fs >= MIN_DELAY_SAMPLES:
             late.append((e, p))
     if not late:
@@ -264,15 +264,17 @@ def _delay_findings(fitted: FittedModel, n_tests: int) -> list[Finding]:
     if len(late) == len(s.sensors) > 1 and all(e.delay_s < 0 for e, _ in late):
         lead = float(np.median([-e.delay_s for e, _ in late]))
         sd = float(np.median([e.delay_sd_s for e, _ in late]))
+        half = sd * max(e.quantile(0.975) for e, _ in late)
         p = max(p for _, p in late)
-        params = {"delay_ms": 1e3 * lead, "delay_ci95_ms": [1e3 * (lead - 1.96 * sd), 1e3 * (lead + 1.96 * sd)]}
+        params = {"delay_ms": 1e3 * lead, "delay_ci95_ms": [1e3 * (lead - half), 1e3 * (lead + half)]}
         params["delay_samples"] = lead * fs
         return [Finding("input_delay", (s.input_name,), "phase_slope_z", lead / sd, p, params)]
     out = []
     for e, p in late:
+        half = e.quantile(0.975) * e.delay_sd_s
         params = {
             "delay_ms": 1e3 * e.delay_s,
-            "delay_ci95_ms": [1e3 * (e.delay_s - 1.96 * e.delay_sd_s), 1e3 * (e.delay_s + 1.96 * e.delay_sd_s)],
+            "delay_ci95_ms": [1e3 * (e.delay_s - half), 1e3 * (e.delay_s + half)],
             "delay_samples": e.delay_s * fs,
         }
         out.append(Finding("input_delay", (e.channel,), "phase_slope_z", e.delay_s / e.delay_sd_s, p, params))
