@@ -222,7 +222,7 @@ def _bridge_dropped_rows(t: np.ndarray, channels: dict, path: Path) -> tuple[np.
 
     steps = np.diff(t)
     dt = float(np.median(steps)) if steps.size else 0.0
-    if not dt > 0:
+    if not dt > 0 or np.any(steps <= 0):  # rows out of order or repeated: refused as they are
         return t, channels, []
     gaps = whole_step_gaps(t, dt, MAX_BRIDGED_SAMPLES, "samples", path.name)
     if not gaps:
@@ -251,11 +251,19 @@ def _fs_from_time(t: np.ndarray, path: Path) -> float:
     dt = float(np.median(steps))
     if dt <= 0:
         raise DataError(f"{path.name}: the time column does not increase.")
+    back = np.flatnonzero(steps <= 0)
+    if back.size:
+        i = int(back[0])
+        raise DataError(
+            f"{path.name}: the time column does not increase from data row {i + 1} to {i + 2} ({t[i]:.6g} s, "
+            f"then {t[i + 1]:.6g} s; {back.size} such step(s)): rows out of order, repeated, or a clock reset. "
+            "Sort the rows, drop the repeats, or cut the record there."
+        )
     worst = int(np.argmax(np.abs(steps - dt)))
     if abs(steps[worst] - dt) > _TIME_JITTER * dt:
         raise DataError(
-            f"{path.name}: the time column is not uniformly spaced: the step after row "
-            f"{worst} is {steps[worst]:.6g} s against a median of {dt:.6g} s (a dropped or "
+            f"{path.name}: the time column is not uniformly spaced: from data row {worst + 1} to {worst + 2} it "
+            f"steps {steps[worst]:.6g} s against a median of {dt:.6g} s (a dropped or "
             "repeated sample?). Resample the data to a uniform grid first."
             + (
                 " A step of a second or more suggests the time column is in milliseconds: convert it to "

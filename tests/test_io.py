@@ -175,6 +175,10 @@ def test_csv_output_selection(tmp_path):
         ("base,a\n1,2\n2,3\n", {}, "fs=.*--fs"),
         ("time,base,a\n0,1,2\n1,2,x3\n2,0,1\n", {}, "column 'a', data row 2: 'x3' is not a number"),
         ("time,base,a\n0,1,2\n1,2,3\n2.5,0,1\n3.5,1,1\n", {}, "not uniformly spaced"),
+        ("time,base,a\n0,1,2\n1,2,3\n2.5,0,1\n3.5,1,1\n", {}, "from data row 2 to 3 it steps 1.5 s"),
+        # rows out of order: once bridged as if samples were missing, then "steps 0 s"
+        ("time,base,a\n0,1,2\n4,2,3\n1,0,1\n2,1,1\n3,1,2\n", {}, "not increase from data row 2 to 3 .4 s, then 1 s"),
+        ("time,base,a\n0,1,2\n1,2,3\n1,0,1\n2,1,1\n", {}, "does not increase from data row 2 to 3 .*repeated"),
         ("time,base,a\n0,1,2\n1,2,3\n6,0,1\n7,1,1\n8,0,2\n", {}, "4 samples missing after row 1 .*cut the record"),
         ("time,base,a\n0,1,2\n1,2,\n2,0,1\n", {}, "data row 2 is empty"),
         ("time,base,a\n0,1,2\n1,2,nan\n2,0,1\n", {}, "channel 'a' has 1 NaN"),
