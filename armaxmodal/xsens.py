@@ -76,6 +76,7 @@ def read_xsens(
             )
             for n, t in gaps
         ]
+    _check_one_rate(series, input)
     stamps = series[input][0]
     start = max(s[0] for s, _ in series.values())
     stop = min(s[-1] for s, _ in series.values())
@@ -94,6 +95,26 @@ def read_xsens(
         input,
         meta=meta,
     )
+
+
+#: sensors whose sample steps differ by more than this fraction run at different output rates
+#: (the DOT's settings are 1-120 Hz, at least 2x apart); a clock's drift is parts per million
+RATE_TOLERANCE = 0.01
+
+
+def _check_one_rate(series: dict, input: str) -> None:
+    """Refuse sensors exported at another rate than the input's: interpolated onto the
+    input's stamps they were upsampled without a word (linear interpolation's images showed
+    as undamped "periodic disturbances" at 43-56 Hz on a 60 Hz copy of a 120 Hz IMU)."""
+    rates = {name: 1e6 / float(np.median(np.diff(stamps))) for name, (stamps, _) in series.items()}
+    other = [name for name, rate in rates.items() if abs(rate / rates[input] - 1) > RATE_TOLERANCE]
+    if other:
+        listed = ", ".join(f"'{name}' {rates[name]:.4g} Hz" for name in other)
+        raise DataError(
+            f"the sensors were exported at different rates: {listed}, the input '{input}' {rates[input]:.4g} Hz. "
+            "Export every sensor at one output rate (or resample them to one rate with an anti-alias filter "
+            "first); the reader does not interpolate between rates."
+        )
 
 
 def _names(files) -> dict:

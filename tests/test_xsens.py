@@ -17,13 +17,13 @@ HEADER = "PacketCounter,SampleTimeFine,Euler_X,Euler_Y,Euler_Z,Acc_X,Acc_Y,Acc_Z
 REAL_PERIOD_RTOL = 0.03
 
 
-def _export(path, t0_us, acc_x, drop=()):
+def _export(path, t0_us, acc_x, drop=(), step_us=STEP_US):
     """An export whose first packet is all zeros, then ``acc_x`` sample by sample; packets
     whose index is in ``drop`` are missing."""
-    lines = [META, HEADER, f"0,{t0_us - STEP_US},0,0,0,0,0,0,0,0,0\n"]
+    lines = [META, HEADER, f"0,{t0_us - step_us},0,0,0,0,0,0,0,0,0\n"]
     for i, a in enumerate(acc_x):
         if i not in drop:
-            lines.append(f"{i + 1},{t0_us + i * STEP_US},0,0,0,{float(a)!r},0.1,9.8,0,0,0\n")
+            lines.append(f"{i + 1},{round(t0_us + i * step_us)},0,0,0,{float(a)!r},0.1,9.8,0,0,0\n")
     with gzip.open(path, "wt", encoding="utf-8") as fh:
         fh.write("".join(lines))
     return path
@@ -60,6 +60,19 @@ def test_a_short_gap_is_bridged_and_flagged_a_long_one_refused(tmp_path, signals
     long_gap = _export(tmp_path / "f2.csv.gz", 0, y, drop=set(range(100, 110)))
     with pytest.raises(DataError, match="10 packets missing"):
         read_xsens({"g": g, "f2": long_gap}, input="g")
+
+
+def test_a_sensor_at_another_rate_is_refused_a_drifting_clock_is_not(tmp_path, signals):
+    """A sensor exported at 60 Hz beside 120 Hz ones was linearly interpolated onto the
+    input's stamps without a word; a clock 100 ppm fast is what stamps are aligned for."""
+    u, y = signals
+    g = _export(tmp_path / "g.csv.gz", 0, u)
+    half = _export(tmp_path / "f1.csv.gz", 0, y[:200], step_us=2 * STEP_US)
+    with pytest.raises(DataError, match="different rates: 'f1' 60 Hz, the input 'g' 120 Hz"):
+        read_xsens({"g": g, "f1": half}, input="g")
+    fast = _export(tmp_path / "f2.csv.gz", 0, y, step_us=STEP_US * (1 + 1e-4))
+    rec = read_xsens({"g": g, "f2": fast}, input="g")
+    assert rec.fs == pytest.approx(1e6 / STEP_US) and rec.n_samples == u.size  # every input stamp
 
 
 def test_bad_exports_are_typed_errors(tmp_path, signals):
