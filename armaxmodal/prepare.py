@@ -181,6 +181,7 @@ def prepare(
         # the scale of a channel left out matters to nothing fitted (its advice would mislead)
         found = [w for w in found if not (w.code == "unit_mismatch" and w.channels[0] in dropped)]
         found = [_left_out(w) if w.code == "incoherent_output" else w for w in found]
+    dropped, keep, found = _leave_out_held(found, keep, dropped, band)
     rec = recording.select(keep) if dropped else recording
     rec, found = _convert_units(rec, found)
     shifts = _whole_sample_shifts(found, rec) if align else {}
@@ -198,6 +199,25 @@ def prepare(
     meta = dict(rec.meta, preprocessing={"detrend": detrend, "analysis_fs": analysis_fs})
     rec = replace(rec, meta=meta)
     return Preparation(rec, recording.fs, analysis_fs, band, detrend, dropped, shifts, tuple(found))
+
+
+def _leave_out_held(found: list, keep: list, dropped: tuple, band) -> tuple[tuple, list, list]:
+    """Outputs held from a lower rate (``held_samples``) are left out while an output at the
+    record's rate remains: their images bent the shared poles (the supine ride with head held
+    at half rate lost two of its four modes). A band below 0.4 of a channel's own rate keeps it:
+    the resampling's anti-alias filter removes the images."""
+    top = band[1] if band is not None else np.inf
+    held = {w.channels[0] for w in found if w.code == "held_samples" and top > 0.4 * w.value}
+    held &= set(keep)
+    if not held or all(s in held for s in keep):
+        return dropped, keep, found
+    notes = [
+        replace(w, message=w.message.rstrip(".") + "; it was left out of the fit.")
+        if w.code == "held_samples" and w.channels[0] in held
+        else w
+        for w in found
+    ]
+    return dropped + tuple(s for s in keep if s in held), [s for s in keep if s not in held], notes
 
 
 def _left_out(w: QualityWarning) -> QualityWarning:

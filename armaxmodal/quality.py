@@ -27,6 +27,8 @@ recording:
   record of pure noise once gave two "modes" with intervals and no warning.
 * ``unit_mismatch`` -- an output in other units than the rest, or every output in other
   units than the input (:mod:`armaxmodal.units`).
+* ``held_samples`` -- a channel sampled at a lower rate and held to the record's
+  (:mod:`armaxmodal.held`): its repeats keep to a cycle.
 
 The sweep adds ``periodic_disturbance`` (:mod:`armaxmodal.disturbance`); preparation
 (:mod:`armaxmodal.prepare`) adds ``offset_removed``, ``offset_step``, ``drift``,
@@ -67,6 +69,7 @@ WARNING_CODES = (
     "periodic_disturbance",
     "stuck_samples",
     "oversampled",
+    "held_samples",
 )
 #: An output less coherent with the input than this (averaged over the input's spectrum) is
 #: not its response: response sensors read 0.63-1.00 on the measured records (the F-16, the
@@ -161,6 +164,9 @@ def check_quality(recording: Recording) -> list[QualityWarning]:
     found += narrowband_input(recording)
     found += clipped_channels(recording)
     found += stuck_channels(recording)
+    from .held import held_samples  # held.py builds on this module's QualityWarning
+
+    found += held_samples(recording)
     found += incoherent_outputs(recording)
     from .units import unit_mismatch  # units.py builds on this module's constants
 

@@ -75,6 +75,9 @@ def _damaged(tmp: Path) -> dict:
     flipped = d.copy()
     flipped["base"] = -flipped["base"]
     save("base inverted", flipped)
+    held = d.copy()
+    held["head"] = held["head"].to_numpy()[np.arange(len(d)) // 2 * 2]  # 30 Hz, forward-filled to 60
+    save("head sampled at 30 Hz and held to 60 Hz", held)
     gap = tmp / "rows 3000-3001 dropped.csv"
     d.drop(index=[3000, 3001]).to_csv(gap, index=False)
     cases["rows 3000-3001 dropped by the logger"] = [str(gap)]
