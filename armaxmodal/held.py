@@ -1,5 +1,5 @@
-"""``held_samples``: a channel recorded at a lower rate and held (forward-filled) to the
-record's rate.
+"""``held_samples``: a channel recorded at a lower rate and held (forward-filled) or linearly
+interpolated to the record's rate.
 
 Loggers that join devices on one time base repeat a slower channel's last value until its
 next sample (pandas' ``ffill`` does the same). Such a channel holds nothing above half its
@@ -11,6 +11,8 @@ channel repeats at the same phases of a k-sample cycle (k = 2 for half rate; for
 to 120 Hz, once every 6 samples at one phase). So the zero steps' positions modulo k are
 tested for uniformity (chi-square, k - 1 degrees of freedom) for every k up to
 :data:`MAX_CYCLE`; the channel's own rate is the record's times its share of non-zero steps.
+A linearly interpolated channel does the same with its second differences: the filled
+samples lie on the straight line through their neighbours.
 """
 
 from __future__ import annotations
@@ -34,30 +36,48 @@ MIN_REPEAT_SHARE = 0.1
 
 
 class HeldChannel(NamedTuple):
-    """A held channel: its repeat cycle (samples), its own rate (Hz: the record's rate times
-    its share of non-zero steps), that share's complement and the test's p-value."""
+    """A channel filled in from a lower rate: ``how`` it was filled ("held": each value
+    repeated; "interpolated": straight lines between its samples), its cycle (samples), its
+    own rate (Hz: the record's rate times its share of samples that are its own), the share
+    of filled samples and the test's p-value."""
 
     name: str
+    how: str
     cycle: int
     own_rate_hz: float
     repeat_share: float
     p: float
 
 
-def _repeat_cycle(x: np.ndarray, n_tests: int) -> tuple[int, float] | None:
-    """``(k, p)``: the cycle the zero steps of ``x`` keep to, when their phases modulo some
-    k are beyond chance (Bonferroni over ``n_tests``); else None. A multiple of the true
-    cycle scores as high, so the shortest cycle within 10 % of the best score is named."""
+#: a second difference this small against its RMS is a straight line through three samples
+#: (what linear interpolation leaves, up to the digits a CSV kept); by chance it happens at
+#: about 1e-4 of the samples
+FLAT_TOLERANCE = 1e-4
+
+
+def _filled_positions(x: np.ndarray) -> dict[str, np.ndarray]:
+    """Sample positions that repeat their predecessor, and those on the straight line through
+    their neighbours."""
+    d2 = np.diff(x, 2)
+    scale = float(np.sqrt(np.mean(d2**2))) if d2.size else 0.0
+    return {
+        "held": np.flatnonzero(np.diff(x) == 0),
+        "interpolated": np.flatnonzero(np.abs(d2) <= FLAT_TOLERANCE * scale) if scale > 0 else np.array([], int),
+    }
+
+
+def _cycle(positions: np.ndarray, steps: int, n_tests: int) -> tuple[int, float] | None:
+    """``(k, p)``: the cycle ``positions`` keep to, when their phases modulo some k are
+    beyond chance (Bonferroni over ``n_tests``); else None. A multiple of the true cycle
+    scores as high, so the shortest cycle within 10 % of the best score is named."""
     from scipy.special import chdtrc  # chi-square survival function without scipy.stats' import
 
-    zero = np.flatnonzero(np.diff(x) == 0)
-    steps = x.size - 1
-    if steps < 4 * MAX_CYCLE or zero.size < MIN_REPEAT_SHARE * steps:
+    if steps < 4 * MAX_CYCLE or positions.size < MIN_REPEAT_SHARE * steps:
         return None
     scores = {}
     for k in range(2, MAX_CYCLE + 1):
-        counts = np.bincount(zero % k, minlength=k)
-        expected = zero.size / k
+        counts = np.bincount(positions % k, minlength=k)
+        expected = positions.size / k
         stat = float(np.sum((counts - expected) ** 2) / expected)
         p = min(1.0, float(chdtrc(k - 1, stat)) * n_tests)
         if p < HELD_ALPHA:
@@ -70,16 +90,18 @@ def _repeat_cycle(x: np.ndarray, n_tests: int) -> tuple[int, float] | None:
 
 
 def held_channels(recording: Recording) -> list[HeldChannel]:
-    """Every channel (input first) whose repeated samples keep to a cycle."""
+    """Every channel (input first) whose repeated or interpolated samples keep to a cycle."""
     names = (recording.input_name, *recording.sensors)
     data = np.column_stack([recording.base, recording.response])
-    n_tests = (MAX_CYCLE - 1) * len(names)
+    n_tests = 2 * (MAX_CYCLE - 1) * len(names)
     found = []
     for name, x in zip(names, data.T, strict=True):
-        hit = _repeat_cycle(x, n_tests)
-        if hit is not None:
-            share = float(np.mean(np.diff(x) == 0))
-            found.append(HeldChannel(name, hit[0], recording.fs * (1 - share), share, hit[1]))
+        for how, positions in _filled_positions(x).items():
+            hit = _cycle(positions, x.size - 1, n_tests)
+            if hit is not None:
+                share = positions.size / (x.size - 1)
+                found.append(HeldChannel(name, how, hit[0], recording.fs * (1 - share), share, hit[1]))
+                break
     return found
 
 
@@ -87,21 +109,27 @@ def _p_text(p: float) -> str:
     return f"= {p:.1g}" if p > 0 else "< 1e-300"
 
 
+_WHAT = {
+    "held": ("repeats its previous value on {share:.0f} % of its steps", "held"),
+    "interpolated": ("lies on the line through its neighbours at {share:.0f} % of its samples", "interpolated"),
+}
+
+
 def held_samples(recording: Recording) -> list[QualityWarning]:
-    """One ``held_samples`` warning per held channel, with its own rate and what to do."""
+    """One ``held_samples`` warning per filled-in channel, with its own rate and what to do."""
     out = []
-    for name, cycle, own_rate, share, p in held_channels(recording):
+    for name, how, cycle, own_rate, share, p in held_channels(recording):
         top = 0.4 * own_rate
         role = "the input" if name == recording.input_name else "output"
+        what, verb = _WHAT[how]
         out.append(
             QualityWarning(
                 "held_samples",
                 (name,),
-                f"{role} '{name}' repeats its previous value on {100 * share:.0f} % of its steps, always at the "
-                f"same phases of a {cycle}-sample cycle (chi-square p {_p_text(p)}): it was sampled at about "
-                f"{own_rate:.3g} Hz and held to {recording.fs:g} Hz, so it carries nothing above "
-                f"{own_rate / 2:.3g} Hz but the images of its steps. Analyse below {top:.3g} Hz "
-                f"(--band LO:{top:.3g}) or re-export it at its own rate.",
+                f"{role} '{name}' {what.format(share=100 * share)}, always at the same phases of a {cycle}-sample "
+                f"cycle (chi-square p {_p_text(p)}): it was sampled at about {own_rate:.3g} Hz and {verb} to "
+                f"{recording.fs:g} Hz, so it carries nothing above {own_rate / 2:.3g} Hz but the images of its "
+                f"filling. Analyse below {top:.3g} Hz (--band LO:{top:.3g}) or re-export it at its own rate.",
                 own_rate,
             )
         )

@@ -207,7 +207,7 @@ def incoherent_outputs(recording: Recording) -> list[QualityWarning]:
                 "input and output columns."
                 if every
                 else ". These outputs do not respond to this input (a wrong column, a dead sensor, a second "
-                "excitation); their poles are not the structure's."
+                "excitation, a logger whose clock drifts against the input's); their poles are not the structure's."
             ),
             min(c for _, c in low),
         )

@@ -78,6 +78,9 @@ def _damaged(tmp: Path) -> dict:
     held = d.copy()
     held["head"] = held["head"].to_numpy()[np.arange(len(d)) // 2 * 2]  # 30 Hz, forward-filled to 60
     save("head sampled at 30 Hz and held to 60 Hz", held)
+    lines = d.copy()
+    lines["head"] = np.interp(np.arange(len(d)), np.arange(0, len(d), 2), d["head"].to_numpy()[::2])
+    save("head sampled at 30 Hz and interpolated to 60 Hz", lines)
     gap = tmp / "rows 3000-3001 dropped.csv"
     d.drop(index=[3000, 3001]).to_csv(gap, index=False)
     cases["rows 3000-3001 dropped by the logger"] = [str(gap)]

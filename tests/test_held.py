@@ -21,6 +21,13 @@ def _held(x: np.ndarray, fs: float, own_rate: float) -> np.ndarray:
     return x[np.floor(np.floor(t * own_rate + 1e-9) / own_rate * fs + 1e-9).astype(int)]
 
 
+def _interpolated(x: np.ndarray, fs: float, own_rate: float) -> np.ndarray:
+    """``x`` sampled at ``own_rate`` and joined by straight lines at the record's rate."""
+    t = np.arange(x.size) / fs
+    slow = np.arange(0.0, t[-1] + 1e-9, 1.0 / own_rate)
+    return np.interp(t, slow, x[np.rint(slow * fs).astype(int)])
+
+
 def _with(rec, column: int, values) -> am.Recording:
     y = rec.response.copy()
     y[:, column] = values
@@ -35,6 +42,19 @@ def test_a_held_channel_is_found_with_its_own_rate(clean, own_rate, cycle):
     assert found.own_rate_hz == pytest.approx(own_rate, rel=0.002)
     assert found.repeat_share == pytest.approx(1 - own_rate / clean.fs, abs=0.002)
     assert found.p < 1e-100
+
+
+@pytest.mark.parametrize("digits", [None, 6])
+@pytest.mark.parametrize("own_rate, cycle", [(30.0, 2), (20.0, 3)])
+def test_an_interpolated_channel_is_found_with_its_own_rate(clean, own_rate, cycle, digits):
+    """Straight lines between a slower channel's samples, also as a CSV with 6 significant
+    digits keeps them (its rounding is far under the tolerance)."""
+    x = _interpolated(clean.response[:, 1], clean.fs, own_rate)
+    if digits is not None:
+        x = np.array([float(f"{v:.{digits}g}") for v in x])
+    (found,) = held_channels(_with(clean, 1, x))
+    assert (found.name, found.how, found.cycle) == ("chest", "interpolated", cycle)
+    assert found.own_rate_hz == pytest.approx(own_rate, rel=0.002) and found.p < 1e-100
 
 
 def test_a_held_input_is_named_as_the_input(clean):
