@@ -124,6 +124,41 @@ MUTANTS = [
     ("armaxmodal/prepare.py", "(candidates * (n - candidates))", "candidates", "unnormalised breakpoint score (step)"),
     ("armaxmodal/prepare.py", "np.cumsum(rest)[candidates - 1]", "np.cumsum(rest)[candidates]", "off by one (step)"),
     ("armaxmodal/prepare.py", "abs(local) >= STEP_Z * spread", "abs(local) >= 0 * spread", "wander as a shift (step)"),
+    # channels filled in from a lower rate (run with --tests tests/test_held.py)
+    (
+        "armaxmodal/held.py",
+        "k = min(k for k, (stat, _)",
+        "k = max(k for k, (stat, _)",
+        "a multiple of the cycle (held)",
+    ),
+    ("armaxmodal/held.py", "recording.fs * (1 - share)", "recording.fs / hit[0]", "own rate from the cycle (held)"),
+    (
+        "armaxmodal/held.py",
+        "if steps < 4 * MAX_CYCLE or positions.size < MIN_REPEAT_SHARE * steps:",
+        "if steps < 4 * MAX_CYCLE:",
+        "a hair-slow channel named (held)",
+    ),
+    (
+        "armaxmodal/held.py",
+        '"held": np.flatnonzero(np.diff(x) == 0),',
+        '"held": np.array([], int),',
+        "holds unseen (held)",
+    ),
+    (
+        "armaxmodal/prepare.py",
+        "if not held or all(s in held for s in keep):",
+        "if not held:",
+        "every output left out (held)",
+    ),
+    ("armaxmodal/prepare.py", "top = band[1] if band is not None else np.inf", "top = np.inf", "band ignored (held)"),
+    # the delay's interval (run with --tests tests/test_prepare.py)
+    ("armaxmodal/quality.py", "            if jackknife > sd:", "            if False:", "jackknife unused (delay)"),
+    (
+        "armaxmodal/quality.py",
+        "return float(stdtrit(max(self.dof, 1), probability))",
+        "return float(stdtrit(1000, probability))",
+        "normal quantile (delay)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/test_guards.py",
