@@ -70,6 +70,9 @@ WARNING_CODES = (
     "stuck_samples",
     "oversampled",
     "held_samples",
+    "mode_not_needed",
+    "modes_do_not_explain_frf",
+    "orders_capped",
 )
 #: An output less coherent with the input than this (averaged over the input's spectrum) is
 #: not its response: response sensors read 0.63-1.00 on the measured records (the F-16, the

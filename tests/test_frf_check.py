@@ -9,7 +9,7 @@ from hypothesis.extra.numpy import arrays
 from scipy.signal import find_peaks
 
 import armaxmodal as am
-from armaxmodal.frf_check import peak_prominences, reconstruction_error, resolving_nperseg, unexplained_peaks
+from armaxmodal.frf_check import peak_prominences, resolving_nperseg, unexplained_peaks
 from armaxmodal.stabilisation import select_modes, stabilisation_diagram
 
 
@@ -20,11 +20,13 @@ def supine(fixtures_dir):
 
 
 def test_the_error_separates_a_complete_selection_from_an_incomplete_one(supine):
-    rec, m, shapes = supine.diagram.recording, supine.modes, supine.shapes
-    full = reconstruction_error(rec, m.freq_hz, m.damping, shapes)[0]
-    assert full < 0.02 and supine.reconstruction_error == pytest.approx(full)
+    from armaxmodal.modal_check import check_modes
+
+    rec, m = supine.diagram.recording, supine.modes
+    full = check_modes(rec, m.freq_hz, m.damping)
+    assert full.overall_error < 0.02 and supine.reconstruction_error == full.overall_error
     for keep in ([0, 1], [0, 2, 3], [1, 2, 3]):
-        assert reconstruction_error(rec, m.freq_hz[keep], m.damping[keep], shapes[:, keep])[0] > 0.15
+        assert check_modes(rec, m.freq_hz[keep], m.damping[keep]).overall_error > 0.08
     # heavily damped modes make no prominent peak of their own: nothing is called unexplained
     assert not [w for w in supine.warnings if w.code == "unexplained_peak"]
 
@@ -48,29 +50,36 @@ def test_a_missing_lightly_damped_mode_is_named_at_its_frequency(light):
     assert set(w.channels) == {"m1", "m2"}
 
 
-def test_split_test_merges_a_fake_split_and_keeps_real_close_modes(light, fixtures_dir):
-    from armaxmodal.frf_check import close_pairs, split_test
+def test_mode_support_merges_a_fake_split_and_keeps_real_close_modes(light, fixtures_dir):
+    from armaxmodal.modal_check import check_modes, mode_support, overlapping_neighbour
+
+    def support(rec, f, x, m):
+        return mode_support(rec, f, x, m, check_modes(rec, f, x))
 
     # one lightly damped peak given two modes 1 % apart: the FRF does not need the second
     s, rec = light
     m = s.modes()
     f = np.r_[m.freq_hz[0], 1.01 * m.freq_hz[0], m.freq_hz[1]]
     x = np.r_[m.damping[0], m.damping[0], m.damping[1]]
-    assert close_pairs(f, x) == [(0, 1)]
-    assert split_test(rec, f, x, 1)[1] > 0.5
+    assert overlapping_neighbour(f, x, 1) == 0 and overlapping_neighbour(f, x, 2) is None
+    fake = support(rec, f, x, 1)
+    assert fake.refitted_neighbour == 0 and not fake.needed and fake.rise < 0.01
+    # each true mode of that record is needed many times over
+    assert min(support(rec, m.freq_hz, m.damping, k).rise for k in range(2)) > 0.5
     # two real modes within each other's half-power band (4.57 and 4.92 Hz, 4 %): both needed
     c = am.Structure.from_chain([10.0, 10.0], [8000.0, 9000.0], [25.0, 25.0], [400.0], [0.0], ("a", "b"))
     mc = c.modes()
-    assert close_pairs(mc.freq_hz, mc.damping) == [(0, 1)]
+    assert overlapping_neighbour(mc.freq_hz, mc.damping, 0) == 1
     u = am.random_vibration(50.0, 240.0, (0.5, 24.0), seed=5)
     rc = am.simulate_recording(c, u, 50.0, noise=0.05, seed=6, hold="bandlimited")
-    assert split_test(rc, mc.freq_hz, mc.damping, 0)[1] < 1e-10
-    assert split_test(rc, mc.freq_hz, mc.damping, 1)[1] < 1e-10
+    for k in range(2):
+        real = support(rc, mc.freq_hz, mc.damping, k)
+        assert real.needed and real.p_value < 1e-10
     # the supine human's heavily damped modes all overlap their neighbours; each is needed
     sup = am.read_recording(fixtures_dir / "supine_random.csv")
     t = am.supine_human().modes()
-    assert close_pairs(t.freq_hz, t.damping) == [(0, 1), (1, 2), (2, 3)]
-    assert max(split_test(sup, t.freq_hz, t.damping, k)[1] for k in range(4)) < 1e-10
+    assert all(overlapping_neighbour(t.freq_hz, t.damping, k) is not None for k in range(4))
+    assert all(support(sup, t.freq_hz, t.damping, k).needed for k in range(4))
 
 
 @given(
