@@ -155,6 +155,7 @@ def _cmd_identify(args) -> int:
         ["freq_hz", "damping", "damped_freq_hz", "freq_ci95_lo", "freq_ci95_hi", "damping_ci95_lo", "damping_ci95_hi"]
     ]
     print(table.to_string(float_format=lambda v: f"{v:.4f}"))
+    _print_check(result.check)
     outputs = []
     if args.json:
         outputs.append((args.json, lambda tmp: write_json(result.to_dict(), tmp)))
@@ -162,6 +163,7 @@ def _cmd_identify(args) -> int:
         poles = result.fit.modes().drop(columns=["pole", "residue"])
         outputs.append((args.csv, lambda tmp: poles.to_csv(tmp, index=False)))
     write_all(outputs)
+    print(_verdict(result.check, len(result.modes)))
     return 0
 
 
@@ -170,19 +172,14 @@ def _cmd_stabilise(args) -> int:
     from .stabilisation import select_modes, stabilisation_diagram
 
     plot_format = _format(args.plot) if args.plot else None
-    try:
-        lo, hi = (int(v) for v in args.orders.split(":"))
-    except ValueError as exc:
-        raise OrderError(f"--orders: expected LO:HI model orders such as 2:40, got {args.orders!r}.") from exc
-    if not 1 <= lo <= hi:
-        raise OrderError(f"--orders: expected 1 <= LO <= HI, got {args.orders!r}.")
+    orders = None if args.orders is None else _order_range(args.orders)
     band = check_band(_parse_pair(args.band, "--band")) if args.band else None
     rec = _load(args)
     check_band(band, rec.fs)
     if not args.quiet:
         outputs = ", ".join(rec.sensors)
         print(f"{args.data}: input {rec.input_name}; outputs {outputs}; {rec.n_samples} samples at {rec.fs:g} Hz")
-    diagram = stabilisation_diagram(rec, range(lo, hi + 1, 2), band=band, detrend=args.detrend, progress=not args.quiet)
+    diagram = stabilisation_diagram(rec, orders, band=band, detrend=args.detrend, progress=not args.quiet)
     try:
         selection = select_modes(diagram, args.modes, band)
     except OrderError:
@@ -208,14 +205,58 @@ def _cmd_stabilise(args) -> int:
                 ]
             ].to_string(float_format=lambda v: f"{v:.4f}")
         )
-        print(f"FRF rebuilt from the modes vs H1: {100 * selection.reconstruction_error:.1f} % error")
+        _print_check(selection.check)
     _print_warnings(selection.warnings)
     outputs = _diagram_outputs(args, diagram, selection, plot_format)
     if args.json:
         report = selection.to_dict(args.shapes.replace("-", "_"))
         outputs.append((args.json, lambda tmp: write_json(report, tmp)))
     _write_outputs(outputs)
+    print(_verdict(selection.check, len(selection.modes)))
     return 0
+
+
+def _order_range(text: str) -> range:
+    """``--orders LO:HI`` as the even-step range of ``na``."""
+    try:
+        lo, hi = (int(v) for v in text.split(":"))
+    except ValueError as exc:
+        raise OrderError(f"--orders: expected LO:HI model orders such as 2:40, got {text!r}.") from exc
+    if not 1 <= lo <= hi:
+        raise OrderError(f"--orders: expected 1 <= LO <= HI, got {text!r}.")
+    return range(lo, hi + 1, 2)
+
+
+def _print_check(check) -> None:
+    """The modal-model check per output, beside the H1's own random error."""
+    from .modal_check import MODEL_ERROR_LIMIT
+
+    print(
+        "modal-model check (LSFD of each H1 by the selected poles, residual terms and a delay; "
+        f"model error = misfit beyond the H1's random error, limit {100 * MODEL_ERROR_LIMIT:.0f} %):"
+    )
+    for k, sensor in enumerate(check.sensors):
+        if not np.isfinite(check.error[k]):
+            print(f"  {sensor}: not checked (too few lines where its coherence is at least 0.8)")
+            continue
+        print(
+            f"  {sensor}: misfit {100 * check.error[k]:.1f} %, H1 random error {100 * check.random_error[k]:.1f} %, "
+            f"model error {100 * check.model_error[k]:.1f} %, delay {1e3 * check.delay_s[k]:+.1f} ms, "
+            f"{check.n_lines[k]} lines"
+        )
+
+
+def _verdict(check, n_modes: int) -> str:
+    """The closing line: whether the modes explain the record."""
+    if check is not None and check.passed:
+        return f"quality: good -- the {n_modes} selected mode(s) explain the measured FRF of every checked output"
+    if check is None or not check.failing:
+        return "quality: POOR -- no output has coherent lines to check the modes against: treat them as unconfirmed"
+    worst = float(np.nanmax(check.model_error))
+    return (
+        f"quality: POOR -- the selected modes do not explain the measured FRF of {', '.join(check.failing)} "
+        f"(model error up to {100 * worst:.0f} %): treat them as unconfirmed (see the warning)"
+    )
 
 
 def _cmd_diagnose(args) -> int:
@@ -523,7 +564,9 @@ def build_parser() -> argparse.ArgumentParser:
         "stabilise", parents=[quiet], help="order sweep, stabilisation plot and automatic mode selection"
     )
     _add_data_args(p)
-    p.add_argument("--orders", default="2:30", help="range of na, LO:HI (even steps); default 2:30")
+    p.add_argument(
+        "--orders", default=None, help="range of na, LO:HI (even steps); default 2:30, capped to suit the record"
+    )
     p.add_argument("--modes", type=_POSITIVE_INT, default=None, help="number of modes to keep (default: automatic)")
     p.add_argument("--band", default=None, help="frequency band LO:HI in Hz")
     p.add_argument("--plot", default=None, help="stabilisation plot (.png, .svg or .pdf)")

@@ -18,6 +18,7 @@ import pandas as pd
 from ._threads import single_blas_thread
 from .fit import ArmaxFit, fit_armax
 from .modal import mode_record
+from .modal_check import ModalCheck, check_modes, finite_or_none
 from .orders import OrderChoice, choose_orders
 from .prepare import Preparation, oversampling_note, prepare
 from .recording import Recording
@@ -71,7 +72,19 @@ class Identification:
             *found,
             *unexplained_peaks(self.recording, freq, damping, band),
             *oversampling_note(freq, self.recording.fs),
+            *self.check.warnings(),
         )
+
+    @cached_property
+    def check(self) -> ModalCheck:
+        """The modal-model check of the reported modes (:func:`armaxmodal.modal_check.check_modes`)."""
+        band = None if self.preparation is None else self.preparation.band
+        return check_modes(self.recording, self.modes.freq_hz.to_numpy(), self.modes.damping.to_numpy(), band)
+
+    @property
+    def quality(self) -> str:
+        """``"good"`` when the modal-model check passes, else ``"poor"``."""
+        return "good" if self.check.passed else "poor"
 
     def to_dict(self) -> dict:
         """The JSON contract: fs, input, outputs, modes (with shapes) and per_sensor rows."""
@@ -100,6 +113,9 @@ class Identification:
             "orders": {"na": na, "nb": nb, "nc": nc, "nk": nk, "shared_poles": self.fit.shared_poles},
             "converged": bool(np.all(self.fit.converged)),
             "fit_percent": dict(zip(rec.sensors, map(float, self.fit.fit_percent), strict=True)),
+            "quality": self.quality,
+            "reconstruction_error": finite_or_none(self.check.overall_error),
+            "modal_check": self.check.to_dict(),
             "modes": modes,
             "per_sensor": per_sensor,
         }

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .frf import excited_band, measured_frf, modal_frf
-from .frf_check import MIN_COHERENCE as COHERENT
+from .frf import excited_band, measured_frf
+from .modal_check import MIN_COHERENCE as COHERENT
+from .modal_check import MODEL_ERROR_LIMIT
 
 __all__ = ["plot_stabilisation", "plot_prediction"]
 
@@ -17,6 +18,7 @@ _STYLE = {
     "f+d+v": ("*", "#d62728", "stable f, ξ, shape"),
 }
 _LOW_COHERENCE = "#fff3b0"  # shading of the bands where some sensor's coherence is low
+_MISFIT = "#e53935"  # shading of the bands the modal model does not explain
 
 
 def plot_stabilisation(diagram, selection=None, ax=None):
@@ -70,31 +72,12 @@ def plot_stabilisation(diagram, selection=None, ax=None):
     for lo, hi in _runs(f, low):
         ax.axvspan(lo, hi, color=_LOW_COHERENCE, alpha=0.5, zorder=0, lw=0)
     if selection is not None:
-        rebuilt = modal_frf(f, selection.modes.freq_hz, selection.modes.damping, selection.shapes)
-        for k in range(len(rec.sensors)):
-            ax_f.semilogy(
-                f,
-                np.abs(rebuilt[:, k]),
-                lw=1.0,
-                ls="--",
-                color="k",
-                alpha=0.6,
-                label="from selected modes" if k == 0 else None,
-            )
+        _draw_check(ax, ax_f, f, selection)
         top = max(o[0] for o in diagram.orders)
         for m in selection.modes.itertuples(index=False):
             ax.axvline(m.freq_hz, color="k", lw=0.8, ls=":")
             ax_d.axvline(m.freq_hz, color="k", lw=0.8, ls=":")
         ax.set_ylim(0, top * 1.05)
-        err = selection.reconstruction_error
-        ax.text(
-            0.01,
-            0.01,
-            f"FRF from selected modes vs H1: {100 * err:.1f} % error where coherence ≥ 0.8",
-            transform=ax.transAxes,
-            fontsize=8,
-            va="bottom",
-        )
     lo, hi = _frequency_span(diagram)
     ax.set_xlim(lo, hi)
     # the curves set the axis inside the input's band only: beyond it an H1 is noise over
@@ -115,6 +98,33 @@ def plot_stabilisation(diagram, selection=None, ax=None):
     ax_d.set_xlabel("frequency (Hz)")
     ax_d.set_ylim(0, tol.max_damping)
     return ax, ax_d
+
+
+def _draw_check(ax, ax_f, f, selection) -> None:
+    """The modal-model check's fitted FRF (dashed), the bands it fails to explain (red), and
+    its verdict in the corner."""
+    check = selection.check
+    if check is None:
+        return
+    fitted = check.frf(f[f > 0])
+    for k in range(fitted.shape[1]):
+        label = "modal model (LSFD, residual terms, delay)" if k == 0 else None
+        ax_f.semilogy(f[f > 0], np.abs(fitted[:, k]), lw=1.0, ls="--", color="k", alpha=0.6, label=label)
+    for i, (_, lo, hi) in enumerate(check.bands):
+        label = "not explained by the modes" if i == 0 else None
+        ax.axvspan(lo, hi, color=_MISFIT, alpha=0.25, zorder=0, lw=0, label=label)
+    worst = np.nanmax(check.model_error) if np.isfinite(check.model_error).any() else np.nan
+    verdict = "modes explain the FRF" if check.passed else "POOR: the modes do not explain the FRF"
+    ax.text(
+        0.01,
+        0.01,
+        f"{verdict}: model error up to {100 * worst:.0f} % beyond the H1's random error "
+        f"(limit {100 * MODEL_ERROR_LIMIT:.0f} %), coherence ≥ {COHERENT:g}",
+        transform=ax.transAxes,
+        fontsize=8,
+        va="bottom",
+        color="k" if check.passed else "#b00020",
+    )
 
 
 def _frequency_span(diagram) -> tuple[float, float]:

@@ -16,7 +16,7 @@ deterministic: the same data gives the same modes.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import cached_property, partial
+from functools import partial
 
 import numpy as np
 import pandas as pd
@@ -28,6 +28,7 @@ from .fit import ArmaxFit, _fit, fit_armax
 from .frf import excited_band
 from .frf_check import peak_support
 from .modal import mode_record
+from .modal_check import ModalCheck, check_modes
 from .orders import _map, default_nb, default_nc, information_criterion
 from .prepare import Preparation, oversampling_note, prepare
 from .quality import QualityWarning
@@ -58,6 +59,16 @@ DELAY_CHOICE_ITERATIONS = 8
 #: samples the record must hold per parameter of one sensor's model (about 3 na + 1 - nk) at
 #: the sweep's highest order: fewer, and the fits describe the noise (and take minutes each)
 SAMPLES_PER_PARAMETER = 20
+#: a clear, coherent FRF peak no selected mode explains takes a cluster of poles of at least
+#: this many orders within this relative frequency of it, when the modal-model check needs it
+PEAK_CLUSTER_MIN_ORDERS = 2
+PEAK_CLUSTER_FREQ = 0.03
+#: a candidate pole this close (relative frequency) to a selected mode is that mode
+DUPLICATE_FREQ = 0.01
+#: the orders swept when none are given, capped at what the record supports
+DEFAULT_ORDERS = range(2, 31, 2)
+#: a default sweep capped below this top order has too few orders to show stability: refused
+MIN_DEFAULT_TOP = 8
 
 
 @dataclass(frozen=True)
@@ -100,11 +111,13 @@ class StabilisationDiagram:
     recording: Recording
     fits: dict = field(repr=False, default_factory=dict)
     preparation: Preparation | None = None
+    notes: tuple = ()
 
     @property
     def warnings(self) -> list[QualityWarning]:
         """Data-quality findings of the preparation and of the sweep itself."""
         found = list(self.preparation.warnings) if self.preparation is not None else []
+        found += list(self.notes)
         found += _nk_edge_warning(self.orders[0][3], self.recording)
         return found + disturbance_lines(self.poles, self.tolerances.min_energy, self.recording, SHARED)
 
@@ -227,7 +240,7 @@ def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=Tr
 
 def stabilisation_diagram(
     recording: Recording,
-    orders=range(2, 31, 2),
+    orders=None,
     *,
     band: tuple[float, float] | None = None,
     detrend: str = "mean",
@@ -248,8 +261,10 @@ def stabilisation_diagram(
     Parameters
     ----------
     recording : Recording
-    orders : iterable of int
-        The ``na`` values; ``nb`` and ``nc`` follow the module's rules.
+    orders : iterable of int, optional
+        The ``na`` values; ``nb`` and ``nc`` follow the module's rules. Orders given are
+        refused when the record cannot support the highest; the default,
+        :data:`DEFAULT_ORDERS`, is capped at what the record supports (``orders_capped``).
     band : (lo, hi), optional
         Frequency band of interest, Hz: sets the analysis rate and, in :func:`select_modes`,
         the band modes are taken from.
@@ -282,6 +297,9 @@ def stabilisation_diagram(
         if not prepared:
             preparation = prepare(recording, band=band, detrend=detrend, resample=resample, align=align)
             recording = preparation.recording
+        notes: tuple = ()
+        if orders is None:
+            orders, notes = _default_orders(recording, preparation)
         _check_top_order(max(orders), recording, preparation)
         known: dict = {}
         if nk is None:
@@ -318,7 +336,33 @@ def stabilisation_diagram(
         poles = pd.DataFrame(rows)
         poles["cls"] = _classify(poles, limits)
         poles["rejected"] = _reject(poles, limits, recording)
-        return StabilisationDiagram(poles, order_list, limits, recording, kept, preparation)
+        return StabilisationDiagram(poles, order_list, limits, recording, kept, preparation, notes)
+
+
+def _supported_top_order(recording: Recording) -> int:
+    """The highest ``na`` whose per-sensor model (``3 na + 1 - nk`` parameters at the most
+    non-causal delay searched) has :data:`SAMPLES_PER_PARAMETER` samples a parameter."""
+    return (recording.n_samples // SAMPLES_PER_PARAMETER - 1 + min(NK_SEARCH) - NK_EXTENSION) // 3
+
+
+def _default_orders(recording: Recording, preparation: Preparation | None) -> tuple[list, tuple]:
+    """:data:`DEFAULT_ORDERS`, capped at what the record supports (the user typed none, so a
+    short record is no error of theirs) with an ``orders_capped`` note; uncapped when the
+    record supports them all. Below :data:`MIN_DEFAULT_TOP` the sweep is refused as usual."""
+    top = _supported_top_order(recording)
+    if top >= max(DEFAULT_ORDERS):
+        return list(DEFAULT_ORDERS), ()
+    if top < MIN_DEFAULT_TOP:
+        return list(DEFAULT_ORDERS), ()  # refused by _check_top_order, with its advice
+    capped = [na for na in DEFAULT_ORDERS if na <= top]
+    note = QualityWarning(
+        "orders_capped", (),
+        f"the default orders 2-{max(DEFAULT_ORDERS)} were capped at na = {max(capped)}: this record "
+        f"({recording.n_samples} samples at {recording.fs:g} Hz) supports at most na = {top} "
+        f"({SAMPLES_PER_PARAMETER} samples a parameter); a longer record allows higher orders",
+        float(max(capped)),
+    )  # fmt: skip
+    return capped, (note,)
 
 
 def _check_top_order(na: int, recording: Recording, preparation: Preparation | None) -> None:
@@ -326,7 +370,7 @@ def _check_top_order(na: int, recording: Recording, preparation: Preparation | N
     per_sensor = 3 * na + 1 - (min(NK_SEARCH) - NK_EXTENSION)
     if per_sensor * SAMPLES_PER_PARAMETER <= recording.n_samples:
         return
-    top = max((recording.n_samples // SAMPLES_PER_PARAMETER - 1 + min(NK_SEARCH) - NK_EXTENSION) // 3, 2)
+    top = max(_supported_top_order(recording), 2)
     narrow = [w for w in (preparation.warnings if preparation else ()) if w.code == "narrowband_input"]
     resampled = preparation is not None and preparation.analysis_fs != preparation.original_fs
     record = f"{recording.n_samples} samples at {recording.fs:g} Hz" + (
@@ -445,20 +489,20 @@ class ModeSelection:
     diagram: StabilisationDiagram
     refinement: ModalRefinement | None = None
     notes: tuple[QualityWarning, ...] = ()
+    check: ModalCheck | None = None
 
-    @cached_property
+    @property
     def reconstruction_error(self) -> float:
-        """Relative RMS difference between the FRF rebuilt from the selected modes (with a
-        constant residual per sensor) and the measured H1, over coherent lines of the band,
-        at a resolution that resolves the narrowest mode (:mod:`armaxmodal.frf_check`).
-        Computed once: the CLI, the figure and the JSON report the same number (recomputed,
-        its last digit can differ with memory alignment on some CPUs)."""
-        from .frf_check import reconstruction_error
+        """The modal-model check's relative misfit (:mod:`armaxmodal.modal_check`): the
+        largest output's relative RMS difference between the measured H1 and its LSFD fit
+        by the selected poles with residual terms and a delay. Computed once, in
+        :func:`select_modes`: the CLI, the figure and the JSON report the same number."""
+        return self.check.overall_error if self.check is not None else float("nan")
 
-        prep = self.diagram.preparation
-        modes = self.modes
-        band = prep.band if prep is not None else None
-        return reconstruction_error(self.diagram.recording, modes.freq_hz, modes.damping, self.shapes, band)[0]
+    @property
+    def quality(self) -> str:
+        """``"good"`` when the modal-model check passes, else ``"poor"``."""
+        return "good" if self.check is not None and self.check.passed else "poor"
 
     @property
     def warnings(self) -> list[QualityWarning]:
@@ -513,7 +557,9 @@ class ModeSelection:
             "nk": self.diagram.orders[0][3],
             "orders_na": [o[0] for o in self.diagram.orders],
             "tolerances": {"freq": t.freq, "damping": t.damping, "shape": t.shape, "max_damping": t.max_damping},
-            "reconstruction_error": self.reconstruction_error,
+            "quality": self.quality,
+            "reconstruction_error": _finite_or_none(self.reconstruction_error),
+            "modal_check": None if self.check is None else self.check.to_dict(),
             "intersample_hold": None if self.refinement is None else self.refinement.hold,
             "estimator": sorted(set(self.modes.estimator)),
             "modes": modes,
@@ -551,7 +597,8 @@ def select_modes(
     ----------
     diagram : StabilisationDiagram
     n_modes : int, optional
-        Keep the ``n_modes`` best-supported modes.
+        Keep the ``n_modes`` best-supported modes (the modal-model check then judges them but
+        neither drops nor adds any).
     band : (lo, hi), optional
         Frequency band in Hz (default: the diagram's band, if it was given one).
     refine : bool
@@ -595,7 +642,12 @@ def select_modes(
         if refine:
             refit, limits = fitted.pop("refit"), (cluster_freq, cluster_damping, merge_mac)
             modes, shapes, refinement = _refined(diagram, modes, shapes, refit, *limits)
-        modes, shapes, notes = _justified_splits(diagram.recording, modes, shapes, band)
+        if n_modes is None:
+            modes, shapes, notes, check = _modes_the_record_needs(diagram.recording, modes, shapes, band)
+            clustering = (cluster_freq, cluster_damping)
+            modes, shapes, check = _modes_the_check_adds(diagram, modes, shapes, band, nas, check, clustering)
+        else:  # the user fixed the number of modes: the check judges them, it does not choose
+            notes, check = [], check_modes(diagram.recording, modes.freq_hz, modes.damping, band)
         if segments >= 2:
             orders_of = lambda i: orders[int(modes.at[i, "na"])]  # noqa: E731
             spread = segment_spread(diagram.recording, modes, orders_of, segments, n_jobs, fitted)
@@ -607,7 +659,8 @@ def select_modes(
         notes += unexplained_peaks(diagram.recording, modes.freq_hz.to_numpy(), modes.damping.to_numpy(), band)
         notes += oversampling_note(modes.freq_hz.to_numpy(), diagram.recording.fs)
         notes += _unresolved_damping_notes(modes, len(nas))
-        return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement, tuple(notes))
+        notes += check.warnings()
+        return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement, tuple(notes), check)
 
 
 def _clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs):
@@ -706,32 +759,106 @@ def _refined(diagram, modes, shapes, refinement, cluster_freq, cluster_damping, 
     return modes, shapes, refinement
 
 
-def _justified_splits(recording: Recording, modes: pd.DataFrame, shapes: np.ndarray, band):
-    """Two modes whose half-power bands overlap stay two only where the measured FRF needs
-    both (:func:`armaxmodal.frf_check.split_test` at ``SPLIT_ALPHA``); otherwise the weaker
-    (less supported) is dropped and a ``split_merged`` note says so with the F-test's p.
-    Returns ``(modes, shapes, notes)``."""
-    from .frf_check import SPLIT_ALPHA, close_pairs, split_test
+def _modes_the_record_needs(recording: Recording, modes: pd.DataFrame, shapes: np.ndarray, band):
+    """Selection by the data: drop, one at a time and least supported first, every mode the
+    modal-model check does not need (:func:`armaxmodal.modal_check.mode_support`: leaving it
+    out, a neighbour inside its half-power band refitted in its place, raises no output's
+    misfit by :data:`~armaxmodal.modal_check.MODEL_ERROR_RISE` significantly). A dropped half
+    of a split peak is a ``split_merged`` note, any other a ``mode_not_needed`` note.
+    Returns ``(modes, shapes, notes, check)`` with the check of the modes kept."""
+    from .modal_check import MODEL_ERROR_RISE, check_modes, mode_support
 
     notes: list[QualityWarning] = []
     while True:
-        rank = modes.sort_values(["support", "count", "energy"], ascending=False).index.tolist()
-        for i, j in close_pairs(modes.freq_hz, modes.damping):
-            weaker, stronger = (i, j) if rank.index(i) > rank.index(j) else (j, i)
-            stat, p = split_test(recording, modes.freq_hz, modes.damping, weaker, band)
-            if not p <= SPLIT_ALPHA and np.isfinite(p):
-                break
+        check = check_modes(recording, modes.freq_hz, modes.damping, band)
+        if len(modes) < 2 or not np.isfinite(check.error).any():
+            return modes, shapes, notes, check
+        support = [mode_support(recording, modes.freq_hz, modes.damping, m, check, band) for m in range(len(modes))]
+        weak = [m for m in range(len(modes)) if not support[m].needed]
+        if not weak:
+            return modes, shapes, notes, check
+        # the least supported across orders goes first (of a split, the half the diagram
+        # shows less), then the least needed
+        rank = modes.sort_values(["support", "count", "energy"]).index.tolist()
+        m = min(weak, key=lambda i: (rank.index(i), support[i].rise))
+        s, f_m, x_m = support[m], modes.at[m, "freq_hz"], modes.at[m, "damping"]
+        evidence = (
+            f"without it no output's misfit rises by {100 * MODEL_ERROR_RISE:g} % "
+            f"(at most {100 * s.rise:+.1f} %, p = {s.p_value:.2g})"
+        )
+        if s.refitted_neighbour is not None:
+            f_n = modes.at[s.refitted_neighbour, "freq_hz"]
+            notes.append(QualityWarning(
+                "split_merged", (),
+                f"modes at {f_n:.3f} and {f_m:.3f} Hz overlap within their half-power bands and the measured FRF does "
+                f"not need both: {evidence} once {f_n:.3f} Hz may take the whole peak; one peak split by the model, "
+                f"{f_n:.3f} Hz is reported", float(f_m),
+            ))  # fmt: skip
         else:
-            return modes, shapes, notes
-        f_weak, f_strong = modes.at[weaker, "freq_hz"], modes.at[stronger, "freq_hz"]
-        notes.append(QualityWarning(
-            "split_merged", (),
-            f"modes at {f_strong:.3f} and {f_weak:.3f} Hz overlap within their half-power bands and the measured FRF "
-            f"does not need both (F = {stat:.2f}, p = {p:.2g}): one peak split by the model; {f_strong:.3f} Hz is "
-            "reported", float(f_weak),
-        ))  # fmt: skip
-        keep = [m for m in range(len(modes)) if m != weaker]
+            notes.append(QualityWarning(
+                "mode_not_needed", (),
+                f"a stable pole at {f_m:.3f} Hz (damping {x_m:.3f}) is left out: the measured FRF does not need it, "
+                f"{evidence}: a spurious pole of the model (noise, a nonlinearity, leakage), not a mode of the record",
+                float(f_m),
+            ))  # fmt: skip
+        keep = [i for i in range(len(modes)) if i != m]
         modes, shapes = modes.iloc[keep].reset_index(drop=True), shapes[:, keep]
+
+
+def _modes_the_check_adds(diagram, modes: pd.DataFrame, shapes: np.ndarray, band, nas, check, clustering):
+    """Stable clusters the support rule left out enter when the modal-model check needs them
+    (as :func:`_modes_the_record_needs` judges, but with the nearest mode refitted in its place,
+    not only an overlapping one: one at a time, the largest first): the
+    candidates are the cluster of poles of at least :data:`PEAK_CLUSTER_MIN_ORDERS` orders
+    within :data:`PEAK_CLUSTER_FREQ` of each clear, coherent H1 peak no selected mode
+    explains (:func:`armaxmodal.frf_check.unexplained_peaks`), and every cluster of kept
+    poles of at least three orders away from the selected modes (heavily damped modes make
+    no clear peak, and their poles scatter over the orders). A peak left unexplained is listed
+    at the end as before. Returns ``(modes, shapes, check)``."""
+    from .modal_check import check_modes, mode_support
+
+    bic = {na: information_criterion(fit) for (src, na), fit in diagram.fits.items() if src == SHARED}
+    for sub in _left_out_clusters(diagram, modes, band, nas, clustering):
+        first = sub.loc[sub.na == _ranked(sub, bic)[0]].iloc[0]
+        if np.any(np.abs(modes.freq_hz.to_numpy() / first.freq_hz - 1) <= DUPLICATE_FREQ):
+            continue  # a selected mode's own pole
+        trial = np.r_[modes.freq_hz, first.freq_hz], np.r_[modes.damping, first.damping]
+        trial_check = check_modes(diagram.recording, *trial, band)
+        if not mode_support(diagram.recording, *trial, len(modes), trial_check, band, reach="nearest").needed:
+            continue
+        rep = _representative(diagram, sub, bic, {})
+        if rep is None:
+            continue
+        row = {**_mode_row(rep, sub, len(nas)), "orders_damping_unresolved": 0, "estimator": "armax"}
+        row["freq_sd_armax"] = (row["freq_ci95_hi"] - row["freq_ci95_lo"]) / (2 * 1.96)
+        row["damping_sd_armax"] = (row["damping_ci95_hi"] - row["damping_ci95_lo"]) / (2 * 1.96)
+        modes = pd.concat([modes, pd.DataFrame([row])], ignore_index=True)
+        shapes = np.column_stack([shapes, rep.vector])
+        check = check_modes(diagram.recording, modes.freq_hz, modes.damping, band)
+    order = modes.sort_values("freq_hz").index.tolist()
+    return modes.loc[order].reset_index(drop=True), shapes[:, order], check
+
+
+def _left_out_clusters(diagram, modes: pd.DataFrame, band, nas, clustering) -> list[pd.DataFrame]:
+    """The candidate clusters of :func:`_modes_the_check_adds`, the largest first."""
+    from .frf_check import unexplained_peaks
+
+    cluster_freq, cluster_damping = clustering
+    cand = _candidates(diagram.poles, band)
+    cand = cand[cand.damping > 0]
+    found = []
+    for peak in unexplained_peaks(diagram.recording, modes.freq_hz.to_numpy(), modes.damping.to_numpy(), band):
+        near = cand[np.abs(cand.freq_hz / peak.value - 1) <= PEAK_CLUSTER_FREQ]
+        clusters = [c for c in _cluster(near, nas, PEAK_CLUSTER_FREQ, None) if len(c) >= PEAK_CLUSTER_MIN_ORDERS]
+        if clusters:
+            found.append(near.loc[max(clusters, key=len)])
+    kept = cand[cand.rejected == ""]
+    selected = modes.freq_hz.to_numpy()
+    for members in _cluster(kept, nas, cluster_freq, cluster_damping):
+        sub = kept.loc[members]
+        if len(members) >= 3 and np.min(np.abs(selected / sub.freq_hz.median() - 1)) > cluster_freq:
+            found.append(sub)
+    return sorted(found, key=len, reverse=True)
 
 
 def _unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[QualityWarning]:

@@ -571,11 +571,14 @@ def test_a_record_sampled_far_above_its_structure_says_so_and_its_advice_finds_t
     first = select_modes(stabilisation_diagram(rec), segments=0)
     (w,) = [w for w in first.warnings if w.code == "oversampled"]
     top = first.modes.freq_hz.max()
-    assert len(first.modes) < 4 and w.value == pytest.approx(top / 500.0)
+    exact = system.modes().freq_hz
+    # the premise: at this rate the sweep does not give the four modes (one once; now five,
+    # one of them a split of the 8.3 Hz mode, which the check cannot refuse here)
+    assert len(first.modes) != 4 or not np.allclose(first.modes.freq_hz, exact, rtol=0.015)
+    assert w.value == pytest.approx(top / 500.0)
     hi = float(np.ceil(2.5 * top))
     assert f"band=(0, {hi:g}) (CLI: --band 0:{hi:g}), which resamples to {1000 / (400 // hi):.4g} Hz" in w.message
     second = select_modes(stabilisation_diagram(rec, range(2, 25, 2), band=(0.0, hi)), segments=0)
-    exact = system.modes().freq_hz
     assert len(second.modes) == 4 and not [w for w in second.warnings if w.code == "oversampled"]
     np.testing.assert_allclose(second.modes.freq_hz, exact, rtol=0.015)
     # identify says it too (there it found 5.76, 8.48, 16.33 Hz, intervals far narrower than

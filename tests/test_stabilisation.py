@@ -232,7 +232,7 @@ def test_poles_crossing_zero_without_an_frf_peak_stay_rejected(light_diagram):
 
 
 def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
-    from armaxmodal.stabilisation import _justified_splits
+    from armaxmodal.stabilisation import _modes_the_record_needs
 
     s, diagram = light_diagram
     m = s.modes()
@@ -246,15 +246,39 @@ def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
         }
     )
     shapes = np.column_stack([m.modal_constants[:, 0], 0.3 * m.modal_constants[:, 0], m.modal_constants[:, 1]])
-    kept, kept_shapes, notes = _justified_splits(diagram.recording, modes, shapes, None)
+    kept, kept_shapes, notes, check = _modes_the_record_needs(diagram.recording, modes, shapes, None)
     assert kept.freq_hz.tolist() == [m.freq_hz[0], m.freq_hz[1]]  # the better-supported one stays
     np.testing.assert_array_equal(kept_shapes, shapes[:, [0, 2]])
     (note,) = notes
     assert note.code == "split_merged" and note.value == pytest.approx(1.01 * m.freq_hz[0])
+    assert check.passed and check.model_error.max() < 0.15  # the check of what is kept (lightly damped: H1 bias)
     # the true modes alone: nothing to merge
     true = modes.iloc[[0, 2]].reset_index(drop=True)
-    again, _, none = _justified_splits(diagram.recording, true, shapes[:, [0, 2]], None)
+    again, _, none, _ = _modes_the_record_needs(diagram.recording, true, shapes[:, [0, 2]], None)
     assert len(again) == 2 and none == []
+
+
+def test_a_spurious_heavily_damped_neighbour_is_left_out_and_said(light_diagram):
+    """A 20 %-damped pole 15 % above a 1 %-damped mode (as measured beside the stiff
+    1-storey model's storey mode) is not needed by the FRF once the mode's own pole is
+    refitted: left out, as a split of that peak (its half-power band covers the mode)."""
+    from armaxmodal.stabilisation import _modes_the_record_needs
+
+    s, diagram = light_diagram
+    m = s.modes()
+    modes = pd.DataFrame(
+        {
+            "freq_hz": [m.freq_hz[0], 1.15 * m.freq_hz[0], m.freq_hz[1]],
+            "damping": [m.damping[0], 0.2, m.damping[1]],
+            "support": [1.0, 0.6, 1.0],
+            "count": [10, 6, 10],
+            "energy": [1.0, 0.1, 1.0],
+        }
+    )
+    shapes = np.column_stack([m.modal_constants[:, 0], 0.1 * m.modal_constants[:, 0], m.modal_constants[:, 1]])
+    kept, _, notes, _ = _modes_the_record_needs(diagram.recording, modes, shapes, None)
+    assert kept.freq_hz.tolist() == [m.freq_hz[0], m.freq_hz[1]]
+    assert [n.code for n in notes] == ["split_merged"] and notes[0].value == pytest.approx(1.15 * m.freq_hz[0])
 
 
 def _none_if_nan(v):

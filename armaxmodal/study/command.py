@@ -23,7 +23,7 @@ def add_parser(sub, parents, numbers: dict) -> None:
     )
     p.add_argument("--scheduler", default=None, help="dask.distributed scheduler address, e.g. tcp://host:8786")
     p.add_argument("--input", default="base", help="base-acceleration channel; default 'base'")
-    p.add_argument("--orders", default="2:30", help="range of na, LO:HI; default 2:30")
+    p.add_argument("--orders", default=None, help="range of na, LO:HI; default 2:30, capped to suit each record")
     p.add_argument(
         "--modes", type=numbers["positive_int"], default=None, help="modes per recording (default: automatic)"
     )
@@ -48,9 +48,12 @@ def _settings(args):
     from ..prepare import check_band
     from .job import StudySettings
 
-    lo, hi = _pair(args.orders, "--orders", int) if ":" in args.orders else (None, None)
-    if lo is None or not 1 <= lo <= hi:
-        raise OrderError(f"--orders: expected LO:HI with 1 <= LO <= HI, such as 2:30; got {args.orders!r}.")
+    orders = None
+    if args.orders is not None:
+        lo, hi = _pair(args.orders, "--orders", int) if ":" in args.orders else (None, None)
+        if lo is None or not 1 <= lo <= hi:
+            raise OrderError(f"--orders: expected LO:HI with 1 <= LO <= HI, such as 2:30; got {args.orders!r}.")
+        orders = (lo, hi)
     band = check_band(_pair(args.band, "--band")) if args.band else None
     lump = None
     if args.lump:
@@ -58,7 +61,7 @@ def _settings(args):
         if len(lump) != 2 or not all(lump) or lump[0] == lump[1]:
             raise DataError(f"--lump: expected two different sensor names A,B such as legs,feet; got {args.lump!r}.")
     sensors = tuple(s.strip() for s in args.sensors.split(",") if s.strip()) if args.sensors else None
-    return StudySettings(args.input, (lo, hi), args.modes, band, args.detrend, sensors, lump)
+    return StudySettings(args.input, orders, args.modes, band, args.detrend, sensors, lump)
 
 
 def _check_paths(args) -> None:

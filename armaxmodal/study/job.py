@@ -26,8 +26,9 @@ class StudySettings:
     ----------
     input : str
         The base-acceleration channel.
-    orders : (lo, hi)
-        The swept AR orders (even steps), as ``stabilise --orders``.
+    orders : (lo, hi) or None
+        The swept AR orders (even steps), as ``stabilise --orders``; None: the default
+        sweep, capped at what each record supports.
     modes : int or None
         Modes kept per recording (None: the automatic selection).
     band : (lo, hi) Hz or None
@@ -39,7 +40,7 @@ class StudySettings:
     """
 
     input: str = "base"
-    orders: tuple[int, int] = (2, 30)
+    orders: tuple[int, int] | None = None
     modes: int | None = None
     band: tuple[float, float] | None = None
     detrend: str = "mean"
@@ -66,16 +67,17 @@ def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[st
     dict with ``sensors``, ``fs``, ``analysis_fs``, ``nk``, ``modes`` (one dict per mode:
     frequency in Hz, damping ratio, 95 % intervals, Eq. 3.35-3.36 weighted values and the
     normalised shape per sensor), ``per_sensor`` (Table 3.2 rows), ``warnings``,
-    ``reconstruction_error``, ``lump`` and ``figure_png`` (base64).
+    ``reconstruction_error`` and ``quality`` (the modal-model check's misfit and verdict),
+    ``lump`` and ``figure_png`` (base64).
     """
     from .._threads import one_blas_thread
     from ..stabilisation import select_modes, stabilisation_diagram
 
     start = time.perf_counter()
-    lo, hi = settings.orders
+    orders = None if settings.orders is None else range(settings.orders[0], settings.orders[1] + 1, 2)
     with one_blas_thread():  # the thumbnail and the lumping check too, not only the fits
         diagram = stabilisation_diagram(
-            rec.select(sensors), range(lo, hi + 1, 2), band=settings.band, detrend=settings.detrend, n_jobs=1
+            rec.select(sensors), orders, band=settings.band, detrend=settings.detrend, n_jobs=1
         )
         selection = select_modes(diagram, settings.modes, settings.band, n_jobs=1)
         report = selection.to_dict("per_sensor")
@@ -96,6 +98,7 @@ def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[st
         "per_sensor": report["per_sensor"],
         "warnings": report["warnings"],
         "reconstruction_error": report["reconstruction_error"],
+        "quality": report["quality"],
         "lump": lump,
         "figure_png": figure,
         "seconds": time.perf_counter() - start,

@@ -112,6 +112,14 @@ def render_report(study, shape_figures: dict, lump_rows: pd.DataFrame | None = N
     settings = pd.DataFrame([{"setting": k, "value": str(v)} for k, v in study.to_dict()["settings"].items()])
     fails = "".join(f"<li class=fail><b>{esc(f['file'])}</b>: {esc(str(f['reason']))}</li>" for f in study.failures)
     notes = "".join(f"<li class=note>{esc(n)}</li>" for n in study.notes)
+    poor = "".join(
+        f"<li class=fail><b>{esc(r['file'])}</b>: "
+        + esc("; ".join(w["message"] for w in r.get("warnings", []) if w["code"] == "modes_do_not_explain_frf"))
+        + "</li>"
+        for r in study.recordings
+        if r.get("quality") == "poor"
+    )
+    poor = "<ul>" + poor + "</ul>" if poor else "<p>none</p>"
     thumbs = "".join(
         f"<figure><img alt='stabilisation diagram of {esc(r['file'])}' "
         f"src='data:image/png;base64,{r['figure_png']}'><figcaption>{esc(r['file'])}</figcaption></figure>"
@@ -139,6 +147,7 @@ def render_report(study, shape_figures: dict, lump_rows: pd.DataFrame | None = N
 {_models(study)}
 {lump}
 <h2>Failures</h2>{"<ul>" + fails + "</ul>" if fails else "<p>none</p>"}
+<h2>Recordings whose modes do not explain their FRF (quality: poor)</h2>{poor}
 <h2>Stabilisation diagrams (click to enlarge)</h2><div class=thumbs>{thumbs}</div>
 <details><summary><b>Per sensor (Table 3.2 form; X: the sensor's own model does not show the mode)</b></summary>
 {_table_3_2(study)}</details>
