@@ -250,6 +250,9 @@ def _verdict(check, n_modes: int) -> str:
     """The closing line: whether the modes explain the record."""
     if check is not None and check.passed:
         return f"quality: good -- the {n_modes} selected mode(s) explain the measured FRF of every checked output"
+    if check is not None and check.unconfirmed_hz and not check.failing:
+        where = ", ".join(f"{f:.2f}" for f in check.unconfirmed_hz)
+        return f"quality: POOR -- the record does not confirm the mode(s) at {where} Hz (no coherent H1 there)"
     if check is None or not check.failing:
         return "quality: POOR -- no output has coherent lines to check the modes against: treat them as unconfirmed"
     worst = float(np.nanmax(check.model_error))

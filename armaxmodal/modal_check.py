@@ -37,7 +37,7 @@ from .frf import coherence, excited_band, h1_relative_error, welch_spectra
 from .quality import QualityWarning
 from .recording import Recording
 
-__all__ = ["ModalCheck", "check_modes", "mode_support", "MODEL_ERROR_LIMIT", "MODEL_ERROR_RISE"]
+__all__ = ["ModalCheck", "check_modes", "confirmed_modes", "mode_support", "MODEL_ERROR_LIMIT", "MODEL_ERROR_RISE"]
 
 #: lines of the band an output's H1 must be this coherent on to enter the check
 MIN_COHERENCE = 0.8
@@ -98,6 +98,9 @@ class ModalCheck:
         ``U_k`` and ``L_k``.
     poles : (n_modes,) complex ndarray
         The selected poles, rad/s.
+    unconfirmed_hz : tuple of float
+        Modes (Hz) with no coherent line of any output within their half-power band
+        (:func:`confirmed_modes`): the record cannot confirm them, whatever the misfit.
     """
 
     sensors: tuple
@@ -111,13 +114,16 @@ class ModalCheck:
     residues: np.ndarray
     residual_terms: np.ndarray
     poles: np.ndarray
+    unconfirmed_hz: tuple = ()
 
     @property
     def passed(self) -> bool:
-        """Every checked output's model error within :data:`MODEL_ERROR_LIMIT` (False when
-        no output has coherent lines: nothing shows that the modes explain the record)."""
+        """Every checked output's model error within :data:`MODEL_ERROR_LIMIT` and every mode
+        confirmed (False when no output has coherent lines: nothing shows that the modes
+        explain the record)."""
         checked = np.isfinite(self.model_error)
-        return bool(checked.any() and np.all(self.model_error[checked] <= MODEL_ERROR_LIMIT))
+        fits = bool(checked.any() and np.all(self.model_error[checked] <= MODEL_ERROR_LIMIT))
+        return fits and not self.unconfirmed_hz
 
     @property
     def failing(self) -> tuple:
@@ -143,15 +149,28 @@ class ModalCheck:
         """``modes_do_not_explain_frf`` when the check fails, naming the outputs and bands."""
         if self.passed:
             return []
+        found = []
+        if self.unconfirmed_hz:
+            where = ", ".join(f"{f:.2f}" for f in self.unconfirmed_hz)
+            found.append(QualityWarning(
+                "modes_do_not_explain_frf", tuple(self.sensors),
+                f"the record does not confirm the mode(s) at {where} Hz: no output's H1 is coherent "
+                f"({MIN_COHERENCE:g}) within their half-power band, so the check cannot test them (another "
+                "excitation, several moving supports, or noise dominate there). Treat them as unconfirmed",
+                float(self.unconfirmed_hz[0]),
+            ))  # fmt: skip
+        checked = np.isfinite(self.model_error)
+        if checked.any() and np.all(self.model_error[checked] <= MODEL_ERROR_LIMIT):
+            return found
         if not self.failing:
-            return [QualityWarning(
+            return found + [QualityWarning(
                 "modes_do_not_explain_frf", tuple(self.sensors),
                 "no output's H1 is coherent (0.8) on enough lines of the band to check the selected modes against: "
                 "treat them as unconfirmed; a longer record or a broader excitation gives the lines",
             )]  # fmt: skip
         worst = float(np.nanmax(self.model_error))
         where = "; ".join(f"{s} {lo:.2f}-{hi:.2f} Hz" for s, lo, hi in self.bands) or "spread over the band"
-        return [QualityWarning(
+        return found + [QualityWarning(
             "modes_do_not_explain_frf", self.failing,
             f"the selected modes do not explain the measured FRF of {', '.join(self.failing)}: model error up to "
             f"{100 * worst:.0f} % (limit {100 * MODEL_ERROR_LIMIT:.0f} %) beyond the H1's random error, misfit "
@@ -179,6 +198,7 @@ class ModalCheck:
                 for k, s in enumerate(self.sensors)
             ],
             "bands": [{"output": s, "lo_hz": lo, "hi_hz": hi} for s, lo, hi in self.bands],
+            "unconfirmed_hz": [float(f) for f in self.unconfirmed_hz],
         }
 
 
@@ -311,13 +331,25 @@ def check_modes(recording: Recording, freq_hz, damping, band=None, *, fit_delay:
         error[k] = np.sqrt(rss / norm)
         rand[k] = np.sqrt(np.sum(lines.sigma**2) / norm)
     model = np.sqrt(np.clip(error**2 - rand**2, 0.0, None))
+    seen = confirmed_modes(all_lines, freq_hz, damping, recording.fs / nperseg)
     check = ModalCheck(
         tuple(recording.sensors), error, rand, model, delay,
         np.array([ln.freq_hz.size for ln in all_lines]), nperseg, (), residues, terms, poles,
+        tuple(float(f) for f, ok in zip(freq_hz, seen, strict=True) if not ok),
     )  # fmt: skip
     if check.passed:
         return check
     return ModalCheck(**{**check.__dict__, "bands": _misfit_bands(check, all_lines)})
+
+
+def confirmed_modes(all_lines: list[_Spectra], freq_hz, damping, line_hz: float) -> np.ndarray:
+    """Per mode: does some output have a coherent line (:func:`measured_lines`) within the
+    mode's half-power band, ``|f - f_m| <= max(xi_m f_m, 2 lines)``? A mode in a band where
+    no H1 is coherent is one the record cannot confirm: the check's fit never sees it."""
+    f, x = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)
+    lines = np.concatenate([ln.freq_hz for ln in all_lines]) if all_lines else np.zeros(0)
+    reach = np.maximum(np.abs(x) * f, 2 * line_hz)
+    return np.array([bool(np.any(np.abs(lines - fm) <= r)) for fm, r in zip(f, reach, strict=True)], dtype=bool)
 
 
 def _misfit_bands(check: ModalCheck, all_lines: list[_Spectra]) -> tuple:

@@ -824,6 +824,8 @@ def _modes_the_check_adds(diagram, modes: pd.DataFrame, shapes: np.ndarray, band
             continue  # a selected mode's own pole
         trial = np.r_[modes.freq_hz, first.freq_hz], np.r_[modes.damping, first.damping]
         trial_check = check_modes(diagram.recording, *trial, band)
+        if float(first.freq_hz) in trial_check.unconfirmed_hz:
+            continue  # no coherent line there: the check cannot judge it, so it cannot enter
         if not mode_support(diagram.recording, *trial, len(modes), trial_check, band, reach="nearest").needed:
             continue
         rep = _representative(diagram, sub, bic, {})

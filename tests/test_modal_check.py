@@ -122,3 +122,22 @@ def test_default_orders_adapt_to_a_short_record_and_typed_ones_are_refused(fixtu
     full = stabilisation_diagram(rec, per_sensor=False)
     assert [o[0] for o in full.orders] == list(DEFAULT_ORDERS)
     assert not [w for w in full.warnings if w.code == "orders_capped"]
+
+
+def test_a_mode_where_no_h1_is_coherent_is_unconfirmed_and_fails_the_verdict(light_ride):
+    """A mode at 24.8 Hz, at the edge of the ride's band where no output responds
+    coherently (as the bridge's 20.7 Hz 'mode' inside a low-coherence band): the fit cannot
+    see it, so the check cannot pass it."""
+    from armaxmodal.modal_check import confirmed_modes, measured_lines
+
+    s, rec = light_ride
+    m = s.modes()
+    f, x = np.r_[m.freq_hz, 24.8], np.r_[m.damping, 0.01]
+    check = check_modes(rec, f, x)
+    lines = measured_lines(rec, check.nperseg)
+    assert not any(np.any(np.abs(ln.freq_hz - 24.8) <= 0.5) for ln in lines)  # the premise
+    assert confirmed_modes(lines, f, x, rec.fs / check.nperseg).tolist() == [True, True, False]
+    assert check.unconfirmed_hz == (24.8,) and not check.passed
+    assert np.all(check.model_error <= MODEL_ERROR_LIMIT)  # the fit alone would pass
+    assert "24.80" in check.warnings()[0].message
+    assert check_modes(rec, m.freq_hz, m.damping).unconfirmed_hz == ()
