@@ -18,6 +18,76 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 # (file, original text, mutated text, what it models)
 MUTANTS = [
+    # the modal-model check and the selection by it (issue 26); run with
+    # --match "(check)" --tests tests/test_modal_check.py tests/test_frf_check.py
+    #   tests/test_stabilisation.py::test_a_split_the_frf_does_not_need_is_merged_and_said
+    #   tests/test_stabilisation.py::test_a_spurious_heavily_damped_neighbour_is_left_out_and_said
+    (
+        "armaxmodal/modal_check.py",
+        "model = np.sqrt(np.clip(error**2 - rand**2, 0.0, None))",
+        "model = error",
+        "the H1's random error not taken out (check)",
+    ),
+    (
+        "armaxmodal/modal_check.py",
+        "return fits and not self.unconfirmed_hz",
+        "return fits",
+        "unconfirmed modes pass (check)",
+    ),
+    (
+        "armaxmodal/modal_check.py",
+        "np.all(self.model_error[checked] <= MODEL_ERROR_LIMIT))",
+        "np.all(self.model_error[checked] < MODEL_ERROR_LIMIT))",
+        "the limit itself fails (check)",
+    ),
+    (
+        "armaxmodal/modal_check.py",
+        "np.exp(2j * np.pi * lines.freq_hz[:, None] * taus[None])",
+        "np.exp(-2j * np.pi * lines.freq_hz[:, None] * taus[None])",
+        "delay sign (check)",
+    ),
+    (
+        "armaxmodal/modal_check.py",
+        "return np.hstack([a + b, 1j * (a - b), one, 1j * one, 1 / s**2, 1j / s**2])",
+        "return np.hstack([a + b, 1j * (a - b), one, 1j * one])",
+        "lower residual dropped (check)",
+    ),
+    (
+        "armaxmodal/modal_check.py",
+        "return bool(self.rise >= MODEL_ERROR_RISE and self.p_value <= SUPPORT_ALPHA)",
+        "return bool(self.rise >= MODEL_ERROR_RISE or self.p_value <= SUPPORT_ALPHA)",
+        "a mode needed by either criterion (check)",
+    ),
+    (
+        "armaxmodal/modal_check.py",
+        "j = (nearest_neighbour if reach == \"nearest\" else overlapping_neighbour)(f, x, m)",
+        "j = None",
+        "no neighbour refitted when a mode is left out (check)",
+    ),
+    (
+        "armaxmodal/modal_check.py",
+        "reach = np.abs(x) * f + CONFIRM_LINES * line_hz",
+        "reach = np.abs(x) * f + 40 * CONFIRM_LINES * line_hz",
+        "a mode confirmed by a far line (check)",
+    ),
+    (
+        "armaxmodal/stabilisation.py",
+        "m = min(weak, key=lambda i: (rank.index(i), support[i].rise))",
+        "m = max(weak, key=lambda i: (rank.index(i), support[i].rise))",
+        "the better-supported half of a split dropped (check)",
+    ),
+    (
+        "armaxmodal/stabilisation.py",
+        "reach=\"nearest\").needed:",
+        "reach=\"overlapping\").needed:",
+        "a candidate judged without its nearest neighbour refitted (check)",
+    ),
+    (
+        "armaxmodal/stabilisation.py",
+        "if len(members) >= 3 and np.min(",
+        "if len(members) >= 99 and np.min(",
+        "no left-out cluster is a candidate (check)",
+    ),
     ("armaxmodal/modal.py", "dxi = (-(li**2)[:, None]", "dxi = ((li**2)[:, None]", "sign error in the damping SD"),
     (
         "armaxmodal/modal.py",
