@@ -6,7 +6,7 @@ inverse modal problem for a physical chain model. See ``shared/METHOD.md`` for t
 from the source thesis to the code.
 """
 
-from .datasets import chapter2_system, supine_human
+from .datasets import chapter2_system, supine_human, supine_with_feet
 from .exceptions import (
     ArmaxModalError,
     ConvergenceWarning,
@@ -47,6 +47,7 @@ __all__ = [
     "simulate_recording",
     "sine_sweep",
     "supine_human",
+    "supine_with_feet",
     "write_recording_csv",
     "write_recording_uff",
 ]

@@ -16,6 +16,7 @@ import argparse
 import time
 
 import numpy as np
+from robustness import random_chain  # scripts/ is on the path when a script runs
 
 import armaxmodal as am
 from armaxmodal.modal_check import check_modes
@@ -23,19 +24,6 @@ from armaxmodal.stabilisation import select_modes, stabilisation_diagram
 
 #: a found mode within this relative frequency of a true one is that mode
 MATCH = 0.05
-
-
-def five_segments_with_feet() -> am.Structure:
-    """Table 4.4's supine chain with a 2.5 kg feet segment on the legs: modes 6.89, 8.36,
-    13.54, 16.25 and 24.84 Hz, damping 0.26-0.40."""
-    return am.Structure.from_chain(
-        [6.2338, 21.3693, 30.0144, 19.9488, 2.5],
-        [40707.0, 18152.0, 116596.0, 1059.0, 40000.0],
-        [300.8, 727.6, 1122.5, 161.3, 250.0],
-        [20992.0, 36921.0, 37109.0, 20000.0],
-        [40.3, 45.3, 267.0, 60.0],
-        ("head", "chest", "pelvis", "legs", "feet"),
-    )
 
 
 def light_six() -> am.Structure:
@@ -49,28 +37,15 @@ def light_six() -> am.Structure:
     )
 
 
-def random_chain(rng) -> am.Structure:
-    n = int(rng.integers(2, 7))
-    masses = rng.uniform(1, 20, n)
-    k = rng.uniform(5e3, 1e5, n) * masses / 5
-    k_s = rng.uniform(5e3, 8e4, n - 1) * masses[:-1] / 5
-    target = float(rng.choice([0.01, 0.03, 0.1, 0.3]))
-    undamped = am.Structure.from_chain(masses, k, np.zeros(n), k_s, np.zeros(n - 1))
-    w1 = 2 * np.pi * undamped.modes().freq_hz[0]
-    c = 2 * target * w1 * masses * rng.uniform(0.5, 1.5, n)
-    c_s = 2 * target * w1 * masses[:-1] * rng.uniform(0.2, 1.0, n - 1)
-    return am.Structure.from_chain(masses, k, c, k_s, c_s)
-
-
 def cases(n_random: int, seed: int):
     ride = am.random_vibration(60.0, 120.0, (0.5, 28.0), seed=1)
     yield "supine 4-DOF, 60 Hz", am.supine_human(), 60.0, ride, "bandlimited"
     yield "Chapter 2 4-DOF, 60 Hz zoh", am.chapter2_system(), 60.0, ride, "zoh"
-    yield "supine 5-DOF with feet, 60 Hz", five_segments_with_feet(), 60.0, ride, "bandlimited"
+    yield "supine 5-DOF with feet, 60 Hz", am.supine_with_feet(), 60.0, ride, "bandlimited"
     yield "light 6-DOF, 100 Hz", light_six(), 100.0, am.random_vibration(100.0, 240.0, (0.5, 45.0), seed=2), "zoh"
     rng = np.random.default_rng(seed)
     for i in range(n_random):
-        s = random_chain(rng)
+        s = random_chain(rng, (0.01, 0.03, 0.1, 0.3))
         fs = float(rng.choice([100.0, 200.0, 400.0]))
         if s.modes().freq_hz.max() > 0.4 * fs:
             fs = 400.0

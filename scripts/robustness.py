@@ -17,12 +17,13 @@ import armaxmodal as am
 from armaxmodal.stabilisation import select_modes, stabilisation_diagram
 
 
-def random_chain(rng):
+def random_chain(rng, dampings=(0.01, 0.05, 0.15, 0.3)):
+    """A chain of 2-6 masses whose first mode's damping is about one of ``dampings``."""
     n = int(rng.integers(2, 7))
     masses = rng.uniform(1, 20, n)
     k = rng.uniform(5e3, 1e5, n) * masses / 5
     k_s = rng.uniform(5e3, 8e4, n - 1) * masses[:-1] / 5
-    target = float(rng.choice([0.01, 0.05, 0.15, 0.3]))
+    target = float(rng.choice(list(dampings)))
     undamped = am.Structure.from_chain(masses, k, np.zeros(n), k_s, np.zeros(n - 1))
     w1 = 2 * np.pi * undamped.modes().freq_hz[0]
     c = 2 * target * w1 * masses * rng.uniform(0.5, 1.5, n)

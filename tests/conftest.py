@@ -23,3 +23,14 @@ def realdata_dir() -> Path:
     if not path.is_dir():
         pytest.skip(f"real data not found at {path} (set ARMAXMODAL_SHARED)")
     return path
+
+
+@pytest.fixture(scope="session")
+def light_ride():
+    """Two lightly damped modes (about 4 and 11 Hz, 1-2 %) on a band-limited random ride
+    with 2 % sensor noise: ``(structure, recording)``."""
+    import armaxmodal as am
+
+    s = am.Structure.from_chain([10.0, 5.0], [8000.0, 0.0], [8.0, 0.0], [12000.0], [5.0], ("m1", "m2"))
+    u = am.random_vibration(50.0, 240.0, (0.5, 24.0), seed=3)
+    return s, am.simulate_recording(s, u, 50.0, noise=0.02, seed=4, hold="bandlimited")

@@ -32,11 +32,8 @@ def test_the_error_separates_a_complete_selection_from_an_incomplete_one(supine)
 
 
 @pytest.fixture(scope="module")
-def light():
-    """Two lightly damped modes (about 4 and 11 Hz, 1-2 %) on a random ride."""
-    s = am.Structure.from_chain([10.0, 5.0], [8000.0, 0.0], [8.0, 0.0], [12000.0], [5.0], ("m1", "m2"))
-    u = am.random_vibration(50.0, 240.0, (0.5, 24.0), seed=3)
-    return s, am.simulate_recording(s, u, 50.0, noise=0.02, seed=4, hold="bandlimited")
+def light(light_ride):
+    return light_ride
 
 
 def test_a_missing_lightly_damped_mode_is_named_at_its_frequency(light):

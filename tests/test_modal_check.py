@@ -20,12 +20,7 @@ from armaxmodal.stabilisation import DEFAULT_ORDERS, select_modes, stabilisation
 CLEAN_MODEL_ERROR = 0.15
 
 
-@pytest.fixture(scope="module")
-def light_ride():
-    """Two lightly damped modes (about 4 and 11 Hz, 1-2 %) on a band-limited random ride."""
-    s = am.Structure.from_chain([10.0, 5.0], [8000.0, 0.0], [8.0, 0.0], [12000.0], [5.0], ("m1", "m2"))
-    u = am.random_vibration(50.0, 240.0, (0.5, 24.0), seed=3)
-    return s, am.simulate_recording(s, u, 50.0, noise=0.01, seed=4, hold="bandlimited")
+# light_ride: tests/conftest.py
 
 
 def test_the_exact_modes_rebuild_the_exact_transmissibility(light_ride):
@@ -147,14 +142,7 @@ def test_the_five_segment_chain_with_feet_gives_its_five_modes():
     """Table 4.4's supine chain with a 2.5 kg feet segment (modes 3-5 heavily damped, the
     fifth near the ride's 28 Hz edge): once gave four modes, 12.49 Hz for 13.54 and the fifth
     missed. The fifth enters by the check; the refit of all five puts each within 3 %."""
-    import importlib.util
-    from pathlib import Path
-
-    path = Path(__file__).resolve().parents[1] / "scripts" / "check_battery.py"
-    spec = importlib.util.spec_from_file_location("check_battery", path)
-    battery = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(battery)
-    s = battery.five_segments_with_feet()
+    s = am.supine_with_feet()
     ride = am.random_vibration(60.0, 120.0, (0.5, 28.0), seed=1)
     rec = am.simulate_recording(s, ride, 60.0, noise=0.05, seed=7, hold="bandlimited")
     sel = select_modes(stabilisation_diagram(rec, per_sensor=False), segments=0)
