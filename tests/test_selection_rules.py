@@ -445,7 +445,7 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     monkeypatch.setattr(st, "refine_modes", refit)
     hold = "bandlimited"
     calls = []
-    monkeypatch.setattr(st, "_apply_refinement", lambda m, s, r, f, x: (calls.append((f, x)) or (m, s)))
+    monkeypatch.setattr(st, "_apply_refinement", lambda m, s, r, f, x, relaxed=False: (calls.append((f, x)) or (m, s)))
     monkeypatch.setattr(st, "_merge_duplicates", lambda m, v, mac, dur: (calls.append((len(v), mac, dur)) or [1]))
     out, out_shapes, _ = st._refined(diagram, modes, shapes, SimpleNamespace(hold=hold), 0.05, 0.5, 0.8)
     assert calls == [(0.05, 0.5), (2, 0.8, rec.duration)]
