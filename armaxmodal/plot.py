@@ -115,6 +115,9 @@ def _draw_check(ax, ax_f, f, selection) -> None:
         ax.axvspan(lo, hi, color=_MISFIT, alpha=0.25, zorder=0, lw=0, label=label)
     worst = np.nanmax(check.model_error) if np.isfinite(check.model_error).any() else np.nan
     verdict = "modes explain the FRF" if check.passed else "POOR: the modes do not explain the FRF"
+    if check.unconfirmed_hz:
+        where = ", ".join(f"{f:.2f}" for f in check.unconfirmed_hz)
+        verdict = f"POOR: no coherent H1 confirms {where} Hz; elsewhere"
     ax.text(
         0.01,
         0.01,
