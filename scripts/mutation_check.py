@@ -71,6 +71,12 @@ MUTANTS = [
         "a mode confirmed by a far line (check)",
     ),
     (
+        "armaxmodal/modal_check.py",
+        "if abs(np.exp(best.x[0]) - 1) <= NEIGHBOUR_MAX_SHIFT:",
+        "if True:",
+        "a neighbour takes over from anywhere (check)",
+    ),
+    (
         "armaxmodal/stabilisation.py",
         "m = min(weak, key=lambda i: (rank.index(i), support[i].rise))",
         "m = max(weak, key=lambda i: (rank.index(i), support[i].rise))",
