@@ -60,6 +60,32 @@ def check_fs(fs) -> float:
     return value
 
 
+#: Largest |sample| a recording may hold, in any unit: the fits square and cube samples
+#: (variances, a cubic spring's regressor), which overflow double precision near 1e150;
+#: no physical reading in SI units or g comes near either bound.
+MAX_AMPLITUDE = 1e30
+#: Smallest largest-|sample| of a channel that is not all zero: below it the squares
+#: underflow (near 1e-160) and every variance reads zero.
+MIN_AMPLITUDE = 1e-30
+
+
+def check_amplitude(x: np.ndarray, name: str, channel_names: Sequence[str] | None = None) -> None:
+    """Raise :class:`DataError` if a channel of ``x`` (n, K) holds samples beyond
+    ``MAX_AMPLITUDE`` or, not all zero, none above ``MIN_AMPLITUDE``: units off by many orders
+    of magnitude (a raw integer stream scaled twice, a unit exponent lost on export)."""
+    peak = np.max(np.abs(x), axis=0)
+    bad = (peak > MAX_AMPLITUDE) | ((peak > 0) & (peak < MIN_AMPLITUDE))
+    if not bad.any():
+        return
+    col = int(np.argmax(bad))
+    label = channel_names[col] if channel_names is not None else f"column {col}"
+    raise DataError(
+        f"{name}: channel '{label}' has its largest |sample| at {peak[col]:.3g}, outside "
+        f"{MIN_AMPLITUDE:g} to {MAX_AMPLITUDE:g}: the fits square and cube samples, which overflow or "
+        "underflow double precision. Give the data in physical units (m/s^2 or g) or rescale the channel."
+    )
+
+
 def check_not_constant(x: np.ndarray, name: str) -> None:
     """Raise if a signal carries no variation (a constant input identifies nothing)."""
     span = np.ptp(x, axis=0)

@@ -390,6 +390,24 @@ def _modal_noise_levels(data: dict) -> dict:
     return sigma
 
 
+def _print_solution(sol, total_mass: float | None) -> None:
+    """The recovered chain's components and its modes, as two tables."""
+    table = sol.to_frame()
+    parts = table[table.component != "mode"].dropna(axis=1, how="all").drop(columns="method")
+    if parts.size:
+        first = sol.structure.names[0]
+        scale = (
+            f"the total mass is {total_mass:g} kg"
+            if total_mass is not None
+            else f"no --total-mass: the scale is unknown, so the mass of '{first}' is set to 1 kg; multiply every "
+            f"value by its true mass in kg (or give --total-mass)"
+        )
+        print(f"components ({sol.method}; {scale}):")
+        print(parts.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    print("modes of the recovered model:")
+    print(sol.modes.to_frame().to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+
+
 def _cmd_invert(args) -> int:
     import json
 
@@ -444,7 +462,7 @@ def _cmd_invert(args) -> int:
 
         prediction = predict_recording(sol.structure, rec)
     if not args.quiet:
-        print(sol.to_frame().to_string(float_format=lambda v: f"{v:.4g}"))
+        _print_solution(sol, total)
         for flag in sol.flags:
             print(f"note: {flag}")
         if prediction is not None:

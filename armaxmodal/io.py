@@ -99,6 +99,12 @@ def read_recording(
     channels, file_fs, info = readers[kind](path)
     if not channels:
         raise DataError(f"{path.name}: no numeric channels found.")
+    if kind == "csv" and input not in channels and all(_is_number(c) for c in channels):
+        raise DataError(
+            f"{path.name}: the first line holds numbers ({', '.join(list(channels)[:3])}, ...), not column names: "
+            "the file has no header row. Add one naming the columns, e.g. 'time,base,head,chest' (time in s), "
+            "and say which is the input with input=... (CLI: --input)."
+        )
     # a row index, sample counter or time column under another name (pandas writes its index
     # as an unnamed first column) is not a sensor: taken as an output it was a ramp that lost
     # modes and raised 'drift'
@@ -110,6 +116,14 @@ def read_recording(
             "fs=... (CLI: --fs)."
         )
     fs = _resolve_fs(file_fs, fs, path)
+    odd = info.get("other_lengths", {})
+    wanted = [c for c in [input, *(outputs or ())] if c in odd]
+    if wanted:
+        n = len(next(iter(channels.values())))
+        raise DataError(
+            f"{path.name}: {', '.join(f'{c!r} has {odd[c]} samples' for c in wanted)} where the other channels have "
+            f"{n}: a recording's channels share one time base. Trim them to a common length (aligned by time)."
+        )
     if input not in channels:
         raise DataError(
             f"{path.name}: input channel '{input}' not found; channels are {list(channels)}. "
@@ -120,7 +134,9 @@ def read_recording(
     if missing:
         raise DataError(f"{path.name}: unknown output channel(s) {missing}; channels are {list(channels)}.")
     if not names:
-        raise DataError(f"{path.name}: only the input channel '{input}' is present; no outputs.")
+        lengths = ", ".join(f"{c!r} has {m} samples" for c, m in odd.items())
+        others = f" ({lengths}, '{input}' {channels[input].size}: trim them to a common length)" if odd else ""
+        raise DataError(f"{path.name}: only the input channel '{input}' is present; no outputs{others}.")
     empty = [c for c in [input, *names] if np.all(np.isnan(channels[c]))]
     if empty:
         raise DataError(
@@ -147,6 +163,15 @@ def read_recording(
         mass_kg if mass_kg is not None else info.get("mass_kg"),
         meta,
     )
+
+
+def _is_number(text: str) -> bool:
+    """``text`` reads as a number (a CSV header cell that is really a data cell)."""
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _is_axis(values: np.ndarray) -> bool:
@@ -490,7 +515,10 @@ def _read_mat(path: Path):
                 else [f"{key}_{i + 1}" for i in range(cols.shape[1])]
             )
             channels.update({name: cols[:, i].copy() for i, name in enumerate(names)})
-    return channels, file_fs, {}
+    # vectors of another length are not channels of this record (a frequency axis, a
+    # calibration table) unless the user names one: then their length is the error to report
+    others = {key: v.size for key, v in numeric.items() if v.ndim == 1 and v.size > 1 and key not in channels}
+    return channels, file_fs, {"other_lengths": others}
 
 
 def _struct_fields(arrays: dict) -> dict:
@@ -526,6 +554,11 @@ def _read_uff(path: Path):
         AttributeError,
     ) as exc:
         raise DataError(f"{path.name}: not a readable UFF file ({exc}).") from exc
+    except Exception as exc:  # pyuff raises a bare Exception for a data set it cannot parse
+        raise DataError(
+            f"{path.name}: not a readable UFF file: a data set could not be parsed ({exc}). Check that it is a "
+            "complete UFF export (type 58 time histories, each closed by a '-1' line), or export to CSV."
+        ) from exc
     _check_uff_complete(path)
     sets = [sets] if isinstance(sets, dict) else list(sets)
     series = [s for s in sets if s.get("type") == 58]

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from ._validate import as_signal_matrix, as_signal_vector, check_fs, check_not_constant
+from ._validate import as_signal_matrix, as_signal_vector, check_amplitude, check_fs, check_not_constant
 from .exceptions import DataError
 
 __all__ = ["Recording"]
@@ -64,6 +64,8 @@ class Recording:
             raise DataError(f"sensors: expected {response.shape[1]} distinct names, got {list(sensors)}.")
         if self.input_name in sensors:
             raise DataError(f"input '{self.input_name}' is also listed as an output sensor.")
+        check_amplitude(base[:, None], "input", (self.input_name,))
+        check_amplitude(response, "response", sensors)
         check_not_constant(base, f"input '{self.input_name}'")
         if self.mass_kg is not None and not (np.isfinite(self.mass_kg) and self.mass_kg > 0):
             raise DataError(f"mass_kg: expected a positive mass in kg, got {self.mass_kg!r}.")

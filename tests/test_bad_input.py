@@ -201,3 +201,77 @@ def test_invert_refuses_bad_modal_files_with_one_line(tmp_path, fixtures_dir, ca
     with pytest.raises(SystemExit):
         main(["invert", str(good), "--total-mass", "-70"])
     assert "finite number > 0" in capsys.readouterr().err
+
+
+def _ride_frame(fixtures_dir):
+    import pandas as pd
+
+    return pd.read_csv(fixtures_dir / "supine_random.csv", comment="#")
+
+
+@pytest.mark.parametrize(
+    ("damage", "words"),
+    [
+        ("huge", "largest |sample| at 3.96e+150"),
+        ("tiny", "largest |sample| at 3.96e-200"),
+        ("no_header", "no header row"),
+        ("short_input_mat", "'base' has 7195 samples where the other channels have 7200"),
+        ("short_outputs_mat", "'head' has 7195 samples"),
+        ("malformed_uff", "a data set could not be parsed"),
+    ],
+)
+def test_damaged_files_end_in_one_line_naming_cause_and_fix(tmp_path, fixtures_dir, capsys, damage, words):
+    """Issue 27's rows of the bad-input matrix: before, a traceback from deep inside scipy (1e150),
+    pyuff's bare 'Error when reading data-set(s)', 'input channel not found' for a MAT input 5
+    samples short, an order message for 1e-200, a time column '0.0' for a CSV without header."""
+    import scipy.io
+
+    frame = _ride_frame(fixtures_dir)
+    cols = {k: frame[k].to_numpy() for k in frame.columns}
+    if damage in ("huge", "tiny"):
+        path = tmp_path / f"{damage}.csv"
+        frame.iloc[:, 1:] *= 1e150 if damage == "huge" else 1e-200
+        frame.to_csv(path, index=False)
+    elif damage == "no_header":
+        path = tmp_path / "ride.csv"
+        frame.to_csv(path, index=False, header=False)
+    elif damage == "short_input_mat":
+        path = tmp_path / "ride.mat"
+        scipy.io.savemat(path, {"base": cols["base"][:-5], "head": cols["head"], "chest": cols["chest"], "fs": 60.0})
+    elif damage == "short_outputs_mat":
+        path = tmp_path / "ride.mat"
+        scipy.io.savemat(path, {"base": cols["base"], "head": cols["head"][:-5], "fs": 60.0})
+    else:
+        path = tmp_path / "ride.uff"
+        path.write_text("    -1\n    58\nthis is not a uff file\n 1 2 3\n garbage\n    -1\n")
+    before = path.read_bytes()
+    for command in ("stabilise", "diagnose"):
+        assert main([command, str(path), "--quiet"]) == 2
+        err = capsys.readouterr().err
+        assert words in err and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    assert path.read_bytes() == before
+
+
+def test_integer_named_columns_with_the_input_named_are_a_header(tmp_path, fixtures_dir):
+    """Sensors numbered rather than named are a header when the input is among them."""
+    from armaxmodal.io import read_recording
+
+    frame = _ride_frame(fixtures_dir).drop(columns="time")
+    frame.columns = ["0", "1", "2", "3", "4"]
+    frame.to_csv(tmp_path / "numbered.csv", index=False)
+    rec = read_recording(tmp_path / "numbered.csv", input="0", fs=60.0)
+    assert rec.sensors == ("1", "2", "3", "4") and rec.n_samples == len(frame)
+
+
+def test_invert_prints_components_and_modes_as_two_tables(tmp_path, fixtures_dir, capsys):
+    """Before: one table mixing both, with columns of NaN; without --total-mass, masses in kg
+    that were relative to the first."""
+    modes = tmp_path / "modes.json"
+    assert main(["--quiet", "stabilise", str(fixtures_dir / "supine_random.csv"), "--json", str(modes)]) == 0
+    assert main(["invert", str(modes)]) == 0
+    out = capsys.readouterr().out
+    components, rest = out.split("modes of the recovered model:")
+    assert "NaN" not in out
+    assert "the mass of 'head' is set to 1 kg" in components and "freq_hz" not in components
+    table = [line for line in rest.strip().splitlines() if not line.startswith("note:")]
+    assert "damping" in table[0] and [int(line.split()[0]) for line in table[1:]] == [1, 2, 3, 4]
