@@ -37,7 +37,7 @@ The sweep adds ``periodic_disturbance`` (:mod:`armaxmodal.disturbance`); prepara
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -152,6 +152,10 @@ class DelayEstimate:
     n_lines: int
     max_freq_hz: float
     dof: int = 1
+    #: The delay with each block of Welch segments left out (s; NaN where too few lines
+    #: remained): the same blocks for every output, so a delay common to several outputs gets
+    #: a jackknife of its own that sees their shared input noise.
+    left_out: tuple[float, ...] = field(default=(), compare=False, repr=False)
 
     def quantile(self, probability: float) -> float:
         """The Student-t quantile with this estimate's degrees of freedom."""
@@ -292,12 +296,13 @@ def estimate_delays(recording: Recording) -> list[DelayEstimate]:
             continue
         delay, sd, sign, n_lines, f_max = fits[0]
         dof = n_lines - 2
-        left_out = np.array([fit[0] for fit in fits[1:] if fit is not None])
+        by_block = tuple(np.nan if fit is None else fit[0] for fit in fits[1:])
+        left_out = np.array([d for d in by_block if np.isfinite(d)])
         if left_out.size >= 3:
             jackknife = np.sqrt((left_out.size - 1) / left_out.size * np.sum((left_out - left_out.mean()) ** 2))
             if jackknife > sd:
                 sd, dof = float(jackknife), left_out.size - 1
-        out.append(DelayEstimate(name, delay, sd, sign, n_lines, f_max, dof))
+        out.append(DelayEstimate(name, delay, sd, sign, n_lines, f_max, dof, by_block))
     return out
 
 

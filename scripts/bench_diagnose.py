@@ -17,6 +17,7 @@ import time
 from pathlib import Path
 
 import armaxmodal as am
+from armaxmodal.diagnose import delays as dl
 from armaxmodal.diagnose import diagnose
 from armaxmodal.diagnose import evidence as ev
 from armaxmodal.diagnose.inject import inject
@@ -56,9 +57,9 @@ def stages(rec: am.Recording) -> None:
     k, eps = len(signals.sensors), model.one_step_errors()
     n_tests, mask = len(ev.EFFECT_TESTS) * k, usable(signals.n, spec)
     table = {"whiteness_p": [], "trend_p": [], "line_p": []}  # as run_tests starts it
-    found = ev._delay_findings(model, n_tests)
+    found = dl.delay_findings(model, n_tests)
     clock.lap("test: delay (quasi-static phase slope)")
-    found += ev._lead_findings(model, n_tests, set())
+    found += dl.lead_findings(model, n_tests, set())
     clock.lap("test: lead (residual-input cross-correlation)")
     found += ev.mode_findings(model, n_tests, table)
     clock.lap("test: unmodelled mode (FRF misfit)")

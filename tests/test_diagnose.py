@@ -294,7 +294,7 @@ def _baseline_model(rec):
 def test_an_output_ahead_beyond_the_noncausal_taps_is_timed_by_the_cross_correlation(clean):
     """An IMU on its own clock runs ahead of the table by more than nk reaches; where no
     quasi-static band can time it, the residual's correlation with future input does."""
-    from armaxmodal.diagnose.evidence import _lead_findings
+    from armaxmodal.diagnose.delays import lead_findings as _lead_findings
 
     n_tests = 7 * len(clean.sensors)
     ahead = inject(clean, "input_delay", ["legs"], samples=-14.0)

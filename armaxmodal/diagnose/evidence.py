@@ -12,15 +12,14 @@ chance of naming any effect on a clean recording stays near ``alpha``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 from scipy import stats
 from scipy.signal import lfilter
 
-from ..quality import MIN_DELAY_SAMPLES, estimate_delays, input_coherence
+from ..quality import input_coherence
 from ..recording import Recording
 from .clipping import rail_pileup
+from .delays import delay_findings, late_start, lead_findings
 from .faults import (
     FAULT_ALPHA,
     FOLLOWS_ALPHA,
@@ -32,6 +31,7 @@ from .faults import (
     shared_by_others,
     stuck_runs,
 )
+from .finding import Finding
 from .missing_mode import mode_findings
 from .model import LINE_MERGE_HZ, UNDAMPED, FittedModel, counted, usable
 from .model import lagged as _lag
@@ -60,15 +60,6 @@ EFFECT_TESTS = (
 #: simulation fit: an offset or a drift the diagnosis has not yet removed ruins the fit of a
 #: response sensor (-180 % with 0.3 on chest) and once made it a "second input".
 SECOND_INPUT_COHERENCE = 0.5
-#: Lags of the residual-input cross-correlation searched for an output that leads the input
-#: beyond the model's non-causal taps (an IMU on its own clock: 15-22 samples on the shake table).
-LEAD_MAX_LAG = 40
-#: lags just past the model's reach left out of that search: a band-limited response's
-#: non-causal tail runs on past any finite nk, and a distorted fit (a drift, a missing mode)
-#: leaks into the first lags there (an offset on chest once read as head 6 samples ahead of
-#: nk = -5; after a line fix, head 8 samples ahead of nk = -3). Leads that short are the
-#: phase slope's to time; this test is for clocks off by more (IMUs: 15-22 samples).
-LEAD_GUARD = 6
 #: Windows of the windowed re-identification (time variation).
 N_WINDOWS = 6
 #: A line in the residual is the input's (model error), not a disturbance, when the input
@@ -78,38 +69,6 @@ N_WINDOWS = 6
 #: fixture's legs went unnamed: the input read p = 7.7e-4 there by chance. None of 10^4
 #: frequencies of those rides reached 1e-6.
 INPUT_LINE_P = 1e-6
-
-
-@dataclass(frozen=True)
-class Finding:
-    """One effect the residual points to.
-
-    Attributes
-    ----------
-    effect : str
-        From :data:`armaxmodal.diagnose.EFFECTS`.
-    channels : tuple of str
-    statistic : str
-        Name of the test statistic.
-    value : float
-        Its value.
-    p : float
-        p-value corrected for sensors x tests.
-    parameters : dict
-        What the test measured (delay in ms, line frequency and amplitude...).
-    """
-
-    effect: str
-    channels: tuple[str, ...]
-    statistic: str
-    value: float
-    p: float
-    parameters: dict = field(default_factory=dict)
-    #: What the fix needs beyond the parameters (a nonlinear term's regressor block).
-    payload: object = field(default=None, compare=False, repr=False)
-
-    def evidence(self) -> dict:
-        return {"statistic": self.statistic, "value": float(self.value), "p": float(self.p)}
 
 
 def gradient_columns(model, y: np.ndarray, u: np.ndarray, eps: np.ndarray) -> np.ndarray:
@@ -153,10 +112,11 @@ def run_tests(fitted: FittedModel, alpha: float = 0.01) -> tuple[list[Finding], 
     eps = fitted.one_step_errors()
     mask = counted(fitted)
     table = {"whiteness_p": [], "trend_p": [], "line_p": []}
+    delays = delay_findings(fitted, n_tests)
     found = _clipping_findings(fitted, n_tests)
-    found += _fault_findings(fitted, eps, mask, n_tests)
-    found += _delay_findings(fitted, n_tests)
-    found += _lead_findings(fitted, n_tests, {c for f in found for c in f.channels})
+    found += _fault_findings(fitted, eps, mask, n_tests, late_start(fitted, delays))
+    found += delays
+    found += lead_findings(fitted, n_tests, {c for f in found for c in f.channels})
     found += mode_findings(fitted, n_tests, table)
     found += _trend_findings(fitted, eps, mask, n_tests, table)
     found += _line_findings(fitted, mask, n_tests, table)
@@ -205,17 +165,23 @@ def _clipping_findings(fitted: FittedModel, n_tests: int) -> list[Finding]:
     return out
 
 
-def _fault_findings(fitted: FittedModel, eps: np.ndarray, mask: np.ndarray, n_tests: int) -> list[Finding]:
+def _fault_findings(
+    fitted: FittedModel, eps: np.ndarray, mask: np.ndarray, n_tests: int, delayed: dict[str, int]
+) -> list[Finding]:
     """Per output, a stuck run or glitches (:mod:`.faults`); p corrected for sensors x tests.
     The payload is the recorded samples the fault spoiled: a stuck run's repeats (its first
-    sample is the last live reading) and each glitch."""
+    sample is the last live reading) and each glitch. A run at the start within the samples a
+    delay explains (``delayed``, :func:`.delays.late_start`) is the late channel's fill."""
     raw, fs = fitted.raw, fitted.raw.fs
     shifts = dict(fitted.spec.shifts)
     known = {name: set(samples) for name, samples in fitted.spec.faults}
     out = []
     scores = np.column_stack([outlier_scores(eps[:, k], m, mask) for k, m in enumerate(fitted.fit.models)])
     for k, name in enumerate(raw.sensors):
-        runs = [r for r in stuck_runs(raw.y[:, k]) if r[0] + 1 not in known.get(name, ())]
+        runs = [
+            r for r in stuck_runs(raw.y[:, k])
+            if r[0] + 1 not in known.get(name, ()) and not (r[0] == 0 and r[1] <= delayed.get(name, 0))
+        ]  # fmt: skip
         lag = int(round(shifts.get(name, 0.0)))  # the residual is in the channel's shifted frame
         model = fitted.fit.models[k]
         spikes, sizes, largest = glitches(eps[:, k], model, mask & ~input_rail_reach(raw.u, model, lag))
@@ -243,81 +209,6 @@ def _fault_findings(fitted: FittedModel, eps: np.ndarray, mask: np.ndarray, n_te
         )
         out.append(Finding("sensor_fault", (name,), statistic, value, p, params, payload=tuple(samples)))
     return out
-
-
-def _delay_findings(fitted: FittedModel, n_tests: int) -> list[Finding]:
-    """A sensor or the input out of time, from the quasi-static transmissibility phase
-    (:func:`armaxmodal.quality.estimate_delays`): its slope is the time offset whatever ``nk``
-    the model needed, and a held input's half sample stays under the reporting floor."""
-    s = fitted.signals
-    rec = Recording(s.fs, s.u, s.y, s.sensors, s.input_name)
-    estimates = estimate_delays(rec)
-    late = []
-    for e in estimates:
-        z = abs(e.delay_s) / max(e.delay_sd_s, 1e-300)
-        p = min(1.0, 2 * stats.t.sf(z, max(e.dof, 1)) * n_tests)  # the sd has few degrees of freedom
-        if abs(e.delay_s) * s.fs >= MIN_DELAY_SAMPLES:
-            late.append((e, p))
-    if not late:
-        return []
-    fs = s.fs
-    if len(late) == len(s.sensors) > 1 and all(e.delay_s < 0 for e, _ in late):
-        lead = float(np.median([-e.delay_s for e, _ in late]))
-        sd = float(np.median([e.delay_sd_s for e, _ in late]))
-        half = sd * max(e.quantile(0.975) for e, _ in late)
-        p = max(p for _, p in late)
-        params = {"delay_ms": 1e3 * lead, "delay_ci95_ms": [1e3 * (lead - half), 1e3 * (lead + half)]}
-        params["delay_samples"] = lead * fs
-        return [Finding("input_delay", (s.input_name,), "phase_slope_z", lead / sd, p, params)]
-    out = []
-    for e, p in late:
-        half = e.quantile(0.975) * e.delay_sd_s
-        params = {
-            "delay_ms": 1e3 * e.delay_s,
-            "delay_ci95_ms": [1e3 * (e.delay_s - half), 1e3 * (e.delay_s + half)],
-            "delay_samples": e.delay_s * fs,
-        }
-        out.append(Finding("input_delay", (e.channel,), "phase_slope_z", e.delay_s / e.delay_sd_s, p, params))
-    return out
-
-
-def _lead_findings(fitted: FittedModel, n_tests: int, timed: set) -> list[Finding]:
-    """An output ahead of the input by more than the model's non-causal taps reach, where the
-    quasi-static phase slope cannot time it (no quasi-static band, as on IMUs): its one-step
-    residual correlates with *future* input beyond lag ``nk`` (MATLAB ``resid``'s region, with
-    the bound of :func:`cross_correlation`; Bonferroni over those lags, sensors and tests). The
-    lead is the lag of the largest correlation there -- the direct term of an acceleration
-    transmissibility puts it at the first future sample the output answers. Every output
-    ahead by the same amount is the input being late. Sensors already timed are left alone."""
-    s = fitted.signals
-    ccf = cross_correlation(fitted, LEAD_MAX_LAG)
-    lags = np.asarray(ccf["lags"])
-    beyond = lags < min(fitted.spec.orders[3], 0) - LEAD_GUARD
-    if not beyond.any():
-        return []
-    found = []
-    for k, name in enumerate(s.sensors):
-        if name in timed:
-            continue
-        z = np.abs(np.asarray(ccf["ccf"][k])[beyond]) * stats.norm.ppf(0.995) / ccf["bound99"][k]
-        i = int(np.argmax(z))
-        p = min(1.0, 2 * float(stats.norm.sf(z[i])) * int(beyond.sum()) * n_tests)
-        found.append((name, float(-lags[beyond][i]), float(z[i]), p))
-    leading = [f for f in found if f[3] < 0.01]
-    if len(leading) == len(s.sensors) > 1 and np.ptp([f[1] for f in leading]) <= 1:
-        lead = float(np.median([f[1] for f in leading]))
-        return [_lead_finding(s.input_name, lead, max(f[2] for f in leading), max(f[3] for f in leading), s.fs)]
-    return [_lead_finding(name, -lead, z, p, s.fs) for name, lead, z, p in found]
-
-
-def _lead_finding(channel: str, delay_samples: float, z: float, p: float, fs: float) -> Finding:
-    """An ``input_delay`` finding from the cross-correlation (whole samples, no interval)."""
-    params = {
-        "delay_samples": delay_samples,
-        "delay_ms": 1e3 * delay_samples / fs,
-        "method": "residual-input cross-correlation beyond the model's non-causal taps",
-    }
-    return Finding("input_delay", (channel,), "residual_input_ccf_z", z, p, params)
 
 
 def _trend_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
@@ -441,30 +332,6 @@ def whiteness_p(fitted: FittedModel) -> list[float]:
     return table["whiteness_p"]
 
 
-def cross_correlation(fitted: FittedModel, max_lag: int = 25) -> dict:
-    """Residual-input cross-correlation at lags -max_lag..max_lag with its 99 % bound (the
-    region of MATLAB's ``resid``): the bound uses both autocorrelations, as the input is
-    coloured."""
-    s = fitted.signals
-    mask = usable(s.n, fitted.spec)
-    eps = fitted.one_step_errors()[mask]
-    u = s.u[mask] - s.u[mask].mean()
-    n = u.size
-    lags = np.arange(-max_lag, max_lag + 1)
-    ru = np.correlate(u, u, "full")[n - 1 : n + 2 * max_lag] / (u @ u)
-    out = {"lags": lags.tolist(), "ccf": [], "bound99": []}
-    for k in range(eps.shape[1]):
-        e = eps[:, k] - eps[:, k].mean()
-        full = np.correlate(e, u, "full") / np.sqrt((e @ e) * (u @ u))
-        ccf = full[n - 1 + lags]
-        re = np.correlate(e, e, "full")[n - 1 : n + 2 * max_lag] / (e @ e)
-        p1 = 1 + 2 * float(np.sum(re[1:] * ru[1:]))
-        out["ccf"].append(ccf.tolist())
-        out["bound99"].append(float(stats.norm.ppf(0.995) * np.sqrt(max(p1, 1e-3) / n)))
-    return out
-
-
-#: Candidate nonlinear restoring forces of a deflection ``d``.
 TERM_KINDS = {"cubic": lambda d: d**3, "quadratic": lambda d: d**2, "abs_times": lambda d: np.abs(d) * d}
 
 

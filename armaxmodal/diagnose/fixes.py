@@ -7,7 +7,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from .evidence import Finding
+from .finding import Finding
 from .model import FittedModel, ModelSpec, response_free_of, usable
 
 __all__ = ["add_effect", "effect_parameters"]

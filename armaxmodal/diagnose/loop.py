@@ -3,7 +3,7 @@ held-out error says so, repeat (at most a few rounds)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -14,7 +14,9 @@ from ..exceptions import DataError
 from ..frf import coherence, welch_spectra
 from ..prepare import prepare
 from ..recording import Recording
-from .evidence import EFFECT_TESTS, Finding, cross_correlation, run_tests, whiteness_p
+from .delays import cross_correlation
+from .evidence import EFFECT_TESTS, run_tests, whiteness_p
+from .finding import Finding
 from .fixes import add_effect, effect_parameters
 from .model import (
     LINE_MERGE_HZ,
@@ -28,6 +30,7 @@ from .model import (
     fit_piecewise,
     held_out,
     held_out_piecewise,
+    model_bic,
     usable,
     widened_start,
 )
@@ -72,6 +75,11 @@ _CRITERION = {
     "stiffness_nonlinearity": "simulation",
     "time_varying": "simulation",
 }
+#: A fix that must only not hurt (a delay the B taps absorbed, a clipped or stuck run filled)
+#: may raise the held-out error by this fraction: the refit's own scatter.
+NO_WORSE = 0.01
+#: nk candidates either side of where a delay's move puts the baseline's (and the baseline's).
+NK_REACH = 1
 #: Fewer samples than this per half cannot hold out a validation part.
 MIN_SAMPLES = 400
 
@@ -84,16 +92,8 @@ class Stage:
     held: HeldOut
 
     def bic(self, kind: str = "one_step", channels=None) -> float:
-        """BIC of the in-sample one-step (or simulation) errors: ``N sum log V_k + p log(N K)``,
-        over ``channels`` (default all: two models compare on the outputs they share)."""
-        s = self.model.signals
-        mask = usable(s.n, self.model.spec)
-        errors = self.model.one_step_errors() if kind == "one_step" else self.model.simulation_errors()
-        e = errors[mask][:, [s.sensors.index(c) for c in (s.sensors if channels is None else channels)]]
-        n, k = e.shape
-        pieces = 2 if isinstance(self.model, PiecewiseModel) else 1
-        p = pieces * self.model.spec.n_parameters(k) + len(self.model.spec.shifts)
-        return float(n * np.sum(np.log(np.mean(e**2, axis=0))) + p * np.log(n * k))
+        """:func:`~.model.model_bic` of the stage's model."""
+        return model_bic(self.model, kind, channels)
 
     def summary(self, noise_floor: dict) -> dict:
         s = self.model.signals
@@ -444,6 +444,9 @@ def _try_fix(stage: Stage, finding: Finding, alpha: float):
         change = finding.payload
         model = fit_piecewise(stage.model.spec, s, change, start=stage.model)
         new = Stage(model, held_out_piecewise(model.spec, s, change, stage.model))
+    elif finding.effect == "input_delay":
+        model = _moved_and_reordered(stage.model, add_effect(stage.model.spec, finding, stage.model), finding)
+        new = Stage(model, held_out(model.spec, s, model))
     else:
         spec = add_effect(stage.model.spec, finding, stage.model)
         model = fit_model(spec, s, start=widened_start(stage.model, spec))
@@ -462,12 +465,24 @@ def _try_fix(stage: Stage, finding: Finding, alpha: float):
     if kind == "simulation":
         params["sim_error_before"] = _pooled_rms(stage.held, idx, kind, common)
         params["sim_error_after"] = _pooled_rms(new.held, idx_new, kind, common)
+    if finding.effect == "input_delay":
+        params["nk_before"], params["nk_after"] = stage.model.spec.orders[3], model.spec.orders[3]
+        params["nb_before"], params["nb_after"] = stage.model.spec.orders[1], model.spec.orders[1]
     if finding.effect == "input_delay" and finding.statistic != "residual_input_ccf_z":
-        # B's taps absorb much of a delay, so the error may barely move: the phase slope names it.
-        # A lead found by the cross-correlation is beyond B's reach: it must lower the error.
-        if after > before * 1.01:
-            return None, f"moving the channel raised the held-out error from {before:.4g} to {after:.4g}"
-        note = "the model's B taps absorb part of a delay, so the error changes little; named from the phase slope"
+        # B's taps absorb a delay within their reach (the baseline's nk was chosen on the
+        # delayed data), so the moved model, its nk chosen again, need only be no worse --
+        # not significantly worse (one-sided Diebold-Mariano) beyond the refit's scatter: two
+        # PEM fits of one real record from different starts differ by 5 % held out (stiff
+        # 1-storey El Centro). The phase slope names the delay. A lead found by the
+        # cross-correlation is beyond B's reach: it must lower the error.
+        moved = f"moved and refitted with nk {params['nk_before']} -> {params['nk_after']} chosen again by BIC"
+        if after > before * (1 + NO_WORSE) and 1 - p < alpha:
+            return None, f"{moved}, the held-out error rose from {before:.4g} to {after:.4g} (p = {1 - p:.2g})"
+        how = "fell" if p < alpha else "is not significantly worse" if after > before else "is no worse"
+        note = (
+            f"{moved}, the held-out error {how} ({before:.4g} -> {after:.4g}); the baseline's B taps had "
+            "absorbed the delay, which the phase slope names and times"
+        )
         return (Effect(finding, params, before, after, p, dbic, note), new), ""
     if finding.effect == "sensor_fault" and finding.statistic == "additive_outlier_z":
         # a glitch is a hypothesis (a heavy-tailed disturbance looks alike): the error must drop
@@ -481,7 +496,7 @@ def _try_fix(stage: Stage, finding: Finding, alpha: float):
     if finding.effect in ("clipping", "sensor_fault"):
         # a pile-up at the rail or a stuck run is a fact of the record, not a hypothesis;
         # a few clipped samples barely move the error on the others, so the fix only must not hurt
-        if after > before * 1.01:
+        if after > before * (1 + NO_WORSE):
             return None, f"filling the samples raised the held-out error from {before:.4g} to {after:.4g}"
         kind = "clipped" if finding.effect == "clipping" else "stuck"
         note = f"the {kind} samples are filled from the model and left out of every error"
@@ -492,3 +507,34 @@ def _try_fix(stage: Stage, finding: Finding, alpha: float):
             f"({before:.4g} -> {after:.4g}, p = {p:.2g}, change in BIC {dbic:+.1f})"
         )
     return (Effect(finding, params, before, after, p, dbic), new), ""
+
+
+def _moved_and_reordered(model, spec: ModelSpec, finding: Finding):
+    """``spec`` (a channel moved) fitted with ``nk`` and ``nb`` chosen again by BIC, as the
+    baseline's were: moving an output ``d`` samples earlier needs ``d`` more non-causal taps
+    (a band-limited response leads its input by a few samples), which the baseline's ``nk``,
+    chosen on the delayed data, does not allow. Candidates: the baseline's ``nk`` and
+    ``NK_REACH`` either side of where the move puts it; ``nb`` keeps the causal taps' count
+    (:func:`armaxmodal.orders.default_nb`). All are scored on the samples every one of them
+    can use."""
+    s = model.raw
+    na, nb0, nc, nk0 = spec.orders
+    d = finding.parameters["delay_samples"]
+    earlier = -d if finding.channels == (s.input_name,) else d  # the outputs' move against the input
+    centre = nk0 - int(round(earlier))
+    fits = []
+    for nk in sorted({nk0, *range(centre - NK_REACH, centre + NK_REACH + 1)}):
+        nb = nb0 - (min(nk, 0) - min(nk0, 0))
+        if nb >= 1:
+            trial = replace(spec, orders=(na, nb, nc, nk))
+            fits.append(fit_model(trial, s, start=model if trial.orders == model.spec.orders else None))
+    mask = np.logical_and.reduce([usable(s.n, m.spec) for m in fits])
+    return min(fits, key=lambda m: _bic_on(m, mask))
+
+
+def _bic_on(model, mask: np.ndarray) -> float:
+    """BIC of the in-sample one-step errors on ``mask`` (:func:`~.model.model_bic`'s criterion)."""
+    e = model.one_step_errors()[mask]
+    n, k = e.shape
+    p = model.spec.n_parameters(k) + len(model.spec.shifts)
+    return float(n * np.sum(np.log(np.mean(e**2, axis=0))) + p * np.log(n * k))

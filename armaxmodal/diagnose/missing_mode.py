@@ -40,7 +40,7 @@ def _misfit(fitted: FittedModel):
 def mode_findings(fitted: FittedModel, n_tests: int, table: dict) -> list:
     """Per sensor the largest misfit, its p-value under Exp(1) corrected for the lines and
     for sensors x tests (a Bonferroni bound)."""
-    from .evidence import Finding
+    from .finding import Finding
 
     f, z, rel, sigma, live = _misfit(fitted)
     old = [float(v) for v in fitted.fit.models[0].modal_parameters()[1] if v > 0]

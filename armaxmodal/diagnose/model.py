@@ -233,6 +233,20 @@ def usable(n: int, spec: ModelSpec) -> np.ndarray:
     return mask
 
 
+def model_bic(model, kind: str = "one_step", channels=None) -> float:
+    """BIC of a model's in-sample one-step (or simulation) errors: ``N sum log V_k + p log(N K)``
+    over ``channels`` (default all: two models compare on the outputs they share); the
+    baseline's order choice uses the same criterion (:func:`armaxmodal.orders.information_criterion`)."""
+    s = model.signals
+    mask = usable(s.n, model.spec)
+    errors = model.one_step_errors() if kind == "one_step" else model.simulation_errors()
+    e = errors[mask][:, [s.sensors.index(c) for c in (s.sensors if channels is None else channels)]]
+    n, k = e.shape
+    pieces = 2 if isinstance(model, PiecewiseModel) else 1
+    p = pieces * model.spec.n_parameters(k) + len(model.spec.shifts)
+    return float(n * np.sum(np.log(np.mean(e**2, axis=0))) + p * np.log(n * k))
+
+
 def clip_masks(spec: ModelSpec, signals: Signals) -> dict[int, np.ndarray]:
     """``{column: (n,) bool}``: the rail samples of each clipped output of ``spec``."""
     columns = [signals.sensors.index(name) for name in spec.clipped]
