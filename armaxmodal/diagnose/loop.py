@@ -469,21 +469,8 @@ def _try_fix(stage: Stage, finding: Finding, alpha: float):
         params["nk_before"], params["nk_after"] = stage.model.spec.orders[3], model.spec.orders[3]
         params["nb_before"], params["nb_after"] = stage.model.spec.orders[1], model.spec.orders[1]
     if finding.effect == "input_delay" and finding.statistic != "residual_input_ccf_z":
-        # B's taps absorb a delay within their reach (the baseline's nk was chosen on the
-        # delayed data), so the moved model, its nk chosen again, need only be no worse --
-        # not significantly worse (one-sided Diebold-Mariano) beyond the refit's scatter: two
-        # PEM fits of one real record from different starts differ by 5 % held out (stiff
-        # 1-storey El Centro). The phase slope names the delay. A lead found by the
-        # cross-correlation is beyond B's reach: it must lower the error.
-        moved = f"moved and refitted with nk {params['nk_before']} -> {params['nk_after']} chosen again by BIC"
-        if after > before * (1 + NO_WORSE) and 1 - p < alpha:
-            return None, f"{moved}, the held-out error rose from {before:.4g} to {after:.4g} (p = {1 - p:.2g})"
-        how = "fell" if p < alpha else "is not significantly worse" if after > before else "is no worse"
-        note = (
-            f"{moved}, the held-out error {how} ({before:.4g} -> {after:.4g}); the baseline's B taps had "
-            "absorbed the delay, which the phase slope names and times"
-        )
-        return (Effect(finding, params, before, after, p, dbic, note), new), ""
+        note, reason = _judge_delay(params, before, after, p, alpha)
+        return ((Effect(finding, params, before, after, p, dbic, note), new), "") if note else (None, reason)
     if finding.effect == "sensor_fault" and finding.statistic == "additive_outlier_z":
         # a glitch is a hypothesis (a heavy-tailed disturbance looks alike): the error must drop
         if p >= alpha:
@@ -507,6 +494,33 @@ def _try_fix(stage: Stage, finding: Finding, alpha: float):
             f"({before:.4g} -> {after:.4g}, p = {p:.2g}, change in BIC {dbic:+.1f})"
         )
     return (Effect(finding, params, before, after, p, dbic), new), ""
+
+
+def _judge_delay(params: dict, before: float, after: float, p: float, alpha: float) -> tuple[str, str]:
+    """``(note, "")`` keeping a phase-slope delay, or ``("", reason)``.
+
+    B's taps absorb a delay within their reach (the baseline's nk was chosen on the delayed
+    data), so the moved model, its nk chosen again, need only be no worse -- not significantly
+    worse (one-sided Diebold-Mariano) beyond the refit's scatter: two PEM fits of one real
+    record from different starts differ by 5 % held out (stiff 1-storey El Centro). The phase
+    slope names the delay. (A lead found by the cross-correlation is beyond B's reach: it must
+    lower the error, by the general rule.)"""
+    moved = f"moved and refitted with nk {params['nk_before']} -> {params['nk_after']} chosen again by BIC"
+    if after > before * (1 + NO_WORSE) and 1 - p < alpha:
+        return "", f"{moved}, the held-out error rose from {before:.4g} to {after:.4g} (p = {1 - p:.2g})"
+    no_worse = after <= before * (1 + NO_WORSE)
+    how = "fell" if p < alpha else "is no worse" if no_worse else "is not significantly worse"
+    alike = ""
+    if "outputs_lag_ms" in params:
+        alike = (
+            f"every output lags the input by {params['outputs_lag_ms']:.3g} ms alike (spread p = "
+            f"{params['spread_p']:.2g}): one delay; "
+        )
+    note = (
+        f"{alike}{moved}, the held-out error {how} ({before:.4g} -> {after:.4g}); the baseline's B taps had "
+        "absorbed the delay, which the phase slope names and times"
+    )
+    return note, ""
 
 
 def _moved_and_reordered(model, spec: ModelSpec, finding: Finding):

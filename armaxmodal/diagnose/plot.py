@@ -116,6 +116,12 @@ def _summary(ax, diagnosis):
     for e in diagnosis.effects:
         where = ", ".join(e.finding.channels)
         lines.append(f"  {e.finding.effect} {where}: one-step {e.error_before:.4g} -> {e.error_after:.4g}")
+        if "outputs_lag_ms" in e.parameters:
+            lo, hi = e.parameters["outputs_lag_ci95_ms"]
+            lines.append(f"    every output lags by {e.parameters['outputs_lag_ms']:.3g} ms ({lo:.3g} to {hi:.3g})")
+        elif "delay_ci95_ms" in e.parameters:
+            lo, hi = e.parameters["delay_ci95_ms"]
+            lines.append(f"    late by {e.parameters['delay_ms']:.3g} ms ({lo:.3g} to {hi:.3g})")
     for u in diagnosis.unconfirmed:
         lines.append(f"unconfirmed: {u['effect']} {', '.join(u['channels'])}")
     before, after = (stage.model.signals for stage in (diagnosis.baseline, diagnosis.final))
