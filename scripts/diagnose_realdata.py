@@ -27,7 +27,19 @@ def _runs(real: Path) -> dict[str, list[str]]:
         folder = real / "mini_shake_table_imu" / model
         runs[f"{model} northridge"] = [*(str(folder / f"northridge__{s}.csv.gz") for s in ("g", "f1", "f2", "f3"))]
         runs[f"{model} northridge"] += ["--input", "g"]
+    for event in ("elcentro1", "northridge1"):  # the top IMU lags the table by about 2.3 samples
+        folder = real / "mini_shake_table_imu" / "stiff1"
+        runs[f"stiff1 {event}"] = [*(str(folder / f"{event}__{s}.csv.gz") for s in ("g", "f1")), "--input", "g"]
     return runs
+
+
+def _delay(effect: dict) -> str:
+    """A delay's size and interval, and the nk the move re-chose."""
+    p = effect["parameters"]
+    if effect["effect"] != "input_delay" or "delay_ci95_ms" not in p:
+        return ""
+    lo, hi = p["delay_ci95_ms"]
+    return f"; {p['delay_ms']:.1f} ms, {lo:.1f}–{hi:.1f}; nk {p['nk_before']} → {p['nk_after']}"
 
 
 def _fmt(values) -> str:
@@ -52,7 +64,9 @@ def main() -> None:
                 print(f"| {name} | failed: {proc.stderr.strip().splitlines()[-1:]} | | | | | {elapsed:.0f} s |")
                 continue
             d = json.loads(out.read_text())
-        kept = "; ".join(f"`{e['effect']}` {', '.join(e['channels'])} ({e['evidence']['p']:.1g})" for e in d["effects"])
+        kept = "; ".join(
+            f"`{e['effect']}` {', '.join(e['channels'])} ({e['evidence']['p']:.1g}{_delay(e)})" for e in d["effects"]
+        )
         errors = "; ".join(f"{e['error_before']:.4g} → {e['error_after']:.4g}" for e in d["effects"])
         fits = f"{_fmt(d['baseline']['fit_val_pct'])} → {_fmt(d['final']['fit_val_pct'])}"
         unsure = ", ".join(sorted({u["effect"] for u in d["unconfirmed"]})) or "–"
