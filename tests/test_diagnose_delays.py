@@ -194,3 +194,27 @@ def test_real_stiff_one_storey_delay_is_confirmed_as_stabilise_times_it(realdata
     assert effect.finding.effect == "input_delay" and effect.finding.channels == ("f1",)
     assert effect.parameters["delay_ms"] == pytest.approx(19.3, abs=1.0)
     assert effect.parameters["nk_after"] < effect.parameters["nk_before"]
+
+
+def test_a_per_output_delay_finding_reports_the_phase_slope_estimate_as_it_is(clean):
+    """The finding's numbers are the estimate's: ms, its Student-t interval, samples at fs;
+    the statistic names the phase slope, which the keep rule reads."""
+    late = inject(clean, "input_delay", ["legs"], samples=2.4)
+    e = next(e for e in estimate_delays(late) if e.channel == "legs")
+    (f,) = delay_findings(_model(late), 28)
+    half = stats.t.ppf(0.975, e.dof) * e.delay_sd_s
+    assert (f.effect, f.channels, f.statistic) == ("input_delay", ("legs",), "phase_slope_z")
+    assert f.parameters["delay_ms"] == pytest.approx(1e3 * e.delay_s, rel=1e-12)
+    assert f.parameters["delay_ci95_ms"] == pytest.approx([1e3 * (e.delay_s - half), 1e3 * (e.delay_s + half)])
+    assert f.parameters["delay_samples"] == pytest.approx(e.delay_s * 60.0, rel=1e-12)
+    assert f.value == pytest.approx(e.delay_s / e.delay_sd_s)
+
+
+def test_a_lead_beyond_the_taps_is_reported_in_samples_and_ms_with_its_method(clean):
+    from armaxmodal.diagnose.delays import lead_findings
+
+    ahead = inject(clean, "input_delay", ["legs"], samples=-14.0)
+    legs = {f.channels[0]: f for f in lead_findings(_model(ahead), 28, set())}["legs"]
+    assert (legs.effect, legs.statistic) == ("input_delay", "residual_input_ccf_z")
+    assert legs.parameters["delay_ms"] == pytest.approx(1e3 * legs.parameters["delay_samples"] / 60.0, rel=1e-12)
+    assert legs.parameters["method"] == "residual-input cross-correlation beyond the model's non-causal taps"

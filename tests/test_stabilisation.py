@@ -370,3 +370,19 @@ def test_rescue_rules_each_decide(light_diagram):
     assert rescued(group(f1, scatter[:3], 0.01)) == []  # three of ten orders: no support
     assert rescued(group(f2, [0.01] * 10, 0.004)) == []  # 0.01 - 1.96 x 0.004 > 0: resolved, not a rescue
     assert rescued(group(f2, [0.01] * 10, 0.006)) == [[f2]]  # 0.01 - 1.96 x 0.006 < 0
+
+
+def test_the_delay_and_order_choices_do_not_depend_on_the_data_unit(fixtures_dir):
+    """The same ride in m/s^2, cm/s^2 and km/s^2 (every channel scaled alike): BIC over fits
+    whose windows differ by a few samples carried n K log(scale^2) and chose nk = -9 in
+    cm/s^2 where it chose -5 in m/s^2. Every candidate is now scored on the samples all share."""
+    from dataclasses import replace
+
+    from armaxmodal.orders import choose_orders
+    from armaxmodal.stabilisation import choose_nk
+
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    scaled = [replace(rec, base=rec.base * s, response=rec.response * s) for s in (1.0, 100.0, 1e-3)]
+    assert len({choose_nk(r, n_jobs=1) for r in scaled}) == 1
+    orders = {choose_orders(r, na_values=(8, 10), nk_values=(-3, -5, -7), n_jobs=1).orders for r in scaled}
+    assert len(orders) == 1
