@@ -26,7 +26,7 @@ from .exceptions import OrderError
 from .fit import ArmaxFit, fit_armax, load_kernels
 from .recording import Recording
 
-__all__ = ["choose_orders", "OrderChoice", "default_nb", "default_nc", "information_criterion", "common_samples"]
+__all__ = ["choose_orders", "OrderChoice", "default_nb", "default_nc"]
 
 
 def default_nb(na: int, nk: int) -> int:
@@ -51,15 +51,9 @@ class OrderChoice:
         return self.fit.orders
 
 
-def information_criterion(fit: ArmaxFit, kind: str = "bic", n: int | None = None) -> float:
-    """BIC (or AIC) of a fit from its per-sensor mean squared prediction errors, over ``n``
-    samples (default the fit's own).
-
-    Fits compared must share ``n`` (:func:`common_samples`): a higher order or a longer delay
-    leaves a few samples fewer, and ``n sum log V`` over different ``n`` carries
-    ``n K log(scale^2)`` -- the choice then depended on the data's unit (the supine ride in
-    cm/s^2 chose nk = -9 where in m/s^2 it chose -5)."""
-    n = fit.n_samples if n is None else n
+def information_criterion(fit: ArmaxFit, kind: str = "bic") -> float:
+    """BIC (or AIC) of a fit from its per-sensor mean squared prediction errors."""
+    n = fit.n_samples
     k = len(fit.models)
     na, nb, nc, _ = fit.orders
     n_in = fit.models[0].b.shape[0]
@@ -67,11 +61,6 @@ def information_criterion(fit: ArmaxFit, kind: str = "bic", n: int | None = None
     fit_term = n * float(np.sum(np.log(fit.loss)))
     penalty = p * np.log(n * k) if kind == "bic" else 2.0 * p
     return fit_term + penalty
-
-
-def common_samples(fits) -> int:
-    """The samples every fit of ``fits`` (None skipped) was scored on: the fewest."""
-    return min(f.n_samples for f in fits if f is not None)
 
 
 def _fit_or_none(recording, orders, **options):
@@ -174,13 +163,10 @@ def choose_orders(
     with tqdm(total=len(candidates), desc="order search", unit="fit", disable=not progress) as bar:
         fits = _map(run, candidates, n_jobs, bar, cost=lambda orders: orders[0])
     rows, best, best_value = [], None, np.inf
-    if all(fit is None for fit in fits):
-        raise OrderError("no candidate order fits this record; give smaller na_values.")
-    n = common_samples(fits)
     for (na, nb, nc, nk), fit in zip(candidates, fits, strict=True):
         if fit is None:
             continue
-        value = information_criterion(fit, criterion, n)
+        value = information_criterion(fit, criterion)
         rows.append(
             {"na": na, "nb": nb, "nc": nc, "nk": nk, criterion: value, "converged": bool(np.all(fit.converged))}
         )

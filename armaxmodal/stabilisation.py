@@ -29,7 +29,7 @@ from .frf import excited_band
 from .frf_check import peak_support
 from .modal import mode_record
 from .modal_check import ModalCheck, check_modes
-from .orders import _map, common_samples, default_nb, default_nc, information_criterion
+from .orders import _map, default_nb, default_nc, information_criterion
 from .prepare import Preparation, oversampling_note, prepare
 from .quality import QualityWarning
 from .recording import Recording
@@ -213,13 +213,6 @@ def _job_cost(job, n_sensors: int) -> float:
     return orders[0] * (n_sensors if source == SHARED else 1)
 
 
-def _shared_bic(diagram) -> dict[int, float]:
-    """``{na: BIC}`` of the shared-pole sweep, every order scored on the samples all share."""
-    shared = {na: fit for (src, na), fit in diagram.fits.items() if src == SHARED}
-    n = common_samples(shared.values())
-    return {na: information_criterion(fit, n=n) for na, fit in shared.items()}
-
-
 def choose_nk(recording: Recording, nk_values=range(0, -7, -1), na_values=(8, 10, 12), n_jobs=None) -> int:
     """The input delay of the lowest-BIC shared-pole model over a few middle orders.
 
@@ -242,8 +235,7 @@ def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=Tr
         n_jobs,
         cost=partial(_job_cost, n_sensors=len(recording.sensors)),
     )
-    n = common_samples([f for f, _ in fits]) if any(f is not None for f, _ in fits) else 0
-    scores = [information_criterion(f, n=n) if f is not None else np.inf for f, _ in fits]
+    scores = [information_criterion(f) if f is not None else np.inf for f, _ in fits]
     nk = int(jobs[int(np.argmin(scores))][1][3])
     if extend and nk == min(nk_values):
         # the best delay is the most non-causal one searched: look NK_EXTENSION further, once
@@ -690,7 +682,7 @@ def _clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damp
     clusters = [c for c in clusters if _supported(len(c), len(nas), min_support)]
     left = cand.drop(index=[m for c in clusters for m in c])
     clusters += _rescued_clusters(diagram, left, nas, cluster_freq, min_support, band)
-    bic = _shared_bic(diagram)
+    bic = {na: information_criterion(fit) for (src, na), fit in diagram.fits.items() if src == SHARED}
     firsts = [_ranked(cand.loc[c][cand.loc[c].damping > 0], bic) for c in clusters]
     finished = _finish_fits(diagram, {ranked[0] for ranked in firsts if ranked}, n_jobs)
     rows, vectors = [], []
@@ -851,7 +843,7 @@ def _modes_the_check_adds(diagram, modes: pd.DataFrame, shapes: np.ndarray, band
     before. Returns ``(modes, shapes, check)``."""
     from .modal_check import check_modes, mode_support
 
-    bic = _shared_bic(diagram)
+    bic = {na: information_criterion(fit) for (src, na), fit in diagram.fits.items() if src == SHARED}
     for sub, at_peak in _left_out_clusters(diagram, modes, band, nas, clustering):
         # the cluster's centre is tried: its lowest-BIC pole may sit at its edge
         centre = float(sub.freq_hz.median()), float(sub.damping.median())

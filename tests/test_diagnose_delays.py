@@ -216,5 +216,66 @@ def test_a_lead_beyond_the_taps_is_reported_in_samples_and_ms_with_its_method(cl
     ahead = inject(clean, "input_delay", ["legs"], samples=-14.0)
     legs = {f.channels[0]: f for f in lead_findings(_model(ahead), 28, set())}["legs"]
     assert (legs.effect, legs.statistic) == ("input_delay", "residual_input_ccf_z")
+    assert legs.value > 30  # the correlation's z (60.9 here; p underflows to 0)
     assert legs.parameters["delay_ms"] == pytest.approx(1e3 * legs.parameters["delay_samples"] / 60.0, rel=1e-12)
     assert legs.parameters["method"] == "residual-input cross-correlation beyond the model's non-causal taps"
+
+
+def test_the_common_delay_is_the_dersimonian_laird_mean_with_its_own_quantile():
+    """Against the formulas written out here: Cochran's Q on K - 1 degrees of freedom, the
+    between-output variance tau^2, the random-effects mean and its standard error, and a
+    Student-t quantile on the estimates' fewest degrees of freedom (1 here: 12.7)."""
+    d, sd = np.array([49.0, 50.0, 50.3]), np.array([0.4, 0.5, 0.3])
+    est = [DelayEstimate(n, v / 1e3, s / 1e3, 1, 40, 4.0, 1) for n, v, s in zip("abc", d, sd, strict=True)]
+    got = _common_delay(est, 60.0)
+    w = 1 / sd**2
+    q = np.sum(w * (d - np.sum(w * d) / w.sum()) ** 2)
+    tau2 = (q - 2) / (w.sum() - np.sum(w**2) / w.sum())
+    w_re = 1 / (sd**2 + tau2)
+    mean, se = np.sum(w_re * d) / w_re.sum(), 1 / np.sqrt(w_re.sum())
+    assert got["spread_p"] == pytest.approx(stats.chi2.sf(q, 2), rel=1e-12)
+    assert 1e3 * got["lag_s"] == pytest.approx(mean, rel=1e-12) and 1e3 * got["sd_s"] == pytest.approx(se, rel=1e-12)
+    half = stats.t.ppf(0.975, 1) * se
+    assert 1e3 * np.array(got["lag_ci95_s"]) == pytest.approx([mean - half, mean + half], rel=1e-12)
+
+
+def test_a_jackknife_over_three_blocks_counts_with_two_degrees_of_freedom():
+    blocks = (47.0, 50.0, 53.0)
+    got = _common_delay([_estimate("a", 50.0, 0.4, blocks), _estimate("b", 50.0, 0.4, blocks)], 60.0)
+    jack = np.sqrt(2 / 3 * 18.0)
+    assert 1e3 * got["sd_s"] == pytest.approx(jack, rel=1e-12)
+    assert 1e3 * np.diff(got["lag_ci95_s"])[0] / 2 == pytest.approx(stats.t.ppf(0.975, 2) * jack, rel=1e-12)
+
+
+def test_the_input_finding_carries_the_common_delay_both_ways(clean):
+    """On the input: how late it is (negative: the outputs lag it) and, for the reader, the
+    outputs' common lag with its interval and each output's own."""
+    from armaxmodal.diagnose.delays import _input_finding
+
+    common = {"lag_s": 0.05, "sd_s": 0.001, "lag_ci95_s": [0.048, 0.052], "per_output_s": {"head": 0.049},
+              "spread_p": 0.3}  # fmt: skip
+    f = _input_finding(common, 1e-6, _model(clean).signals)
+    assert (f.effect, f.channels, f.statistic, f.value, f.p) == ("input_delay", ("base",), "phase_slope_z", 50.0, 1e-6)
+    expected = {"delay_ms": -50.0, "delay_ci95_ms": [-52.0, -48.0], "delay_samples": -3.0, "outputs_lag_ms": 50.0,
+                "outputs_lag_ci95_ms": [48.0, 52.0], "spread_p": 0.3}  # fmt: skip
+    assert set(f.parameters) == {*expected, "per_output_lag_ms"}
+    assert f.parameters["per_output_lag_ms"] == pytest.approx({"head": 49.0})
+    for key, value in expected.items():
+        assert f.parameters[key] == pytest.approx(value), key
+
+
+def test_the_delay_keep_rule_at_its_boundaries():
+    """Kept unless the moved model is both worse by over 1 % and significantly so; the note
+    says which of fell / no worse / not significantly worse, and the common lag."""
+    params = {"nk_before": -2, "nk_after": -5}
+    judge = loop._judge_delay
+    assert "error fell" in judge(params, 1.0, 0.9, 0.001, 0.01)[0]
+    assert "is no worse" in judge(params, 1.0, 1.0099, 0.5, 0.01)[0]
+    assert "is not significantly worse" in judge(params, 1.0, 1.0101, 0.5, 0.01)[0]
+    assert "is not significantly worse" in judge(params, 1.0, 1.05, 1 - 0.0101, 0.01)[0]
+    note, reason = judge(params, 1.0, 1.05, 1 - 0.0099, 0.01)
+    assert note == "" and "rose from 1 to 1.05 (p = 0.0099)" in reason and "nk -2 -> -5" in reason
+    note, reason = judge(params, 1.0, 1.0099, 1 - 1e-6, 0.01)  # significant but within the refit's scatter
+    assert reason == "" and "is no worse" in note
+    alike = judge({**params, "outputs_lag_ms": 49.6, "spread_p": 0.095}, 1.0, 1.0, 0.5, 0.01)[0]
+    assert alike.startswith("every output lags the input by 49.6 ms alike (spread p = 0.095)")
