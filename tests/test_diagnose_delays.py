@@ -216,7 +216,7 @@ def test_a_lead_beyond_the_taps_is_reported_in_samples_and_ms_with_its_method(cl
     ahead = inject(clean, "input_delay", ["legs"], samples=-14.0)
     legs = {f.channels[0]: f for f in lead_findings(_model(ahead), 28, set())}["legs"]
     assert (legs.effect, legs.statistic) == ("input_delay", "residual_input_ccf_z")
-    assert legs.value > 30  # the correlation's z (60.9 here; p underflows to 0)
+    assert legs.value > 30 and legs.p < 1e-6  # the correlation's z (60.9 here; p underflows to 0)
     assert legs.parameters["delay_ms"] == pytest.approx(1e3 * legs.parameters["delay_samples"] / 60.0, rel=1e-12)
     assert legs.parameters["method"] == "residual-input cross-correlation beyond the model's non-causal taps"
 
@@ -270,8 +270,11 @@ def test_the_delay_keep_rule_at_its_boundaries():
     params = {"nk_before": -2, "nk_after": -5}
     judge = loop._judge_delay
     assert "error fell" in judge(params, 1.0, 0.9, 0.001, 0.01)[0]
-    assert "is no worse" in judge(params, 1.0, 1.0099, 0.5, 0.01)[0]
-    assert "is not significantly worse" in judge(params, 1.0, 1.0101, 0.5, 0.01)[0]
+    assert judge(params, 1.0, 1.0099, 0.5, 0.01)[0] == (
+        "moved and refitted with nk -2 -> -5 chosen again by BIC, the held-out error is no worse (1 -> 1.01); "
+        "the baseline's B taps had absorbed the delay, which the phase slope names and times"
+    )
+    assert ", the held-out error is not significantly worse (1 -> 1.01);" in judge(params, 1.0, 1.0101, 0.5, 0.01)[0]
     assert "is not significantly worse" in judge(params, 1.0, 1.05, 1 - 0.0101, 0.01)[0]
     note, reason = judge(params, 1.0, 1.05, 1 - 0.0099, 0.01)
     assert note == "" and "rose from 1 to 1.05 (p = 0.0099)" in reason and "nk -2 -> -5" in reason
@@ -279,3 +282,38 @@ def test_the_delay_keep_rule_at_its_boundaries():
     assert reason == "" and "is no worse" in note
     alike = judge({**params, "outputs_lag_ms": 49.6, "spread_p": 0.095}, 1.0, 1.0, 0.5, 0.01)[0]
     assert alike.startswith("every output lags the input by 49.6 ms alike (spread p = 0.095)")
+
+
+def test_the_moved_model_tries_nk_around_the_move_with_nb_keeping_the_causal_taps(clean, monkeypatch):
+    """The candidates, their nb and their starts, recorded by a stand-in for the fit; the
+    lowest BIC on the samples all candidates share wins."""
+    base = _model(clean)
+    tried = []
+
+    class Stub:
+        def __init__(self, spec, start):
+            self.spec, self.start = spec, start
+
+        def one_step_errors(self):
+            # nk = -1 fits best by BIC's sum of per-output log variances, not by their pooled mean
+            row = [1.0, 1.0, 1.0, 100.0] if self.spec.orders[3] == -1 else [10.0] * 4
+            return np.tile(row, (clean.n_samples, 1))
+
+    def record(spec, signals, start=None):
+        tried.append((spec.orders, start))
+        return Stub(spec, start)
+
+    monkeypatch.setattr(loop, "fit_model", record)
+    # a baseline at nk = 1 (a zero-order hold), nb = 1; the output 2 samples late is moved earlier
+    spec = replace(base.spec, orders=(10, 1, 10, 1), shifts=(("legs", 2.0),))
+    start = replace(base, spec=replace(spec, shifts=()))
+    late = loop.Finding("input_delay", ("legs",), "phase_slope_z", 9.0, 1e-9, {"delay_samples": 2.0})
+    best = loop._moved_and_reordered(start, spec, late)
+    assert [orders for orders, _ in tried] == [(10, 3, 10, -2), (10, 2, 10, -1), (10, 1, 10, 0), (10, 1, 10, 1)]
+    assert [s is start for _, s in tried] == [False, False, False, True]
+    assert best.spec.orders == (10, 2, 10, -1)
+    # the input late by 2: the outputs move the other way, nk around 3
+    tried.clear()
+    early = loop.Finding("input_delay", ("base",), "phase_slope_z", 9.0, 1e-9, {"delay_samples": 2.0})
+    loop._moved_and_reordered(start, replace(spec, shifts=(("base", 2.0),)), early)
+    assert [orders[3] for orders, _ in tried] == [1, 2, 3, 4]
