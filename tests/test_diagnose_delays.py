@@ -317,3 +317,56 @@ def test_the_moved_model_tries_nk_around_the_move_with_nb_keeping_the_causal_tap
     early = loop.Finding("input_delay", ("base",), "phase_slope_z", 9.0, 1e-9, {"delay_samples": 2.0})
     loop._moved_and_reordered(start, replace(spec, shifts=(("base", 2.0),)), early)
     assert [orders[3] for orders, _ in tried] == [1, 2, 3, 4]
+
+
+def _findings_for(monkeypatch, clean, estimates, sensors=None):
+    """``delay_findings`` on the clean ride's model with the phase-slope estimates given."""
+    from armaxmodal.diagnose import delays
+
+    monkeypatch.setattr(delays, "estimate_delays", lambda rec: estimates)
+    model = _model(clean)
+    if sensors is not None:
+        model = replace(model, signals=replace(model.signals, sensors=sensors, y=model.signals.y[:, : len(sensors)]))
+    return delays.delay_findings(model, 28)
+
+
+def test_only_outputs_late_or_early_alike_make_an_input_delay(clean, monkeypatch):
+    wide = 5.0  # ms: intervals wide enough that the spread test passes
+    late = [_estimate(n, 40.0, wide) for n in clean.sensors]
+    assert [f.channels for f in _findings_for(monkeypatch, clean, late)] == [("base",)]
+    early = [_estimate(n, -40.0, wide) for n in clean.sensors]
+    assert [f.channels for f in _findings_for(monkeypatch, clean, early)] == [("base",)]
+    # alike by the spread test (intervals of 80 ms), but one early and three late
+    mixed = [_estimate(n, 20.0 if n != "head" else -20.0, 80.0) for n in clean.sensors]
+    assert [f.channels for f in _findings_for(monkeypatch, clean, mixed)] == [(n,) for n in clean.sensors]
+    # two outputs are enough; one output is its own
+    two = [_estimate("head", 40.0, wide), _estimate("chest", 41.0, wide)]
+    assert [f.channels for f in _findings_for(monkeypatch, clean, two, ("head", "chest"))] == [("base",)]
+    one = [_estimate("head", 40.0, wide)]
+    assert [f.channels for f in _findings_for(monkeypatch, clean, one, ("head",))] == [("head",)]
+    # under the reporting floor (3/4 sample at 60 Hz, 12.5 ms) nothing is named
+    assert _findings_for(monkeypatch, clean, [_estimate("head", 12.4, 0.1)], ("head",)) == []
+    assert len(_findings_for(monkeypatch, clean, [_estimate("head", 12.6, 0.1)], ("head",))) == 1
+
+
+def test_a_delay_p_value_is_two_sided_student_t_times_the_family(clean, monkeypatch):
+    for dof, sd in ((3, 0.006), (1, 0.0001)):  # p = 0.10 and 0.036 after the factor 28
+        e = DelayEstimate("head", 0.05, sd, 1, 40, 4.0, dof)
+        (f,) = _findings_for(monkeypatch, clean, [e], ("head",))
+        assert f.p == pytest.approx(2 * stats.t.sf(0.05 / sd, dof) * 28, rel=1e-12) and f.p < 0.2
+    weak = DelayEstimate("head", 0.02, 0.05, 1, 40, 4.0, 3)
+    (f,) = _findings_for(monkeypatch, clean, [weak], ("head",))
+    assert f.p == 1.0
+
+
+def test_late_start_counts_the_samples_each_delay_explains(clean):
+    from armaxmodal.diagnose.delays import late_start
+
+    model = _model(clean)
+    assert late_start(model, []) == {}
+    moved = replace(model, spec=replace(model.spec, shifts=(("legs", 2.5),)))
+    assert late_start(moved, []) == {"legs": 4}
+    on_input = loop.Finding("input_delay", ("base",), "phase_slope_z", 9.0, 1e-9, {"delay_samples": -0.5})
+    assert late_start(moved, [on_input]) == {"head": 2, "chest": 2, "pelvis": 2, "legs": 4}
+    input_late = loop.Finding("input_delay", ("base",), "phase_slope_z", 9.0, 1e-9, {"delay_samples": 3.0})
+    assert late_start(model, [input_late]) == {}
