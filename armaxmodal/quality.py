@@ -299,11 +299,18 @@ def estimate_delays(recording: Recording) -> list[DelayEstimate]:
         by_block = tuple(np.nan if fit is None else fit[0] for fit in fits[1:])
         left_out = np.array([d for d in by_block if np.isfinite(d)])
         if left_out.size >= 3:
-            jackknife = np.sqrt((left_out.size - 1) / left_out.size * np.sum((left_out - left_out.mean()) ** 2))
+            jackknife = jackknife_sd(left_out)
             if jackknife > sd:
                 sd, dof = float(jackknife), left_out.size - 1
         out.append(DelayEstimate(name, delay, sd, sign, n_lines, f_max, dof, by_block))
     return out
+
+
+def jackknife_sd(left_out: np.ndarray) -> float:
+    """Delete-a-block jackknife standard deviation from the estimates with each block left
+    out, (B,): ``sqrt((B - 1) / B * sum (x_b - mean)^2)``."""
+    b = left_out.size
+    return float(np.sqrt((b - 1) / b * np.sum((left_out - left_out.mean()) ** 2)))
 
 
 def _fit_segments(f, puu, puy, pyy):

@@ -292,7 +292,7 @@ def test_the_moved_model_tries_nk_around_the_move_with_nb_keeping_the_causal_tap
 
     class Stub:
         def __init__(self, spec, start):
-            self.spec, self.start = spec, start
+            self.spec, self.start, self.signals = spec, start, base.signals
 
         def one_step_errors(self):
             # nk = -1 fits best by BIC's sum of per-output log variances, not by their pooled mean

@@ -15,7 +15,7 @@ import numpy as np
 from scipy import stats
 from scipy.special import stdtrit
 
-from ..quality import MIN_DELAY_SAMPLES, DelayEstimate, estimate_delays
+from ..quality import MIN_DELAY_SAMPLES, DelayEstimate, estimate_delays, jackknife_sd
 from ..recording import Recording
 from .finding import Finding
 from .model import FittedModel, usable
@@ -116,7 +116,7 @@ def _common_delay(estimates: list[DelayEstimate], fs: float) -> dict | None:
         blocks = np.array([e.left_out for e in estimates]).reshape(d.size, -1)
         means = (w @ blocks[:, np.all(np.isfinite(blocks), axis=0)]) / w.sum()
         if means.size >= 3:
-            jackknife = float(np.sqrt((means.size - 1) / means.size * np.sum((means - means.mean()) ** 2)))
+            jackknife = jackknife_sd(means)
             if jackknife > sd:
                 sd, dof = jackknife, means.size - 1
     half = float(stdtrit(max(dof, 1), 0.975)) * sd

@@ -543,12 +543,5 @@ def _moved_and_reordered(model, spec: ModelSpec, finding: Finding):
             trial = replace(spec, orders=(na, nb, nc, nk))
             fits.append(fit_model(trial, s, start=model if trial.orders == model.spec.orders else None))
     mask = np.logical_and.reduce([usable(s.n, m.spec) for m in fits])
-    return min(fits, key=lambda m: _bic_on(m, mask))
+    return min(fits, key=lambda m: model_bic(m, mask=mask))
 
-
-def _bic_on(model, mask: np.ndarray) -> float:
-    """BIC of the in-sample one-step errors on ``mask`` (:func:`~.model.model_bic`'s criterion)."""
-    e = model.one_step_errors()[mask]
-    n, k = e.shape
-    p = model.spec.n_parameters(k) + len(model.spec.shifts)
-    return float(n * np.sum(np.log(np.mean(e**2, axis=0))) + p * np.log(n * k))

@@ -233,12 +233,14 @@ def usable(n: int, spec: ModelSpec) -> np.ndarray:
     return mask
 
 
-def model_bic(model, kind: str = "one_step", channels=None) -> float:
+def model_bic(model, kind: str = "one_step", channels=None, mask: np.ndarray | None = None) -> float:
     """BIC of a model's in-sample one-step (or simulation) errors: ``N sum log V_k + p log(N K)``
-    over ``channels`` (default all: two models compare on the outputs they share); the
-    baseline's order choice uses the same criterion (:func:`armaxmodal.orders.information_criterion`)."""
+    over ``channels`` (default all: two models compare on the outputs they share) and the
+    samples ``mask`` (default :func:`usable`'s; models of different orders compare on the
+    samples all can use); the baseline's order choice uses the same criterion
+    (:func:`armaxmodal.orders.information_criterion`)."""
     s = model.signals
-    mask = usable(s.n, model.spec)
+    mask = usable(s.n, model.spec) if mask is None else mask
     errors = model.one_step_errors() if kind == "one_step" else model.simulation_errors()
     e = errors[mask][:, [s.sensors.index(c) for c in (s.sensors if channels is None else channels)]]
     n, k = e.shape
