@@ -516,11 +516,12 @@ def _judge_delay(params: dict, before: float, after: float, p: float, alpha: flo
             f"every output lags the input by {params['outputs_lag_ms']:.3g} ms alike (spread p = "
             f"{params['spread_p']:.2g}): one delay; "
         )
-    note = (
-        f"{alike}{moved}, the held-out error {how} ({before:.4g} -> {after:.4g}); the baseline's B taps had "
-        "absorbed the delay, which the phase slope names and times"
+    why = (
+        "the phase slope names and times the delay"
+        if p < alpha
+        else "the baseline's B taps had absorbed the delay, which the phase slope names and times"
     )
-    return note, ""
+    return f"{alike}{moved}, the held-out error {how} ({before:.4g} -> {after:.4g}); {why}", ""
 
 
 def _moved_and_reordered(model, spec: ModelSpec, finding: Finding):
@@ -544,4 +545,3 @@ def _moved_and_reordered(model, spec: ModelSpec, finding: Finding):
             fits.append(fit_model(trial, s, start=model if trial.orders == model.spec.orders else None))
     mask = np.logical_and.reduce([usable(s.n, m.spec) for m in fits])
     return min(fits, key=lambda m: model_bic(m, mask=mask))
-
