@@ -59,7 +59,7 @@ def _cross_correlation(ax, cc, names):
 def _psd(x, fs):
     from scipy.signal import welch
 
-    return welch(x, fs, nperseg=min(x.size, int(2 ** np.ceil(np.log2(20 * fs)))), axis=0)
+    return welch(x, fs, nperseg=min(x.shape[0], int(2 ** np.ceil(np.log2(20 * fs)))), axis=0)  # samples, not n x K
 
 
 def _spectra(ax, diagnosis, mask):
@@ -101,8 +101,11 @@ def _traces(ax, diagnosis):
     named = [c for e in diagnosis.effects for c in (*e.finding.channels, *driven(e))]
     affected = [c for c in named if c in s.sensors]
     k = s.sensors.index(affected[0]) if affected else 0
-    n_show = min(s.n // 2, int(10 * s.fs))
-    start = s.n // 2 + n_show // 4  # inside the second half, predicted by the first half's model
+    # inside the second half, predicted by the first half's model: its middle 10 s at most (a
+    # fixed offset ran past the end of a 21 s record, and the figure raised instead of drawing)
+    half = s.n - s.n // 2
+    n_show = min(half, int(10 * s.fs))
+    start = s.n // 2 + (half - n_show) // 2
     t = np.arange(start, start + n_show) / s.fs
     ax.plot(t, diagnosis.baseline.held.simulation[start : start + n_show, k], lw=0.8, label="simulation error before")
     ax.plot(t, diagnosis.final.held.simulation[start : start + n_show, k], lw=0.8, label="simulation error after")
