@@ -1,53 +1,111 @@
 """armaxmodal: time-domain modal analysis of base-excited structures and people.
 
 Fits ARMAX models by the prediction-error method (PEM) to a base-acceleration input and
-body/structure sensor outputs, turns poles and residues into modes, and solves the
-inverse modal problem for a physical chain model. See ``shared/METHOD.md`` for the map
-from the source thesis to the code.
+body/structure sensor outputs, turns poles and residues into modes, and solves the inverse
+modal problem for a physical chain model. The stages, in the order a recording goes through
+them, are the subpackages :mod:`~armaxmodal.io`, :mod:`~armaxmodal.prepare`,
+:mod:`~armaxmodal.estimate`, :mod:`~armaxmodal.modes`, then :mod:`~armaxmodal.diagnosis`,
+:mod:`~armaxmodal.inverse` and :mod:`~armaxmodal.lumping`, and :mod:`~armaxmodal.study` over
+many recordings; :mod:`~armaxmodal.systems` holds the systems with known truth.
+
+The functions a user needs are here::
+
+    import armaxmodal as am
+    rec = am.read_recording("ride.csv")
+    selection = am.select_modes(am.stabilisation_diagram(rec))
 """
 
-from .datasets import chapter2_system, supine_human, supine_with_feet
-from .exceptions import (
-    ArmaxModalError,
-    ConvergenceWarning,
-    DataError,
-    OrderError,
-    StructureError,
-)
-from .fit import ArmaxFit, fit_armax
-from .identify import Identification, identify
-from .io import read_recording, write_recording_csv, write_recording_uff
-from .orders import choose_orders
-from .recording import Recording
-from .simulate import add_noise, random_vibration, simulate, simulate_recording, sine_sweep
-from .structure import ChainComponents, ExactModes, Structure
+from __future__ import annotations
 
-__version__ = "0.1.0"
+import importlib
+
+from armaxmodal._version import __version__
+from armaxmodal.estimate import ArmaxFit, choose_orders, fit_armax
+from armaxmodal.exceptions import ArmaxModalError, ConvergenceWarning, DataError, OrderError, StructureError
+from armaxmodal.io import read_recording, read_xsens, write_recording_csv, write_recording_uff
+from armaxmodal.modes import (
+    Identification,
+    ModeSelection,
+    StabilisationDiagram,
+    identify,
+    select_modes,
+    stabilisation_diagram,
+)
+from armaxmodal.notes import QualityWarning
+from armaxmodal.recording import Recording
+from armaxmodal.systems import (
+    ChainComponents,
+    ExactModes,
+    Structure,
+    add_noise,
+    chapter2_system,
+    random_vibration,
+    simulate,
+    simulate_recording,
+    sine_sweep,
+    supine_human,
+    supine_with_feet,
+)
+
+# The later stages load on first use (PEP 562): the diagnosis, the study (dask) and the
+# wavelet check (pycwt, scipy.stats) would add about a second to every command's start.
+_LATER = {
+    "diagnose": ("armaxmodal.diagnosis", "diagnose"),
+    "Diagnosis": ("armaxmodal.diagnosis", "Diagnosis"),
+    "run_study": ("armaxmodal.study", "run_study"),
+    "write_study": ("armaxmodal.study", "write_study"),
+    "check_lumping": ("armaxmodal.lumping", "lump_check"),
+    "model_update": ("armaxmodal.inverse", "model_update"),
+    "evphc": ("armaxmodal.inverse", "evphc"),
+    "pia": ("armaxmodal.inverse", "pia"),
+    "inner_solve": ("armaxmodal.inverse", "inner_solve"),
+    "inner_solve_sdp": ("armaxmodal.inverse", "inner_solve_sdp"),
+    "InverseSolution": ("armaxmodal.inverse", "InverseSolution"),
+}
 
 __all__ = [
     "ArmaxFit",
     "ArmaxModalError",
-    "Identification",
-    "choose_orders",
-    "fit_armax",
-    "identify",
     "ChainComponents",
     "ConvergenceWarning",
     "DataError",
     "ExactModes",
+    "Identification",
+    "ModeSelection",
     "OrderError",
+    "QualityWarning",
     "Recording",
+    "StabilisationDiagram",
     "Structure",
     "StructureError",
+    "__version__",
     "add_noise",
     "chapter2_system",
+    "choose_orders",
+    "fit_armax",
+    "identify",
     "random_vibration",
     "read_recording",
+    "read_xsens",
+    "select_modes",
     "simulate",
     "simulate_recording",
     "sine_sweep",
+    "stabilisation_diagram",
     "supine_human",
     "supine_with_feet",
     "write_recording_csv",
     "write_recording_uff",
+    *_LATER,
 ]
+
+
+def __getattr__(name: str):
+    if name not in _LATER:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    module, attribute = _LATER[name]
+    return getattr(importlib.import_module(module), attribute)
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

@@ -1,3 +1,3 @@
-from .cli import run
+from armaxmodal.cli.main import run
 
 run()

@@ -13,11 +13,11 @@ from numba import njit, uint64
 # Samples per tile of the residual's FIR part: three tiles of doubles (24 KB) stay in L1.
 _TILE = 1024
 
-_JIT = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
+JIT_OPTIONS = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
 
 
-@njit(**_JIT)
-def _hold_recursion(phi, gam, u_pad, n_steps, stride):
+@njit(**JIT_OPTIONS)
+def hold_recursion(phi, gam, u_pad, n_steps, stride):
     """Run ``x[k+1] = phi x[k] + sum_m gam[:, m] u_pad[k + m]`` from ``x[0] = 0``.
 
     Parameters
@@ -60,8 +60,8 @@ def _hold_recursion(phi, gam, u_pad, n_steps, stride):
     return out
 
 
-@njit(**_JIT)
-def _divide_by_c(x, c, out):
+@njit(**JIT_OPTIONS)
+def divide_by_c(x, c, out):
     """``out = x / C(q)`` for one signal: ``out[t] = x[t] - sum_i c[i] out[t-i]``, zero start.
 
     The sum runs in four accumulators: one accumulator makes every step wait on the
@@ -96,8 +96,8 @@ def _divide_by_c(x, c, out):
         out[uint64(t)] = x[uint64(t)] - ((a0 + a1) + (a2 + a3))
 
 
-@njit(**_JIT)
-def _inverse_filter(x, c):
+@njit(**JIT_OPTIONS)
+def inverse_filter(x, c):
     """``x_f = x / C(q)`` with zero initial state: ``x_f[t] = x[t] - sum_i c[i] x_f[t-i]``.
 
     ``c`` is monic (``c[0] == 1``); shape (nc + 1,). ``x`` is (n_sig, n) and every row is
@@ -134,8 +134,8 @@ def _inverse_filter(x, c):
     return out
 
 
-@njit(**_JIT)
-def _armax_residual(y, u, a, b, nk, c):
+@njit(**JIT_OPTIONS)
+def armax_residual(y, u, a, b, nk, c):
     """One-step prediction errors ``eps = (A y - q^-nk B u) / C`` with zero padding.
 
     Parameters
@@ -174,19 +174,19 @@ def _armax_residual(y, u, a, b, nk, c):
                 for t in range(hi - lo):
                     w_j[t] -= bj * u_j[t]
     eps = np.empty(n)
-    _divide_by_c(w, c, eps)
+    divide_by_c(w, c, eps)
     return eps
 
 
-@njit(**_JIT)
-def _lagged_value(sig, s, k):
+@njit(**JIT_OPTIONS)
+def lagged_value(sig, s, k):
     if k < 0 or k >= sig.shape[1]:
         return 0.0
     return sig[s, k]
 
 
-@njit(**_JIT)
-def _lagged_gram(sig, col_sig, col_lag, col_sign, t0, t1):
+@njit(**JIT_OPTIONS)
+def lagged_gram(sig, col_sig, col_lag, col_sign, t0, t1):
     """Gram matrix of regressor columns that are lagged copies of a few signals.
 
     Column ``c`` is ``col_sign[c] * sig[col_sig[c], t - col_lag[c]]`` for t in [t0, t1)
@@ -216,8 +216,8 @@ def _lagged_gram(sig, col_sig, col_lag, col_sign, t0, t1):
                     col_sign[c1]
                     * col_sign[c2]
                     * (
-                        _lagged_value(sig, s1, t0 - l1) * _lagged_value(sig, s2, t0 - l2)
-                        - _lagged_value(sig, s1, t1 - l1) * _lagged_value(sig, s2, t1 - l2)
+                        lagged_value(sig, s1, t0 - l1) * lagged_value(sig, s2, t0 - l2)
+                        - lagged_value(sig, s1, t1 - l1) * lagged_value(sig, s2, t1 - l2)
                     )
                 )
             else:
@@ -232,8 +232,8 @@ def _lagged_gram(sig, col_sig, col_lag, col_sign, t0, t1):
     return g
 
 
-@njit(**_JIT)
-def _lagged_cross(sig, col_sig, col_lag, col_sign, target, t0, t1):
+@njit(**JIT_OPTIONS)
+def lagged_cross(sig, col_sig, col_lag, col_sign, target, t0, t1):
     """``sum_t column_c(t) * target(t)`` for t in [t0, t1), for every column; shape (p,)."""
     p = col_sig.size
     out = np.zeros(p)
@@ -248,8 +248,8 @@ def _lagged_cross(sig, col_sig, col_lag, col_sign, target, t0, t1):
     return out
 
 
-@njit(**_JIT)
-def _max_root_radius_below(p, radius):
+@njit(**JIT_OPTIONS)
+def max_root_radius_below(p, radius):
     """True when every root of the monic polynomial ``p`` lies strictly inside ``radius``.
 
     Schur-Cohn step-down recursion on the polynomial scaled to the unit circle: the roots

@@ -6,7 +6,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .exceptions import DataError, StructureError
+from armaxmodal.exceptions import DataError, StructureError
 
 
 def as_signal_matrix(x, name: str, channel_names: Sequence[str] | None = None) -> np.ndarray:

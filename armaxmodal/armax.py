@@ -16,10 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._kernels import _armax_residual, _inverse_filter
-from ._validate import as_signal_matrix, as_signal_vector
-from .exceptions import DataError
-from .modal import discrete_modal_parameters
+from armaxmodal._kernels import armax_residual, inverse_filter
+from armaxmodal._validate import as_signal_matrix, as_signal_vector
+from armaxmodal.exceptions import DataError
+from armaxmodal.modal import discrete_modal_parameters
 
 __all__ = ["ArmaxModel"]
 
@@ -137,13 +137,13 @@ class ArmaxModel:
             ok = (idx >= 0) & (idx < full.size)
             v[ok] += full[idx[ok]]
         a = np.asarray(self.a, dtype=float)
-        return _inverse_filter((v / a[0])[None, :], np.ascontiguousarray(a / a[0]))[0]  # 1/A from rest
+        return inverse_filter((v / a[0])[None, :], np.ascontiguousarray(a / a[0]))[0]  # 1/A from rest
 
     def prediction_errors(self, y, u) -> np.ndarray:
         """One-step prediction errors ``(A y - q^-nk B u) / C`` from zero initial conditions."""
         y = as_signal_vector(y, "y")
         u = as_signal_matrix(u, "u")
-        return _armax_residual(y, np.ascontiguousarray(u.T), self.a, self.b, self.nk, self.c)
+        return armax_residual(y, np.ascontiguousarray(u.T), self.a, self.b, self.nk, self.c)
 
     def predict(self, y, u) -> np.ndarray:
         """One-step-ahead prediction ``y - eps``."""

@@ -8,8 +8,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from ._validate import as_signal_matrix, as_signal_vector, check_amplitude, check_fs, check_not_constant
-from .exceptions import DataError
+from armaxmodal._validate import as_signal_matrix, as_signal_vector, check_amplitude, check_fs, check_not_constant
+from armaxmodal.exceptions import DataError
 
 __all__ = ["Recording"]
 

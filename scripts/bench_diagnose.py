@@ -17,13 +17,13 @@ import time
 from pathlib import Path
 
 import armaxmodal as am
-from armaxmodal.diagnose import delays as dl
-from armaxmodal.diagnose import diagnose
-from armaxmodal.diagnose import evidence as ev
-from armaxmodal.diagnose.inject import inject
-from armaxmodal.diagnose.loop import _baseline_orders, _signals, _try_fix
-from armaxmodal.diagnose.model import ModelSpec, fit_model, held_out, usable
-from armaxmodal.fit import load_kernels
+from armaxmodal.diagnosis import delays as dl
+from armaxmodal.diagnosis import diagnose
+from armaxmodal.diagnosis import evidence as ev
+from armaxmodal.diagnosis.inject import inject
+from armaxmodal.diagnosis.loop import _baseline_orders, _signals, _try_fix
+from armaxmodal.diagnosis.model import ModelSpec, fit_model, held_out, usable
+from armaxmodal.estimate.fit import load_kernels
 
 ROOT = Path(__file__).resolve().parents[1]
 PLANTS = {
@@ -75,7 +75,7 @@ def stages(rec: am.Recording) -> None:
     clock.lap("test: stiffness nonlinearity (score tests)")
     significant = sorted((f for f in found if f.p < 0.01), key=lambda f: f.p)
     if significant:
-        from armaxmodal.diagnose.loop import Stage
+        from armaxmodal.diagnosis.loop import Stage
 
         _try_fix(Stage(model, held), significant[0], 0.01)
         clock.lap(f"one fix with its held-out folds: {significant[0].effect}")

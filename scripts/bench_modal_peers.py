@@ -21,8 +21,9 @@ from pathlib import Path
 import numpy as np
 
 import armaxmodal as am
-from armaxmodal.frf import measured_frf
-from armaxmodal.stabilisation import select_modes, stabilisation_diagram
+from armaxmodal.modes.diagram import stabilisation_diagram
+from armaxmodal.modes.selection import select_modes
+from armaxmodal.prepare.frf import measured_frf
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = {

@@ -31,8 +31,8 @@ import scipy.optimize
 import scipy.signal
 
 import armaxmodal as am
-from armaxmodal import fit as fitmod
 from armaxmodal.armax import ArmaxModel
+from armaxmodal.estimate import fit as fitmod
 
 ROOT = Path(__file__).resolve().parents[1]
 NA, NB, NC, NK = 8, 9, 4, 0
@@ -112,7 +112,7 @@ def one_fit(rec, quick):
 
 
 def sweep(rec, quick):
-    from armaxmodal.stabilisation import stabilisation_diagram
+    from armaxmodal.modes.diagram import stabilisation_diagram
 
     orders = range(2, 21 if quick else 41)
     print(

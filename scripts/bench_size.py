@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 import armaxmodal as am
-from armaxmodal.datasets import five_mass_chain
+from armaxmodal.systems.datasets import five_mass_chain
 
 FS = 100.0
 
@@ -53,9 +53,10 @@ def run_cli(path: Path, out: Path) -> float:
 
 
 def stages(rec: am.Recording) -> None:
-    from armaxmodal import stabilisation as st
-    from armaxmodal.fit import load_kernels
-    from armaxmodal.prepare import prepare
+    from armaxmodal.estimate.fit import load_kernels
+    from armaxmodal.modes import diagram as st
+    from armaxmodal.modes.selection import select_modes
+    from armaxmodal.prepare.preparation import prepare
 
     load_kernels()
     marks = [("start", time.perf_counter())]
@@ -65,11 +66,11 @@ def stages(rec: am.Recording) -> None:
     marks.append((f"delay choice (nk = {nk})", time.perf_counter()))
     diagram = st.stabilisation_diagram(prep.recording, prepared=True, nk=nk)
     marks.append(("sweep, shared + per sensor", time.perf_counter()))
-    st.select_modes(diagram, refine=False, segments=0)
+    select_modes(diagram, refine=False, segments=0)
     marks.append(("selection with finishing fits", time.perf_counter()))
-    st.select_modes(diagram, segments=0)
+    select_modes(diagram, segments=0)
     marks.append(("... and frequency-domain refit", time.perf_counter()))
-    st.select_modes(diagram)
+    select_modes(diagram)
     marks.append(("... and segment refits", time.perf_counter()))
     for (name, t1), (_, t0) in zip(marks[1:], marks[:-1], strict=True):
         print(f"  {name}: {t1 - t0:.2f} s")

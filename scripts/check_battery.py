@@ -19,8 +19,9 @@ import numpy as np
 from robustness import random_chain  # scripts/ is on the path when a script runs
 
 import armaxmodal as am
-from armaxmodal.modal_check import check_modes
-from armaxmodal.stabilisation import select_modes, stabilisation_diagram
+from armaxmodal.modes.diagram import stabilisation_diagram
+from armaxmodal.modes.modal_check import check_modes
+from armaxmodal.modes.selection import select_modes
 
 #: a found mode within this relative frequency of a true one is that mode
 MATCH = 0.05

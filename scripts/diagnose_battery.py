@@ -18,8 +18,8 @@ from dataclasses import replace
 import numpy as np
 
 import armaxmodal as am
-from armaxmodal.diagnose import diagnose
-from armaxmodal.diagnose.inject import cubic_spring_ride, inject
+from armaxmodal.diagnosis import diagnose
+from armaxmodal.diagnosis.inject import cubic_spring_ride, inject
 
 SYSTEMS = {"supine": (am.supine_human, 60.0, 28.0), "chapter2": (am.chapter2_system, 100.0, 45.0)}
 

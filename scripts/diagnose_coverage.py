@@ -17,8 +17,8 @@ import time
 import numpy as np
 
 import armaxmodal as am
-from armaxmodal.diagnose import diagnose
-from armaxmodal.diagnose.inject import inject
+from armaxmodal.diagnosis import diagnose
+from armaxmodal.diagnosis.inject import inject
 
 FS = 60.0
 

@@ -15,8 +15,8 @@ import argparse
 import time
 
 import armaxmodal as am
-from armaxmodal.diagnose import diagnose
-from armaxmodal.diagnose.inject import inject
+from armaxmodal.diagnosis import diagnose
+from armaxmodal.diagnosis.inject import inject
 
 SYSTEMS = {
     "supine 60 Hz": (am.supine_human, 60.0, 28.0),

@@ -160,8 +160,8 @@ def run(seeds: int) -> None:
 def chapter4(seeds: int) -> None:
     """The issue's Chapter 4 setting: supine model, 10 % shape, 5 % transmissibility, 1 %
     frequency and 5 % damping noise; total mass known; Table 4.2 mass-ratio bounds."""
-    from armaxmodal.datasets import TABLE_4_2_MASS_FRACTION
-    from armaxmodal.inverse._modal_data import body_mass_bounds
+    from armaxmodal.inverse.modal_data import body_mass_bounds
+    from armaxmodal.systems.datasets import TABLE_4_2_MASS_FRACTION
 
     s = am.supine_human()
     m = s.modes()

@@ -11,7 +11,7 @@ import argparse
 from pathlib import Path
 
 import armaxmodal as am
-from armaxmodal.io import write_json
+from armaxmodal.io.write import write_json
 
 SUBJECTS = {
     "supine_human": "supine-human model (thesis Section 4.4)",

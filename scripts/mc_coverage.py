@@ -20,7 +20,8 @@ import time
 import numpy as np
 
 import armaxmodal as am
-from armaxmodal.stabilisation import select_modes, stabilisation_diagram
+from armaxmodal.modes.diagram import stabilisation_diagram
+from armaxmodal.modes.selection import select_modes
 
 
 def one_ride(structure, truth, seed: int, hold: str, duration: float) -> np.ndarray:

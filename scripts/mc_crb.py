@@ -18,9 +18,9 @@ import argparse
 import numpy as np
 
 import armaxmodal as am
-from armaxmodal.fit import covariance_at
+from armaxmodal.estimate.fit import covariance_at
 from armaxmodal.modal import pole_uncertainty
-from armaxmodal.simulate import exact_armax
+from armaxmodal.systems.simulation import exact_armax
 
 
 def run(seeds: int) -> None:

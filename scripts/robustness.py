@@ -14,7 +14,8 @@ import time
 import numpy as np
 
 import armaxmodal as am
-from armaxmodal.stabilisation import select_modes, stabilisation_diagram
+from armaxmodal.modes.diagram import stabilisation_diagram
+from armaxmodal.modes.selection import select_modes
 
 
 def random_chain(rng, dampings=(0.01, 0.05, 0.15, 0.3)):

@@ -3,7 +3,7 @@ import scipy.signal
 
 import armaxmodal as am
 from armaxmodal.armax import ArmaxModel
-from armaxmodal.simulate import exact_armax
+from armaxmodal.systems.simulation import exact_armax
 
 RTOL = 1e-10
 

@@ -54,7 +54,7 @@ def test_bad_input_is_a_one_line_error_and_touches_nothing(tmp_path, fixtures_di
 
 
 def test_interrupt_is_one_line_and_exit_130(monkeypatch, fixtures_dir, capsys, tmp_path):
-    import armaxmodal.stabilisation as stab
+    import armaxmodal.modes.diagram as stab
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
@@ -165,7 +165,7 @@ def test_an_all_missing_column_is_named_not_dropped(tmp_path, fixtures_dir, caps
 @pytest.mark.parametrize("fraction", [0.3, 0.55, 0.93])
 def test_a_truncated_uff_file_is_refused_not_shortened(tmp_path, fixtures_dir, capsys, fraction):
     import armaxmodal as am
-    from armaxmodal.io import write_recording_uff
+    from armaxmodal.io.write import write_recording_uff
 
     full = write_recording_uff(am.read_recording(fixtures_dir / "supine_random.csv"), tmp_path / "full.uff")
     assert am.read_recording(full).sensors == ("head", "chest", "pelvis", "legs")
@@ -254,7 +254,7 @@ def test_damaged_files_end_in_one_line_naming_cause_and_fix(tmp_path, fixtures_d
 
 def test_integer_named_columns_with_the_input_named_are_a_header(tmp_path, fixtures_dir):
     """Sensors numbered rather than named are a header when the input is among them."""
-    from armaxmodal.io import read_recording
+    from armaxmodal.io.read import read_recording
 
     frame = _ride_frame(fixtures_dir).drop(columns="time")
     frame.columns = ["0", "1", "2", "3", "4"]

@@ -15,10 +15,10 @@ import pytest
 
 import armaxmodal as am
 from armaxmodal.cli import main
-from armaxmodal.diagnose import diagnose
-from armaxmodal.diagnose.inject import inject
-from armaxmodal.diagnose.model import fractional_shift
-from armaxmodal.diagnose.spectral import harmonic_f_test
+from armaxmodal.diagnosis import diagnose
+from armaxmodal.diagnosis.inject import inject
+from armaxmodal.diagnosis.model import fractional_shift
+from armaxmodal.diagnosis.spectral import harmonic_f_test
 from armaxmodal.exceptions import DataError
 
 ORDERS = (10, 16, 10, -5)  # the supine fixture's orders chosen by BIC (README)
@@ -155,7 +155,7 @@ def test_bad_input_is_refused_before_any_fit(clean):
 
 
 def test_cli_writes_strict_json_with_the_contract(tmp_path, clean):
-    from armaxmodal.io import write_recording_csv
+    from armaxmodal.io.write import write_recording_csv
 
     data = tmp_path / "ride.csv"
     write_recording_csv(inject(clean, "offset_drift", ["chest"], offset=0.3, drift_per_s=0.004), data)
@@ -176,14 +176,14 @@ def test_cli_writes_strict_json_with_the_contract(tmp_path, clean):
 def nonlinear_rides():
     """The supine human with a cubic spring between chest and pelvis (its force equal to 0.3
     of the linear spring's at the RMS deflection), and its linear twin (ratio 0)."""
-    from armaxmodal.diagnose.inject import cubic_spring_ride
+    from armaxmodal.diagnosis.inject import cubic_spring_ride
 
     u = am.random_vibration(60.0, 120.0, band=(0.5, 28.0), seed=1)
     return {r: cubic_spring_ride(am.supine_human(), u, 60.0, (1, 2), r, seed=2) for r in (0.0, 0.3)}
 
 
 def test_cubic_spring_ride_reduces_to_the_exact_linear_simulation():
-    from armaxmodal.diagnose.inject import cubic_spring_ride
+    from armaxmodal.diagnosis.inject import cubic_spring_ride
 
     u = am.random_vibration(60.0, 20.0, band=(0.5, 28.0), seed=5)
     rk4 = cubic_spring_ride(am.supine_human(), u, 60.0, (1, 2), 0.0, noise=0.0)
@@ -275,7 +275,7 @@ def test_a_mode_the_baseline_lacks_is_named_and_found(clean):
 
 def test_a_disturbance_fits_beside_a_nonlinear_term(clean):
     # a term makes the input (n, 2): the disturbance fit once took its size for n (stiff3 IMU ride)
-    from armaxmodal.diagnose.model import ModelSpec, Signals, fit_model
+    from armaxmodal.diagnosis.model import ModelSpec, Signals, fit_model
 
     n = 3000
     y = clean.response[:n] + np.array([0.3, 0.0, -0.2, 0.0])
@@ -285,7 +285,7 @@ def test_a_disturbance_fits_beside_a_nonlinear_term(clean):
 
 
 def _baseline_model(rec):
-    from armaxmodal.diagnose.model import ModelSpec, Signals, fit_model
+    from armaxmodal.diagnosis.model import ModelSpec, Signals, fit_model
 
     signals = Signals(rec.base, rec.response, rec.fs, rec.sensors, rec.input_name)
     return fit_model(ModelSpec(ORDERS), signals)
@@ -294,7 +294,7 @@ def _baseline_model(rec):
 def test_an_output_ahead_beyond_the_noncausal_taps_is_timed_by_the_cross_correlation(clean):
     """An IMU on its own clock runs ahead of the table by more than nk reaches; where no
     quasi-static band can time it, the residual's correlation with future input does."""
-    from armaxmodal.diagnose.delays import lead_findings as _lead_findings
+    from armaxmodal.diagnosis.delays import lead_findings as _lead_findings
 
     n_tests = 7 * len(clean.sensors)
     ahead = inject(clean, "input_delay", ["legs"], samples=-14.0)
@@ -322,7 +322,7 @@ def _clip_top(x: np.ndarray, k: int) -> np.ndarray:
 def test_rail_pileup_counts_and_its_poisson_p():
     from scipy import stats
 
-    from armaxmodal.diagnose.clipping import clipped_mask, rail_pileup
+    from armaxmodal.diagnosis.clipping import clipped_mask, rail_pileup
 
     x = np.random.default_rng(5).standard_normal(5000)
     (hi, k_hi, lam_hi, p_hi), (lo, k_lo, _, p_lo) = rail_pileup(_clip_top(x, 9))
@@ -337,7 +337,7 @@ def test_rail_pileup_counts_and_its_poisson_p():
 def test_fill_by_prediction_leaves_zero_innovation_where_samples_are_missing(clean):
     """Against the model's own predictor: on the filled record the prediction errors are zero
     at the missing samples and unchanged before the first one."""
-    from armaxmodal.diagnose.clipping import fill_by_prediction
+    from armaxmodal.diagnosis.clipping import fill_by_prediction
 
     m = am.fit_armax(clean, *ORDERS, shared_poles=True, warn=False).models[1]
     y, u = clean.response[:, 1], clean.base
@@ -376,7 +376,7 @@ def test_clipping_near_its_threshold_and_on_the_input(clean):
     """Three samples at a rail are what a continuous signal may show (p = 0.08 before the
     correction): not named; twelve are (p = 1e-9): named. A clipped input is named but not
     'fixed': no fill restores the base motion the structure felt."""
-    from armaxmodal.diagnose.evidence import run_tests
+    from armaxmodal.diagnosis.evidence import run_tests
 
     def clipping(rec):
         return [f for f in run_tests(_baseline_model(rec))[0] if f.effect == "clipping"]
@@ -400,7 +400,7 @@ def test_input_rail_reach_spans_b_and_the_predictor_memory():
     """A clipped input sample at s spoils the output from s + nk to s + nk + nb + len(pi) - 2
     (white noise model: pi = 1), in the output's own shifted frame."""
     from armaxmodal.armax import ArmaxModel
-    from armaxmodal.diagnose.faults import input_rail_reach
+    from armaxmodal.diagnosis.faults import input_rail_reach
 
     u = np.sin(np.arange(400) / 7.0)
     model = ArmaxModel(np.array([1.0]), np.ones((1, 3)), np.array([1.0]), 2, 100.0)
@@ -412,7 +412,7 @@ def test_input_rail_reach_spans_b_and_the_predictor_memory():
 
 def test_stuck_runs_and_glitches_against_planted_ones():
     from armaxmodal.armax import ArmaxModel
-    from armaxmodal.diagnose.faults import glitches, stuck_runs
+    from armaxmodal.diagnosis.faults import glitches, stuck_runs
 
     rng = np.random.default_rng(11)
     x = rng.standard_normal(6000)
@@ -458,7 +458,7 @@ def test_glitches_and_a_stuck_sensor_are_named_filled_and_back_to_the_clean_erro
 
 def test_outliers_where_the_input_is_strongest_are_not_a_sensor_fault(clean):
     """Glitches fall anywhere; outliers gathered in the strong part of a ride are the model's."""
-    from armaxmodal.diagnose.faults import follows_excitation
+    from armaxmodal.diagnosis.faults import follows_excitation
 
     u = clean.base * np.where(np.arange(clean.n_samples) < 3600, 1.0, 3.0)  # a strong second half
     rng = np.random.default_rng(2)
@@ -524,7 +524,7 @@ def test_a_second_input_on_another_structure_and_rate():
 def test_widened_start_predicts_as_the_model_it_widens(clean):
     """A start for a spec with a new input is the old model with zero B for it: the same
     one-step errors, without the output that became an input."""
-    from armaxmodal.diagnose.model import ModelSpec, Signals, fit_model, widened_start
+    from armaxmodal.diagnosis.model import ModelSpec, Signals, fit_model, widened_start
 
     rec = _with_force(clean, 0.3)
     signals = Signals(rec.base, rec.response, rec.fs, rec.sensors, rec.input_name)
@@ -556,8 +556,8 @@ def test_the_noise_floor_is_the_sensor_noise_and_none_where_the_record_cannot_re
     """The supine ride's floor is its 5 % sensor noise; a 0.3 %-damped two-mode ride of 60 s
     smears its peaks at every segment the record allows (its 'floor' lies above the linear
     baseline's own held-out error): no floor rather than a wrong one."""
-    from armaxmodal.diagnose.loop import _noise_floor
-    from armaxmodal.diagnose.model import Signals
+    from armaxmodal.diagnosis.loop import _noise_floor
+    from armaxmodal.diagnosis.model import Signals
 
     def floor(rec):
         s = Signals(rec.base, rec.response, rec.fs, rec.sensors, rec.input_name)
@@ -582,7 +582,7 @@ def test_outliers_other_sensors_share_are_not_one_sensors_glitches():
     test of coincidences against their rate at random moments."""
     from scipy.stats import binom
 
-    from armaxmodal.diagnose.faults import SHARED_LEVEL, shared_by_others
+    from armaxmodal.diagnosis.faults import SHARED_LEVEL, shared_by_others
 
     rng = np.random.default_rng(2)
     n = 6000

@@ -15,12 +15,12 @@ import pytest
 from scipy import stats
 
 import armaxmodal as am
-from armaxmodal.diagnose import diagnose, loop
-from armaxmodal.diagnose.delays import _common_delay, delay_findings
-from armaxmodal.diagnose.evidence import EFFECT_TESTS, run_tests
-from armaxmodal.diagnose.inject import inject
-from armaxmodal.diagnose.model import ModelSpec, Signals, fit_model, fractional_shift, usable
-from armaxmodal.quality import DelayEstimate, estimate_delays
+from armaxmodal.diagnosis import diagnose, loop
+from armaxmodal.diagnosis.delays import _common_delay, delay_findings
+from armaxmodal.diagnosis.evidence import EFFECT_TESTS, run_tests
+from armaxmodal.diagnosis.inject import inject
+from armaxmodal.diagnosis.model import ModelSpec, Signals, fit_model, fractional_shift, usable
+from armaxmodal.prepare.quality import DelayEstimate, estimate_delays
 
 ORDERS = (10, 16, 10, -5)  # the supine fixture's orders chosen by BIC
 
@@ -185,7 +185,7 @@ def test_real_stiff_one_storey_delay_is_confirmed_as_stabilise_times_it(realdata
     """The top IMU of the stiff 1-storey shake-table model lags the table by about 2.3
     samples (stabilise: 19.3 ms, 18.3-20.3). Before, diagnose left the delay unconfirmed
     (held-out 0.0784 -> 0.101 at the delayed data's nk = 0)."""
-    from armaxmodal.xsens import read_xsens
+    from armaxmodal.io.xsens import read_xsens
 
     files = [str(realdata_dir / "mini_shake_table_imu" / "stiff1" / f"elcentro1__{s}.csv.gz") for s in ("g", "f1")]
     rec = read_xsens(files, input="g")
@@ -211,7 +211,7 @@ def test_a_per_output_delay_finding_reports_the_phase_slope_estimate_as_it_is(cl
 
 
 def test_a_lead_beyond_the_taps_is_reported_in_samples_and_ms_with_its_method(clean):
-    from armaxmodal.diagnose.delays import lead_findings
+    from armaxmodal.diagnosis.delays import lead_findings
 
     ahead = inject(clean, "input_delay", ["legs"], samples=-14.0)
     legs = {f.channels[0]: f for f in lead_findings(_model(ahead), 28, set())}["legs"]
@@ -250,7 +250,7 @@ def test_a_jackknife_over_three_blocks_counts_with_two_degrees_of_freedom():
 def test_the_input_finding_carries_the_common_delay_both_ways(clean):
     """On the input: how late it is (negative: the outputs lag it) and, for the reader, the
     outputs' common lag with its interval and each output's own."""
-    from armaxmodal.diagnose.delays import _input_finding
+    from armaxmodal.diagnosis.delays import _input_finding
 
     common = {"lag_s": 0.05, "sd_s": 0.001, "lag_ci95_s": [0.048, 0.052], "per_output_s": {"head": 0.049},
               "spread_p": 0.3}  # fmt: skip
@@ -323,7 +323,7 @@ def test_the_moved_model_tries_nk_around_the_move_with_nb_keeping_the_causal_tap
 
 def _findings_for(monkeypatch, clean, estimates, sensors=None):
     """``delay_findings`` on the clean ride's model with the phase-slope estimates given."""
-    from armaxmodal.diagnose import delays
+    from armaxmodal.diagnosis import delays
 
     monkeypatch.setattr(delays, "estimate_delays", lambda rec: estimates)
     model = _model(clean)
@@ -362,7 +362,7 @@ def test_a_delay_p_value_is_two_sided_student_t_times_the_family(clean, monkeypa
 
 
 def test_late_start_counts_the_samples_each_delay_explains(clean):
-    from armaxmodal.diagnose.delays import late_start
+    from armaxmodal.diagnosis.delays import late_start
 
     model = _model(clean)
     assert late_start(model, []) == {}
@@ -380,7 +380,7 @@ def test_the_figure_of_a_short_record_is_drawn(tmp_path, clean):
     past the record's end and the CLI raised from matplotlib, writing nothing; the residual
     spectrum's segment was capped at n x K values, not n samples (scipy warned)."""
     from armaxmodal.cli import main
-    from armaxmodal.io import write_recording_csv
+    from armaxmodal.io.write import write_recording_csv
 
     short = replace(clean, base=clean.base[:1300], response=clean.response[:1300])
     data, fig, out = tmp_path / "short.csv", tmp_path / "d.png", tmp_path / "d.json"

@@ -5,13 +5,13 @@ import numpy as np
 import pytest
 
 import armaxmodal as am
-import armaxmodal._gauss_newton as gn
-from armaxmodal import fit as fitmod
-from armaxmodal._kernels import _armax_residual, _inverse_filter, _lagged_cross, _lagged_gram
+import armaxmodal.estimate._gauss_newton as gn
+from armaxmodal._kernels import armax_residual, inverse_filter, lagged_cross, lagged_gram
+from armaxmodal.estimate import fit as fitmod
+from armaxmodal.estimate.fit import covariance_at, fit_armax
+from armaxmodal.estimate.orders import choose_orders
 from armaxmodal.exceptions import ConvergenceWarning, DataError, OrderError
-from armaxmodal.fit import covariance_at, fit_armax
-from armaxmodal.orders import choose_orders
-from armaxmodal.simulate import exact_armax
+from armaxmodal.systems.simulation import exact_armax
 
 from . import naive
 
@@ -64,7 +64,7 @@ def _physical(modes, band):
 # -- kernels against slow references -----------------------------------------------------
 def _assert_residual_matches_reference(y, u, a, b, nk, c):
     expected = naive.armax_residual(y, u, a, b, nk, c)
-    np.testing.assert_allclose(_armax_residual(y, u, a, b, nk, c), expected, rtol=KERNEL_RTOL, atol=1e-12)
+    np.testing.assert_allclose(armax_residual(y, u, a, b, nk, c), expected, rtol=KERNEL_RTOL, atol=1e-12)
 
 
 def test_residual_kernel_matches_lfilter():
@@ -80,7 +80,7 @@ def test_inverse_filter_kernel_matches_lfilter():
     rng = np.random.default_rng(1)
     x = rng.standard_normal((3, 400))
     c = np.array([1.0, -0.5, 0.2, 0.1])
-    np.testing.assert_allclose(_inverse_filter(x, c), naive.inverse_filter(x, c), rtol=KERNEL_RTOL, atol=1e-12)
+    np.testing.assert_allclose(inverse_filter(x, c), naive.inverse_filter(x, c), rtol=KERNEL_RTOL, atol=1e-12)
 
 
 def test_kernels_match_references_at_sweep_orders_and_short_records():
@@ -92,7 +92,7 @@ def test_kernels_match_references_at_sweep_orders_and_short_records():
         c = np.concatenate([[1.0], 0.4 * rng.standard_normal(order) / order])
         a = np.concatenate([[1.0], 0.4 * rng.standard_normal(order + 2) / order])
         x = rng.standard_normal((n_sig, n))
-        np.testing.assert_allclose(_inverse_filter(x, c), naive.inverse_filter(x, c), rtol=KERNEL_RTOL, atol=1e-12)
+        np.testing.assert_allclose(inverse_filter(x, c), naive.inverse_filter(x, c), rtol=KERNEL_RTOL, atol=1e-12)
         y, u = rng.standard_normal(n), rng.standard_normal((2, n))
         for nk in (-4, 0, 2):
             _assert_residual_matches_reference(y, u, a, rng.standard_normal((2, order + 1 - min(nk, 0))), nk, c)
@@ -100,7 +100,7 @@ def test_kernels_match_references_at_sweep_orders_and_short_records():
 
 def test_lagged_input_sum_matches_the_residual_reference():
     """The Steiglitz-McBride reweighting's ``B u`` (every delay sign, lags past the record)."""
-    from armaxmodal.fit import _lagged_sum
+    from armaxmodal.estimate.fit import _lagged_sum
 
     rng = np.random.default_rng(4)
     one = np.array([1.0])
@@ -113,12 +113,12 @@ def test_lagged_input_sum_matches_the_residual_reference():
 def test_lagged_gram_and_cross_match_explicit_design():
     rng = np.random.default_rng(2)
     sig = rng.standard_normal((3, 300))
-    cols = gn._columns(4, 5, 3, 1, 1)
+    cols = gn.columns(4, 5, 3, 1, 1)
     target = rng.standard_normal(300)
     design = naive.lagged_design(sig, *cols, 6, 300)
-    np.testing.assert_allclose(_lagged_gram(sig, *cols, 6, 300), design.T @ design, rtol=KERNEL_RTOL, atol=1e-10)
+    np.testing.assert_allclose(lagged_gram(sig, *cols, 6, 300), design.T @ design, rtol=KERNEL_RTOL, atol=1e-10)
     np.testing.assert_allclose(
-        _lagged_cross(sig, *cols, target, 6, 300),
+        lagged_cross(sig, *cols, target, 6, 300),
         design.T @ target[6:300],
         rtol=KERNEL_RTOL,
         atol=1e-10,
@@ -134,7 +134,7 @@ def test_gradient_is_exact(nk):
     t0, t1 = max(na, nc, nk + nb - 1), y.size
     theta = fitmod._hannan_rissanen(y, u_t, na, nb, nc, nk, t0, t1)
     eps, _, c = fitmod._residual_and_loss(y, u_t, theta, na, nb, nc, nk, t0, t1)
-    _, g = gn._normal_equations(y, u_t, eps, c, gn._columns(na, nb, nc, nk, 1), t0, t1)
+    _, g = gn.normal_equations(y, u_t, eps, c, gn.columns(na, nb, nc, nk, 1), t0, t1)
     numeric = np.zeros_like(theta)
     h = 1e-7
     for i in range(theta.size):
@@ -411,14 +411,14 @@ def test_output_error_form(supine_zoh):
 
 
 def test_stability_kernel_matches_roots():
-    from armaxmodal._kernels import _max_root_radius_below
+    from armaxmodal._kernels import max_root_radius_below
 
     rng = np.random.default_rng(5)
     for _ in range(300):
         roots = rng.uniform(0.2, 1.2, 6) * np.exp(1j * rng.uniform(0, np.pi, 6))
         p = np.real(np.poly(np.r_[roots, np.conj(roots)]))
         for radius in (0.9, 0.995, 1.0):
-            assert _max_root_radius_below(p, radius) == naive.max_root_radius_below(p, radius)
+            assert max_root_radius_below(p, radius) == naive.max_root_radius_below(p, radius)
 
 
 def test_miso_recovers_a_known_two_input_system():
@@ -444,7 +444,7 @@ def test_a_crawl_along_an_undetermined_valley_ends_the_fit_without_moving_the_mo
     floor-damped Gauss-Newton steps keep gaining a steady 0.004 in 2 log L and never meet the
     expected-improvement rule. The crawl rule ends the fit within a few dozen iterations, its
     modes within 0.02 standard error of a fit left to crawl to a 300-iteration cap."""
-    from armaxmodal.datasets import five_mass_chain
+    from armaxmodal.systems.datasets import five_mass_chain
 
     chain = five_mass_chain()
     ride = am.random_vibration(100.0, 40.0, (0.5, 40.0), seed=1)
@@ -483,8 +483,8 @@ def test_a_fit_flagged_not_converged_says_why(stopped, valid, said, not_said):
     """The iteration cap and an invalid model are different failures with different remedies:
     the supine chest alone at 8,9,4,0 ends at a pole at 1.003 after 14 iterations, and was
     reported as 'did not converge in 100 iterations'."""
+    from armaxmodal.estimate.fit import _warn_not_converged
     from armaxmodal.exceptions import ConvergenceWarning
-    from armaxmodal.fit import _warn_not_converged
 
     with pytest.warns(ConvergenceWarning) as record:
         _warn_not_converged(["a", "b"], np.array(stopped), np.array(valid), 100, (8, 9, 4, 0))

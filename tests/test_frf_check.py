@@ -9,8 +9,9 @@ from hypothesis.extra.numpy import arrays
 from scipy.signal import find_peaks
 
 import armaxmodal as am
-from armaxmodal.frf_check import peak_prominences, resolving_nperseg, unexplained_peaks
-from armaxmodal.stabilisation import select_modes, stabilisation_diagram
+from armaxmodal.modes.diagram import stabilisation_diagram
+from armaxmodal.modes.frf_check import peak_prominences, resolving_nperseg, unexplained_peaks
+from armaxmodal.modes.selection import select_modes
 
 
 @pytest.fixture(scope="module")
@@ -20,7 +21,7 @@ def supine(fixtures_dir):
 
 
 def test_the_error_separates_a_complete_selection_from_an_incomplete_one(supine):
-    from armaxmodal.modal_check import check_modes
+    from armaxmodal.modes.modal_check import check_modes
 
     rec, m = supine.diagram.recording, supine.modes
     full = check_modes(rec, m.freq_hz, m.damping)
@@ -48,7 +49,7 @@ def test_a_missing_lightly_damped_mode_is_named_at_its_frequency(light):
 
 
 def test_mode_support_merges_a_fake_split_and_keeps_real_close_modes(light, fixtures_dir):
-    from armaxmodal.modal_check import check_modes, mode_support, overlapping_neighbour
+    from armaxmodal.modes.modal_check import check_modes, mode_support, overlapping_neighbour
 
     def support(rec, f, x, m):
         return mode_support(rec, f, x, m, check_modes(rec, f, x))

@@ -22,8 +22,8 @@ from hypothesis import strategies as st
 
 import armaxmodal as am
 from armaxmodal.exceptions import ArmaxModalError
-from armaxmodal.io import write_recording_uff
-from armaxmodal.prepare import check_band
+from armaxmodal.io.write import write_recording_uff
+from armaxmodal.prepare.preparation import check_band
 
 settings.register_profile(
     "ci", max_examples=40, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture]

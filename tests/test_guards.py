@@ -9,13 +9,13 @@ import pandas as pd
 import pytest
 
 import armaxmodal as am
-import armaxmodal._gauss_newton as gn
-import armaxmodal.fit as fitmod
-from armaxmodal.frf import excited_band
+import armaxmodal.estimate._gauss_newton as gn
+import armaxmodal.estimate.fit as fitmod
+from armaxmodal.estimate.orders import default_nb
 from armaxmodal.modal import discrete_modal_parameters, pole_uncertainty
-from armaxmodal.orders import default_nb
-from armaxmodal.refine import refine_modes
-from armaxmodal.stabilisation import Tolerances, _mac, _reject
+from armaxmodal.modes.poles import Tolerances, mac, rejection_reasons
+from armaxmodal.modes.refine import refine_modes
+from armaxmodal.prepare.frf import excited_band
 
 FS = 60.0
 
@@ -58,7 +58,7 @@ def test_output_error_gradient_is_exact(fixtures_dir):
     t0, t1 = na + nb, y.size
     theta = fitmod._hannan_rissanen(y, u_t, na, nb, 2, nk, t0, t1)[: na + nb]
     eps, _, c = fitmod._residual_and_loss(y, u_t, theta, na, nb, nc, nk, t0, t1, oe=True)
-    _, g = gn._normal_equations(y, u_t, eps, c, gn._columns(na, nb, nc, nk, 1), t0, t1, oe=True)
+    _, g = gn.normal_equations(y, u_t, eps, c, gn.columns(na, nb, nc, nk, 1), t0, t1, oe=True)
     numeric = np.zeros_like(theta)
     h = 1e-7
     for i in range(theta.size):
@@ -73,12 +73,12 @@ def test_output_error_gradient_is_exact(fixtures_dir):
 def test_mac_is_one_for_any_complex_scaling_and_is_conjugate_symmetric():
     rng = np.random.default_rng(1)
     a = rng.standard_normal(4) + 1j * rng.standard_normal(4)
-    assert _mac(a, a * (0.3 - 2.1j)) == pytest.approx(1.0, abs=1e-12)
+    assert mac(a, a * (0.3 - 2.1j)) == pytest.approx(1.0, abs=1e-12)
     b = rng.standard_normal(4) + 1j * rng.standard_normal(4)
     expect = abs(np.sum(np.conj(a) * b)) ** 2 / (np.sum(np.abs(a) ** 2) * np.sum(np.abs(b) ** 2))
-    assert _mac(a, b) == pytest.approx(expect, rel=1e-12) and _mac(b, a) == pytest.approx(expect, rel=1e-12)
-    assert _mac(a, np.conj(a)) < 0.99  # a complex shape is not its own conjugate
-    assert _mac(a, np.zeros(4)) == 0.0
+    assert mac(a, b) == pytest.approx(expect, rel=1e-12) and mac(b, a) == pytest.approx(expect, rel=1e-12)
+    assert mac(a, np.conj(a)) < 0.99  # a complex shape is not its own conjugate
+    assert mac(a, np.zeros(4)) == 0.0
 
 
 def test_rejection_rules_and_their_ceiling(fixtures_dir):
@@ -97,7 +97,7 @@ def test_rejection_rules_and_their_ceiling(fixtures_dir):
     poles = pd.DataFrame(
         [{"source": "shared", "na": 10, "freq_hz": f, "damping": x, "energy": e} for f, x, e, _ in rows]
     )
-    assert _reject(poles, tol, rec) == [r[3] for r in rows]
+    assert rejection_reasons(poles, tol, rec) == [r[3] for r in rows]
 
 
 @pytest.mark.parametrize("na, nk, nb", [(10, 0, 11), (10, -5, 16), (8, -1, 10), (8, 3, 9)])
@@ -173,7 +173,7 @@ def _shared_problem(fixtures_dir, oe=False):
     na, nb, nc, nk = 4, 5, 0 if oe else 3, 1
     t0, t1 = max(na, nc, nk + nb - 1), 1200
     p_k = nb + nc
-    cols = gn._columns(na, nb, nc, nk, 1)
+    cols = gn.columns(na, nb, nc, nk, 1)
     parts = [fitmod._hannan_rissanen(y, u_t, na, nb, 3, nk, t0, t1)[: na + p_k] for y in ys]
     theta = fitmod._project_shared(np.concatenate([parts[0][:na]] + [p[na:] for p in parts]), na, nb, nc, 1, 3, oe)
 
@@ -184,7 +184,7 @@ def _shared_problem(fixtures_dir, oe=False):
         ]
 
     variances = np.array([0.7, 1.3, 2.1]) * np.mean([np.var(y) for y in ys])
-    normal = gn._shared_normal_equations(ys, u_t, residuals(theta), variances, cols, na, p_k, t0, t1, oe)
+    normal = gn.shared_normal_equations(ys, u_t, residuals(theta), variances, cols, na, p_k, t0, t1, oe)
     return theta, residuals, variances, normal, (t0, t1)
 
 
@@ -222,20 +222,20 @@ def test_the_schur_solve_equals_the_dense_damped_solve(fixtures_dir):
 
 
 def test_pole_rows_of_a_shared_and_a_single_sensor_fit(fixtures_dir):
-    """The diagram's pole rows (``_poles_of``) against the fit's own mode table: every column
+    """The diagram's pole rows (``pole_rows``) against the fit's own mode table: every column
     carried over, the shared shape from each sensor's residue, the energies as defined."""
-    from armaxmodal.stabilisation import _POLE_COLUMNS, _poles_of
+    from armaxmodal.modes.poles import POLE_COLUMNS, pole_rows
 
     rec = am.read_recording(fixtures_dir / "supine_random.csv")
     rec = am.Recording(rec.fs, rec.base[:2400], rec.response[:2400, :2], rec.sensors[:2])
     shared = fitmod.fit_armax(rec, 4, 5, 4, 0, shared_poles=True)
     table = shared.modes()
     first = table[table.sensor == rec.sensors[0]].reset_index(drop=True)
-    rows = _poles_of(shared, "shared")
+    rows = pole_rows(shared, "shared")
     assert len(rows) == len(first) == 2
     for row, (_, ref) in zip(rows, first.iterrows(), strict=True):
-        assert list(row) == _POLE_COLUMNS and row["source"] == "shared" and row["na"] == 4
-        for col in _POLE_COLUMNS[2:-3]:  # freq_hz .. damping_ci95_hi
+        assert list(row) == POLE_COLUMNS and row["source"] == "shared" and row["na"] == 4
+        for col in POLE_COLUMNS[2:-3]:  # freq_hz .. damping_ci95_hi
             assert row[col] == ref[col], col
         assert row["pole"] == ref["pole"]
         lam = np.log(ref.pole) * rec.fs  # Eq. 3.24 from the discrete residue R: M = -R fs / lambda^2
@@ -245,7 +245,7 @@ def test_pole_rows_of_a_shared_and_a_single_sensor_fit(fixtures_dir):
         assert row["energy"] == pytest.approx(np.linalg.norm(np.asarray(own) * ref.freq_hz), rel=1e-10)
     single = fitmod.fit_armax(rec.select([rec.sensors[1]]), 4, 5, 4, 0)
     ref = single.modes()
-    rows = _poles_of(single, rec.sensors[1])
+    rows = pole_rows(single, rec.sensors[1])
     assert len(rows) == len(ref) >= 1
     for row, (_, r) in zip(rows, ref.iterrows(), strict=True):
         assert row["source"] == rec.sensors[1] and row["freq_hz"] == r.freq_hz and row["damping_sd"] == r.damping_sd
@@ -261,11 +261,11 @@ def test_solves_fall_back_to_least_squares_where_cholesky_fails():
     g = np.array([1.0, -2.0, 0.5])
     for damping in (0.0, 0.1):
         expected = np.linalg.lstsq(gn._damped(a, damping), g, rcond=None)[0]
-        np.testing.assert_allclose(gn._solve(a, g, damping), expected, rtol=1e-12)
+        np.testing.assert_allclose(gn.solve(a, g, damping), expected, rtol=1e-12)
     singular = np.array([[1.0, 1.0], [1.0, 1.0]])
-    np.testing.assert_allclose(gn._inverse(singular), np.linalg.pinv(singular), rtol=1e-12)
+    np.testing.assert_allclose(gn.inverse(singular), np.linalg.pinv(singular), rtol=1e-12)
     spd = np.array([[4.0, 1.0], [1.0, 3.0]])
-    np.testing.assert_allclose(gn._inverse(spd), np.linalg.inv(spd), rtol=1e-12)
+    np.testing.assert_allclose(gn.inverse(spd), np.linalg.inv(spd), rtol=1e-12)
     # the block-arrow step with an indefinite sensor block equals the dense damped solve
     arrow = gn._Arrow(
         aa=np.array([[5.0, 0.3], [0.3, 4.0]]),

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 import armaxmodal as am
-from armaxmodal.held import held_channels
-from armaxmodal.prepare import prepare
-from armaxmodal.quality import check_quality
+from armaxmodal.prepare.checks import check_quality
+from armaxmodal.prepare.held import held_channels
+from armaxmodal.prepare.preparation import prepare
 
 
 @pytest.fixture(scope="module")

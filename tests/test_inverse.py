@@ -4,7 +4,7 @@ import pytest
 import armaxmodal as am
 from armaxmodal.exceptions import StructureError
 from armaxmodal.inverse import inner_solve, model_update, pia
-from armaxmodal.inverse._modal_data import to_eigenvalues
+from armaxmodal.inverse.modal_data import to_eigenvalues
 
 # Issue targets on exact data: convex and updating methods to 1e-8 after the scale fix, PIA to
 # its own 1e-4 iteration tolerance (a factor 10 of headroom for the K inverse).
@@ -183,9 +183,9 @@ def test_scaling_keeps_modes_and_prediction_matches_simulation(fixtures_dir):
 def test_weight_sweep_shows_the_chapter_4_trade_off():
     """Averaged modes (Table 4.1) and the thesis model's transmissibility disagree: weighting
     the modes reproduces Table 4.1, weighting the transmissibility reproduces Table 4.3."""
-    from armaxmodal import datasets
     from armaxmodal.inverse import weight_sweep
-    from armaxmodal.inverse._modal_data import body_mass_bounds, to_eigenvalues
+    from armaxmodal.inverse.modal_data import body_mass_bounds, to_eigenvalues
+    from armaxmodal.systems import datasets
 
     s = am.supine_human()
     f = np.linspace(0.5, 20.0, 60)

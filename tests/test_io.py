@@ -201,7 +201,7 @@ def test_a_dropped_row_is_bridged_and_named(tmp_path, fixtures_dir, lost):
     that many samples more there. The rows are filled by linear interpolation in every
     channel, every other sample is the file's, and the gap is a ``dropped_packet`` warning
     with its time."""
-    from armaxmodal.prepare import prepare
+    from armaxmodal.prepare.preparation import prepare
 
     frame = pd.read_csv(fixtures_dir / "supine_random.csv", comment="#")
     path = tmp_path / "gap.csv"
@@ -242,7 +242,7 @@ def test_input_file_is_never_modified(tmp_path, rec):
 
 
 def test_failed_write_leaves_nothing(tmp_path, rec):
-    from armaxmodal.io import atomic_write
+    from armaxmodal.io.write import atomic_write
 
     def broken(tmp):
         with open(tmp, "w") as fh:
@@ -329,7 +329,7 @@ def test_json_is_strict_nan_and_infinity_become_null(tmp_path):
     """Strict parsers reject bare NaN: the writer turns every non-finite number into null."""
     import json
 
-    from armaxmodal.io import write_json
+    from armaxmodal.io.write import write_json
 
     path = write_json(
         {"a": float("nan"), "b": np.array([1.5, np.inf]), "c": [np.float64(-np.inf), 2]}, tmp_path / "x.json"
@@ -343,12 +343,12 @@ def test_an_all_numeric_csv_reads_the_same_doubles_as_the_cell_by_cell_path(fixt
     and on awkward but valid numbers (exponents, integers, signs, spaces after commas)."""
     import pandas as pd
 
-    from armaxmodal.io import _read_csv, _text_channels
+    from armaxmodal.io.csv_format import _text_channels, read_csv_file
 
     awkward = tmp_path / "awkward.csv"
     awkward.write_text("time, base, a\n0, 1e-3, -2\n0.01, -4.5E+2, 3\n0.02, 0.1, +7.25\n0.03, 12, 1e300\n")
     for path in (fixtures_dir / "supine_random.csv", awkward):
-        fast, _, _ = _read_csv(path)
+        fast, _, _ = read_csv_file(path)
         text = pd.read_csv(path, comment="#", skipinitialspace=True, dtype=str, keep_default_na=False)
         text.columns = [c.strip() for c in text.columns]
         slow = _text_channels(text, path)

@@ -8,8 +8,8 @@ import armaxmodal as am
 from armaxmodal.exceptions import DataError
 from armaxmodal.lumping import lump_check, relative_transmissibility, scalogram, wavelet_coherence
 from armaxmodal.recording import Recording
-from armaxmodal.simulate import add_noise, random_vibration, simulate
 from armaxmodal.study.synthetic import subject_structure
+from armaxmodal.systems.simulation import add_noise, random_vibration, simulate
 
 FS = 60.0
 
@@ -94,7 +94,7 @@ def test_lump_check_refuses_missing_or_identical_segments():
 
 def test_lump_cli_writes_verdict_and_figure(tmp_path, capsys):
     from armaxmodal.cli import main
-    from armaxmodal.io import write_recording_csv
+    from armaxmodal.io.write import write_recording_csv
 
     _, rec = _feet_ride(True)
     data = write_recording_csv(rec, tmp_path / "ride.csv")

@@ -4,10 +4,11 @@ import numpy as np
 import pytest
 
 import armaxmodal as am
-from armaxmodal import datasets
 from armaxmodal.exceptions import DataError
-from armaxmodal.merge import summarise_subjects, supplement_shapes
-from armaxmodal.stabilisation import select_modes, stabilisation_diagram
+from armaxmodal.modes.diagram import stabilisation_diagram
+from armaxmodal.modes.merge import summarise_subjects, supplement_shapes
+from armaxmodal.modes.selection import select_modes
+from armaxmodal.systems import datasets
 
 # Table 3.3 prints four decimals.
 TABLE_ATOL = 0.6e-4

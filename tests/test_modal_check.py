@@ -10,9 +10,10 @@ import pytest
 
 import armaxmodal as am
 from armaxmodal.exceptions import OrderError
-from armaxmodal.modal_check import MODEL_ERROR_LIMIT, ModalCheck, check_modes
+from armaxmodal.modes.diagram import DEFAULT_ORDERS, stabilisation_diagram
+from armaxmodal.modes.modal_check import MODEL_ERROR_LIMIT, ModalCheck, check_modes
+from armaxmodal.modes.selection import select_modes
 from armaxmodal.recording import Recording
-from armaxmodal.stabilisation import DEFAULT_ORDERS, select_modes, stabilisation_diagram
 
 #: the exact modes of the lightly damped ride leave 10 % beyond the H1's random error: the
 #: record (240 s, 8 segments) allows 1.5 lines per half-power bandwidth of the 0.5 %-damped
@@ -88,7 +89,7 @@ def test_the_verdict_is_the_limit_on_every_checked_output():
 
 
 def test_a_cluster_the_support_rule_left_out_enters_when_the_check_needs_it(light_ride):
-    from armaxmodal.stabilisation import _modes_the_check_adds
+    from armaxmodal.modes.completeness import modes_the_check_adds
 
     s, rec = light_ride
     diagram = stabilisation_diagram(rec, range(2, 21, 2), per_sensor=False)
@@ -98,7 +99,7 @@ def test_a_cluster_the_support_rule_left_out_enters_when_the_check_needs_it(ligh
     nas = sorted(o[0] for o in diagram.orders)
     one = sel.modes.iloc[[0]].reset_index(drop=True)
     check = check_modes(rec, one.freq_hz, one.damping)
-    modes, shapes, again = _modes_the_check_adds(diagram, one, sel.shapes[:, [0]], None, nas, check, (0.05, 0.5))
+    modes, shapes, again = modes_the_check_adds(diagram, one, sel.shapes[:, [0]], None, nas, check, (0.05, 0.5))
     np.testing.assert_allclose(modes.freq_hz, truth, rtol=0.01)
     assert shapes.shape == (2, 2) and again.passed
 
@@ -123,7 +124,7 @@ def test_a_mode_where_no_h1_is_coherent_is_unconfirmed_and_fails_the_verdict(lig
     """A mode at 24.8 Hz, at the edge of the ride's band where no output responds
     coherently (as the bridge's 20.7 Hz 'mode' inside a low-coherence band): the fit cannot
     see it, so the check cannot pass it."""
-    from armaxmodal.modal_check import confirmed_modes, measured_lines
+    from armaxmodal.modes.modal_check import confirmed_modes, measured_lines
 
     s, rec = light_ride
     m = s.modes()
@@ -153,7 +154,7 @@ def test_the_five_segment_chain_with_feet_gives_its_five_modes():
 
 
 def test_a_refit_may_move_a_mode_halfway_to_its_neighbour_within_twice_the_cluster_rule():
-    from armaxmodal.stabilisation import _refit_reach
+    from armaxmodal.modes.selected_refit import _refit_reach
 
     far = np.array([8.27, 12.49, 16.08])
     assert _refit_reach(far, 1, 0.05) == pytest.approx(0.10)  # half the gap is 14 %: capped at 10 %
@@ -165,7 +166,7 @@ def test_a_refit_may_move_a_mode_halfway_to_its_neighbour_within_twice_the_clust
 
 
 def test_a_mode_is_confirmed_by_a_coherent_line_within_its_half_width_and_four_lines():
-    from armaxmodal.modal_check import CONFIRM_LINES, ModeSupport, _Spectra, confirmed_modes
+    from armaxmodal.modes.modal_check import CONFIRM_LINES, ModeSupport, _Spectra, confirmed_modes
 
     f = np.arange(1.0, 2.0001, 0.1)  # coherent lines 1.0-2.0 Hz, 0.1 Hz apart
     lines = [_Spectra(f, np.ones(f.size, complex), np.full(f.size, 0.01))]
@@ -200,7 +201,7 @@ def test_real_stiff_one_storey_runs_keep_their_storey_mode_alone(realdata_dir):
     table by about 2.3 samples): the El Centro run once added a 42.9 Hz pole and, judged
     without its neighbour's pole refitted, a 24.4 Hz, 5 %-damped one beside the storey mode.
     Both runs now give the storey mode alone, and the check passes."""
-    from armaxmodal.xsens import read_xsens
+    from armaxmodal.io.xsens import read_xsens
 
     for event in ("elcentro1", "northridge1"):
         files = [str(realdata_dir / "mini_shake_table_imu" / "stiff1" / f"{event}__{s}.csv.gz") for s in ("g", "f1")]

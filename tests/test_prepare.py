@@ -9,10 +9,12 @@ import scipy.stats
 
 import armaxmodal as am
 from armaxmodal.exceptions import DataError
-from armaxmodal.frf import excited_band
-from armaxmodal.prepare import check_band, prepare
-from armaxmodal.quality import check_quality, estimate_delays
-from armaxmodal.stabilisation import select_modes, stabilisation_diagram
+from armaxmodal.modes.diagram import stabilisation_diagram
+from armaxmodal.modes.selection import select_modes
+from armaxmodal.prepare.checks import check_quality
+from armaxmodal.prepare.frf import excited_band
+from armaxmodal.prepare.preparation import check_band, prepare
+from armaxmodal.prepare.quality import estimate_delays
 
 FIXTURES = ["supine_random", "supine_sweep", "supine_random_zoh", "chapter2_random_zoh"]
 # a delay estimate is right when it is within this many samples of the planted one
@@ -254,7 +256,7 @@ def test_a_sensor_offset_jumping_mid_record_is_found_removed_and_the_modes_kept(
 
 @pytest.mark.parametrize("where", [0.1, 0.5, 0.9])
 def test_level_shifts_are_located_and_sized_a_drift_is_not_one(clean, where):
-    from armaxmodal.prepare import level_shifts
+    from armaxmodal.prepare.preparation import level_shifts
 
     x = clean.response[:, 1].copy()
     at = int(where * x.size)
@@ -357,7 +359,7 @@ def test_decimate_equals_scipy_resample_poly_on_the_samples_kept(n, factor):
     on a drifting random walk whose ends differ: the kept samples never see scipy's padding."""
     from scipy.signal import resample_poly
 
-    from armaxmodal.prepare import RESAMPLE_EDGE, decimate
+    from armaxmodal.prepare.preparation import RESAMPLE_EDGE, decimate
 
     rng = np.random.default_rng(n)
     x = rng.standard_normal((n, 3)).cumsum(axis=0) + np.linspace(0.0, 50.0, n)[:, None]
@@ -395,7 +397,7 @@ def test_outputs_that_do_not_respond_to_the_input_are_named(clean):
     estimate's bias (0.07); the clean ride's sensors read 0.78-1.00 and give no warning. When
     no output responds, the message says the modes found are not the structure's (a record of
     pure noise once gave two 'modes' with intervals and no warning)."""
-    from armaxmodal.quality import INCOHERENT, input_coherence
+    from armaxmodal.prepare.quality import INCOHERENT, input_coherence
 
     assert [w for w in check_quality(clean) if w.code == "incoherent_output"] == []
     coherence = input_coherence(clean.base, clean.response, clean.fs)
@@ -447,7 +449,7 @@ def test_an_output_in_other_units_is_measured_named_and_converted(clean, channel
     unit conversion is that near (the prepared record is then the clean one), by the measured
     ratio where two are (mg 101.97 and Gal 100), which leaves the channel within the ratio's
     scatter (2 %) of the clean one."""
-    from armaxmodal.units import UNIT_MATCH, unit_conversion
+    from armaxmodal.prepare.units import UNIT_MATCH, unit_conversion
 
     y = clean.response.copy()
     y[:, channel] *= factor
@@ -546,7 +548,7 @@ def test_a_sensor_that_stopped_updating_is_named_with_its_run(clean):
 def test_a_few_padded_samples_at_the_edges_are_not_a_dropout_but_a_long_dead_end_is(clean):
     """A channel shifted into alignment repeats its first value a few times: padding, not
     reported; the last 60 samples (1 s) frozen are a dead sensor: reported."""
-    from armaxmodal.quality import STUCK_EDGE_MIN
+    from armaxmodal.prepare.quality import STUCK_EDGE_MIN
 
     y = clean.response.copy()
     y[:3, 0] = y[3, 0]
@@ -563,7 +565,7 @@ def test_a_record_sampled_far_above_its_structure_says_so_and_its_advice_finds_t
     structure, so the rate is kept, and the sweep found one of the four modes with nothing
     said. Every mode found lies below 10 % of the Nyquist frequency: 'oversampled' names it
     and the band to use; with that band all four modes are found, within 1.5 %."""
-    from armaxmodal.prepare import oversampling_note
+    from armaxmodal.prepare.preparation import oversampling_note
 
     system = am.supine_human()
     ride = am.random_vibration(1000.0, 15.0, (0.5, 400.0), seed=1)

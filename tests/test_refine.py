@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import armaxmodal as am
-from armaxmodal.frf import excited_band
-from armaxmodal.refine import refine_modes
+from armaxmodal.modes.refine import refine_modes
+from armaxmodal.prepare.frf import excited_band
 
 
 def _start(fixtures_dir, name):
@@ -68,7 +68,7 @@ def test_too_few_lines_for_the_modes_is_a_clear_error(fixtures_dir):
 def test_variable_projection_jacobian_matches_finite_differences(fixtures_dir, hold):
     from scipy.optimize._numdiff import approx_derivative
 
-    from armaxmodal.refine import _SeparableModel
+    from armaxmodal.modes.refine import _SeparableModel
 
     rec = am.read_recording(fixtures_dir / "supine_random.csv")
     dt = 1 / rec.fs
@@ -87,7 +87,7 @@ def test_sandwich_errors_equal_statsmodels_hc1_on_a_linear_regression():
     """White's HC1 covariance of a heteroscedastic linear regression, against statsmodels."""
     import statsmodels.api as sm
 
-    from armaxmodal.refine import _sandwich_sd
+    from armaxmodal.modes.refine import _sandwich_sd
 
     rng = np.random.default_rng(3)
     x = np.column_stack([np.ones(400), rng.standard_normal(400), rng.uniform(0, 3, 400)])

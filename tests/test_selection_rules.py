@@ -1,7 +1,7 @@
 """The stabilisation diagram's rules on small hand-made pole tables: classes between
 consecutive orders, clustering across orders, merging of split modes, the order cap and the
 delay-edge warning, and the refit's hand-over. Each expected value follows from the rule's
-definition in :mod:`armaxmodal.stabilisation`; no fit runs, so these also serve the mutation
+definition in :mod:`armaxmodal.modes.stabilisation`; no fit runs, so these also serve the mutation
 run (mutmut) over that module."""
 
 from __future__ import annotations
@@ -12,17 +12,10 @@ import pytest
 
 import armaxmodal as am
 from armaxmodal.exceptions import OrderError
-from armaxmodal.stabilisation import (
-    SAMPLES_PER_PARAMETER,
-    Tolerances,
-    _apply_refinement,
-    _check_top_order,
-    _classify,
-    _cluster,
-    _merge_duplicates,
-    _nk_edge_warning,
-    _supported,
-)
+from armaxmodal.modes.clusters import _supported, cluster_poles, merge_duplicates
+from armaxmodal.modes.diagram import SAMPLES_PER_PARAMETER, _check_top_order, _nk_edge_warning
+from armaxmodal.modes.poles import Tolerances, stability_classes
+from armaxmodal.modes.selected_refit import _apply_refinement
 
 SHAPE = np.array([1.0 + 0.2j, 0.5 - 0.1j, -0.3 + 0.05j])
 
@@ -46,7 +39,7 @@ def test_classes_follow_frequency_then_damping_then_shape():
             ("shared", 6, 12.3, 0.050, other_shape),  # f 1.6 % off: new
         ]
     )
-    assert _classify(poles, Tolerances()) == ["new", "new", "f+d+v", "f+d", "f", "new"]
+    assert stability_classes(poles, Tolerances()) == ["new", "new", "f+d+v", "f+d", "f", "new"]
 
 
 def test_single_sensor_classes_compare_residue_magnitudes():
@@ -58,7 +51,7 @@ def test_single_sensor_classes_compare_residue_magnitudes():
             ("chest", 2, 5.0, 0.1, [1.0]),  # another source starts its own chain
         ]
     )
-    assert _classify(poles, Tolerances()) == ["new", "f+d+v", "f+d", "new"]
+    assert stability_classes(poles, Tolerances()) == ["new", "f+d+v", "f+d", "new"]
 
 
 def test_clusters_take_one_pole_per_order_within_frequency_and_damping():
@@ -68,13 +61,13 @@ def test_clusters_take_one_pole_per_order_within_frequency_and_damping():
     rows += [("shared", 8, 5.1, 0.10, SHAPE)]  # a second pole near 5 Hz at na = 8: its own cluster
     rows += [("shared", 6, 9.05, 0.05, SHAPE)]  # damping 150 % off the 9 Hz cluster's
     poles = _poles(rows).assign(energy=1.0)
-    clusters = _cluster(poles, [2, 4, 6, 8], 0.05, 0.5)
+    clusters = cluster_poles(poles, [2, 4, 6, 8], 0.05, 0.5)
     sizes = sorted(len(c) for c in clusters)
     assert sizes == [1, 1, 4, 4]
     for c in clusters:
         assert poles.loc[c, "na"].is_unique
     # by frequency alone the odd-damping pole joins nothing new: the 9 Hz cluster has its na = 6 already
-    assert sorted(len(c) for c in _cluster(poles, [2, 4, 6, 8], 0.05, None)) == [1, 1, 4, 4]
+    assert sorted(len(c) for c in cluster_poles(poles, [2, 4, 6, 8], 0.05, None)) == [1, 1, 4, 4]
     assert _supported(3, 7, 0.4) and not _supported(2, 4, 0.4) and not _supported(3, 10, 0.4)
 
 
@@ -88,14 +81,14 @@ def test_split_modes_merge_within_resolution_or_bandwidth_with_alike_shapes():
     other = np.array([1.0, -1.0, 0.3 + 0.0j])
     # 10.00 and 10.15 Hz at 2 % damping (half-power 0.4 Hz): alike shapes merge, unlike stay
     modes = _modes([10.0, 10.15], [0.02, 0.02], [1.0, 0.6])
-    assert _merge_duplicates(modes, [SHAPE, SHAPE * 1j], 0.8, 60.0) == [0]
-    assert _merge_duplicates(modes, [SHAPE, other], 0.8, 60.0) == [0, 1]
+    assert merge_duplicates(modes, [SHAPE, SHAPE * 1j], 0.8, 60.0) == [0]
+    assert merge_duplicates(modes, [SHAPE, other], 0.8, 60.0) == [0, 1]
     # within 2 / T (T = 10 s: 0.2 Hz) nothing tells them apart, whatever the shapes
-    assert _merge_duplicates(modes, [SHAPE, other], 0.8, 10.0) == [0]
+    assert merge_duplicates(modes, [SHAPE, other], 0.8, 10.0) == [0]
     # beyond the bandwidth they are two modes; the weaker survives when it is the first
     far = _modes([10.0, 10.6], [0.02, 0.02], [0.5, 1.0])
-    assert _merge_duplicates(far, [SHAPE, SHAPE], 0.8, 60.0) == [0, 1]
-    assert _merge_duplicates(_modes([10.0, 10.15], [0.02, 0.02], [0.5, 1.0]), [SHAPE, SHAPE], 0.8, 60.0) == [1]
+    assert merge_duplicates(far, [SHAPE, SHAPE], 0.8, 60.0) == [0, 1]
+    assert merge_duplicates(_modes([10.0, 10.15], [0.02, 0.02], [0.5, 1.0]), [SHAPE, SHAPE], 0.8, 60.0) == [1]
 
 
 def _recording(n: int) -> am.Recording:
@@ -153,14 +146,14 @@ def test_refit_is_reported_unless_it_left_the_mode():
 def test_class_rules_at_their_edges():
     # an order's unmatched pole does not stop its later poles from being classed
     poles = _poles([("shared", 2, 5.0, 0.1, SHAPE), ("shared", 4, 9.0, 0.1, SHAPE), ("shared", 4, 5.0, 0.1, SHAPE)])
-    assert _classify(poles, Tolerances()) == ["new", "new", "f+d+v"]
+    assert stability_classes(poles, Tolerances()) == ["new", "new", "f+d+v"]
     # two sensors: the shape test is the MAC (0.5 here), not the first residue's magnitude
     poles = _poles([("shared", 2, 5.0, 0.1, [1.0, 0.0]), ("shared", 4, 5.0, 0.1, [1.0, 1.0])])
-    assert _classify(poles, Tolerances()) == ["new", "f+d"]
+    assert stability_classes(poles, Tolerances()) == ["new", "f+d"]
     # one sensor: the magnitude ratio for residues of any size, within 5 x 0.02 = 10 %
     sizes = [1e-3, 1.05e-3, 1.1655e-3]
     poles = _poles([("head", na, 5.0, 0.1, [r]) for na, r in zip((2, 4, 6), sizes, strict=True)])
-    assert _classify(poles, Tolerances()) == ["new", "f+d+v", "f+d"]  # +5 %, then +11 %
+    assert stability_classes(poles, Tolerances()) == ["new", "f+d+v", "f+d"]  # +5 %, then +11 %
 
 
 def _band_limited(fs: float = 100.0, n: int = 6000) -> am.Recording:
@@ -173,8 +166,8 @@ def _band_limited(fs: float = 100.0, n: int = 6000) -> am.Recording:
 
 
 def test_rejection_reasons_each_at_its_threshold():
-    from armaxmodal.frf import excited_band
-    from armaxmodal.stabilisation import UNRESOLVED_DAMPING, _reject
+    from armaxmodal.modes.poles import UNRESOLVED_DAMPING, rejection_reasons
+    from armaxmodal.prepare.frf import excited_band
 
     rec = _band_limited()
     lo, hi = excited_band(rec)
@@ -201,20 +194,20 @@ def test_rejection_reasons_each_at_its_threshold():
             for f, x, sd, e, _ in rows
         ]
     )
-    assert _reject(poles, Tolerances(), rec) == [r[4] for r in rows]
+    assert rejection_reasons(poles, Tolerances(), rec) == [r[4] for r in rows]
     # a pole table without standard errors: a non-positive damping is plainly negative
     bare = pd.DataFrame([{"source": "shared", "na": 2, "freq_hz": 8.0, "damping": -0.001, "energy": 1.0}])
-    assert _reject(bare, Tolerances(), rec) == ["negative damping"]
+    assert rejection_reasons(bare, Tolerances(), rec) == ["negative damping"]
     # a user's lower frequency limit replaces the 3 / T default; so does a ceiling on energy's ratio
     low = pd.DataFrame([{"source": "shared", "na": 2, "freq_hz": 0.5, "damping": 0.05, "energy": 1.0}])
-    assert _reject(low, Tolerances(min_freq_hz=1.0), rec) == ["near 0 Hz"]
-    assert _reject(low.assign(freq_hz=0.06), Tolerances(), rec) != ["near 0 Hz"]  # 0.06 > 3 / 60 s
+    assert rejection_reasons(low, Tolerances(min_freq_hz=1.0), rec) == ["near 0 Hz"]
+    assert rejection_reasons(low.assign(freq_hz=0.06), Tolerances(), rec) != ["near 0 Hz"]  # 0.06 > 3 / 60 s
 
 
 def test_order_cap_message_names_the_record_the_cause_and_a_supported_range():
     from types import SimpleNamespace
 
-    from armaxmodal.quality import QualityWarning
+    from armaxmodal.notes import QualityWarning
 
     # 1,040 samples: (1040 // 20 - 1 - 6 - 3) // 3 = 14
     with pytest.raises(OrderError, match=r"this record \(1040 samples at 60 Hz\) supports at most na = 14 "):
@@ -248,14 +241,15 @@ def test_delay_edge_warning_says_the_range_and_what_to_do():
 
 
 def test_finite_or_none_keeps_numbers_and_drops_nan_and_inf():
-    from armaxmodal.stabilisation import _finite_or_none
+    from armaxmodal.modes.selection import _finite_or_none
 
     assert _finite_or_none(np.float64(2.5)) == 2.5 and type(_finite_or_none(np.float64(2.5))) is float
     assert _finite_or_none(float("nan")) is None and _finite_or_none(np.inf) is None
 
 
 def test_candidates_are_shared_poles_kept_or_unresolved_inside_the_band():
-    from armaxmodal.stabilisation import UNRESOLVED_DAMPING, _candidates
+    from armaxmodal.modes.clusters import candidate_poles
+    from armaxmodal.modes.poles import UNRESOLVED_DAMPING
 
     poles = pd.DataFrame(
         {
@@ -264,13 +258,13 @@ def test_candidates_are_shared_poles_kept_or_unresolved_inside_the_band():
             "rejected": ["", "", "", "", "over-damped", UNRESOLVED_DAMPING],
         }
     )
-    assert _candidates(poles, None).index.tolist() == [0, 1, 2, 5]
-    assert _candidates(poles, (2.0, 5.0)).index.tolist() == [0, 1, 5]  # band edges included
-    assert _candidates(poles, (3.0, 8.0)).index.tolist() == [1, 2, 5]
+    assert candidate_poles(poles, None).index.tolist() == [0, 1, 2, 5]
+    assert candidate_poles(poles, (2.0, 5.0)).index.tolist() == [0, 1, 5]  # band edges included
+    assert candidate_poles(poles, (3.0, 8.0)).index.tolist() == [1, 2, 5]
 
 
 def test_modes_rank_their_orders_by_bic_then_order():
-    from armaxmodal.stabilisation import _ranked
+    from armaxmodal.modes.clusters import _ranked
 
     poles = pd.DataFrame({"na": [4, 8, 6, 10]})
     assert _ranked(poles, {4: 10.0, 6: -5.0, 8: 3.0, 10: -5.0}) == [6, 10, 8, 4]
@@ -278,7 +272,7 @@ def test_modes_rank_their_orders_by_bic_then_order():
 
 
 def test_mode_row_reports_the_representative_and_the_cluster_medoid_and_spread():
-    from armaxmodal.stabilisation import _mode_row
+    from armaxmodal.modes.clusters import mode_row
 
     sub = pd.DataFrame(
         {
@@ -293,7 +287,7 @@ def test_mode_row_reports_the_representative_and_the_cluster_medoid_and_spread()
         {"na": 6, "freq_hz": 5.021, "damping": 0.0521, "damped_freq_hz": 5.01, "freq_ci95_lo": 5.0,
          "freq_ci95_hi": 5.04, "damping_ci95_lo": 0.045, "damping_ci95_hi": 0.059}
     )  # fmt: skip
-    row = _mode_row(rep, sub, 10)
+    row = mode_row(rep, sub, 10)
     assert row["freq_hz"] == 5.021 and row["damping_ci95_hi"] == 0.059 and row["na"] == 6
     assert (row["count"], row["support"], row["energy"]) == (4, 0.4, 2.5)
     assert row["freq_spread"] == pytest.approx(np.std(sub.freq_hz, ddof=1))
@@ -305,9 +299,9 @@ def test_mode_row_reports_the_representative_and_the_cluster_medoid_and_spread()
         {"na": [2, 4, 6, 8, 10], "freq_hz": [4.79, 4.94, 5.25, 4.73, 5.19],
          "damping": [0.047, 0.063, 0.03, 0.045, 0.033], "damping_sd": 0.066, "energy": 1.0}
     )  # fmt: skip
-    assert _mode_row(rep, wide, 10)["medoid_freq_hz"] == 4.79
+    assert mode_row(rep, wide, 10)["medoid_freq_hz"] == 4.79
     narrow = wide.assign(freq_hz=[5.11, 4.81, 4.94, 4.7, 4.86], damping=[0.047, 0.034, 0.055, 0.045, 0.059])
-    assert _mode_row(rep, narrow.assign(damping_sd=0.002), 10)["medoid_freq_hz"] == 4.7
+    assert mode_row(rep, narrow.assign(damping_sd=0.002), 10)["medoid_freq_hz"] == 4.7
 
 
 def _notes_modes(**overrides):
@@ -318,7 +312,7 @@ def _notes_modes(**overrides):
 
 
 def test_unresolved_damping_notes_state_the_facts_and_the_reason():
-    from armaxmodal.stabilisation import _unresolved_damping_notes
+    from armaxmodal.modes.selection import _unresolved_damping_notes
 
     assert _unresolved_damping_notes(_notes_modes(), 10) == []  # a resolved damping: no note
     (note,) = _unresolved_damping_notes(_notes_modes(damping_ci95_lo=0.0), 10)  # interval reaches zero
@@ -343,7 +337,7 @@ def test_per_sensor_table_and_its_weighted_averages():
     the mode at fewer than half the orders from the mode's own up), and the |M|-weighted means."""
     from types import SimpleNamespace
 
-    from armaxmodal.stabilisation import _per_sensor_table
+    from armaxmodal.modes.per_sensor import per_sensor_table
 
     def replace(ns, **kw):
         return SimpleNamespace(**{**vars(ns), **kw})
@@ -369,7 +363,7 @@ def test_per_sensor_table_and_its_weighted_averages():
     diagram = SimpleNamespace(poles=poles, fits=fits, recording=SimpleNamespace(sensors=("a", "b")))
     modes = pd.DataFrame({"freq_hz": [5.0, 9.0], "na": [4, 4]})
     shapes = np.array([[1.0, 0.5j], [0.2, -1.5]])
-    table, weighted = _per_sensor_table(diagram, modes, shapes, 0.05)
+    table, weighted = per_sensor_table(diagram, modes, shapes, 0.05)
     t = table.set_index(["sensor", "mode"])
     assert t.loc[("a", 1), "freq_hz"] == 5.01 and t.loc[("a", 1), "damping"] == 0.050  # medians of 3
     damped = [5.01 * np.sqrt(1 - 0.05**2), 5.02 * np.sqrt(1 - 0.052**2), 4.99 * np.sqrt(1 - 0.049**2)]
@@ -384,7 +378,7 @@ def test_per_sensor_table_and_its_weighted_averages():
     assert w.loc[2, "freq_hz"] == pytest.approx(8.9) and w.loc[2, "damping"] == pytest.approx(0.022)
     # with a's 9.1 Hz pole at two orders it shows the mode too: the means weigh by |M|
     more = pd.concat([poles, poles.iloc[[4]].assign(na=8, freq_hz=9.12)], ignore_index=True)
-    _, weighted = _per_sensor_table(replace(diagram, poles=more), modes, shapes, 0.05)
+    _, weighted = per_sensor_table(replace(diagram, poles=more), modes, shapes, 0.05)
     w = weighted.set_index("mode")
     assert w.loc[2, "sensors"] == 2
     assert w.loc[2, "freq_hz"] == pytest.approx((0.5 * 9.11 + 1.5 * 8.9) / 2.0)
@@ -394,7 +388,7 @@ def test_per_sensor_table_and_its_weighted_averages():
 def test_finished_pole_takes_the_nearest_finished_estimate_within_five_percent():
     from types import SimpleNamespace
 
-    from armaxmodal.stabilisation import _finished_pole
+    from armaxmodal.modes.clusters import _finished_pole
 
     def pole(freq_hz, damping, **extra):
         mu = np.exp((-damping + 1j) * 2 * np.pi * freq_hz / 100.0)
@@ -413,8 +407,8 @@ def test_finished_pole_takes_the_nearest_finished_estimate_within_five_percent()
 def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_data(monkeypatch):
     from types import SimpleNamespace
 
-    import armaxmodal.stabilisation as st
-    from armaxmodal.frf import excited_band
+    import armaxmodal.modes.selected_refit as st
+    from armaxmodal.prepare.frf import excited_band
 
     rec = _recording(2000)
     lo, hi = excited_band(rec)
@@ -427,26 +421,26 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     monkeypatch.setattr(st, "refine_modes", refit)
     modes, shapes = _modes([5.0, 9.0], [0.1, 0.05], [1.0, 1.0]), np.eye(2, dtype=complex)
     diagram = SimpleNamespace(recording=rec)
-    assert st._refit_band(rec, (4.0, 12.0)) == (max(lo, 4.0), min(hi, 12.0))
-    assert st._refit_band(rec, None) == (lo, hi)
+    assert st.refit_band(rec, (4.0, 12.0)) == (max(lo, 4.0), min(hi, 12.0))
+    assert st.refit_band(rec, None) == (lo, hi)
     hold = "zoh"
-    ref = st._selection_job(rec, [], modes, ("refit", (4.0, 12.0)))
+    ref = st.selection_job(rec, [], modes, ("refit", (4.0, 12.0)))
     assert seen[-1] == (4.0, 12.0) and ref.hold == "zoh"
-    out, out_shapes, kept = st._refined(diagram, modes, shapes, ref, 0.05, 0.5, 0.8)
+    out, out_shapes, kept = st.refined_modes(diagram, modes, shapes, ref, 0.05, 0.5, 0.8)
     assert kept is ref and out is modes and out_shapes is shapes  # a held input: the ARMAX values are reported
 
     def failing(recording, freq_hz, damping, band_hz):
         raise OrderError("too few lines")
 
     monkeypatch.setattr(st, "refine_modes", failing)
-    assert st._selection_job(rec, [], modes, ("refit", (lo, hi))) is None  # the ARMAX values stand
-    out, out_shapes, kept = st._refined(diagram, modes, shapes, None, 0.05, 0.5, 0.8)
+    assert st.selection_job(rec, [], modes, ("refit", (lo, hi))) is None  # the ARMAX values stand
+    out, out_shapes, kept = st.refined_modes(diagram, modes, shapes, None, 0.05, 0.5, 0.8)
     assert kept is None and out is modes and out_shapes is shapes
     monkeypatch.setattr(st, "refine_modes", refit)
     hold = "bandlimited"
     calls = []
     monkeypatch.setattr(st, "_apply_refinement", lambda m, s, r, f, x, relaxed=False: (calls.append((f, x)) or (m, s)))
-    monkeypatch.setattr(st, "_merge_duplicates", lambda m, v, mac, dur: (calls.append((len(v), mac, dur)) or [1]))
-    out, out_shapes, _ = st._refined(diagram, modes, shapes, SimpleNamespace(hold=hold), 0.05, 0.5, 0.8)
+    monkeypatch.setattr(st, "merge_duplicates", lambda m, v, mac, dur: (calls.append((len(v), mac, dur)) or [1]))
+    out, out_shapes, _ = st.refined_modes(diagram, modes, shapes, SimpleNamespace(hold=hold), 0.05, 0.5, 0.8)
     assert calls == [(0.05, 0.5), (2, 0.8, rec.duration)]
     assert out.freq_hz.tolist() == [9.0] and out.index.tolist() == [0] and out_shapes.tolist() == [[0.0], [1.0]]

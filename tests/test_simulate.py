@@ -3,7 +3,7 @@ import pytest
 import scipy.signal
 
 import armaxmodal as am
-from armaxmodal._kernels import _hold_recursion
+from armaxmodal._kernels import hold_recursion
 from armaxmodal.exceptions import DataError
 
 from . import naive
@@ -29,7 +29,7 @@ def test_kernel_matches_naive_reference():
     phi = rng.standard_normal((5, 5)) * 0.3
     gam = rng.standard_normal((5, 4))
     u = rng.standard_normal(403)
-    got = _hold_recursion(phi, gam, u, 400, 4)
+    got = hold_recursion(phi, gam, u, 400, 4)
     ref = naive.hold_recursion(phi, gam, u, 400, 4)
     np.testing.assert_allclose(got, ref, rtol=KERNEL_RTOL, atol=1e-12)
 

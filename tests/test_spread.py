@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 import armaxmodal as am
-from armaxmodal.spread import apply_segment_spread
-from armaxmodal.stabilisation import select_modes, stabilisation_diagram
+from armaxmodal.modes.diagram import stabilisation_diagram
+from armaxmodal.modes.selection import select_modes
+from armaxmodal.modes.spread import apply_segment_spread
 
 FS = 60.0
 # the stiffer half of the changing ride: every spring 12 % stiffer (modes about 6 % higher)

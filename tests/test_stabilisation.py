@@ -7,7 +7,8 @@ import pytest
 import armaxmodal as am
 from armaxmodal.cli import main
 from armaxmodal.exceptions import DataError, OrderError
-from armaxmodal.stabilisation import select_modes, stabilisation_diagram
+from armaxmodal.modes.diagram import stabilisation_diagram
+from armaxmodal.modes.selection import select_modes
 
 # Issue targets for automatic selection with nothing told but the data.
 FREQ_RTOL, DAMPING_RTOL = 0.02, 0.10
@@ -191,12 +192,12 @@ def _crossing_zero(poles: pd.DataFrame, near_hz: float) -> pd.DataFrame:
 def test_a_mode_whose_damping_crosses_zero_is_kept_where_the_frf_shows_its_peak(light_diagram):
     from dataclasses import replace
 
-    from armaxmodal.stabilisation import _reject
+    from armaxmodal.modes.poles import rejection_reasons
 
     s, diagram = light_diagram
     truth = s.modes()
     poles, at = _crossing_zero(diagram.poles, truth.freq_hz[0])
-    poles["rejected"] = _reject(poles, diagram.tolerances, diagram.recording)
+    poles["rejected"] = rejection_reasons(poles, diagram.tolerances, diagram.recording)
     assert (poles.loc[at, "rejected"] == "damping not resolved").sum() == 2  # the two negative ones
     damaged = replace(diagram, poles=poles)
     selection = select_modes(damaged, segments=0)
@@ -206,16 +207,17 @@ def test_a_mode_whose_damping_crosses_zero_is_kept_where_the_frf_shows_its_peak(
     assert note.value == pytest.approx(f[0]) and "not positive at 2 of 10 orders" in note.message
     assert selection.modes.orders_damping_unresolved.tolist() == [2, 0]
     # without the rescue (the old rule: kept poles, relative damping) the mode is lost
-    from armaxmodal.stabilisation import _cluster, _supported
+    from armaxmodal.modes.clusters import _supported, cluster_poles
 
-    old = [c for c in _cluster(poles[poles.rejected == ""], range(2, 21, 2), 0.05, 0.5) if _supported(len(c), 10, 0.4)]
+    kept = poles[poles.rejected == ""]
+    old = [c for c in cluster_poles(kept, range(2, 21, 2), 0.05, 0.5) if _supported(len(c), 10, 0.4)]
     assert all(abs(poles.loc[c, "freq_hz"].median() / truth.freq_hz[0] - 1) > 0.02 for c in old)
 
 
 def test_poles_crossing_zero_without_an_frf_peak_stay_rejected(light_diagram):
     from dataclasses import replace
 
-    from armaxmodal.stabilisation import _reject
+    from armaxmodal.modes.poles import rejection_reasons
 
     s, diagram = light_diagram
     # the same scatter planted at 7 Hz, where neither sensor's FRF has a peak
@@ -225,14 +227,14 @@ def test_poles_crossing_zero_without_an_frf_peak_stay_rejected(light_diagram):
     poles = pd.concat([diagram.poles, fake], ignore_index=True)
     poles, at = _crossing_zero(poles, 7.0)
     assert len(at) == 10
-    poles["rejected"] = _reject(poles, diagram.tolerances, diagram.recording)
+    poles["rejected"] = rejection_reasons(poles, diagram.tolerances, diagram.recording)
     selection = select_modes(replace(diagram, poles=poles), segments=0)
     assert np.allclose(selection.modes.freq_hz, s.modes().freq_hz, rtol=0.005)
     assert not [w for w in selection.warnings if w.code == "damping_unresolved"]
 
 
 def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
-    from armaxmodal.stabilisation import _modes_the_record_needs
+    from armaxmodal.modes.completeness import modes_the_record_needs
 
     s, diagram = light_diagram
     m = s.modes()
@@ -246,7 +248,7 @@ def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
         }
     )
     shapes = np.column_stack([m.modal_constants[:, 0], 0.3 * m.modal_constants[:, 0], m.modal_constants[:, 1]])
-    kept, kept_shapes, notes, check = _modes_the_record_needs(diagram.recording, modes, shapes, None)
+    kept, kept_shapes, notes, check = modes_the_record_needs(diagram.recording, modes, shapes, None)
     assert kept.freq_hz.tolist() == [m.freq_hz[0], m.freq_hz[1]]  # the better-supported one stays
     np.testing.assert_array_equal(kept_shapes, shapes[:, [0, 2]])
     (note,) = notes
@@ -254,7 +256,7 @@ def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
     assert check.passed and check.model_error.max() < 0.15  # the check of what is kept (lightly damped: H1 bias)
     # the true modes alone: nothing to merge
     true = modes.iloc[[0, 2]].reset_index(drop=True)
-    again, _, none, _ = _modes_the_record_needs(diagram.recording, true, shapes[:, [0, 2]], None)
+    again, _, none, _ = modes_the_record_needs(diagram.recording, true, shapes[:, [0, 2]], None)
     assert len(again) == 2 and none == []
 
 
@@ -262,7 +264,7 @@ def test_a_spurious_heavily_damped_neighbour_is_left_out_and_said(light_diagram)
     """A 20 %-damped pole 15 % above a 1 %-damped mode (as measured beside the stiff
     1-storey model's storey mode) is not needed by the FRF once the mode's own pole is
     refitted: left out, as a split of that peak (its half-power band covers the mode)."""
-    from armaxmodal.stabilisation import _modes_the_record_needs
+    from armaxmodal.modes.completeness import modes_the_record_needs
 
     s, diagram = light_diagram
     m = s.modes()
@@ -276,7 +278,7 @@ def test_a_spurious_heavily_damped_neighbour_is_left_out_and_said(light_diagram)
         }
     )
     shapes = np.column_stack([m.modal_constants[:, 0], 0.1 * m.modal_constants[:, 0], m.modal_constants[:, 1]])
-    kept, _, notes, _ = _modes_the_record_needs(diagram.recording, modes, shapes, None)
+    kept, _, notes, _ = modes_the_record_needs(diagram.recording, modes, shapes, None)
     assert kept.freq_hz.tolist() == [m.freq_hz[0], m.freq_hz[1]]
     assert [n.code for n in notes] == ["split_merged"] and notes[0].value == pytest.approx(1.15 * m.freq_hz[0])
 
@@ -288,7 +290,7 @@ def _none_if_nan(v):
 def test_the_json_report_carries_the_selection_as_computed(light_diagram):
     """``ModeSelection.to_dict`` (the stabilise command's JSON contract) field by field
     against the selection it reports: no value renamed, dropped, rounded or NaN."""
-    from armaxmodal.stabilisation import Tolerances
+    from armaxmodal.modes.poles import Tolerances
 
     s, diagram = light_diagram
     sel = select_modes(diagram)
@@ -344,7 +346,7 @@ def test_rescue_rules_each_decide(light_diagram):
     a positive estimate, and the FRF shows a coherent peak inside the band."""
     from types import SimpleNamespace
 
-    from armaxmodal.stabilisation import _rescued_clusters
+    from armaxmodal.modes.clusters import _rescued_clusters
 
     s, diagram = light_diagram
     f1, f2 = s.modes().freq_hz
@@ -385,8 +387,8 @@ def test_the_delay_and_order_choices_do_not_depend_on_the_data_unit(fixtures_dir
     delay choice's rework (issue 29), judged by the modes it gives."""
     from dataclasses import replace
 
-    from armaxmodal.orders import choose_orders
-    from armaxmodal.stabilisation import choose_nk
+    from armaxmodal.estimate.orders import choose_orders
+    from armaxmodal.modes.diagram import choose_nk
 
     rec = am.read_recording(fixtures_dir / "supine_random.csv")
     scaled = [replace(rec, base=rec.base * s, response=rec.response * s) for s in (1.0, 100.0, 1e-3)]

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 import armaxmodal as am
-from armaxmodal import datasets
 from armaxmodal.exceptions import StructureError
+from armaxmodal.systems import datasets
 
 # Table 2.1 prints two decimals: agreement after rounding is exact.
 TABLE_2_1_DECIMALS = 2

@@ -282,7 +282,7 @@ def test_a_folder_study_takes_subjects_from_the_files_and_notes_a_mixed_rate(stu
     from scipy.signal import resample_poly
 
     import armaxmodal as am
-    from armaxmodal.io import write_recording_csv
+    from armaxmodal.io.write import write_recording_csv
 
     folder, _ = study_dir
     rides = tmp_path / "rides"

@@ -12,18 +12,11 @@ import pandas as pd
 import pytest
 
 import armaxmodal as am
-from armaxmodal.orders import default_nb, default_nc, information_criterion
+from armaxmodal.estimate.orders import default_nb, default_nc, information_criterion
+from armaxmodal.modes.diagram import NK_SEARCH, SWEEP_TOL, _job_cost, choose_nk, stabilisation_diagram, sweep_fit
+from armaxmodal.modes.poles import SHARED
+from armaxmodal.modes.selection import select_modes
 from armaxmodal.recording import Recording
-from armaxmodal.stabilisation import (
-    NK_SEARCH,
-    SHARED,
-    SWEEP_TOL,
-    _fit_job,
-    _job_cost,
-    choose_nk,
-    select_modes,
-    stabilisation_diagram,
-)
 
 ORDERS = range(2, 11, 2)
 PER_SENSOR_MAX = 6
@@ -105,7 +98,7 @@ def test_the_sweep_continues_the_delay_choice_fits_exactly(ride):
     (after at most 8 iterations); continued in the sweep, each is the fit the sweep would
     have made from the start (to rounding, :func:`_same_fit`)."""
     from armaxmodal._threads import one_blas_thread
-    from armaxmodal.stabilisation import _choose_nk
+    from armaxmodal.modes.diagram import _choose_nk
 
     rec = ride[1]
     with one_blas_thread():
@@ -113,7 +106,7 @@ def test_the_sweep_continues_the_delay_choice_fits_exactly(ride):
         assert nk == 0
         assert sorted(checkpoints) == [(SHARED, (na, default_nb(na, nk), default_nc(na), nk)) for na in (4, 6)]
         for job, checkpoint in checkpoints.items():
-            continued = _fit_job(rec, job + (checkpoint,), 30, SWEEP_TOL)[0]
+            continued = sweep_fit(rec, job + (checkpoint,), 30, SWEEP_TOL)[0]
             fresh = am.fit_armax(
                 rec, *job[1], shared_poles=True, max_iter=30, tol=SWEEP_TOL, stop="decrease", warn=False
             )
@@ -137,15 +130,15 @@ def test_a_fit_stopped_by_its_cap_continues_exactly(ride, na, cap, stop, where):
     (:func:`_same_fit`): the damping, the crawl count and the variances weighting the run
     are all carried over."""
     from armaxmodal._threads import one_blas_thread
-    from armaxmodal.fit import _fit
+    from armaxmodal.estimate.fit import fit_resumable
 
     rec = ride[1]
     options = {"shared_poles": True, "tol": SWEEP_TOL if stop == "decrease" else 1e-9, "stop": stop, "warn": False}
     orders = (na, default_nb(na, -1), default_nc(na), -1)
     with one_blas_thread():
-        short, checkpoint = _fit(rec, orders, max_iter=cap, covariance=False, **options)
-        fresh = _fit(rec, orders, max_iter=30, **options)[0]
-        continued = _fit(rec, orders, max_iter=30, resume=checkpoint, **options)[0]
+        short, checkpoint = fit_resumable(rec, orders, max_iter=cap, covariance=False, **options)
+        fresh = fit_resumable(rec, orders, max_iter=30, **options)[0]
+        continued = fit_resumable(rec, orders, max_iter=30, resume=checkpoint, **options)[0]
     progress = checkpoint.progress
     kind = "converged" if checkpoint.converged else "between runs" if progress is None else "mid-run"
     if progress is not None and progress.crawling:
@@ -242,17 +235,17 @@ def test_the_segment_spread_is_that_of_refits_on_thirds(diagram):
 def test_one_sweep_job_fits_its_own_source(diagram):
     rec = diagram.recording
     orders = diagram.orders[1]
-    single, no_checkpoint = _fit_job(rec, (rec.sensors[1], orders), 30, SWEEP_TOL)
+    single, no_checkpoint = sweep_fit(rec, (rec.sensors[1], orders), 30, SWEEP_TOL)
     assert no_checkpoint is None  # only shared-pole fits are continued
     alone = am.fit_armax(rec.select([rec.sensors[1]]), *orders, max_iter=30, tol=SWEEP_TOL, stop="decrease")
     assert not single.shared_poles and len(single.models) == 1
     np.testing.assert_allclose(single.models[0].a, alone.models[0].a, rtol=1e-9, atol=1e-12)
-    shared, checkpoint = _fit_job(rec, (SHARED, orders), 30, SWEEP_TOL)
+    shared, checkpoint = sweep_fit(rec, (SHARED, orders), 30, SWEEP_TOL)
     assert shared.shared_poles and len(shared.models) == len(rec.sensors)
     assert checkpoint.iterations <= shared.iterations[0]
     assert np.array_equal(checkpoint.theta[: orders[0]], shared.models[0].a[1:])
     # orders the record cannot carry are skipped, not raised
-    assert _fit_job(rec, (SHARED, (400, 401, 400, 0)), 30, SWEEP_TOL) == (None, None)
+    assert sweep_fit(rec, (SHARED, (400, 401, 400, 0)), 30, SWEEP_TOL) == (None, None)
 
 
 def test_job_cost_scales_with_order_and_sensors():
@@ -387,8 +380,8 @@ def test_the_frf_axis_spans_the_curves_inside_the_input_band():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from armaxmodal.frf import excited_band, measured_frf
-    from armaxmodal.plot import _limit_frf_axis
+    from armaxmodal.modes.plot import _limit_frf_axis
+    from armaxmodal.prepare.frf import excited_band, measured_frf
 
     s, _ = _two_mode_ride(30.0)
     ride = am.simulate_recording(s, am.random_vibration(50.0, 30.0, (0.5, 16.0), seed=3), 50.0, noise=0.05, seed=4)
@@ -409,7 +402,7 @@ def test_the_frf_axis_spans_the_curves_inside_the_input_band():
 def test_a_sweep_capped_below_the_delay_choice_fits_its_orders_afresh(ride):
     """The delay choice's fits ran DELAY_CHOICE_ITERATIONS iterations; a sweep capped lower
     must not take them over (they would exceed its cap): every fit respects the sweep's cap."""
-    from armaxmodal.stabilisation import DELAY_CHOICE_ITERATIONS
+    from armaxmodal.modes.diagram import DELAY_CHOICE_ITERATIONS
 
     cap = 2
     assert cap < DELAY_CHOICE_ITERATIONS
@@ -443,7 +436,7 @@ def test_a_line_the_input_does_not_drive_is_named_as_a_periodic_disturbance(ride
 def test_a_structure_damped_below_the_line_threshold_is_not_a_disturbance():
     """Modes at 0.066 % and 0.089 % damping are as undamped as a hum, but the input drives
     them (residues 11 % and 100 % of the strongest): modes, never a periodic disturbance."""
-    from armaxmodal.disturbance import UNDAMPED_LINE
+    from armaxmodal.prepare.disturbance import UNDAMPED_LINE
 
     s = am.Structure.from_chain([10.0, 5.0], [8000.0, 0.0], [0.5, 0.0], [12000.0], [0.3], ("m1", "m2"))
     assert max(s.modes().damping) < UNDAMPED_LINE

@@ -8,7 +8,7 @@ import pytest
 
 from armaxmodal.cli import main
 from armaxmodal.exceptions import DataError
-from armaxmodal.xsens import read_xsens
+from armaxmodal.io.xsens import read_xsens
 
 STEP_US = 8333
 META = "sep=,\nDeviceTag:,Xsens DOT\nFirmwareVersion:,3.0.0\nAppVersion:,2023.6.0\nStartTime: ,x\n© Movella\n\n"

@@ -13,13 +13,13 @@ Acronyms: EVPHC, eigenvector phase correction (the thesis's method); PIA, Pilkey
 algorithm; EPFRF, equivalent point frequency response function.
 """
 
-from .evphc import evphc
-from .inner import inner_solve
-from .pia import pia
-from .result import InverseSolution
-from .sdp import inner_solve_sdp
-from .update import model_update, weight_sweep
-from .validate import predict_recording, scale_to_subject
+from armaxmodal.inverse.evphc import evphc
+from armaxmodal.inverse.inner import inner_solve
+from armaxmodal.inverse.pia import pia
+from armaxmodal.inverse.result import InverseSolution
+from armaxmodal.inverse.sdp import inner_solve_sdp
+from armaxmodal.inverse.update import model_update, weight_sweep
+from armaxmodal.inverse.validate import predict_recording, scale_to_subject
 
 __all__ = [
     "InverseSolution",

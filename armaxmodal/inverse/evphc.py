@@ -19,10 +19,10 @@ import time
 import numpy as np
 import scipy.optimize
 
-from ..exceptions import StructureError
-from ._modal_data import check_modes
-from .inner import inner_solve
-from .result import InverseSolution
+from armaxmodal.exceptions import StructureError
+from armaxmodal.inverse.inner import inner_solve
+from armaxmodal.inverse.modal_data import check_modes
+from armaxmodal.inverse.result import InverseSolution
 
 
 def evphc(

@@ -17,10 +17,10 @@ import time
 import numpy as np
 import scipy.optimize
 
-from ..exceptions import StructureError
-from ..structure import Structure
-from ._modal_data import check_modes
-from .result import InverseSolution
+from armaxmodal.exceptions import StructureError
+from armaxmodal.inverse.modal_data import check_modes
+from armaxmodal.inverse.result import InverseSolution
+from armaxmodal.systems.structure import Structure
 
 # Relative residual of the eigen-equations above which the topology is flagged: a chain's own
 # modes stay below 0.05 even with 20 % eigenvector noise; a non-chain's modes give about 0.2.
@@ -49,7 +49,7 @@ def _design(lam: np.ndarray, psi: np.ndarray) -> np.ndarray:
     return np.vstack(rows)
 
 
-def _mass_bounds(n: int, mass_ratio_bounds) -> tuple[np.ndarray, np.ndarray]:
+def mass_bounds(n: int, mass_ratio_bounds) -> tuple[np.ndarray, np.ndarray]:
     lo, hi = np.zeros(n), np.full(n, np.inf)
     lo[0] = hi[0] = 1.0
     if mass_ratio_bounds is not None:
@@ -107,7 +107,7 @@ def inner_solve(
     w_ref = 2 * np.pi * reference_hz if reference_hz else float(np.exp(np.mean(np.log(np.abs(lam)))))
     a = _design(lam / w_ref, psi)
     a_real = np.vstack([a.real, a.imag])
-    lo, hi = _mass_bounds(n, mass_ratio_bounds)
+    lo, hi = mass_bounds(n, mass_ratio_bounds)
     free = np.arange(1, a_real.shape[1])
     lb = np.r_[lo[1:], np.zeros(a_real.shape[1] - n)]
     ub = np.r_[hi[1:], np.full(a_real.shape[1] - n, np.inf)]

@@ -13,10 +13,10 @@ import time
 
 import numpy as np
 
-from ..exceptions import StructureError
-from ..structure import Structure
-from ._modal_data import check_modes
-from .result import InverseSolution
+from armaxmodal.exceptions import StructureError
+from armaxmodal.inverse.modal_data import check_modes
+from armaxmodal.inverse.result import InverseSolution
+from armaxmodal.systems.structure import Structure
 
 
 def pia(eigenvalues, shapes, mass, *, tol: float = 1e-4, max_iter: int = 500, names=None) -> InverseSolution:

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import pandas as pd
 
-from ..structure import ChainComponents, ExactModes, Structure
+from armaxmodal.systems.structure import ChainComponents, ExactModes, Structure
 
 
 @dataclass(frozen=True)

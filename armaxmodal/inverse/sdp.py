@@ -20,11 +20,11 @@ import time
 import numpy as np
 import scipy.sparse
 
-from ..exceptions import StructureError
-from ..structure import Structure
-from ._modal_data import check_modes
-from .inner import _mass_bounds
-from .result import InverseSolution
+from armaxmodal.exceptions import StructureError
+from armaxmodal.inverse.inner import mass_bounds
+from armaxmodal.inverse.modal_data import check_modes
+from armaxmodal.inverse.result import InverseSolution
+from armaxmodal.systems.structure import Structure
 
 
 def _svec_rows(n: int, entries: list[tuple[int, int]], offset: int, n_var: int) -> scipy.sparse.csc_matrix:
@@ -98,24 +98,69 @@ def inner_solve_sdp(
     n = psi.shape[0]
     psi = psi / np.linalg.norm(psi, axis=0)
     w_ref = float(np.exp(np.mean(np.log(np.abs(lam)))))  # non-dimensionalise by a reference frequency
+    entries = _coupled_entries(n, pattern)
+    design = _design(lam / w_ref, psi, entries)
+    a, b_vec, n_zero, n_nonneg = _conic_constraints(n, entries, mass_ratio_bounds, design, thesis_t)
+    cones = [clarabel.NonnegativeConeT(n_nonneg), clarabel.PSDTriangleConeT(n), clarabel.PSDTriangleConeT(n)]
+    if n_zero:
+        cones.insert(0, clarabel.ZeroConeT(n_zero))
+    n_var = design.shape[1]
+    if thesis_t is None:  # minimise |D x|^2 = x^T (D^T D) x; Clarabel minimises x^T P x / 2 + q^T x
+        p_mat, q = 2.0 * design.T @ design, np.zeros(n_var)
+    else:  # minimise (m1 - 1)^2
+        p_mat, q = np.zeros((n_var, n_var)), np.zeros(n_var)
+        p_mat[0, 0], q[0] = 2.0, -2.0
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    solution = clarabel.DefaultSolver(
+        scipy.sparse.triu(scipy.sparse.csc_matrix(p_mat)).tocsc(), q, a, b_vec, cones, settings
+    ).solve()
+    status = str(solution.status)
+    if status not in ("Solved", "AlmostSolved"):
+        raise StructureError(f"the semi-definite inner problem ended as {status}: no model with this pattern fits.")
+    x = np.asarray(solution.x)
+    s = _structure(x, entries, n, w_ref, total_mass, m1, names)
+    try:
+        comps = s.chain_components()
+    except StructureError:
+        comps = None  # another coupling pattern: the matrices are the result (see Returns)
+    flags = ["solver reported an inaccurate optimum"] if status == "AlmostSolved" else []
+    return InverseSolution(
+        s,
+        comps,
+        s.modes(),
+        {"eigen_residual": float(np.linalg.norm(design @ x))},
+        "inner_solve_sdp" if thesis_t is None else "thesis_compat",
+        int(solution.iterations),
+        time.perf_counter() - start,
+        True,
+        flags,
+    )
+
+
+def _coupled_entries(n: int, pattern) -> list[tuple[int, int]]:
+    """The upper-triangle entries ``(i, j)`` of C and K that may be non-zero (a chain by default)."""
     allowed = np.eye(n, dtype=bool) | (np.abs(np.subtract.outer(np.arange(n), np.arange(n))) == 1)
     if pattern is not None:
         allowed = np.asarray(pattern, dtype=bool)
         if allowed.shape != (n, n) or not np.array_equal(allowed, allowed.T):
             raise StructureError(f"pattern: expected a symmetric ({n}, {n}) boolean matrix.")
         allowed = allowed | np.eye(n, dtype=bool)
-    entries = [(i, j) for j in range(n) for i in range(j + 1) if allowed[i, j]]
+    return [(i, j) for j in range(n) for i in range(j + 1) if allowed[i, j]]
+
+
+def _conic_constraints(n: int, entries, mass_ratio_bounds, design: np.ndarray, thesis_t) -> tuple:
+    """``(A, b, zero rows, non-negative rows)`` of ``A x + s = b``, ``s`` in the zero cone
+    (m1 = 1), the non-negative cone (masses, bounds, coupling signs, the printed form's
+    tolerance) and two PSD cones (C and K, K >= 1e-9 I), rows grouped by cone."""
     n_e = len(entries)
     n_var = n + 2 * n_e
-    design = _design(lam / w_ref, psi, entries)
-
-    # constraints A x + s = b, s in the cone; rows grouped by cone
     eye = np.eye(n_var)
     zero_rows, zero_b = ([eye[0]], [1.0]) if thesis_t is None else ([], [])  # m1 = 1 fixes the scale
     nonneg_rows, nonneg_b = [], []
     nonneg_rows += [-eye[i] for i in range(n)]  # masses >= 0
     nonneg_b += [0.0] * n
-    lo, hi = _mass_bounds(n, mass_ratio_bounds)  # validated as for the chain solve
+    lo, hi = mass_bounds(n, mass_ratio_bounds)  # validated as for the chain solve
     for i in range(1, n):
         if lo[i] > 0:
             nonneg_rows.append(-eye[i])
@@ -142,43 +187,16 @@ def inner_solve_sdp(
         ]
     ).tocsc()
     b_vec = np.r_[zero_b, nonneg_b, np.zeros(svec_c.shape[0]), -1e-9 * svec_eye]  # K >= 1e-9 I
-    cones = [clarabel.NonnegativeConeT(len(nonneg_b)), clarabel.PSDTriangleConeT(n), clarabel.PSDTriangleConeT(n)]
-    if zero_b:
-        cones.insert(0, clarabel.ZeroConeT(len(zero_b)))
-    if thesis_t is None:  # minimise |D x|^2 = x^T (D^T D) x; Clarabel minimises x^T P x / 2 + q^T x
-        p_mat, q = 2.0 * design.T @ design, np.zeros(n_var)
-    else:  # minimise (m1 - 1)^2
-        p_mat, q = np.zeros((n_var, n_var)), np.zeros(n_var)
-        p_mat[0, 0], q[0] = 2.0, -2.0
-    settings = clarabel.DefaultSettings()
-    settings.verbose = False
-    solution = clarabel.DefaultSolver(
-        scipy.sparse.triu(scipy.sparse.csc_matrix(p_mat)).tocsc(), q, a, b_vec, cones, settings
-    ).solve()
-    status = str(solution.status)
-    if status not in ("Solved", "AlmostSolved"):
-        raise StructureError(f"the semi-definite inner problem ended as {status}: no model with this pattern fits.")
-    x = np.asarray(solution.x)
+    return a, b_vec, len(zero_b), len(nonneg_b)
+
+
+def _structure(x: np.ndarray, entries, n: int, w_ref: float, total_mass, m1, names) -> Structure:
+    """The structure of the solution ``x`` in physical units, at the mass scale."""
+    n_e = len(entries)
     mm = x[:n]
     cc, kk = np.zeros((n, n)), np.zeros((n, n))
     for v, (i, j) in enumerate(entries):
         cc[i, j] = cc[j, i] = x[n + v] * w_ref
         kk[i, j] = kk[j, i] = x[n + n_e + v] * w_ref**2
     scale = total_mass / mm.sum() if total_mass is not None else (m1 if m1 is not None else 1.0) / mm[0]
-    s = Structure(np.diag(mm * scale), cc * scale, kk * scale, tuple(names or ()))
-    try:
-        comps = s.chain_components()
-    except StructureError:
-        comps = None
-    flags = ["solver reported an inaccurate optimum"] if status == "AlmostSolved" else []
-    return InverseSolution(
-        s,
-        comps,
-        s.modes(),
-        {"eigen_residual": float(np.linalg.norm(design @ x))},
-        "inner_solve_sdp" if thesis_t is None else "thesis_compat",
-        int(solution.iterations),
-        time.perf_counter() - start,
-        True,
-        flags,
-    )
+    return Structure(np.diag(mm * scale), cc * scale, kk * scale, tuple(names or ()))

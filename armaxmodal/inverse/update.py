@@ -17,15 +17,16 @@ or the total mass). Started from :func:`inner_solve` unless a start is given.
 from __future__ import annotations
 
 import time
+from functools import partial
 
 import numpy as np
 import scipy.optimize
 
-from ..exceptions import StructureError
-from ..structure import ChainComponents, Structure
-from ._modal_data import check_modes
-from .inner import inner_solve
-from .result import InverseSolution
+from armaxmodal.exceptions import StructureError
+from armaxmodal.inverse.inner import inner_solve
+from armaxmodal.inverse.modal_data import check_modes
+from armaxmodal.inverse.result import InverseSolution
+from armaxmodal.systems.structure import ChainComponents, Structure
 
 DEFAULT_SIGMA = {"freq": 0.01, "damping": 0.05, "shape": 0.05, "frf": 0.05}
 
@@ -85,7 +86,7 @@ def model_update(
         Noise levels, all relative standard deviations: ``freq``, ``damping`` (scalars or one
         per mode), ``shape`` (of each shape component, complex rms) and ``frf`` (of each
         transmissibility value, complex rms; a scalar or an array shaped like T, e.g. from the
-        coherence, see :func:`armaxmodal.frf.h1_relative_error`). Defaults: 1 %, 5 %, 5 %, 5 %.
+        coherence, see :func:`armaxmodal.prepare.frf.h1_relative_error`). Defaults: 1 %, 5 %, 5 %, 5 %.
     shape_magnitude_only, frf_magnitude_only : bool
         Use magnitudes only for that block (phases not trusted).
     mass_ratio_bounds, m1, total_mass, names
@@ -95,6 +96,45 @@ def model_update(
     """
     t_start = time.perf_counter()
     sig = {**DEFAULT_SIGMA, **(sigma or {})}
+    lam, psi = _checked_data(eigenvalues, shapes, frf)
+    if start is None:
+        if lam is None:
+            raise StructureError("without modal data give a start model (start=...).")
+        start = inner_solve(lam, psi, mass_ratio_bounds=mass_ratio_bounds, m1=1.0, names=names)
+    comps = start.components
+    if comps is None:
+        raise StructureError("the start model is not a chain; start from inner_solve or a chain.")
+    n = comps.masses.size
+    x0, scale, lo, hi = _parameters(comps, mass_ratio_bounds)
+    build = partial(_chain, scale=scale, n=n, names=names)
+
+    def residual(z):
+        return _residual(build(z), lam, psi, frf, sig, shape_magnitude_only, frf_magnitude_only)
+
+    z0 = np.clip(x0 / scale, lo, hi)
+    res = scipy.optimize.least_squares(
+        residual, z0, bounds=(lo, hi), method="trf", x_scale=1.0, xtol=1e-14, ftol=1e-14, gtol=1e-14, max_nfev=max_nfev
+    )
+    s = build(res.x)
+    mass_scale = total_mass / s.masses.sum() if total_mass is not None else (m1 if m1 is not None else 1.0)
+    s = _scaled(s, mass_scale, names)
+    std = _component_std(res, scale, n, total_mass, mass_scale, s.chain_components())
+    return InverseSolution(
+        s,
+        s.chain_components(),
+        s.modes(),
+        {"weighted_rms": float(np.sqrt(np.mean(res.fun**2)))},
+        "model_update",
+        int(res.nfev),
+        time.perf_counter() - t_start,
+        bool(res.success),
+        _flags(res, n),
+        std,
+    )
+
+
+def _checked_data(eigenvalues, shapes, frf) -> tuple:
+    """``(lam, psi)``, None without modal data; refused when no block can be fitted."""
     if eigenvalues is None and frf is None:
         raise StructureError("model_update needs modal data (eigenvalues, shapes) or a transmissibility (frf).")
     lam = psi = None
@@ -108,13 +148,12 @@ def model_update(
                 f"{label}: a value is exactly zero; their noise is modelled as relative, so a zero (a "
                 "missing or dead channel) cannot be fitted. Drop that sensor or fill the gap first."
             )
-    if start is None:
-        if lam is None:
-            raise StructureError("without modal data give a start model (start=...).")
-        start = inner_solve(lam, psi, mass_ratio_bounds=mass_ratio_bounds, m1=1.0, names=names)
-    comps = start.components
-    if comps is None:
-        raise StructureError("the start model is not a chain; start from inner_solve or a chain.")
+    return lam, psi
+
+
+def _parameters(comps: ChainComponents, mass_ratio_bounds) -> tuple:
+    """The start ``x0`` (first mass = 1: mass ratios, dampers, springs), each parameter's
+    ``scale`` and the bounds ``lo``, ``hi`` in the optimiser's units (start values)."""
     n = comps.masses.size
     x0 = np.r_[comps.masses[1:], comps.c, comps.c_s, comps.k, comps.k_s] / comps.masses[0]
     kinds = np.r_[np.zeros(n - 1), np.ones(n), np.ones(n - 1), 2 * np.ones(n), 2 * np.ones(n - 1)]
@@ -127,46 +166,46 @@ def model_update(
         b = np.asarray(mass_ratio_bounds, dtype=float)
         lo[: n - 1], hi[: n - 1] = b[:, 0], b[:, 1]
     lo[kinds == 2] = 1e-9 * scale[kinds == 2]  # a spring must keep K positive definite
-    lo, hi = lo / scale, hi / scale  # ... and in the optimiser's units (start values)
+    return x0, scale, lo / scale, hi / scale  # ... and in the optimiser's units (start values)
 
-    def build(z):
-        v = z * scale
-        return Structure.from_chain(
-            np.r_[1.0, v[: n - 1]],
-            v[3 * n - 2 : 4 * n - 2],
-            v[n - 1 : 2 * n - 1],
-            v[4 * n - 2 :],
-            v[2 * n - 1 : 3 * n - 2],
-            names,
-        )
 
-    def residual(z):
-        s = build(z)
-        parts = []
-        if lam is not None:
-            model = s.modes()
-            f_meas, x_meas = np.abs(lam) / (2 * np.pi), -lam.real / np.abs(lam)
-            idx = [int(np.argmin(np.abs(model.freq_hz - f))) for f in f_meas]
-            parts.append((model.freq_hz[idx] - f_meas) / (sig["freq"] * f_meas))
-            parts.append((model.damping[idx] - x_meas) / (sig["damping"] * x_meas))
-            for r, i in enumerate(idx):
-                parts += _shape_residual(psi[:, r], model.shapes[:, i], sig["shape"], shape_magnitude_only)
-        if frf is not None:
-            f, t_meas = frf
-            t_mod = s.transmissibility(f)
-            parts += _log_ratio(t_meas, t_mod, sig["frf"], frf_magnitude_only)
-        return np.concatenate(parts)
-
-    z0 = np.clip(x0 / scale, lo, hi)
-    res = scipy.optimize.least_squares(
-        residual, z0, bounds=(lo, hi), method="trf", x_scale=1.0, xtol=1e-14, ftol=1e-14, gtol=1e-14, max_nfev=max_nfev
+def _chain(z, scale, n, names) -> Structure:
+    """The chain of the optimiser's parameters ``z`` (first mass 1)."""
+    v = z * scale
+    return Structure.from_chain(
+        np.r_[1.0, v[: n - 1]],
+        v[3 * n - 2 : 4 * n - 2],
+        v[n - 1 : 2 * n - 1],
+        v[4 * n - 2 :],
+        v[2 * n - 1 : 3 * n - 2],
+        names,
     )
-    s = build(res.x)
-    mass_scale = total_mass / s.masses.sum() if total_mass is not None else (m1 if m1 is not None else 1.0)
+
+
+def _residual(s: Structure, lam, psi, frf, sig, shape_magnitude_only, frf_magnitude_only) -> np.ndarray:
+    """Every block's misfit in units of its noise: frequencies, damping, shapes, transmissibility."""
+    parts = []
+    if lam is not None:
+        model = s.modes()
+        f_meas, x_meas = np.abs(lam) / (2 * np.pi), -lam.real / np.abs(lam)
+        idx = [int(np.argmin(np.abs(model.freq_hz - f))) for f in f_meas]
+        parts.append((model.freq_hz[idx] - f_meas) / (sig["freq"] * f_meas))
+        parts.append((model.damping[idx] - x_meas) / (sig["damping"] * x_meas))
+        for r, i in enumerate(idx):
+            parts += _shape_residual(psi[:, r], model.shapes[:, i], sig["shape"], shape_magnitude_only)
+    if frf is not None:
+        f, t_meas = frf
+        t_mod = s.transmissibility(f)
+        parts += _log_ratio(t_meas, t_mod, sig["frf"], frf_magnitude_only)
+    return np.concatenate(parts)
+
+
+def _scaled(s: Structure, mass_scale: float, names) -> Structure:
+    """The fitted chain (first mass 1) at the mass scale."""
     comps = s.chain_components()
     # components read back from C and K carry round-off (seen: a damper of -9e-14 N s/m where
     # the optimiser's bound is 0); the bounds are exact, so clip to them
-    s = Structure.from_chain(
+    return Structure.from_chain(
         comps.masses * mass_scale,
         np.maximum(comps.k, 0.0) * mass_scale,
         np.maximum(comps.c, 0.0) * mass_scale,
@@ -174,7 +213,10 @@ def model_update(
         np.maximum(comps.c_s, 0.0) * mass_scale,
         names,
     )
-    std = _component_std(res, scale, n, total_mass, mass_scale, s.chain_components())
+
+
+def _flags(res, n: int) -> list[str]:
+    """What the user must know about the fit: stopped early, blocks in disagreement, values at a bound."""
     flags = [] if res.success else [f"model updating stopped: {res.message}"]
     dof = max(res.fun.size - int(np.sum(res.active_mask == 0)), 1)
     if np.sum(res.fun**2) / dof > 2.0:
@@ -192,18 +234,7 @@ def model_update(
     at_bound = [lab for lab, a in zip(labels, res.active_mask, strict=True) if a != 0]
     if at_bound:
         flags.append(f"at a bound: {', '.join(at_bound)} (a component at zero or a mass ratio at its limit)")
-    return InverseSolution(
-        s,
-        s.chain_components(),
-        s.modes(),
-        {"weighted_rms": float(np.sqrt(np.mean(res.fun**2)))},
-        "model_update",
-        int(res.nfev),
-        time.perf_counter() - t_start,
-        bool(res.success),
-        flags,
-        std,
-    )
+    return flags
 
 
 def _component_std(res, scale, n, total_mass, mass_scale, comps: ChainComponents) -> ChainComponents:

@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..exceptions import DataError
-from ..recording import Recording
-from ..simulate import simulate
-from ..structure import Structure
+from armaxmodal.exceptions import DataError
+from armaxmodal.recording import Recording
+from armaxmodal.systems.simulation import simulate
+from armaxmodal.systems.structure import Structure
 
 
 def scale_to_subject(structure: Structure, mass_kg: float) -> Structure:

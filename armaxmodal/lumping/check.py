@@ -12,10 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..exceptions import DataError
-from ..frf import excited_band, welch_spectra
-from ..recording import Recording
-from .wavelet import WaveletCoherence, scalogram, wavelet_coherence
+from armaxmodal.exceptions import DataError
+from armaxmodal.lumping.wavelet import WaveletCoherence, scalogram, wavelet_coherence
+from armaxmodal.prepare.frf import excited_band, welch_spectra
+from armaxmodal.recording import Recording
 
 __all__ = ["LumpCheck", "lump_check", "relative_transmissibility", "LIMITS"]
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .check import LIMITS, LumpCheck
+from armaxmodal.lumping.check import LIMITS, LumpCheck
 
 __all__ = ["plot_lump"]
 

@@ -8,12 +8,12 @@ Chapter 3 tables and figures, and a self-contained HTML report.
 * :func:`make_study` -- a synthetic study with known truth (15 subjects x 2 rides).
 """
 
-from .job import StudySettings, analyse_recording
-from .manifest import Entry, read_manifest
-from .output import write_study
-from .run import Study, run_study
-from .synthetic import make_study
-from .tables import StudyTables, build_tables, match_modes
+from armaxmodal.study.job import StudySettings, analyse_recording
+from armaxmodal.study.manifest import Entry, read_manifest
+from armaxmodal.study.output import write_study
+from armaxmodal.study.run import Study, run_study
+from armaxmodal.study.synthetic import make_study
+from armaxmodal.study.tables import StudyTables, build_tables, match_modes
 
 __all__ = [
     "Entry",

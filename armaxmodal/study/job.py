@@ -12,8 +12,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .. import __version__
-from ..recording import Recording
+from armaxmodal._version import __version__
+from armaxmodal.recording import Recording
 
 __all__ = ["StudySettings", "analyse_recording"]
 
@@ -70,8 +70,9 @@ def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[st
     ``reconstruction_error`` and ``quality`` (the modal-model check's misfit and verdict),
     ``lump`` and ``figure_png`` (base64).
     """
-    from .._threads import one_blas_thread
-    from ..stabilisation import select_modes, stabilisation_diagram
+    from armaxmodal._threads import one_blas_thread
+    from armaxmodal.modes.diagram import stabilisation_diagram
+    from armaxmodal.modes.selection import select_modes
 
     start = time.perf_counter()
     orders = None if settings.orders is None else range(settings.orders[0], settings.orders[1] + 1, 2)
@@ -121,6 +122,6 @@ def _thumbnail(diagram, selection) -> str:
 def _lump(rec: Recording, settings: StudySettings) -> dict | None:
     if settings.lump is None or not set(settings.lump) <= set(rec.sensors):
         return None
-    from ..lumping import lump_check
+    from armaxmodal.lumping import lump_check
 
     return lump_check(rec, *settings.lump, wavelet=False).to_dict()

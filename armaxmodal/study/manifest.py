@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..exceptions import DataError
+from armaxmodal.exceptions import DataError
 
 __all__ = ["Entry", "read_manifest", "RECORDING_SUFFIXES"]
 

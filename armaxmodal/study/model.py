@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..datasets import TABLE_4_2_MASS_FRACTION
-from ..exceptions import ArmaxModalError
-from ..inverse import model_update, scale_to_subject
-from ..inverse._modal_data import body_mass_bounds, to_eigenvalues
+from armaxmodal.exceptions import ArmaxModalError
+from armaxmodal.inverse import model_update, scale_to_subject
+from armaxmodal.inverse.modal_data import body_mass_bounds, to_eigenvalues
+from armaxmodal.systems.datasets import TABLE_4_2_MASS_FRACTION
 
 __all__ = ["average_subject_models"]
 

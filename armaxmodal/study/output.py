@@ -7,10 +7,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..io import write_all
-from .plot import plot_shapes
-from .report import render_report
-from .run import Study
+from armaxmodal.io.write import write_all
+from armaxmodal.study.plot import plot_shapes
+from armaxmodal.study.report import render_report
+from armaxmodal.study.run import Study
 
 __all__ = ["write_study", "lump_table"]
 

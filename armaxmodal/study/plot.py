@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .tables import StudyTables
+from armaxmodal.study.tables import StudyTables
 
 __all__ = ["plot_shapes"]
 

@@ -11,11 +11,12 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..exceptions import ArmaxModalError, DataError
-from ..io import atomic_write, read_recording, strict_json
-from .job import StudySettings, analyse_recording
-from .manifest import Entry, content_hash, read_manifest
-from .tables import StudyTables, build_tables
+from armaxmodal.exceptions import ArmaxModalError, DataError
+from armaxmodal.io.read import read_recording
+from armaxmodal.io.write import atomic_write, strict_json
+from armaxmodal.study.job import StudySettings, analyse_recording
+from armaxmodal.study.manifest import Entry, content_hash, read_manifest
+from armaxmodal.study.tables import StudyTables, build_tables
 
 __all__ = ["Study", "run_study"]
 
@@ -139,7 +140,7 @@ def run_study(
     tables = build_tables(recordings, sensors)
     study = Study(settings, sensors, recordings, failures, tables, reused, notes + tables.notes)
     if model:
-        from .model import average_subject_models
+        from armaxmodal.study.model import average_subject_models
 
         study.models, study.scaled = average_subject_models(study)
         study.notes += [
@@ -249,7 +250,7 @@ def _on_processes(todo, settings, sensors, jobs, finished, bar) -> None:
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    from ..fit import load_kernels
+    from armaxmodal.estimate.fit import load_kernels
 
     # fork, as the order sweep does: spawn would re-import the caller's script (which then
     # needs a __main__ guard) and compile or load every kernel once per worker

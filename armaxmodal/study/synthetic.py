@@ -15,11 +15,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..datasets import MEAN_SUBJECT_MASS_KG, TABLE_4_4
-from ..io import write_json, write_recording_csv
-from ..recording import Recording
-from ..simulate import add_noise, random_vibration, simulate, sine_sweep
-from ..structure import Structure
+from armaxmodal.io.write import write_json, write_recording_csv
+from armaxmodal.recording import Recording
+from armaxmodal.systems.datasets import MEAN_SUBJECT_MASS_KG, TABLE_4_4
+from armaxmodal.systems.simulation import add_noise, random_vibration, simulate, sine_sweep
+from armaxmodal.systems.structure import Structure
 
 __all__ = ["make_study", "subject_structure", "RIDES"]
 

@@ -1,0 +1,102 @@
+"""``armaxmodal diagnose``: find the effect the model lacks, add it, refit, report before and after."""
+
+from __future__ import annotations
+
+from armaxmodal.cli.common import (
+    NONNEG_INT,
+    add_data_args,
+    load_recording,
+    output_format,
+    parse_pair,
+    print_warnings,
+    write_outputs,
+)
+from armaxmodal.io.write import write_json
+
+
+def add_parser(sub, parents) -> None:
+    """Register the ``diagnose`` command."""
+    p = sub.add_parser(
+        "diagnose", parents=parents, help="find the effect the model lacks, add it, refit, report before/after"
+    )
+    add_data_args(p)
+    p.add_argument("--band", default=None, help="frequency band LO:HI in Hz (sets the analysis rate)")
+    p.add_argument("--max-rounds", type=NONNEG_INT, default=3, help="effects added at most; default 3")
+    p.add_argument("--json", default=None, help="write the diagnosis as JSON")
+    p.add_argument("--plot", default=None, help="figure page (.png/.svg/.pdf)")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from armaxmodal.diagnosis import diagnose
+    from armaxmodal.prepare.preparation import check_band
+
+    plot_format = output_format(args.plot) if args.plot else None
+    band = check_band(parse_pair(args.band, "--band")) if args.band else None
+    rec = load_recording(args)
+    result = diagnose(rec, band=band, max_rounds=args.max_rounds, progress=not args.quiet)
+    print_warnings(result.warnings)
+    report = result.to_dict()
+    print(_diagnosis_text(args.data, report))
+    outputs = []
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from armaxmodal.diagnosis.plot import plot_diagnosis
+
+        fig = plot_diagnosis(result)
+        outputs.append((args.plot, lambda tmp: fig.savefig(tmp, dpi=120, format=plot_format)))
+    if args.json:
+        outputs.append((args.json, lambda tmp: write_json(report, tmp)))
+    write_outputs(outputs)
+    return 0
+
+
+def _diagnosis_text(name: str, report: dict) -> str:
+    """The diagnosis as a person reads it: fits before and after, each effect with its numbers."""
+    sensors = report["outputs"]
+    base, final = report["baseline"], report["final"]
+    lines = [f"{name}: {len(sensors)} sensors at {report['analysis_fs']:g} Hz; baseline orders {report['orders']}"]
+    lines.append(f"{'sensor':>12} {'fit before %':>13} {'fit after %':>12} {'resid RMS':>10} {'H1 floor':>12}")
+    for k, s in enumerate(sensors):
+        if final["fit_val_pct"][k] is None:
+            lines.append(f"{s:>12} {base['fit_val_pct'][k]:13.1f}   now an input (a second excitation)")
+            continue
+        lines.append(
+            f"{s:>12} {base['fit_val_pct'][k]:13.1f} {final['fit_val_pct'][k]:12.1f} "
+            f"{final['sim_resid_rms'][k]:10.4g} {_or_unresolved(final['noise_floor_rms'][k]):>12}"
+        )
+    if not report["effects"]:
+        lines.append("no effect kept (the tests' p-values are in the JSON's 'tests').")
+    for e in report["effects"]:
+        params = {k: v for k, v in e["parameters"].items() if not isinstance(v, dict)}
+        lines.append(
+            f"effect {e['effect']} on {', '.join(e['channels'])}: "
+            f"{e['evidence']['statistic']} p = {e['evidence']['p']:.2g}; "
+            f"held-out one-step RMS {e['error_before']:.4g} -> {e['error_after']:.4g}; {_short(params)}"
+        )
+        if e.get("note"):
+            lines.append(f"  note: {e['note']}")
+    for u in report["unconfirmed"]:
+        lines.append(f"unconfirmed {u['effect']} on {', '.join(u['channels'])}: {u['reason']}")
+    if report["not_tested"]:
+        lines.append("not tested by this version: " + ", ".join(report["not_tested"]))
+    lines.append("verdict: " + report["verdict"])
+    return "\n".join(lines)
+
+
+def _or_unresolved(value) -> str:
+    """A noise floor, or why there is none (the record cannot resolve its lightest mode)."""
+    return "unresolved" if value is None else f"{value:.4g}"
+
+
+def _short(params: dict) -> str:
+    def fmt(v):
+        if isinstance(v, float):
+            return f"{v:.4g}"
+        if isinstance(v, list):
+            return "[" + ", ".join(fmt(x) for x in v) + "]"
+        return str(v)
+
+    return ", ".join(f"{k} {fmt(v)}" for k, v in params.items())

@@ -1,0 +1,64 @@
+"""Command-line interface: a thin layer over the public API, one module per command.
+
+armaxmodal info DATA [--input COL] [--fs HZ]
+armaxmodal modes --system supine|chapter2 [--json OUT]
+armaxmodal simulate --system supine --excitation random|sweep --out DATA.csv
+armaxmodal diagnose DATA [--input COL] [--fs HZ] [--json OUT] [--plot OUT]
+armaxmodal study MANIFEST_OR_FOLDER --out DIR [--report FILE] [--jobs N] [--scheduler ADDRESS]
+armaxmodal lump DATA A B [--json OUT] [--plot OUT]
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import sys
+from collections.abc import Sequence
+
+from armaxmodal.cli import diagnose, identify, info, invert, lump, modes, simulate, stabilise, study
+from armaxmodal.cli.common import check_output_paths
+from armaxmodal.exceptions import ArmaxModalError
+
+#: the commands in the order ``--help`` lists them
+COMMANDS = (stabilise, invert, identify, diagnose, info, modes, simulate, study, lump)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="armaxmodal", description="Time-domain modal analysis of base-excited systems."
+    )
+    parser.add_argument("--quiet", action="store_true", help="no progress or chatter")
+    # --quiet is accepted after the command too; SUPPRESS keeps a subcommand's unset default
+    # from overwriting the top-level flag
+    quiet = argparse.ArgumentParser(add_help=False)
+    quiet.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS, help="no progress or chatter")
+    sub = parser.add_subparsers(dest="command", required=True)
+    for command in COMMANDS:
+        command.add_parser(sub, [quiet])
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        check_output_paths(args)
+        return args.func(args)
+    except (ArmaxModalError, FileNotFoundError) as exc:
+        print(f"armaxmodal: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        # outputs are staged and moved in whole, so an interrupted run leaves none behind
+        print("armaxmodal: interrupted; no output was written.", file=sys.stderr)
+        return 130
+
+
+def run() -> None:
+    """Console entry point: :func:`main`, then exit with its status."""
+    status = main()
+    # The process ends here with every output written and closed. Moving the live objects
+    # (the imported libraries, the fits) out of the collector's reach spares the
+    # interpreter's final collection, about 0.4 s of a 5 s command; only that scan is
+    # skipped. Not in main(): called in-process, it would pin the caller's objects.
+    gc.freeze()
+    sys.exit(status)

@@ -1,0 +1,148 @@
+"""``armaxmodal stabilise``: order sweep, stabilisation plot and automatic mode selection."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from armaxmodal.cli.common import (
+    DETREND_HELP,
+    POSITIVE_INT,
+    add_data_args,
+    load_recording,
+    order_range,
+    output_format,
+    parse_pair,
+    print_warnings,
+    write_outputs,
+)
+from armaxmodal.exceptions import OrderError
+from armaxmodal.io.write import write_json
+
+
+def add_parser(sub, parents) -> None:
+    """Register the ``stabilise`` command."""
+    p = sub.add_parser(
+        "stabilise", parents=parents, help="order sweep, stabilisation plot and automatic mode selection"
+    )
+    add_data_args(p)
+    p.add_argument(
+        "--orders", default=None, help="range of na, LO:HI (even steps); default 2:30, capped to suit the record"
+    )
+    p.add_argument("--modes", type=POSITIVE_INT, default=None, help="number of modes to keep (default: automatic)")
+    p.add_argument("--band", default=None, help="frequency band LO:HI in Hz")
+    p.add_argument("--plot", default=None, help="stabilisation plot (.png, .svg or .pdf)")
+    p.add_argument("--json", default=None, help="selected modes as JSON")
+    p.add_argument("--csv", default=None, help="every pole of the sweep as CSV")
+    p.add_argument(
+        "--detrend",
+        choices=["mean", "linear", "none"],
+        default="mean",
+        help=DETREND_HELP,
+    )
+    p.add_argument(
+        "--shapes",
+        choices=["shared", "per-sensor"],
+        default="shared",
+        help="mode shapes from the shared-pole fit, or per sensor with gaps filled by Eq. 3.34",
+    )
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from armaxmodal.modes.diagram import stabilisation_diagram
+    from armaxmodal.modes.selection import select_modes
+    from armaxmodal.prepare.preparation import check_band
+
+    plot_format = output_format(args.plot) if args.plot else None
+    orders = None if args.orders is None else order_range(args.orders)
+    band = check_band(parse_pair(args.band, "--band")) if args.band else None
+    rec = load_recording(args)
+    check_band(band, rec.fs)
+    if not args.quiet:
+        outputs = ", ".join(rec.sensors)
+        print(f"{args.data}: input {rec.input_name}; outputs {outputs}; {rec.n_samples} samples at {rec.fs:g} Hz")
+    diagram = stabilisation_diagram(rec, orders, band=band, detrend=args.detrend, progress=not args.quiet)
+    try:
+        selection = select_modes(diagram, args.modes, band)
+    except OrderError:
+        # no mode: the diagram and the pole table still show the user why
+        print_warnings(diagram.warnings)
+        write_outputs(_diagram_outputs(args, diagram, None, plot_format))
+        raise
+    if not args.quiet:
+        prep = diagram.preparation
+        if prep is not None and prep.analysis_fs != prep.original_fs:
+            print(f"analysis at {prep.analysis_fs:g} Hz (resampled from {prep.original_fs:g} Hz)")
+        print(
+            selection.modes[
+                [
+                    "freq_hz",
+                    "damping",
+                    "damped_freq_hz",
+                    "freq_ci95_lo",
+                    "freq_ci95_hi",
+                    "damping_ci95_lo",
+                    "damping_ci95_hi",
+                    "count",
+                ]
+            ].to_string(float_format=lambda v: f"{v:.4f}")
+        )
+        print_check(selection.check)
+    print_warnings(selection.warnings)
+    outputs = _diagram_outputs(args, diagram, selection, plot_format)
+    if args.json:
+        report = selection.to_dict(args.shapes.replace("-", "_"))
+        outputs.append((args.json, lambda tmp: write_json(report, tmp)))
+    write_outputs(outputs)
+    print(verdict(selection.check, len(selection.modes)))
+    return 0
+
+
+def print_check(check) -> None:
+    """The modal-model check per output, beside the H1's own random error."""
+    from armaxmodal.modes.modal_check import MODEL_ERROR_LIMIT
+
+    print(
+        "modal-model check (LSFD of each H1 by the selected poles, residual terms and a delay; "
+        f"model error = misfit beyond the H1's random error, limit {100 * MODEL_ERROR_LIMIT:.0f} %):"
+    )
+    for k, sensor in enumerate(check.sensors):
+        if not np.isfinite(check.error[k]):
+            print(f"  {sensor}: not checked (too few lines where its coherence is at least 0.8)")
+            continue
+        print(
+            f"  {sensor}: misfit {100 * check.error[k]:.1f} %, H1 random error {100 * check.random_error[k]:.1f} %, "
+            f"model error {100 * check.model_error[k]:.1f} %, delay {1e3 * check.delay_s[k]:+.1f} ms, "
+            f"{check.n_lines[k]} lines"
+        )
+
+
+def verdict(check, n_modes: int) -> str:
+    """The closing line: whether the modes explain the record."""
+    if check is not None and check.passed:
+        return f"quality: good -- the {n_modes} selected mode(s) explain the measured FRF of every checked output"
+    if check is not None and check.unconfirmed_hz and not check.failing:
+        where = ", ".join(f"{f:.2f}" for f in check.unconfirmed_hz)
+        return f"quality: POOR -- the record does not confirm the mode(s) at {where} Hz (no coherent H1 there)"
+    if check is None or not check.failing:
+        return "quality: POOR -- no output has coherent lines to check the modes against: treat them as unconfirmed"
+    worst = float(np.nanmax(check.model_error))
+    return (
+        f"quality: POOR -- the selected modes do not explain the measured FRF of {', '.join(check.failing)} "
+        f"(model error up to {100 * worst:.0f} %): treat them as unconfirmed (see the warning)"
+    )
+
+
+def _diagram_outputs(args, diagram, selection, plot_format) -> list:
+    """The stabilisation plot and pole table as ``(path, write)`` pairs for :func:`write_all`."""
+    outputs = []
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        ax, _ = diagram.plot(selection)
+        outputs.append((args.plot, lambda tmp: ax.figure.savefig(tmp, dpi=150, format=plot_format)))
+    if args.csv:
+        table = diagram.to_frame()
+        outputs.append((args.csv, lambda tmp: table.to_csv(tmp, index=False)))
+    return outputs

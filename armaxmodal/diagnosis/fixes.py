@@ -1,0 +1,159 @@
+"""Each effect's fix: the model spec with that effect added, and what the fit says about it."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from armaxmodal.diagnosis.finding import Finding
+from armaxmodal.diagnosis.model import FittedModel, ModelSpec, response_free_of, usable
+
+__all__ = ["add_effect", "effect_parameters"]
+
+#: C coefficients a richer noise model adds.
+EXTRA_NC_STEP = 6
+
+
+def add_effect(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
+    """``spec`` with the effect of ``finding`` added (see :mod:`armaxmodal.diagnosis.model`)."""
+    if finding.effect == "input_delay":
+        shifts = dict(spec.shifts)
+        name = finding.channels[0]
+        lead = finding.parameters["delay_samples"]
+        # an input late by d is moved earlier by d; a sensor late by d likewise
+        shifts[name] = shifts.get(name, 0.0) + lead
+        return replace(spec, shifts=tuple(sorted(shifts.items())))
+    if finding.effect == "offset_drift":
+        return replace(spec, trend_degree=min(2, max(1, spec.trend_degree + 1)))
+    if finding.effect == "periodic_disturbance":
+        f0 = refine_line(fitted, finding.parameters["freq_hz"], finding.channels)
+        return replace(spec, lines_hz=spec.lines_hz + (f0,))
+    if finding.effect == "coloured_noise":
+        return replace(spec, extra_nc=spec.extra_nc + EXTRA_NC_STEP)
+    if finding.effect == "unmodelled_mode":  # one more pole pair; nb and nc follow na's rules
+        na, nb, nc, nk = spec.orders
+        return replace(spec, orders=(na + 2, nb + 2, nc + 2, nk))
+    if finding.effect == "clipping":
+        return replace(spec, clipped=tuple(sorted(set(spec.clipped) | set(finding.channels))))
+    if finding.effect == "sensor_fault":
+        return replace(spec, faults=spec.faults + ((finding.channels[0], tuple(finding.payload)),))
+    if finding.effect == "second_input":
+        name = finding.channels[0]
+        return replace(spec, terms=spec.terms + (name,), inputs_from=spec.inputs_from + (name,))
+    if finding.effect == "stiffness_nonlinearity":
+        name = f"{finding.parameters['term']}:{'-'.join(finding.parameters['between'])}#{len(spec.terms) + 1}"
+        fitted.signals.extra[name] = finding.payload
+        return replace(spec, terms=spec.terms + (name,))
+    raise ValueError(f"no fix for effect {finding.effect!r}")
+
+
+def refine_line(fitted: FittedModel, freq_hz: float, channels) -> float:
+    """The line's frequency to a small fraction of the record's resolution: the maximum of
+    the periodogram (least squares for one sine) of the channels' residual from a response
+    model that cannot carry the line (:func:`~.model.response_free_of`), summed over channels."""
+    s = fitted.signals
+    mask = usable(s.n, fitted.spec)
+    t = np.flatnonzero(mask) / s.fs
+    trial = replace(fitted.spec, lines_hz=fitted.spec.lines_hz + (freq_hz,))
+    idx = [s.sensors.index(c) for c in channels]
+    y = s.y - fitted.disturbance()
+    r = (y - response_free_of(trial, fitted.fit, s.u, y))[mask][:, idx]
+
+    def power(f):
+        e = np.exp(-2j * np.pi * f * t)
+        return -float(np.sum(np.abs(e @ r) ** 2))
+
+    df = s.fs / s.n
+    grid = freq_hz + np.linspace(-df, df, 81)
+    best = grid[int(np.argmin([power(f) for f in grid]))]
+    step = grid[1] - grid[0]
+    res = minimize_scalar(power, bounds=(best - step, best + step), method="bounded", options={"xatol": 1e-4 * step})
+    return float(res.x)
+
+
+def effect_parameters(finding: Finding, fitted) -> dict:
+    """The effect's parameters in the refitted model, with 95 % intervals where the fit gives them."""
+    if finding.effect == "time_varying":
+        return {**finding.parameters, "modes_each_side": _modes_each_side(fitted)}
+    spec, s = fitted.spec, fitted.signals
+    if finding.effect == "offset_drift":
+        dur = s.n / s.fs
+        out = {}
+        for name in finding.channels:
+            k = s.sensors.index(name)
+            th, cov = fitted.theta[:, k], fitted.theta_cov[k]
+            sd = np.sqrt(np.clip(np.diag(cov), 0, None))
+            # tau runs -1..1 over the record: the offset is the value mid-record, drift per s
+            out[name] = {
+                "offset": float(th[0]),
+                "offset_ci95": [float(th[0] - 1.96 * sd[0]), float(th[0] + 1.96 * sd[0])],
+                "drift_per_s": float(th[1] * 2 / dur),
+                "drift_ci95_per_s": [float((th[1] - 1.96 * sd[1]) * 2 / dur), float((th[1] + 1.96 * sd[1]) * 2 / dur)],
+            }
+        return {"trend_degree": spec.trend_degree, "per_channel": out}
+    if finding.effect == "periodic_disturbance":
+        i0 = spec.trend_degree + 1 + 2 * (len(spec.lines_hz) - 1)
+        amps = {}
+        for name in finding.channels:
+            k = s.sensors.index(name)
+            a, b = fitted.theta[i0 : i0 + 2, k]
+            cov = fitted.theta_cov[k][i0 : i0 + 2, i0 : i0 + 2]
+            amp = float(np.hypot(a, b))
+            grad = np.array([a, b]) / max(amp, 1e-300)
+            sd = float(np.sqrt(max(grad @ cov @ grad, 0.0)))
+            amps[name] = {"amp": amp, "amp_ci95": [amp - 1.96 * sd, amp + 1.96 * sd]}
+        first = amps[finding.channels[0]]
+        return {"freq_hz": spec.lines_hz[-1], "amp": first["amp"], "amp_ci95": first["amp_ci95"], "per_channel": amps}
+    if finding.effect == "stiffness_nonlinearity":
+        # the term's share of each channel: RMS of its simulated contribution over the output's
+        u = np.zeros((s.n, 1 + len(spec.terms)))
+        u[:, -1] = s.extra[spec.terms[-1]]
+        share = {
+            name: float(np.std(fitted.fit.models[k].simulate(u)) / np.std(s.y[:, k]))
+            for k, name in enumerate(s.sensors)
+            if name in finding.channels
+        }
+        return {**finding.parameters, "rms_share_of_output": share}
+    if finding.effect == "second_input":
+        # each explained channel's share of the response to the new input
+        u = np.zeros((s.n, 1 + len(spec.terms)))
+        u[:, 1 + spec.terms.index(finding.channels[0])] = s.extra[finding.channels[0]]
+        share = {
+            name: float(np.std(fitted.fit.models[k].simulate(u)) / np.std(s.y[:, k]))
+            for k, name in enumerate(s.sensors)
+            if name in finding.parameters["explains"]
+        }
+        return {**finding.parameters, "rms_share_of_output": share}
+    if finding.effect == "unmodelled_mode":
+        from armaxmodal.diagnosis.missing_mode import added_modes
+
+        return {**finding.parameters, "na": spec.orders[0], "added_modes": added_modes(finding.payload, fitted)}
+    if finding.effect == "coloured_noise":
+        return {"nc": spec.orders[2] + spec.extra_nc, "nc_before": spec.orders[2] + spec.extra_nc - EXTRA_NC_STEP}
+    return dict(finding.parameters)
+
+
+def _modes_each_side(piecewise) -> list[dict]:
+    """Each mode of the fit before the change with its nearest match after it."""
+    from armaxmodal.modes.poles import SHARED, pole_rows
+
+    def modes(fit):
+        return [r for r in pole_rows(fit, SHARED) if 0 < r["damping"] < 0.6]
+
+    after = modes(piecewise.after.fit)
+    out = []
+    for r in sorted(modes(piecewise.before.fit), key=lambda r: r["freq_hz"]):
+        if not after:
+            break
+        a = min(after, key=lambda x: abs(x["freq_hz"] - r["freq_hz"]))
+        out.append(
+            {
+                "freq_before_hz": float(r["freq_hz"]),
+                "freq_after_hz": float(a["freq_hz"]),
+                "damping_before": float(r["damping"]),
+                "damping_after": float(a["damping"]),
+            }
+        )
+    return out

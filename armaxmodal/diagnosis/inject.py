@@ -1,0 +1,266 @@
+"""Effects planted with known size in a recording, so tests build data whose effect the
+diagnosis is not told (and ``armaxmodal simulate --effect`` writes such rides)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numba
+import numpy as np
+from scipy.signal import lfilter
+
+from armaxmodal.diagnosis.model import fractional_shift
+from armaxmodal.exceptions import DataError
+from armaxmodal.recording import Recording
+
+__all__ = ["inject", "INJECTABLE", "add_second_input"]
+
+INJECTABLE = (
+    "input_delay",
+    "offset_drift",
+    "periodic_disturbance",
+    "coloured_noise",
+    "clipping",
+    "sensor_fault",
+    "second_input",
+)
+#: Each effect's parameters: required, then optional.
+PARAMETERS = {
+    "input_delay": (("samples",), ()),
+    "offset_drift": ((), ("offset", "drift_per_s")),
+    "periodic_disturbance": (("freq_hz", "amp"), ()),
+    "coloured_noise": (("level",), ("pole", "freq_hz")),
+    "clipping": (("fraction",), ()),
+    "sensor_fault": ((), ("spikes", "spike_size", "stuck_s")),
+    "second_input": (("level",), ()),
+}
+
+
+def check_effect(effect: str, params: dict) -> None:
+    """Raise :class:`DataError` unless ``effect`` is injectable with exactly these parameters."""
+    if effect not in INJECTABLE:
+        raise DataError(f"effect: expected one of {INJECTABLE}, got {effect!r}.")
+    required, optional = PARAMETERS[effect]
+    missing = [k for k in required if k not in params]
+    unknown = [k for k in params if k not in required + optional]
+    if missing or unknown:
+        raise DataError(
+            f"effect {effect!r}: needs {', '.join(required) or 'no parameter'}"
+            f"{' (optional ' + ', '.join(optional) + ')' if optional else ''}; "
+            f"missing {missing or 'none'}, unknown {unknown or 'none'}."
+        )
+    if any(not np.isfinite(float(v)) for v in params.values()):
+        raise DataError(f"effect {effect!r}: parameters must be finite numbers, got {params}.")
+    if effect == "second_input" and not float(params["level"]) > 0:
+        raise DataError(f"effect 'second_input': level must be > 0, got {params['level']}.")
+    if effect == "clipping" and not 0 < float(params["fraction"]) <= 1:
+        raise DataError(f"effect 'clipping': fraction must be in (0, 1] (1 clips nothing), got {params['fraction']}.")
+    if effect == "sensor_fault" and not (
+        int(params.get("spikes", 0)) == params.get("spikes", 0) >= 0 <= params.get("stuck_s", 0)
+        and params.get("spikes", 0) + params.get("stuck_s", 0) > 0
+    ):
+        raise DataError(
+            f"effect 'sensor_fault': give spikes (a whole number >= 0) and/or stuck_s (seconds >= 0), "
+            f"not both zero; got {params}."
+        )
+
+
+def _channel(rec: Recording, name: str) -> int | None:
+    """Column of ``name`` in the response, None for the input."""
+    if name == rec.input_name:
+        return None
+    if name not in rec.sensors:
+        raise DataError(f"channel {name!r} is not in this recording ({rec.input_name}, {', '.join(rec.sensors)}).")
+    return rec.sensors.index(name)
+
+
+def inject(recording: Recording, effect: str, channels=None, seed: int = 0, structure=None, **params) -> Recording:
+    """A copy of ``recording`` with one effect planted.
+
+    Parameters
+    ----------
+    recording : Recording
+    effect : str
+        ``"input_delay"`` (``samples``, may be fractional: the channel is recorded that late),
+        ``"offset_drift"`` (``offset`` in signal units, ``drift_per_s``),
+        ``"periodic_disturbance"`` (``freq_hz``; ``amp``, the line's RMS as a fraction of
+        each channel's RMS),
+        ``"coloured_noise"`` (``level`` as a fraction of RMS; AR(1) ``pole``, or with
+        ``freq_hz`` an AR(2) resonance of radius ``pole`` there),
+        ``"clipping"`` (``fraction``: both rails at this fraction of the channel's largest
+        excursion from its median; 1 clips nothing),
+        ``"sensor_fault"`` (``spikes`` single-sample glitches of ``spike_size`` (default 8)
+        times the channel's RMS, random sign, at random samples; ``stuck_s`` seconds from 40 %
+        of the record on which the channel repeats its last value),
+        ``"second_input"`` (``level``; see :func:`add_second_input`: needs ``structure``).
+    channels : sequence of str, optional
+        Where: default every output (an input delay: the input; a second input: the first
+        sensor).
+    seed : int
+        Random seed of a noise effect.
+    structure : Structure, optional
+        The structure recorded (a second input's force acts on it).
+
+    Returns
+    -------
+    Recording
+        With ``meta["injected"]`` recording what was planted.
+    """
+    check_effect(effect, params)
+    if effect == "second_input":
+        if structure is None:
+            raise DataError("effect 'second_input' needs the structure the force acts on: pass structure=.")
+        names = list(channels) if channels is not None else [recording.sensors[0]]
+        if len(names) != 1:
+            raise DataError(f"effect 'second_input': one channel (where the force acts), got {names}.")
+        return add_second_input(recording, structure, names[0], float(params["level"]), seed)
+    default = [recording.input_name] if effect == "input_delay" else list(recording.sensors)
+    names = list(channels) if channels is not None else default
+    base, y = recording.base.copy(), np.array(recording.response, dtype=float)
+    rng = np.random.default_rng(seed)
+    t = np.arange(recording.n_samples) / recording.fs
+    for name in names:
+        k = _channel(recording, name)
+        x = base if k is None else y[:, k]
+        rms = float(np.std(x))
+        if effect == "input_delay":
+            x[:] = fractional_shift(x, -float(params["samples"]))
+        elif effect == "offset_drift":
+            x += float(params.get("offset", 0.0)) + float(params.get("drift_per_s", 0.0)) * (t - t.mean())
+        elif effect == "sensor_fault":
+            at = rng.choice(np.arange(10, t.size - 10), int(params.get("spikes", 0)), replace=False)
+            x[at] += float(params.get("spike_size", 8.0)) * rms * rng.choice([-1.0, 1.0], at.size)
+            first, held = int(0.4 * t.size), int(round(float(params.get("stuck_s", 0.0)) * recording.fs))
+            x[first + 1 : first + 1 + held] = x[first]
+        elif effect == "clipping":
+            mid = float(np.median(x))
+            rail = float(params["fraction"]) * float(np.max(np.abs(x - mid)))
+            x[:] = np.clip(x, mid - rail, mid + rail)
+        elif effect == "periodic_disturbance":
+            x += float(params["amp"]) * rms * np.sqrt(2) * np.sin(2 * np.pi * float(params["freq_hz"]) * t + 0.7)
+        else:
+            w = rng.standard_normal(t.size)
+            pole = float(params.get("pole", 0.95))
+            if "freq_hz" in params:  # narrowband: an AR(2) resonance of radius ``pole``
+                wn = 2 * np.pi * float(params["freq_hz"]) / recording.fs
+                v = lfilter([1.0], [1.0, -2 * pole * np.cos(wn), pole**2], w)
+            else:
+                v = lfilter([1.0], [1.0, -pole], w)
+            x += float(params["level"]) * rms * v / np.std(v)
+    meta = dict(recording.meta, injected={"effect": effect, "channels": names, **params})
+    return replace(recording, base=base, response=y, meta=meta)
+
+
+def cubic_spring_ride(
+    structure,
+    base: np.ndarray,
+    fs: float,
+    between: tuple[int, int],
+    ratio: float,
+    *,
+    noise: float = 0.05,
+    seed: int = 0,
+    oversample: int = 16,
+) -> Recording:
+    """A ride of ``structure`` with a cubic spring added between DOFs ``between = (i, j)``
+    (``j = -1``: to the base), the truth for ``stiffness_nonlinearity``.
+
+    The spring force is ``k3 s^3`` on the deflection ``s = z_i - z_j``, with ``k3`` set so
+    that at the linear ride's RMS deflection it is ``ratio`` times the linear force
+    ``|K_ij| s`` there. Integrated by classical Runge-Kutta on a grid ``oversample`` times
+    finer than ``fs`` with the band-limited input interpolated exactly (FFT); relative
+    coordinates ``M z'' + C z' + K z + f_nl(z) = -M 1 a``; outputs are absolute accelerations
+    with white noise of ``noise`` times their RMS. ``meta["injected"]`` holds ``k3``.
+    """
+    from scipy.signal import resample
+
+    from armaxmodal.systems.simulation import add_noise, simulate
+
+    i, j = between
+    m_inv = 1.0 / np.diag(structure.M)
+    lin = simulate(structure, base, fs, hold="bandlimited", quantity="displacement", frame="relative")
+    s_lin = lin[:, i] - (lin[:, j] if j >= 0 else 0.0)
+    k_lin = abs(structure.K[i, j]) if j >= 0 else abs(structure.K[i].sum())
+    k3 = ratio * k_lin / float(np.mean(s_lin**2))
+    r = int(oversample)
+    fine = resample(base, base.size * 2 * r)  # values at every half step
+    c, k = np.ascontiguousarray(structure.C, float), np.ascontiguousarray(structure.K, float)
+    acc = _rk4_cubic(m_inv, c, k, np.ascontiguousarray(fine), 1.0 / (fs * r), i, j, float(k3))
+    absolute = acc[::r][: base.size] + base[:, None]
+    rng = np.random.default_rng(seed)
+    y = add_noise(absolute, noise, rng)
+    meta = {"injected": {"effect": "stiffness_nonlinearity", "between": [i, j], "k3": k3, "ratio": ratio}}
+    names = structure.names or tuple(f"dof{k + 1}" for k in range(y.shape[1]))
+    return Recording(fs, base.copy(), y, names, meta=meta)
+
+
+@numba.njit(cache=True)
+def _accel(m_inv, c, k, z, v, a_base, i, j, k3):
+    f = c @ v + k @ z
+    s = z[i] - (z[j] if j >= 0 else 0.0)
+    f[i] += k3 * s**3
+    if j >= 0:
+        f[j] -= k3 * s**3
+    return -m_inv * f - a_base
+
+
+@numba.njit(cache=True)
+def _rk4_cubic(m_inv, c, k, fine, h, i, j, k3):
+    """Relative accelerations at every step of ``h`` (input sampled at half steps); numba
+    because the loop is 10^5 small steps."""
+    n_dof = m_inv.size
+    steps = fine.size // 2
+    z, v = np.zeros(n_dof), np.zeros(n_dof)
+    out = np.empty((steps, n_dof))
+    for t in range(steps):
+        a0, a_half, a1 = fine[2 * t], fine[2 * t + 1], fine[(2 * t + 2) % fine.size]
+        k1v = _accel(m_inv, c, k, z, v, a0, i, j, k3)
+        out[t] = k1v
+        k1z = v
+        k2v = _accel(m_inv, c, k, z + 0.5 * h * k1z, v + 0.5 * h * k1v, a_half, i, j, k3)
+        k2z = v + 0.5 * h * k1v
+        k3v = _accel(m_inv, c, k, z + 0.5 * h * k2z, v + 0.5 * h * k2v, a_half, i, j, k3)
+        k3z = v + 0.5 * h * k2v
+        k4v = _accel(m_inv, c, k, z + h * k3z, v + h * k3v, a1, i, j, k3)
+        k4z = v + h * k3v
+        z = z + h / 6 * (k1z + 2 * k2z + 2 * k3z + k4z)
+        v = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)
+    return out
+
+
+def add_second_input(recording: Recording, structure, at: str, level: float, seed: int = 0) -> Recording:
+    """``recording`` with a second excitation: a force on the mass of sensor ``at``, recorded
+    as an extra column ``"force"`` that nothing declares an input (the truth for
+    ``second_input``).
+
+    The force is Gaussian random vibration over the base input's default band with its own
+    seed, held between samples (a DAC-driven exciter); its response -- absolute accelerations
+    of the structure on a base held still, ``M z'' + C z' + K z = e_at f`` discretised exactly
+    for that hold -- is added to every output, scaled so that at ``at`` its RMS is ``level``
+    times that channel's RMS before. Superposition makes this the ride under both inputs.
+    """
+    from scipy.signal import cont2discrete, dlsim
+
+    from armaxmodal.systems.simulation import random_vibration
+
+    k_at = _channel(recording, at)
+    if k_at is None:
+        raise DataError("effect 'second_input': the force acts on a sensor's mass, not on the input.")
+    m, c, k = (np.asarray(x, float) for x in (structure.M, structure.C, structure.K))
+    dof = m.shape[0]
+    if recording.response.shape[1] != dof:
+        raise DataError(f"effect 'second_input': the recording has {recording.response.shape[1]} outputs, "
+                        f"the structure {dof} masses.")  # fmt: skip
+    m_inv = np.linalg.inv(m)
+    a = np.block([[np.zeros((dof, dof)), np.eye(dof)], [-m_inv @ k, -m_inv @ c]])
+    b = np.r_[np.zeros(dof), m_inv[:, k_at]][:, None]
+    cc, d = a[dof:], b[dof:]
+    n, fs = recording.n_samples, recording.fs
+    force = random_vibration(fs, n / fs, band=(0.5, min(28.0, 0.47 * fs)), seed=seed + 7919)[:n]
+    ad, bd, cd, dd, _ = cont2discrete((a, b, cc, d), 1.0 / fs, method="zoh")
+    _, response, _ = dlsim((ad, bd, cd, dd, 1.0 / fs), force)
+    scale = level * float(np.std(recording.response[:, k_at])) / float(np.std(response[:, k_at]))
+    y = np.column_stack([recording.response + scale * response, scale * force])
+    meta = dict(recording.meta, injected={"effect": "second_input", "channels": ["force"], "at": at,
+                                         "level": level, "force_scale": scale})  # fmt: skip
+    return replace(recording, response=y, sensors=(*recording.sensors, "force"), meta=meta)

@@ -1,0 +1,133 @@
+"""Automatic choice of ARMAX orders and input delay by an information criterion.
+
+Rules (documented defaults, all overridable):
+
+* ``nc = na``: white sensor noise on the outputs makes the true C equal to A.
+* ``nb = na + 1 - nk``: the causal part keeps ``na + 1`` taps (a b0 term: acceleration in,
+  acceleration out is biproper) and each step of negative ``nk`` adds one non-causal tap,
+  as band-limited sampled data needs.
+* The criterion is BIC of the concentrated Gaussian likelihood,
+  ``N sum_k log(V_k / N) + p log(N K)`` for K sensors (shared poles) or per sensor.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+from functools import partial
+
+import numpy as np
+import pandas as pd
+
+from armaxmodal.estimate.fit import ArmaxFit, fit_armax
+from armaxmodal.estimate.pool import parallel_map
+from armaxmodal.exceptions import OrderError
+from armaxmodal.recording import Recording
+
+__all__ = ["choose_orders", "OrderChoice", "default_nb", "default_nc"]
+
+
+def default_nb(na: int, nk: int) -> int:
+    """``na + 1 - nk`` B coefficients (see the module docstring)."""
+    return na + 1 - min(nk, 0)
+
+
+def default_nc(na: int) -> int:
+    """``nc = na``."""
+    return na
+
+
+@dataclass(frozen=True)
+class OrderChoice:
+    """The chosen fit and the criterion table (one row per candidate)."""
+
+    fit: ArmaxFit
+    table: pd.DataFrame
+
+    @property
+    def orders(self) -> tuple[int, int, int, int]:
+        return self.fit.orders
+
+
+def information_criterion(fit: ArmaxFit, kind: str = "bic") -> float:
+    """BIC (or AIC) of a fit from its per-sensor mean squared prediction errors."""
+    n = fit.n_samples
+    k = len(fit.models)
+    na, nb, nc, _ = fit.orders
+    n_in = fit.models[0].b.shape[0]
+    p = na + k * (n_in * nb + nc) if fit.shared_poles else k * (na + n_in * nb + nc)
+    fit_term = n * float(np.sum(np.log(fit.loss)))
+    penalty = p * np.log(n * k) if kind == "bic" else 2.0 * p
+    return fit_term + penalty
+
+
+def fit_or_none(recording, orders, **options):
+    """A fit, or None when the record cannot support the orders (candidates are skipped)."""
+    try:
+        return fit_armax(recording, *orders, warn=False, **options)
+    except OrderError:
+        return None
+
+
+
+
+
+
+
+
+
+
+
+
+def choose_orders(
+    recording: Recording,
+    na_values: Iterable[int] = range(4, 21, 2),
+    nk_values: Iterable[int] = range(0, -7, -1),
+    *,
+    shared_poles: bool = True,
+    criterion: str = "bic",
+    max_iter: int = 100,
+    n_jobs: int | None = None,
+    progress: bool = False,
+) -> OrderChoice:
+    """Fit every (na, nk) candidate with the default nb and nc and keep the best by BIC/AIC.
+
+    Parameters
+    ----------
+    recording : Recording
+    na_values, nk_values : iterables of int
+        Candidates; orders the record cannot support are skipped.
+    shared_poles : bool
+        Choose for the shared-pole form (default) or the per-sensor form.
+    criterion : {"bic", "aic"}
+    n_jobs : int, optional
+        Worker processes (default: all cores; 1 runs in this process). Workers are forked,
+        so they reuse the compiled kernels.
+    progress : bool
+        Show a progress bar.
+
+    Returns
+    -------
+    OrderChoice
+    """
+    if criterion not in ("bic", "aic"):
+        raise ValueError(f"criterion: expected 'bic' or 'aic', got {criterion!r}.")
+    candidates = [(na, default_nb(na, nk), default_nc(na), nk) for na in na_values for nk in nk_values]
+    run = partial(fit_or_none, recording, shared_poles=shared_poles, max_iter=max_iter)
+    from tqdm import tqdm
+
+    with tqdm(total=len(candidates), desc="order search", unit="fit", disable=not progress) as bar:
+        fits = parallel_map(run, candidates, n_jobs, bar, cost=lambda orders: orders[0])
+    rows, best, best_value = [], None, np.inf
+    for (na, nb, nc, nk), fit in zip(candidates, fits, strict=True):
+        if fit is None:
+            continue
+        value = information_criterion(fit, criterion)
+        rows.append(
+            {"na": na, "nb": nb, "nc": nc, "nk": nk, criterion: value, "converged": bool(np.all(fit.converged))}
+        )
+        if value < best_value:
+            best, best_value = fit, value
+    if best is None:
+        raise OrderError("no candidate order fits this record; give smaller na_values.")
+    return OrderChoice(best, pd.DataFrame(rows).sort_values(criterion).reset_index(drop=True))

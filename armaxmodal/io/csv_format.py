@@ -1,0 +1,178 @@
+"""CSV files: layout and separator checked first, comment metadata lines, a units row, text
+cells, and the channels returned with the time axis.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from armaxmodal.exceptions import DataError
+from armaxmodal.io.time_axis import TO_SECONDS, bridge_dropped_rows, fs_from_time, time_scale
+
+
+# -- CSV ------------------------------------------------------------------------------
+def _check_csv_layout(path: Path) -> None:
+    """Name the usual export mistakes before pandas turns them into a tokenizer error: a
+    gzip file named .csv, another delimiter, metadata lines before the header."""
+    import gzip
+    import zlib
+
+    with open(path, "rb") as fh:
+        head = fh.read(1 << 16)
+    if head[:2] == b"\x1f\x8b":
+        if path.suffix.lower() != ".gz":
+            raise DataError(
+                f"{path.name}: the file is gzip-compressed; name it {path.name}.gz (read as is) or unzip it."
+            )
+        try:
+            head = gzip.decompress(head) if len(head) < (1 << 16) else gzip.open(path).read(1 << 16)
+        except (EOFError, OSError, zlib.error) as exc:
+            raise DataError(f"{path.name}: a damaged or truncated gzip file ({exc}); copy or export it again.") from exc
+    lines = [
+        ln for ln in head.decode("utf-8", errors="replace").splitlines()[:-1] if ln.strip() and not ln.startswith("#")
+    ]
+    if not lines:
+        return
+    _check_separator(path, lines[:200])
+    commas = [ln.count(",") for ln in lines[:200]]
+    if max(commas) == 0:
+        return
+    fields = max(set(commas), key=commas.count)
+    leading = next((i for i, c in enumerate(commas) if c == fields), 0)
+    if leading:
+        raise DataError(
+            f"{path.name}: {leading} line(s) before the header have fewer fields than the data (first: "
+            f"{lines[0][:40]!r}): metadata lines. Put '#' before each (they are then read as comments) or "
+            "delete them. Xsens DOT exports are read as they are when you pass one file per sensor."
+        )
+
+
+def _check_separator(path: Path, lines: list[str]) -> None:
+    """Refuse semicolon- or tab-separated files by name: most lines hold the same number of
+    the separator. Such exports often write decimal commas too (a European spreadsheet),
+    which once read as 'metadata lines before the header'."""
+    for sep, name in ((";", "semicolons"), ("\t", "tabs")):
+        counts = [ln.count(sep) for ln in lines]
+        fields = max(set(counts), key=counts.count)
+        if fields == 0 or counts.count(fields) < 0.8 * len(counts):
+            continue
+        leading = next(i for i, c in enumerate(counts) if c == fields)
+        decimal = any(re.search(r"\d,\d", ln) for ln in lines[leading + 1 :])
+        raise DataError(
+            f"{path.name}: the columns are separated by {name}, not commas"
+            + (", and the numbers use decimal commas" if decimal else "")
+            + (f", after {leading} metadata line(s) before the header" if leading else "")
+            + "; re-export as comma-separated CSV with a '.' decimal point"
+            + (" (and '#' before each metadata line)." if leading else ".")
+        )
+
+
+_MISSING = ("", "na", "n/a", "nan", "null", "none", "-")
+
+
+def read_csv_file(path: Path):
+    _check_csv_layout(path)
+    info = _csv_comments(path)
+    try:
+        # every cell a number, the common case, is parsed in C; anything else (text, empty or
+        # missing cells) is read again as text below, to say which cell is wrong (the same
+        # doubles either way: checked on the fixtures and a 20,000-row record)
+        frame = pd.read_csv(path, comment="#", skipinitialspace=True, keep_default_na=False)
+        numeric = all(dtype.kind in "iuf" for dtype in frame.dtypes)
+        if not numeric:
+            frame = pd.read_csv(path, comment="#", skipinitialspace=True, dtype=str, keep_default_na=False)
+    except pd.errors.EmptyDataError as exc:
+        raise DataError(f"{path.name}: the file is empty; expected a header row and data.") from exc
+    except (pd.errors.ParserError, UnicodeDecodeError, OSError, EOFError) as exc:
+        raise DataError(f"{path.name}: not a readable CSV file ({exc}).") from exc
+    if frame.shape[0] == 0:
+        raise DataError(f"{path.name}: header only, no data rows.")
+    frame.columns = [str(c).strip() for c in frame.columns]
+    units = {} if numeric else _units_row(frame)
+    if units:
+        frame = frame.iloc[1:].reset_index(drop=True)
+        info["units"] = units
+    if numeric:
+        channels = {col: frame[col].to_numpy(dtype=float) for col in frame.columns}
+    else:
+        channels = _text_channels(frame, path)
+    file_fs = None
+    time_col = next((c for c in channels if time_scale(c) is not None), None)
+    if time_col is not None:
+        t = channels.pop(time_col)
+        if not np.all(np.isfinite(t)):
+            raise DataError(f"{path.name}: the time column contains NaN or empty cells.")
+        scale = TO_SECONDS.get(units.get(time_col, "").strip("()[] ").lower()) or time_scale(time_col)
+        t, channels, info["read_warnings"] = bridge_dropped_rows(t * scale, channels, path)
+        file_fs = fs_from_time(t, path)
+    return channels, file_fs, info
+
+
+def _units_row(frame: pd.DataFrame) -> dict[str, str]:
+    """``{column: unit}`` when the first row under the header is a row of units (every cell
+    text, such as ``s, m/s^2``, above rows of numbers), as many exports write; else empty."""
+    if len(frame) < 2:
+        return {}
+    first = frame.iloc[0].str.strip()
+    if pd.to_numeric(first, errors="coerce").notna().any():  # a blank unit is allowed
+        return {}
+    second = pd.to_numeric(frame.iloc[1].str.strip(), errors="coerce")
+    return dict(zip(frame.columns, first, strict=True)) if second.notna().all() else {}
+
+
+def _text_channels(frame: pd.DataFrame, path: Path) -> dict[str, np.ndarray]:
+    """Channels of a CSV read as text: numbers parsed, text columns skipped, an all-missing
+    column kept as NaN (refused by name if used), any other missing or non-numeric cell an
+    error that names it."""
+    channels: dict[str, np.ndarray] = {}
+    for col in frame.columns:
+        text = frame[col].str.strip()
+        values = pd.to_numeric(text, errors="coerce").to_numpy(dtype=float)
+        bad = np.isnan(values) & ~text.str.lower().isin(["nan"]).to_numpy()
+        if text.str.lower().isin(_MISSING).all():
+            channels[col] = np.full(len(text), np.nan)  # refused by name if it is used
+            continue
+        if bad.all():
+            continue  # a text column (labels, comments): not a channel
+        if bad.any():
+            row = int(np.argmax(bad))
+            if text.iloc[row] == "":
+                raise DataError(
+                    f"{path.name}: column '{col}', data row {row + 1} is empty (a missing "
+                    "sample); fill or trim it before analysis."
+                )
+            raise DataError(
+                f"{path.name}: column '{col}', data row {row + 1}: {frame[col].iloc[row]!r} is "
+                "not a number; fix or remove that cell."
+            )
+        channels[col] = values
+    return channels
+
+
+def _csv_comments(path: Path) -> dict:
+    """``# key: value`` lines before the header (subject, mass_kg)."""
+    import gzip
+
+    opener = gzip.open if path.suffix.lower() == ".gz" else open
+    info: dict = {}
+    try:
+        with opener(path, "rt", encoding="utf-8") as fh:
+            for line in fh:
+                if not line.startswith("#"):
+                    break
+                key, _, value = line[1:].partition(":")
+                key, value = key.strip().lower(), value.strip()
+                if key == "subject":
+                    info["subject"] = value
+                elif key == "mass_kg":
+                    try:
+                        info["mass_kg"] = float(value)
+                    except ValueError as exc:
+                        raise DataError(f"{path.name}: '# mass_kg: {value}' is not a number.") from exc
+    except (UnicodeDecodeError, OSError, EOFError) as exc:
+        raise DataError(f"{path.name}: not a readable text file ({exc}).") from exc
+    return info

@@ -1,0 +1,147 @@
+"""A file's time column: its unit, its sampling rate, and the dropped rows a logger leaves
+(bridged when a few samples are missing, refused when more are).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from armaxmodal.exceptions import DataError
+
+_TIME_NAMES = ("time", "t", "time_s")
+
+
+# A time column named with its unit, as exports write it: "time (s)", "Time [ms]", "t_ms",
+# "timestamp_us"; the unit sets the scale to seconds.
+_TIME_UNIT = re.compile(
+    r"^(?:t|time|timestamp)(?:\s*[\(\[]\s*(s|sec|ms|us|µs)\s*[\)\]]|[_\s]+(s|sec|ms|us|µs))$", re.IGNORECASE
+)
+
+
+TO_SECONDS = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
+
+
+def time_scale(name: str) -> float | None:
+    """Seconds per unit of a time column called ``name``, or None if it is not one."""
+    if name.strip().lower() in _TIME_NAMES:
+        return 1.0
+    match = _TIME_UNIT.match(name.strip())
+    return TO_SECONDS[(match.group(1) or match.group(2)).lower()] if match else None
+
+
+# Relative jitter allowed in a time column before it counts as non-uniform (device clocks
+# quantise to a microsecond: 1e-4 of a 120 Hz step).
+TIME_JITTER = 1e-3
+
+
+# A time base slower than this (Hz) is a time column in ms or us read as seconds.
+SLOWEST_FS = 1.0
+
+
+#: rows missing from a CSV's time column bridged by interpolation; a longer gap is an error
+MAX_BRIDGED_SAMPLES = 3
+
+
+def is_number(text: str) -> bool:
+    """``text`` reads as a number (a CSV header cell that is really a data cell)."""
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def is_axis(values: np.ndarray) -> bool:
+    """Increasing in equal steps (within the time column's jitter): a row index, a sample
+    counter or a time axis. No sensor records a ramp that exact."""
+    steps = np.diff(values)
+    if steps.size < 2 or not np.all(np.isfinite(steps)):
+        return False
+    step = float(np.median(steps))
+    return bool(step > 0 and np.all(np.abs(steps - step) <= TIME_JITTER * step))
+
+
+def whole_step_gaps(t: np.ndarray, step: float, max_gap: int, unit: str, source: str) -> list[tuple[int, int]]:
+    """``(i, n)`` for each step of ``t`` (seconds) after sample ``i`` that spans ``n + 1``
+    whole steps of ``step`` (within the time jitter): ``n`` samples or packets a logger
+    dropped there. More than ``max_gap`` at once is refused: bridging them would invent data.
+    Shared by the CSV reader and :func:`armaxmodal.io.xsens.read_xsens`."""
+    ratio = np.diff(t) / step
+    whole = np.rint(ratio)
+    gaps = []
+    for i in np.flatnonzero((whole >= 2) & (np.abs(ratio - whole) <= TIME_JITTER * whole)):
+        n = int(whole[i]) - 1
+        if n > max_gap:
+            raise DataError(
+                f"{source}: {n} {unit} missing after row {i} ({t[i] - t[0]:.3f} s), more than the {max_gap} "
+                "that can be bridged honestly; cut the record there and analyse the parts apart."
+            )
+        gaps.append((int(i), n))
+    return gaps
+
+
+def bridge_dropped_rows(t: np.ndarray, channels: dict, path: Path) -> tuple[np.ndarray, dict, list]:
+    """Rows missing from a uniform time column (:func:`whole_step_gaps`, at most
+    ``MAX_BRIDGED_SAMPLES`` at once) filled by linear interpolation in every channel, each
+    gap a ``dropped_packet`` warning. Other uneven steps are left to :func:`fs_from_time`,
+    which refuses them."""
+    from armaxmodal.notes import QualityWarning
+
+    steps = np.diff(t)
+    dt = float(np.median(steps)) if steps.size else 0.0
+    if not dt > 0 or np.any(steps <= 0):  # rows out of order or repeated: refused as they are
+        return t, channels, []
+    gaps = whole_step_gaps(t, dt, MAX_BRIDGED_SAMPLES, "samples", path.name)
+    if not gaps:
+        return t, channels, []
+    notes = [
+        QualityWarning(
+            "dropped_packet",
+            tuple(channels),
+            f"{n} sample(s) missing at {t[i] - t[0]:.3f} s (the time column steps {steps[i]:.6g} s there, "
+            f"{n + 1} samples); bridged by linear interpolation.",
+            float(n),
+        )
+        for i, n in gaps
+    ]
+    inserted = [t[i] + steps[i] * np.arange(1, n + 1) / (n + 1) for i, n in gaps]
+    grid = np.sort(np.concatenate([t, *inserted]))
+    return grid, {name: np.interp(grid, t, x) for name, x in channels.items()}, notes
+
+
+def fs_from_time(t: np.ndarray, path: Path) -> float:
+    if t.size < 2:
+        raise DataError(f"{path.name}: the time column needs at least two samples.")
+    if not np.all(np.isfinite(t)):
+        raise DataError(f"{path.name}: the time column holds NaN or infinite values; fix it, or drop it and give --fs.")
+    steps = np.diff(t)
+    dt = float(np.median(steps))
+    if dt <= 0:
+        raise DataError(f"{path.name}: the time column does not increase.")
+    back = np.flatnonzero(steps <= 0)
+    if back.size:
+        i = int(back[0])
+        raise DataError(
+            f"{path.name}: the time column does not increase from data row {i + 1} to {i + 2} ({t[i]:.6g} s, "
+            f"then {t[i + 1]:.6g} s; {back.size} such step(s)): rows out of order, repeated, or a clock reset. "
+            "Sort the rows, drop the repeats, or cut the record there."
+        )
+    worst = int(np.argmax(np.abs(steps - dt)))
+    if abs(steps[worst] - dt) > TIME_JITTER * dt:
+        raise DataError(
+            f"{path.name}: the time column is not uniformly spaced: from data row {worst + 1} to {worst + 2} it "
+            f"steps {steps[worst]:.6g} s against a median of {dt:.6g} s (a dropped or "
+            "repeated sample?). Resample the data to a uniform grid first."
+            + (
+                " A step of a second or more suggests the time column is in milliseconds: convert it to "
+                "seconds, or drop it and give --fs."
+                if dt >= 1
+                else ""
+            )
+        )
+    # The mean step over the whole record is far less sensitive to printed rounding; ten
+    # significant digits is more than any printed time column carries.
+    return float(f"{(t.size - 1) / float(t[-1] - t[0]):.10g}")

@@ -1,0 +1,142 @@
+"""Writing outputs: every file goes to a temporary name beside the target and is renamed over
+it when complete, so a failed run leaves nothing behind; JSON is strict (no bare NaN).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from armaxmodal.recording import Recording
+
+
+# -- writers --------------------------------------------------------------------------
+def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
+    """Call ``write(tmp_path)`` and move the file into place only if it succeeds."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        write(tmp)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def write_all(outputs) -> list[Path]:
+    """Write every ``(path, write)`` pair or none: each ``write(tmp)`` fills a temporary file
+    beside its target; only when all have succeeded are they moved into place."""
+    staged: list[tuple[str, Path]] = []
+    try:
+        for path, write in outputs:
+            path = Path(path)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+            os.close(fd)
+            staged.append((tmp, path))
+            write(tmp)
+        umask = os.umask(0)
+        os.umask(umask)
+        for tmp, path in staged:
+            os.chmod(tmp, 0o666 & ~umask)
+            os.replace(tmp, path)
+    finally:
+        for tmp, _ in staged:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+    return [path for _, path in staged]
+
+
+def write_recording_csv(recording: Recording, path: str | os.PathLike, float_format: str = "%.9g") -> Path:
+    """Write ``time``, the input and every sensor as CSV, with subject lines if known."""
+
+    def write(tmp: str) -> None:
+        with open(tmp, "w", encoding="utf-8", newline="") as fh:
+            if recording.subject is not None:
+                fh.write(f"# subject: {recording.subject}\n")
+            if recording.mass_kg is not None:
+                fh.write(f"# mass_kg: {recording.mass_kg:.6g}\n")
+            frame = recording.to_frame()
+            # Enough digits that the sampling rate read back from the times is exact.
+            frame["time"] = [f"{t:.12g}" for t in frame["time"]]
+            frame.to_csv(fh, index=False, float_format=float_format, lineterminator="\n")
+
+    return atomic_write(path, write)
+
+
+def write_recording_uff(recording: Recording, path: str | os.PathLike) -> Path:
+    """Write every channel (input first) as a type-58 time-response data set."""
+    import pyuff
+
+    names = [recording.input_name, *recording.sensors]
+    signals = [recording.base, *recording.response.T]
+
+    def write(tmp: str) -> None:
+        os.unlink(tmp)  # pyuff refuses to overwrite in 'add' mode; let it create the file
+        uff = pyuff.UFF(tmp)
+        for node, (name, x) in enumerate(zip(names, signals, strict=True), start=1):
+            uff.write_sets(
+                pyuff.prepare_58(
+                    id1=name,
+                    func_type=1,
+                    rsp_node=node,
+                    rsp_dir=3,
+                    ref_node=1,
+                    ref_dir=3,
+                    ord_data_type=4,
+                    abscissa_spacing=1,
+                    abscissa_min=0.0,
+                    abscissa_inc=1.0 / recording.fs,
+                    num_pts=x.size,
+                    data=np.asarray(x),
+                    x=recording.time,
+                    ordinate_spec_data_type=12,
+                    abscissa_spec_data_type=17,
+                    orddenom_spec_data_type=0,  # pyuff has no default for this one
+                ),
+                mode="add",
+            )
+
+    return atomic_write(path, write)
+
+
+def strict_json(obj):
+    """``obj`` with numpy values made plain and every non-finite float made ``None``: strict
+    JSON has no NaN or Infinity, and strict parsers reject them."""
+    if isinstance(obj, dict):
+        return {str(k): strict_json(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [strict_json(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return strict_json(obj.tolist())
+    if isinstance(obj, np.generic):
+        obj = obj.item()
+    if isinstance(obj, float) and not np.isfinite(obj):
+        return None
+    if isinstance(obj, complex):
+        raise TypeError("cannot write a complex number to JSON; split it into real and imaginary parts")
+    return obj
+
+
+def write_json(obj, path: str | os.PathLike) -> Path:
+    """Write ``obj`` as indented strict JSON (numpy values converted, NaN and infinities as
+    ``null``; ``allow_nan=False`` so a bare NaN can never slip through)."""
+    clean = strict_json(obj)
+
+    def write(tmp: str) -> None:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            json.dump(clean, fh, indent=2, allow_nan=False)
+            fh.write("\n")
+
+    return atomic_write(path, write)

@@ -1,0 +1,29 @@
+"""From fits to modes (thesis Sections 3.3-3.4).
+
+* :func:`stabilisation_diagram` -- the order sweep and its pole table (:mod:`.diagram`,
+  :mod:`.poles`).
+* :func:`select_modes` -- the physical modes picked from it (:mod:`.selection`,
+  :mod:`.clusters`, :mod:`.completeness`), refitted in the frequency domain (:mod:`.refine`),
+  with intervals widened by the segment spread (:mod:`.spread`) and judged by the
+  modal-model check (:mod:`.modal_check`).
+* :func:`identify` -- one model, its modes and the same check.
+"""
+
+from armaxmodal.modes.diagram import StabilisationDiagram, choose_nk, stabilisation_diagram
+from armaxmodal.modes.identification import Identification, identify
+from armaxmodal.modes.modal_check import ModalCheck, check_modes
+from armaxmodal.modes.poles import Tolerances
+from armaxmodal.modes.selection import ModeSelection, select_modes
+
+__all__ = [
+    "Identification",
+    "ModalCheck",
+    "ModeSelection",
+    "StabilisationDiagram",
+    "Tolerances",
+    "check_modes",
+    "choose_nk",
+    "identify",
+    "select_modes",
+    "stabilisation_diagram",
+]

@@ -1,0 +1,327 @@
+"""The stabilisation diagram: the order sweep (thesis Sections 3.3.2 and 3.4).
+
+The model order is unknown: too low misses modes, too high adds spurious poles. The sweep
+fits the shared-pole model (the default source of modes) and every sensor alone for
+``na`` over a range, with the documented rules ``nb = na + 1 - nk`` and ``nc = na``, and one
+input delay ``nk`` chosen by BIC at a middle order (:func:`choose_nk`). Physical poles stay
+put as the order grows; :mod:`armaxmodal.modes.poles` classes each one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import partial
+
+import numpy as np
+import pandas as pd
+
+from armaxmodal._threads import one_blas_thread
+from armaxmodal.estimate.fit import fit_resumable
+from armaxmodal.estimate.orders import default_nb, default_nc, information_criterion
+from armaxmodal.estimate.pool import parallel_map
+from armaxmodal.exceptions import OrderError
+from armaxmodal.modes.poles import SHARED, Tolerances, pole_rows, rejection_reasons, stability_classes
+from armaxmodal.notes import QualityWarning
+from armaxmodal.prepare.disturbance import disturbance_lines
+from armaxmodal.prepare.preparation import Preparation, prepare
+from armaxmodal.recording import Recording
+
+# A sweep fit stops when an iteration lowers the loss by less than this fraction (a tenth of
+# its statistical resolution, 1/N, for records up to 10^4 samples): enough to place poles.
+# The fits whose estimates are reported are finished to fit_armax's default criterion.
+SWEEP_TOL = 1e-5
+
+
+#: input delays the sweep searches (non-causal taps for band-limited data)
+NK_SEARCH = range(0, -7, -1)
+
+
+#: when the best delay is the most non-causal searched, this many more are tried once
+NK_EXTENSION = 3
+
+
+#: iteration cap of the delay choice's fits; the sweep continues those of the chosen delay
+DELAY_CHOICE_ITERATIONS = 8
+
+
+#: samples the record must hold per parameter of one sensor's model (about 3 na + 1 - nk) at
+#: the sweep's highest order: fewer, and the fits describe the noise (and take minutes each)
+SAMPLES_PER_PARAMETER = 20
+
+
+#: the orders swept when none are given, capped at what the record supports
+DEFAULT_ORDERS = range(2, 31, 2)
+
+
+#: a default sweep capped below this top order has too few orders to show stability: refused
+MIN_DEFAULT_TOP = 8
+
+
+@dataclass(frozen=True)
+class StabilisationDiagram:
+    """Poles of every order and source.
+
+    Attributes
+    ----------
+    poles : DataFrame
+        One row per pole: source (``shared`` or a sensor), na, freq_hz, damping,
+        damped_freq_hz, freq_sd, damping_sd, energy (residue energy), cls (stability class),
+        rejected (reason, empty when kept), pole (complex), vector (complex shape over
+        sensors for shared poles; the residue for a sensor's own pole).
+    orders : list of (na, nb, nc, nk)
+    tolerances : Tolerances
+    recording : Recording
+        The record the sweep fitted (after :func:`armaxmodal.prepare.preparation.prepare`).
+    preparation : Preparation or None
+        What was done to the record first, with the quality warnings.
+    """
+
+    poles: pd.DataFrame
+    orders: list
+    tolerances: Tolerances
+    recording: Recording
+    fits: dict = field(repr=False, default_factory=dict)
+    preparation: Preparation | None = None
+    notes: tuple = ()
+
+    @property
+    def warnings(self) -> list[QualityWarning]:
+        """Data-quality findings of the preparation and of the sweep itself."""
+        found = list(self.preparation.warnings) if self.preparation is not None else []
+        found += list(self.notes)
+        found += _nk_edge_warning(self.orders[0][3], self.recording)
+        return found + disturbance_lines(self.poles, self.tolerances.min_energy, self.recording, SHARED)
+
+    def to_frame(self) -> pd.DataFrame:
+        """The tidy pole table without the complex columns (for CSV)."""
+        return self.poles.drop(columns=["pole", "vector"])
+
+    def plot(self, selection=None, ax=None):
+        from armaxmodal.modes.plot import plot_stabilisation
+
+        return plot_stabilisation(self, selection, ax=ax)
+
+
+def sweep_fit(recording: Recording, job, max_iter: int, tol: float, covariance: bool = True):
+    """``(fit, checkpoint)`` of a sweep job ``(source, orders[, checkpoint])``: the shared
+    fit continues the checkpoint when there is one; ``(None, None)`` when the record cannot
+    support the orders."""
+    source, orders = job[:2]
+    rec = recording if source == SHARED else recording.select([source])
+    try:
+        return fit_resumable(
+            rec, orders, shared_poles=source == SHARED, max_iter=max_iter, tol=tol, stop="decrease", warn=False,
+            resume=job[2] if len(job) > 2 else None, covariance=covariance,
+        )  # fmt: skip
+    except OrderError:
+        return None, None
+
+
+def _fit_and_poles(recording: Recording, job, max_iter: int, tol: float):
+    """A sweep job run in a worker: the fit and its pole rows (computing the rows there
+    keeps the parent's serial share small)."""
+    fit = sweep_fit(recording, job, max_iter, tol)[0]
+    return fit, ([] if fit is None else pole_rows(fit, job[0]))
+
+
+def _job_cost(job, n_sensors: int) -> float:
+    """Relative run time of a sweep fit: about linear in na and in the number of sensors."""
+    source, orders = job[:2]
+    return orders[0] * (n_sensors if source == SHARED else 1)
+
+
+def choose_nk(recording: Recording, nk_values=range(0, -7, -1), na_values=(8, 10, 12), n_jobs=None) -> int:
+    """The input delay of the lowest-BIC shared-pole model over a few middle orders.
+
+    The delay and the order interact (band-limited data trade non-causal taps for poles), so
+    they are chosen jointly; one order alone can pick a delay that biases heavily damped modes.
+    """
+    return _choose_nk(recording, nk_values, na_values, n_jobs)[0]
+
+
+def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=True):
+    """``(nk, {(SHARED, orders): checkpoint})``: the chosen delay and where its fits stopped,
+    which the sweep continues instead of fitting those orders again."""
+    jobs = [(SHARED, (na, default_nb(na, nk), default_nc(na), nk)) for na in na_values for nk in nk_values]
+    # BIC differences between delays are large; 8 iterations settle the choice (checked on
+    # every fixture, a lightly damped structure and the real recordings against 20 and 50).
+    # Only the criterion is needed here: no covariances.
+    fits = parallel_map(
+        partial(sweep_fit, recording, max_iter=DELAY_CHOICE_ITERATIONS, tol=tol, covariance=False),
+        jobs,
+        n_jobs,
+        cost=partial(_job_cost, n_sensors=len(recording.sensors)),
+    )
+    scores = [information_criterion(f) if f is not None else np.inf for f, _ in fits]
+    nk = int(jobs[int(np.argmin(scores))][1][3])
+    if extend and nk == min(nk_values):
+        # the best delay is the most non-causal one searched: look NK_EXTENSION further, once
+        return _choose_nk(recording, range(nk, nk - NK_EXTENSION - 1, -1), na_values, n_jobs, tol, extend=False)
+    return nk, {job: ck for job, (_, ck) in zip(jobs, fits, strict=True) if job[1][3] == nk and ck is not None}
+
+
+def stabilisation_diagram(
+    recording: Recording,
+    orders=None,
+    *,
+    band: tuple[float, float] | None = None,
+    detrend: str = "mean",
+    resample: bool = True,
+    align: bool = True,
+    prepared: bool = False,
+    nk: int | None = None,
+    per_sensor: bool = True,
+    per_sensor_max_order: int = 20,
+    tolerances: Tolerances | None = None,
+    max_iter: int = 30,
+    tol: float = SWEEP_TOL,
+    n_jobs: int | None = None,
+    progress: bool = False,
+) -> StabilisationDiagram:
+    """Sweep the model order and class every pole.
+
+    Parameters
+    ----------
+    recording : Recording
+    orders : iterable of int, optional
+        The ``na`` values; ``nb`` and ``nc`` follow the module's rules. Orders given are
+        refused when the record cannot support the highest; the default,
+        :data:`DEFAULT_ORDERS`, is capped at what the record supports (``orders_capped``).
+    band : (lo, hi), optional
+        Frequency band of interest, Hz: sets the analysis rate and, in :func:`select_modes`,
+        the band modes are taken from.
+    detrend, resample, align
+        Preparation of the record (:func:`armaxmodal.prepare.preparation.prepare`): remove each
+        channel's mean (or ``"linear"`` trend, or ``"none"``), resample a record sampled far
+        above its band, align channels late by whole samples.
+    prepared : bool
+        The record is already prepared: fit it as it is (no checks, no warnings).
+    nk : int, optional
+        Input delay; by default chosen by BIC (:func:`choose_nk`).
+    per_sensor : bool
+        Also sweep every sensor alone (the thesis's per-sensor view, Table 3.2).
+    per_sensor_max_order : int
+        Highest ``na`` of the single-sensor sweeps.
+    tolerances : Tolerances, optional
+    max_iter : int
+        Levenberg-Marquardt cap per fit (a sweep needs positions, not the last digit).
+    tol : float
+        Relative loss decrease at which a sweep fit stops; looser than :func:`fit_armax`'s
+        default for the same reason. :func:`select_modes` finishes the fits it reports.
+    n_jobs : int, optional
+        Worker processes (default: all cores).
+    progress : bool
+        Show a progress bar.
+    """
+    with one_blas_thread():  # a with block, not a decorator: mutmut skips decorated functions
+        limits = tolerances or Tolerances()
+        preparation = None
+        if not prepared:
+            preparation = prepare(recording, band=band, detrend=detrend, resample=resample, align=align)
+            recording = preparation.recording
+        notes: tuple = ()
+        if orders is None:
+            orders, notes = _default_orders(recording, preparation)
+        _check_top_order(max(orders), recording, preparation)
+        known: dict = {}
+        if nk is None:
+            nk, known = _choose_nk(recording, NK_SEARCH, (8, 10, 12), n_jobs, tol)
+        sources = [SHARED] + (list(recording.sensors) if per_sensor else [])
+        order_list = [(na, default_nb(na, nk), default_nc(na), nk) for na in orders]
+        # single sensors cannot support high orders (their bounds are wide): stop them earlier
+        jobs = [(s, o) for o in order_list for s in sources if s == SHARED or o[0] <= per_sensor_max_order]
+        # the delay choice's fits of these orders continue from where they stopped, exactly
+        # as if fitted here from the start (unless this sweep's cap is below theirs)
+        if max_iter < DELAY_CHOICE_ITERATIONS:
+            known = {}
+        todo = [job + ((known[job],) if job in known else ()) for job in jobs]
+        from tqdm import tqdm
+
+        with tqdm(total=len(jobs), desc="stabilisation sweep", unit="fit", disable=not progress) as bar:
+            fitted = parallel_map(
+                partial(_fit_and_poles, recording, max_iter=max_iter, tol=tol),
+                todo,
+                n_jobs,
+                bar,
+                cost=partial(_job_cost, n_sensors=len(recording.sensors)),
+            )
+        done = dict(zip(jobs, fitted, strict=True))
+        rows, kept = [], {}
+        for source, o in jobs:
+            fit, fit_rows = done[(source, o)]
+            if fit is None:
+                continue
+            kept[(source, o[0])] = fit
+            rows += fit_rows
+        if not rows:
+            raise OrderError("no order in the sweep could be fitted; use lower orders or a longer record.")
+        poles = pd.DataFrame(rows)
+        poles["cls"] = stability_classes(poles, limits)
+        poles["rejected"] = rejection_reasons(poles, limits, recording)
+        return StabilisationDiagram(poles, order_list, limits, recording, kept, preparation, notes)
+
+
+def _supported_top_order(recording: Recording) -> int:
+    """The highest ``na`` whose per-sensor model (``3 na + 1 - nk`` parameters at the most
+    non-causal delay searched) has :data:`SAMPLES_PER_PARAMETER` samples a parameter."""
+    return (recording.n_samples // SAMPLES_PER_PARAMETER - 1 + min(NK_SEARCH) - NK_EXTENSION) // 3
+
+
+def _default_orders(recording: Recording, preparation: Preparation | None) -> tuple[list, tuple]:
+    """:data:`DEFAULT_ORDERS`, capped at what the record supports (the user typed none, so a
+    short record is no error of theirs) with an ``orders_capped`` note; uncapped when the
+    record supports them all. Below :data:`MIN_DEFAULT_TOP` the sweep is refused as usual."""
+    top = _supported_top_order(recording)
+    if top >= max(DEFAULT_ORDERS):
+        return list(DEFAULT_ORDERS), ()
+    if top < MIN_DEFAULT_TOP:
+        return list(DEFAULT_ORDERS), ()  # refused by _check_top_order, with its advice
+    capped = [na for na in DEFAULT_ORDERS if na <= top]
+    note = QualityWarning(
+        "orders_capped", (),
+        f"the default orders 2-{max(DEFAULT_ORDERS)} were capped at na = {max(capped)}: this record "
+        f"({recording.n_samples} samples at {recording.fs:g} Hz) supports at most na = {top} "
+        f"({SAMPLES_PER_PARAMETER} samples a parameter); a longer record allows higher orders",
+        float(max(capped)),
+    )  # fmt: skip
+    return capped, (note,)
+
+
+def _check_top_order(na: int, recording: Recording, preparation: Preparation | None) -> None:
+    """Refuse, before any fit, a sweep whose highest order the record cannot support."""
+    per_sensor = 3 * na + 1 - (min(NK_SEARCH) - NK_EXTENSION)
+    if per_sensor * SAMPLES_PER_PARAMETER <= recording.n_samples:
+        return
+    top = max(_supported_top_order(recording), 2)
+    narrow = [w for w in (preparation.warnings if preparation else ()) if w.code == "narrowband_input"]
+    resampled = preparation is not None and preparation.analysis_fs != preparation.original_fs
+    record = f"{recording.n_samples} samples at {recording.fs:g} Hz" + (
+        f", resampled from {preparation.original_fs:g} Hz to the "
+        + ("band" if preparation.band is not None else "input's band")
+        if resampled
+        else ""
+    )
+    lead = f"{narrow[0].message.rstrip('.')}; check that the input excites the structure. " if narrow else ""
+    raise OrderError(
+        f"{lead}Orders up to na = {na} need about {per_sensor} parameters per sensor; this record ({record}) "
+        f"supports at most na = {top} ({SAMPLES_PER_PARAMETER} samples a parameter). Lower the top order, "
+        f"e.g. --orders 2:{min(top, 40)}."
+    )
+
+
+def _nk_edge_warning(nk: int, recording: Recording) -> list[QualityWarning]:
+    """The BIC-chosen delay at the most non-causal end of its search range: the data may
+    need more (an input that lags the outputs)."""
+    edge = min(NK_SEARCH) - NK_EXTENSION
+    if nk > edge:
+        return []
+    return [
+        QualityWarning(
+            "nk_at_search_edge",
+            (recording.input_name,),
+            f"the chosen input delay nk = {nk} sits at the edge of its search range "
+            f"({edge} to {max(NK_SEARCH)}): the outputs may lead the input by more (a late input "
+            "or a filter delay); look at the sensor_delay check and align the channels.",
+            float(nk),
+        )
+    ]

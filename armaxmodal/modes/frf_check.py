@@ -1,0 +1,155 @@
+"""The clear, coherent peaks of the measured FRF (an H1 fine enough to resolve the narrowest
+mode) and those no selected mode accounts for (thesis Section 3.3.3's check, made
+quantitative). The modal-model check itself is :mod:`armaxmodal.modes.modal_check`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from armaxmodal.notes import QualityWarning
+from armaxmodal.prepare.frf import coherence, excited_band, welch_spectra
+from armaxmodal.recording import Recording
+
+__all__ = ["resolving_nperseg", "unexplained_peaks", "coherent_peaks", "peak_support"]
+
+#: lines per half-power bandwidth of the narrowest mode the comparison needs
+LINES_PER_BANDWIDTH = 4
+#: fewest Welch segments kept (the H1's random error grows as segments get fewer)
+MIN_SEGMENTS = 4
+MIN_COHERENCE = 0.8
+
+
+def resolving_nperseg(
+    recording: Recording,
+    freq_hz,
+    damping,
+    lines_per_bandwidth: int = LINES_PER_BANDWIDTH,
+    min_segments: int = MIN_SEGMENTS,
+) -> int:
+    """Welch segment length whose line spacing puts ``lines_per_bandwidth`` lines in the
+    half-power bandwidth ``2 xi f`` of the narrowest mode (a power of two, at least 256
+    samples), within the record's ``min_segments`` half-overlapping segments."""
+    bw = 2 * np.min(np.asarray(damping, float) * np.asarray(freq_hz, float)) if len(freq_hz) else 0.0
+    longest = 2 * recording.n_samples // (min_segments + 1)
+    want = recording.fs * lines_per_bandwidth / bw if bw > 0 else longest
+    return int(np.clip(2 ** int(np.ceil(np.log2(max(want, 16)))), min(256, longest), longest))
+
+
+def _measured(recording: Recording, nperseg: int):
+    f, puu, puy, pyy = welch_spectra(recording.base, recording.response, recording.fs, nperseg)
+    return f, puy / puu[:, None], coherence(puu, puy, pyy)
+
+
+def peak_prominences(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Local maxima of ``x`` and their prominences, as ``scipy.signal.find_peaks(x,
+    prominence=0)`` gives them (a plateau's peak at its middle, rounded down).
+
+    Written here because importing ``scipy.signal`` imports ``scipy.stats``: 0.8 s of every
+    ``stabilise`` run, for a few hundred lines of one spectrum (``tests/test_frf_check.py``
+    checks it against scipy on random and plateau-rich data).
+
+    Parameters
+    ----------
+    x : (n,) array
+
+    Returns
+    -------
+    peaks : (m,) int array, indices of the maxima
+    prominences : (m,) array, height above the higher of the two bases
+    """
+    x = np.asarray(x, dtype=float)
+    peaks = []
+    i = 1
+    while i < x.size - 1:
+        if x[i - 1] < x[i]:
+            ahead = i + 1
+            while ahead < x.size - 1 and x[ahead] == x[i]:
+                ahead += 1
+            if x[ahead] < x[i]:
+                peaks.append((i + ahead - 1) // 2)
+                i = ahead
+        i += 1
+    prominences = []
+    for p in peaks:
+        left = p
+        while left > 0 and x[left - 1] <= x[p]:
+            left -= 1
+        right = p
+        while right < x.size - 1 and x[right + 1] <= x[p]:
+            right += 1
+        prominences.append(x[p] - max(x[left : p + 1].min(), x[p : right + 1].min()))
+    return np.array(peaks, dtype=int), np.array(prominences, dtype=float)
+
+
+def coherent_peaks(recording: Recording, nperseg: int, band=None) -> list[tuple[float, str, float]]:
+    """Clear, coherent peaks of each sensor's measured FRF: ``(freq_hz, sensor, |H1|)``.
+
+    A clear peak: coherence at least 0.8 on it and two lines either side, a third of its
+    height above both neighbouring valleys, the highest within :data:`LINES_PER_BANDWIDTH`
+    lines either side (a mode spans that many lines at the resolution of
+    :func:`resolving_nperseg`; a noise bump is a line or two wide), and at least 5 % of the
+    sensor's strongest coherent response.
+    """
+    f, h, coh = _measured(recording, nperseg)
+    lo, hi = band if band is not None else excited_band(recording)
+    out = []
+    for k, sensor in enumerate(recording.sensors):
+        mag = np.abs(h[:, k])
+        ok = (coh[:, k] >= MIN_COHERENCE) & (f >= lo) & (f <= hi)
+        if not ok.any():
+            continue
+        peaks, prominences = peak_prominences(np.where(ok, mag, 0.0))
+        for i, prom in zip(peaks, prominences, strict=True):
+            span = slice(max(i - LINES_PER_BANDWIDTH, 0), i + LINES_PER_BANDWIDTH + 1)
+            if prom < 0.33 * mag[i] or mag[i] < 0.05 * mag[ok].max() or mag[i] < mag[span].max():
+                continue
+            if ok[max(i - 2, 0) : i + 3].all():
+                out.append((float(f[i]), sensor, float(mag[i])))
+    return out
+
+
+def _explains(freq_hz: float, line_hz: float, modes_hz, damping) -> bool:
+    """A mode lies within the peak's half-power bandwidth ``2 xi f`` (at least 1 % or 3 lines)."""
+    return any(
+        abs(freq_hz - fm) <= max(2 * fm * x, 0.01 * fm, 3 * line_hz) for fm, x in zip(modes_hz, damping, strict=True)
+    )
+
+
+def unexplained_peaks(recording: Recording, freq_hz, damping, band=None) -> list[QualityWarning]:
+    """Coherent peaks of the measured FRF (:func:`coherent_peaks`) with no selected mode
+    within its half-power bandwidth: each a ``unexplained_peak`` warning."""
+    n = resolving_nperseg(recording, freq_hz, damping)
+    df = recording.fs / n
+    peaks = coherent_peaks(recording, n, band)
+    return _merged([p for p in peaks if not _explains(p[0], df, freq_hz, damping)], df)
+
+
+def peak_support(recording: Recording, freq_hz: float, damping: float, band=None) -> float | None:
+    """Frequency of the clear, coherent FRF peak (:func:`coherent_peaks`) that a mode at
+    ``freq_hz`` explains, or None: the data's own evidence for a mode whose poles alone are
+    not conclusive (a lightly damped pole whose damping estimate crosses zero)."""
+    n = resolving_nperseg(recording, [freq_hz], [max(damping, 1e-6)])
+    df = recording.fs / n
+    near = [p for p in coherent_peaks(recording, n, band) if _explains(p[0], df, [freq_hz], [max(damping, 0.0)])]
+    return max(near, key=lambda p: p[2])[0] if near else None
+
+
+def _merged(peaks, df) -> list[QualityWarning]:
+    """One warning per peak seen on several sensors (within 3 % or 3 lines of each other)."""
+    groups: list[list] = []
+    for p in sorted(peaks):
+        if groups and p[0] - groups[-1][-1][0] <= max(0.03 * p[0], 3 * df):
+            groups[-1].append(p)
+        else:
+            groups.append([p])
+    warnings = []
+    for g in groups:
+        f0 = max(g, key=lambda p: p[2])[0]
+        sensors = tuple(sorted({p[1] for p in g}))
+        warnings.append(QualityWarning(
+            "unexplained_peak", sensors,
+            f"the measured FRF has a clear, coherent peak at {f0:.2f} Hz ({', '.join(sensors)}) that no "
+            "selected mode explains: a mode the selection missed (widen --orders or --modes), or a disturbance "
+            "(run 'armaxmodal diagnose')", f0,
+        ))  # fmt: skip
+    return warnings

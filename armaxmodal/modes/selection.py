@@ -1,0 +1,274 @@
+"""Automatic mode selection from a stabilisation diagram (thesis Section 3.4).
+
+:func:`select_modes` clusters the stable shared-pole estimates across orders, keeps the
+clusters supported by a good share of the orders, reports each from its lowest-BIC fit,
+refits them to the recording's DFT, lets the modal-model check drop or add modes, and widens
+the intervals by the segment spread. It is deterministic: the same data gives the same
+modes. :class:`ModeSelection` is the result and its JSON contract.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from armaxmodal._threads import one_blas_thread
+from armaxmodal.exceptions import OrderError
+from armaxmodal.modal import mode_record
+from armaxmodal.modes.clusters import clustered_modes, merge_duplicates
+from armaxmodal.modes.completeness import modes_the_check_adds, modes_the_record_needs, refit_with_added
+from armaxmodal.modes.diagram import StabilisationDiagram
+from armaxmodal.modes.modal_check import ModalCheck, check_modes
+from armaxmodal.modes.per_sensor import per_sensor_table
+from armaxmodal.modes.refine import ModalRefinement
+from armaxmodal.modes.selected_refit import refined_modes, refit_and_segment_fits
+from armaxmodal.modes.spread import (
+    N_SEGMENTS,
+    apply_segment_spread,
+    segment_spread,
+)
+from armaxmodal.notes import QualityWarning
+from armaxmodal.prepare.preparation import oversampling_note
+
+
+# -- automatic selection -----------------------------------------------------------------------
+@dataclass(frozen=True)
+class ModeSelection:
+    """Physical modes picked from a stabilisation diagram.
+
+    Attributes
+    ----------
+    modes : DataFrame
+        One row per mode, by frequency: freq_hz, damping, damped_freq_hz and 95 % intervals
+        (from the representative fit), na of that fit, count and support of the cluster,
+        its spread (standard deviation over orders) and medoid.
+    shapes : (n_sensors, n_modes) complex ndarray
+        EPFRF modal constants per sensor (Eq. 3.24) from the representative fit.
+    per_sensor : DataFrame
+        Table 3.2 form: one row per sensor and mode with the sensor's own frequency, damping
+        and residue magnitude, NaN where the sensor does not show the mode (the thesis's X).
+    weighted : DataFrame
+        Eqs. 3.35-3.36: per mode, the mean of the per-sensor values weighted by ``|M_ij|``.
+    diagram : StabilisationDiagram
+    refinement : ModalRefinement or None
+        The frequency-domain refit (:mod:`armaxmodal.modes.refine`); its ``hold`` is the
+        inter-sample behaviour the data chose. ``modes.estimator`` says which values are
+        reported: the refit for a band-limited recording, the ARMAX fit (the exact model
+        class) for a held input.
+    """
+
+    modes: pd.DataFrame
+    shapes: np.ndarray
+    per_sensor: pd.DataFrame
+    weighted: pd.DataFrame
+    diagram: StabilisationDiagram
+    refinement: ModalRefinement | None = None
+    notes: tuple[QualityWarning, ...] = ()
+    check: ModalCheck | None = None
+
+    @property
+    def reconstruction_error(self) -> float:
+        """The modal-model check's relative misfit (:mod:`armaxmodal.modes.modal_check`): the
+        largest output's relative RMS difference between the measured H1 and its LSFD fit
+        by the selected poles with residual terms and a delay. Computed once, in
+        :func:`select_modes`: the CLI, the figure and the JSON report the same number."""
+        return self.check.overall_error if self.check is not None else float("nan")
+
+    @property
+    def quality(self) -> str:
+        """``"good"`` when the modal-model check passes, else ``"poor"``."""
+        return "good" if self.check is not None and self.check.passed else "poor"
+
+    @property
+    def warnings(self) -> list[QualityWarning]:
+        """The diagram's data-quality warnings and the selection's own."""
+        return self.diagram.warnings + list(self.notes)
+
+    def to_dict(self, shapes: str = "shared") -> dict:
+        """The JSON contract of the ``stabilise`` command.
+
+        ``shapes="shared"`` reports the shared-pole residues (complete by construction);
+        ``"per_sensor"`` each sensor's own residue, with gaps filled by Eq. (3.34) and
+        flagged ``supplemented``.
+        """
+        if shapes not in ("shared", "per_sensor"):
+            raise ValueError(f"shapes: expected 'shared' or 'per_sensor', got {shapes!r}.")
+        rec = self.diagram.recording
+        if shapes == "shared":
+            matrix, flags = self.shapes, np.zeros(self.shapes.shape, dtype=bool)
+        else:
+            from armaxmodal.modes.merge import supplement_shapes
+
+            matrix, flags = supplement_shapes(self)
+        modes = []
+        for i, row in enumerate(self.modes.itertuples(index=False)):
+            record = mode_record(row, matrix[:, i], rec.sensors, flags[:, i])
+            record.update(
+                orders_supporting=int(row.count),
+                freq_spread_hz=float(row.freq_spread),
+                damping_spread=float(row.damping_spread),
+            )
+            if "segments_found" in self.modes:
+                record["segment_spread"] = {
+                    "segments_found": int(row.segments_found),
+                    "freq_sd_hz": _finite_or_none(row.freq_segment_sd),
+                    "damping_sd": _finite_or_none(row.damping_segment_sd),
+                }
+                record["model_error_dominates"] = bool(row.model_error_dominates)
+            modes.append(record)
+        per_sensor = [
+            {k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in r.items()}
+            for r in self.per_sensor.drop(columns=["own_modal_constant"]).to_dict("records")
+        ]
+        t = self.diagram.tolerances
+        prep = self.diagram.preparation
+        return {
+            "fs": rec.fs if prep is None else prep.original_fs,
+            "analysis_fs": rec.fs,
+            "preprocessing": None if prep is None else prep.to_dict(),
+            "warnings": [w.to_dict() for w in self.warnings],
+            "input": rec.input_name,
+            "outputs": list(rec.sensors),
+            "nk": self.diagram.orders[0][3],
+            "orders_na": [o[0] for o in self.diagram.orders],
+            "tolerances": {"freq": t.freq, "damping": t.damping, "shape": t.shape, "max_damping": t.max_damping},
+            "quality": self.quality,
+            "reconstruction_error": _finite_or_none(self.reconstruction_error),
+            "modal_check": None if self.check is None else self.check.to_dict(),
+            "intersample_hold": None if self.refinement is None else self.refinement.hold,
+            "estimator": sorted(set(self.modes.estimator)),
+            "modes": modes,
+            "per_sensor": per_sensor,
+        }
+
+
+def select_modes(
+    diagram: StabilisationDiagram,
+    n_modes: int | None = None,
+    band: tuple[float, float] | None = None,
+    *,
+    min_support: float = 0.4,
+    cluster_freq: float = 0.05,
+    cluster_damping: float = 0.5,
+    merge_mac: float = 0.8,
+    refine: bool = True,
+    segments: int = N_SEGMENTS,
+    n_jobs: int | None = None,
+) -> ModeSelection:
+    """Pick the physical modes from the shared-pole poles of a diagram.
+
+    Kept, non-rejected poles are clustered across orders (greedy, in order of increasing
+    ``na``; a pole joins the nearest cluster whose median lies within ``cluster_freq``
+    relative frequency and ``cluster_damping`` relative damping and which has no pole of that
+    order yet). A cluster is a mode when it holds poles of at least ``min_support`` of the
+    swept orders. Each mode is reported from the
+    fit of lowest BIC among the orders in its cluster -- the most parsimonious adequate model;
+    over-parameterised orders scatter heavily damped modes -- with the cluster's medoid,
+    spread and count alongside. Two modes closer than the half-power bandwidth of the
+    better-supported one (``2 xi f``) whose shapes agree (MAC >= ``merge_mac``) are one mode
+    split by over-modelling; the weaker is dropped.
+
+    Parameters
+    ----------
+    diagram : StabilisationDiagram
+    n_modes : int, optional
+        Keep the ``n_modes`` best-supported modes (the modal-model check then judges them but
+        neither drops nor adds any).
+    band : (lo, hi), optional
+        Frequency band in Hz (default: the diagram's band, if it was given one).
+    refine : bool
+        Refit the selected modes to the recording's DFT under the inter-sample behaviour the
+        data choose (:func:`armaxmodal.modes.refine.refine_modes`) and report the refit when the
+        recording is band-limited, where the discrete ARMAX class is biased.
+    segments : int
+        Refit each mode's representative orders on this many disjoint segments and widen
+        the intervals where their spread exceeds them (:mod:`armaxmodal.modes.spread`); 0 skips.
+    n_jobs : int, optional
+        Worker processes for the finishing and segment fits (default: all cores; 1 inside a
+        process that may not start its own, e.g. a dask worker).
+    """
+    with one_blas_thread():
+        if band is None and diagram.preparation is not None:
+            band = diagram.preparation.band
+        nas = sorted({o[0] for o in diagram.orders})
+        modes, vectors = clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs)
+        if not modes.empty:
+            keep = merge_duplicates(modes, vectors, merge_mac, diagram.recording.duration)
+            modes, vectors = modes.loc[keep].reset_index(drop=True), [vectors[i] for i in keep]
+        if modes.empty:
+            raise OrderError(
+                "no stable mode found"
+                + (f" in {band[0]:g}-{band[1]:g} Hz" if band else "")
+                + "; widen the band, extend the order range, or check that the input excites the structure."
+            )
+        order = modes.sort_values(["support", "count", "energy"], ascending=False).index
+        if n_modes is not None:
+            order = order[:n_modes]
+        order = modes.loc[order].sort_values("freq_hz").index
+        modes = modes.loc[order].reset_index(drop=True)
+        shapes = np.column_stack([vectors[i] for i in order])
+        modes["estimator"] = "armax"
+        # the segment refits are ARMAX fits: their spread is judged against the ARMAX intervals
+        modes["freq_sd_armax"] = (modes.freq_ci95_hi - modes.freq_ci95_lo) / (2 * 1.96)
+        modes["damping_sd_armax"] = (modes.damping_ci95_hi - modes.damping_ci95_lo) / (2 * 1.96)
+        refinement = None
+        orders = {o[0]: o for o in diagram.orders}
+        fitted = refit_and_segment_fits(diagram, modes, band, refine, segments, orders, n_jobs)
+        if refine:
+            refit, limits = fitted.pop("refit"), (cluster_freq, cluster_damping, merge_mac)
+            modes, shapes, refinement = refined_modes(diagram, modes, shapes, refit, *limits)
+        if n_modes is None:
+            modes, shapes, notes, check = modes_the_record_needs(diagram.recording, modes, shapes, band)
+            clustering, n_before = (cluster_freq, cluster_damping), len(modes)
+            modes, shapes, check = modes_the_check_adds(diagram, modes, shapes, band, nas, check, clustering)
+            if len(modes) > n_before:  # a mode the added ones make redundant goes (a merge of two)
+                modes, shapes, more, check = modes_the_record_needs(diagram.recording, modes, shapes, band)
+                notes += more
+            if refine and len(modes) > n_before:  # the refit saw fewer modes than are reported
+                limits = (cluster_freq, cluster_damping, merge_mac)
+                modes, shapes, refinement, check = refit_with_added(diagram, modes, shapes, band, limits, refinement)
+        else:  # the user fixed the number of modes: the check judges them, it does not choose
+            notes, check = [], check_modes(diagram.recording, modes.freq_hz, modes.damping, band)
+        if segments >= 2:
+            orders_of = lambda i: orders[int(modes.at[i, "na"])]  # noqa: E731
+            spread = segment_spread(diagram.recording, modes, orders_of, segments, n_jobs, fitted)
+            modes, spread_notes = apply_segment_spread(modes, spread, segments)
+            notes += spread_notes
+        per_sensor, weighted = per_sensor_table(diagram, modes, shapes, cluster_freq)
+        from armaxmodal.modes.frf_check import unexplained_peaks
+
+        notes += unexplained_peaks(diagram.recording, modes.freq_hz.to_numpy(), modes.damping.to_numpy(), band)
+        notes += oversampling_note(modes.freq_hz.to_numpy(), diagram.recording.fs)
+        notes += _unresolved_damping_notes(modes, len(nas))
+        notes += check.warnings()
+        return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement, tuple(notes), check)
+
+
+def _unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[QualityWarning]:
+    """A ``damping_unresolved`` note for every mode whose damping interval reaches zero or
+    whose damping estimate is not positive at some orders of the sweep, with the reason."""
+    notes = []
+    for m in modes.itertuples(index=False):
+        crossed = int(m.orders_damping_unresolved)
+        if crossed == 0 and m.damping_ci95_lo > 0:
+            continue
+        facts = [f"damping {m.damping:.2g}, 95 % interval [{m.damping_ci95_lo:.2g}, {m.damping_ci95_hi:.2g}]"]
+        if crossed:
+            facts.append(f"its estimate is not positive at {crossed} of {n_orders} orders")
+        if getattr(m, "model_error_dominates", False):
+            why = ("the interval is the spread of the record's thirds (model_error_dominates): the thirds disagree "
+                   "about this damping; run 'armaxmodal diagnose'")  # fmt: skip
+        else:
+            why = "the damping is below what this record resolves: a longer record, or more excitation here, narrows it"
+        notes.append(QualityWarning(
+            "damping_unresolved", (),
+            f"mode at {m.freq_hz:.3f} Hz ([{m.freq_ci95_lo:.4g}, {m.freq_ci95_hi:.4g}] Hz): {'; '.join(facts)}. {why}",
+            float(m.freq_hz),
+        ))  # fmt: skip
+    return notes
+
+
+def _finite_or_none(value) -> float | None:
+    return float(value) if np.isfinite(value) else None

@@ -1,0 +1,59 @@
+"""The notes every stage returns: a data-quality or method finding with its code, the
+channels it concerns, a sentence with the measured number, and that number. They travel with
+a result into its JSON (``warnings``) and the command line's ``note:`` lines."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["QualityWarning", "WARNING_CODES"]
+
+WARNING_CODES = (
+    "duplicate_channel",
+    "inverted_sensor",
+    "sensor_delay",
+    "narrowband_input",
+    "clipping",
+    "dropped_packet",
+    "offset_removed",
+    "offset_step",
+    "drift",
+    "trend_removed",
+    "resampled",
+    "model_error_dominates",
+    "nk_at_search_edge",
+    "unexplained_peak",
+    "damping_unresolved",
+    "split_merged",
+    "no_modes",
+    "incoherent_output",
+    "unit_mismatch",
+    "periodic_disturbance",
+    "stuck_samples",
+    "oversampled",
+    "held_samples",
+    "mode_not_needed",
+    "modes_do_not_explain_frf",
+    "orders_capped",
+)
+
+@dataclass(frozen=True)
+class QualityWarning:
+    """One data-quality finding: ``code`` (see :data:`WARNING_CODES`), the channels it
+    concerns, a sentence with the measured number, and that number (``value``, its unit in
+    the message)."""
+
+    code: str
+    channels: tuple[str, ...]
+    message: str
+    value: float | None = None
+
+    def __post_init__(self):
+        if self.code not in WARNING_CODES:
+            raise ValueError(f"unknown warning code {self.code!r}; expected one of {WARNING_CODES}.")
+
+    def to_dict(self) -> dict:
+        value = None if self.value is None or not np.isfinite(self.value) else float(self.value)
+        return {"code": self.code, "channels": list(self.channels), "message": self.message, "value": value}

@@ -1,0 +1,12 @@
+"""Preparation of a record before any fit, and every data-quality check.
+
+* :func:`prepare` -- checks, level shifts, detrending, alignment of late channels and
+  resampling to the analysis band; :class:`Preparation` says what was done.
+* :func:`check_quality` -- the pre-fit checks (:mod:`.quality`, :mod:`.held`, :mod:`.units`).
+* :mod:`.frf` -- Welch spectra, H1 and coherence, shared by every later stage.
+"""
+
+from armaxmodal.prepare.checks import check_quality
+from armaxmodal.prepare.preparation import Preparation, prepare
+
+__all__ = ["Preparation", "check_quality", "prepare"]

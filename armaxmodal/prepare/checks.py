@@ -1,0 +1,39 @@
+"""Every data-quality check run before a fit, in one call (the checks themselves live in
+:mod:`armaxmodal.prepare.quality`, :mod:`~armaxmodal.prepare.held` and
+:mod:`~armaxmodal.prepare.units`)."""
+
+from __future__ import annotations
+
+from armaxmodal.notes import QualityWarning
+from armaxmodal.prepare.held import held_samples
+from armaxmodal.prepare.quality import (
+    clipped_channels,
+    delay_and_inversion,
+    duplicate_channels,
+    incoherent_outputs,
+    narrowband_input,
+    stuck_channels,
+)
+from armaxmodal.prepare.units import unit_mismatch
+from armaxmodal.recording import Recording
+
+__all__ = ["check_quality"]
+
+
+def check_quality(recording: Recording) -> list[QualityWarning]:
+    """Every pre-fit check on ``recording`` (see :mod:`armaxmodal.prepare.quality`).
+
+    Returns
+    -------
+    list of QualityWarning
+        The findings, in the order the checks run.
+    """
+    found = duplicate_channels(recording)
+    found += delay_and_inversion(recording)
+    found += narrowband_input(recording)
+    found += clipped_channels(recording)
+    found += stuck_channels(recording)
+    found += held_samples(recording)
+    found += incoherent_outputs(recording)
+    found += unit_mismatch(recording)
+    return found
