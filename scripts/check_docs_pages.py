@@ -1,0 +1,79 @@
+"""A headless look at the built documentation: every page opens in Chromium, shows its title,
+and every figure it shows exists; no example printed a traceback. Run by .ci/run after the build.
+
+Run:  python scripts/check_docs_pages.py [docs/_build/html]
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+PAGES = {
+    "index.html": "armaxmodal",
+    "getting_started.html": "Getting started",
+    "user_guide/index.html": "User guide",
+    "auto_examples/index.html": "Examples",
+    "method.html": "The method",
+    "architecture.html": "How the code is laid out",
+    "validation.html": "Validation",
+    "performance.html": "Performance",
+    "api.html": "API reference",
+}
+
+
+def rendered(browser: str, page: Path) -> str:
+    """The page's DOM after Chromium has run its scripts."""
+    out = subprocess.run(
+        [browser, "--headless", "--no-sandbox", "--disable-gpu", "--dump-dom", page.as_uri()],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    if out.returncode != 0 or "<html" not in out.stdout:
+        raise SystemExit(f"{page}: Chromium could not render it ({out.stderr.strip()[-300:]})")
+    return out.stdout
+
+
+def problems(site: Path, browser: str) -> list[str]:
+    found = []
+    examples = sorted(p.relative_to(site).as_posix() for p in (site / "auto_examples").glob("plot_*.html"))
+    if len(examples) < 6:
+        found.append(f"only {len(examples)} gallery examples were built")
+    for name in [*PAGES, *examples]:
+        page = site / name
+        if not page.exists():
+            found.append(f"{name}: missing")
+            continue
+        dom = rendered(browser, page)
+        title = re.search(r"<h1[^>]*>(.*?)</h1>", dom, re.S)
+        text = re.sub(r"<[^>]+>", "", title.group(1)) if title else ""
+        if name in PAGES and PAGES[name].lower() not in text.lower():
+            found.append(f"{name}: heading {text.strip()[:60]!r}, expected {PAGES[name]!r}")
+        for src in re.findall(r'<img[^>]+src="([^"]+)"', dom):
+            if not src.startswith(("http:", "https:", "data:")) and not (page.parent / src).resolve().exists():
+                found.append(f"{name}: image {src} not found")
+        if "Traceback (most recent call last)" in dom:
+            found.append(f"{name}: shows a traceback")
+        figure = "sphx-glr-single-img" in dom or "sphx-glr-multi-img" in dom
+        if name.startswith("auto_examples/plot_") and not figure:
+            found.append(f"{name}: no figure")
+    return found
+
+
+def main() -> None:
+    site = Path(sys.argv[1] if len(sys.argv) > 1 else "docs/_build/html").resolve()
+    browser = shutil.which("chromium") or shutil.which("chromium-browser")
+    if browser is None:
+        raise SystemExit("chromium is not installed (Debian package 'chromium'); .ci/run installs it")
+    found = problems(site, browser)
+    for line in found:
+        print(line)
+    if found:
+        raise SystemExit(1)
+    print(f"{site}: every page renders, with its title and figures")
+
+
+if __name__ == "__main__":
+    main()
