@@ -13,7 +13,8 @@ from pathlib import Path
 import armaxmodal as am
 
 # the repository's bundled rides, found from wherever the example runs
-fixtures = next(d / "fixtures" for d in (Path.cwd(), *Path.cwd().parents) if (d / "fixtures" / "supine_random.csv").exists())
+folders = (Path.cwd(), *Path.cwd().parents)
+fixtures = next(d / "fixtures" for d in folders if (d / "fixtures" / "supine_random.csv").exists())
 rec = am.read_recording(fixtures / "supine_random.csv")
 diagram = am.stabilisation_diagram(rec, orders=range(2, 21, 2), per_sensor=False)
 selection = am.select_modes(diagram, segments=0)

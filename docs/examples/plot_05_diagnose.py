@@ -19,7 +19,8 @@ import armaxmodal as am
 from armaxmodal.diagnosis.plot import plot_diagnosis
 
 # the repository's bundled rides, found from wherever the example runs
-fixtures = next(d / "fixtures" for d in (Path.cwd(), *Path.cwd().parents) if (d / "fixtures" / "supine_random.csv").exists())
+folders = (Path.cwd(), *Path.cwd().parents)
+fixtures = next(d / "fixtures" for d in folders if (d / "fixtures" / "supine_random.csv").exists())
 rec = am.read_recording(fixtures / "supine_random.csv")
 t = np.arange(rec.n_samples) / rec.fs
 response = rec.response.copy()
