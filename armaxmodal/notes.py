@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["QualityWarning", "WARNING_CODES"]
+__all__ = ["QualityWarning", "WARNING_CODES", "not_run"]
 
 WARNING_CODES = (
     "duplicate_channel",
@@ -37,6 +37,8 @@ WARNING_CODES = (
     "mode_not_needed",
     "modes_do_not_explain_frf",
     "orders_capped",
+    "refit_failed",
+    "check_not_run",
 )
 
 @dataclass(frozen=True)
@@ -57,3 +59,9 @@ class QualityWarning:
     def to_dict(self) -> dict:
         value = None if self.value is None or not np.isfinite(self.value) else float(self.value)
         return {"code": self.code, "channels": list(self.channels), "message": self.message, "value": value}
+
+
+def not_run(check: str, channels: tuple[str, ...], why: str) -> QualityWarning:
+    """The note that a check could not run on ``channels`` (a check that says nothing has run
+    and found nothing)."""
+    return QualityWarning("check_not_run", tuple(channels), f"{check} not tested: {why}")

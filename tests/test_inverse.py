@@ -269,3 +269,28 @@ def test_model_update_standard_errors_match_its_scatter():
 
 def _complex_normal(rng, shape):
     return (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)) / np.sqrt(2)
+
+
+def test_evphc_says_when_the_inner_problem_had_no_solution(monkeypatch):
+    """Phases with no feasible chain are a barrier for the optimiser, never a silent cost: the
+    result counts them."""
+    import armaxmodal.inverse.phase_correction as module
+    from armaxmodal.exceptions import StructureError
+
+    s = am.chapter2_system()
+    m = s.modes()
+    f = np.linspace(0.5, 30.0, 60)
+    calls = []
+
+    def sometimes_infeasible(*args, **kwargs):
+        calls.append(1)
+        if len(calls) in (2, 3):  # the first call (the measured phases) solves
+            raise StructureError("no chain")
+        return inner_solve(*args, **kwargs)
+
+    monkeypatch.setattr(module, "inner_solve", sometimes_infeasible)
+    result = module.evphc(m.eigenvalues, m.shapes, (f, s.transmissibility(f)), m1=6.0, starts=1)
+    (flag,) = [x for x in result.flags if "no solution" in x]
+    assert "at 2 of" in flag
+    clean = module.evphc(m.eigenvalues, m.shapes, (f, s.transmissibility(f)), m1=6.0, starts=1)
+    assert not [x for x in clean.flags if "no solution" in x]

@@ -433,9 +433,12 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
         raise OrderError("too few lines")
 
     monkeypatch.setattr(st, "refine_modes", failing)
-    assert st.selection_job(rec, [], modes, ("refit", (lo, hi))) is None  # the ARMAX values stand
-    out, out_shapes, kept = st.refined_modes(diagram, modes, shapes, None, 0.05, 0.5, 0.8)
-    assert kept is None and out is modes and out_shapes is shapes
+    failed = st.selection_job(rec, [], modes, ("refit", (lo, hi)))
+    assert isinstance(failed, st.RefitFailure) and failed.reason == "too few lines"  # said, not silent
+    (note,) = failed.notes()
+    assert note.code == "refit_failed" and "too few lines" in note.message
+    out, out_shapes, kept = st.refined_modes(diagram, modes, shapes, failed, 0.05, 0.5, 0.8)
+    assert kept is None and out is modes and out_shapes is shapes  # the ARMAX values stand
     monkeypatch.setattr(st, "refine_modes", refit)
     hold = "bandlimited"
     calls = []

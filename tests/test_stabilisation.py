@@ -395,3 +395,25 @@ def test_the_delay_and_order_choices_do_not_depend_on_the_data_unit(fixtures_dir
     assert len({choose_nk(r, n_jobs=1) for r in scaled}) == 1
     orders = {choose_orders(r, na_values=(8, 10), nk_values=(-3, -5, -7), n_jobs=1).orders for r in scaled}
     assert len(orders) == 1
+
+
+def test_a_refit_that_cannot_be_made_is_said_not_taken_for_refine_false(monkeypatch, fixtures_dir):
+    """A failed frequency-domain refit leaves the ARMAX values and a ``refit_failed`` note in
+    the result (and so in the JSON); refine=False leaves no such note."""
+    import armaxmodal.modes.selected_refit as selected_refit
+
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    diagram = stabilisation_diagram(rec, range(4, 13, 2), per_sensor=False, n_jobs=1)
+
+    def cannot(*args, **kwargs):
+        raise OrderError("too few lines in the band")
+
+    monkeypatch.setattr(selected_refit, "refine_modes", cannot)
+    failed = select_modes(diagram, segments=0, n_jobs=1)
+    plain = select_modes(diagram, refine=False, segments=0, n_jobs=1)
+    notes = [w for w in failed.warnings if w.code == "refit_failed"]
+    assert notes and "too few lines in the band" in notes[0].message
+    assert not [w for w in plain.warnings if w.code == "refit_failed"]
+    assert set(failed.modes.estimator) == {"armax"} and failed.refinement is None
+    np.testing.assert_array_equal(failed.modes.freq_hz, plain.modes.freq_hz)
+    assert "refit_failed" in json.dumps(failed.to_dict())

@@ -40,9 +40,6 @@ def run(args) -> int:
     print(_diagnosis_text(args.data, report))
     outputs = []
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
         from armaxmodal.diagnosis.plot import plot_diagnosis
 
         fig = plot_diagnosis(result)

@@ -137,9 +137,6 @@ def _diagram_outputs(args, diagram, selection, plot_format) -> list:
     """The stabilisation plot and pole table as ``(path, write)`` pairs for :func:`write_all`."""
     outputs = []
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
         ax, _ = diagram.plot(selection)
         outputs.append((args.plot, lambda tmp: ax.figure.savefig(tmp, dpi=150, format=plot_format)))
     if args.csv:

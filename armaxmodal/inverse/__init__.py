@@ -13,9 +13,9 @@ Acronyms: EVPHC, eigenvector phase correction (the thesis's method); PIA, Pilkey
 algorithm; EPFRF, equivalent point frequency response function.
 """
 
-from armaxmodal.inverse.evphc import evphc
 from armaxmodal.inverse.inner import inner_solve
-from armaxmodal.inverse.pia import pia
+from armaxmodal.inverse.phase_correction import evphc
+from armaxmodal.inverse.pilkey_inman import pia
 from armaxmodal.inverse.result import InverseSolution
 from armaxmodal.inverse.sdp import inner_solve_sdp
 from armaxmodal.inverse.update import model_update, weight_sweep

@@ -24,6 +24,10 @@ from armaxmodal.inverse.inner import inner_solve
 from armaxmodal.inverse.modal_data import check_modes
 from armaxmodal.inverse.result import InverseSolution
 
+#: the cost of phases for which the inner problem has no solution: far above the transmissibility
+#: misfit of any fitted chain, so the optimiser steps back from them
+INFEASIBLE_COST = 1e3
+
 
 def evphc(
     eigenvalues,
@@ -82,11 +86,14 @@ def evphc(
             out[i, r] = psi[i, r] * np.exp(g + 1j * d)
         return out
 
+    infeasible = []  # the phase sets for which the inner problem had no solution
+
     def objective(offsets):
         try:
             sol = inner_solve(lam, shapes_for(offsets), **kw)
         except StructureError:
-            return 1e3
+            infeasible.append(1)
+            return INFEASIBLE_COST
         t_mod = sol.structure.transmissibility(f)
         diff = np.abs(t_mod) - np.abs(t_meas) if cost == "magnitude" else t_mod - t_meas
         return float(np.mean(np.sum(np.abs(diff), axis=1)))
@@ -110,6 +117,7 @@ def evphc(
     )
     freqs = np.array([inner_solve(lam, shapes_for(r.x), **kw).modes.freq_hz for r in results])
     flags = list(sol.flags)
+    flags += _infeasible_flag(len(infeasible), int(sum(r.nfev for r in results)))
     if len(results) > 1 and np.ptp(freqs, axis=0).max() > 0.01 * freqs.mean(axis=0).min():
         flags.append("EVPHC starts disagree by more than 1 % in frequency: local minima; check the result")
     converged = bool(best.fun <= cost_tol or best.success)
@@ -124,3 +132,13 @@ def evphc(
         converged,
         flags,
     )
+
+
+def _infeasible_flag(count: int, evaluations: int) -> list[str]:
+    """Say how many phase sets had no feasible chain (scored :data:`INFEASIBLE_COST`)."""
+    if not count:
+        return []
+    return [
+        f"the inner problem had no solution at {count} of {evaluations} phase sets tried; they were "
+        f"scored {INFEASIBLE_COST:g} (a barrier the optimiser steps back from), not fitted"
+    ]

@@ -12,7 +12,7 @@ from armaxmodal.estimate.orders import information_criterion
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, representative_pole
 from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.poles import SHARED
-from armaxmodal.modes.selected_refit import refined_modes, refit_band, selection_job
+from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_band, selection_job
 from armaxmodal.notes import QualityWarning
 from armaxmodal.recording import Recording
 
@@ -85,12 +85,16 @@ def refit_with_added(diagram, modes, shapes, band, limits, refinement):
     """The frequency-domain refit again, of every mode once the check has added some: a mode
     missing from a refit biases its neighbours (a five-segment chain's 13.5 Hz mode came out
     at 12.5 Hz while the 24.8 Hz one was missing, and its refit was refused as too far; now
-    13.3 Hz for the exact 13.54). ``(modes, shapes, refinement, check)``."""
+    13.3 Hz for the exact 13.54). ``(modes, shapes, refinement, check, notes)``."""
 
     refit = selection_job(diagram.recording, [], modes, ("refit", refit_band(diagram.recording, band)))
-    if refit is not None:  # the first refit's start lacked these modes: its refusals may not stand
+    notes = []
+    if isinstance(refit, RefitFailure):
+        notes = refit.notes("the modes with those the check added")
+    else:  # the first refit's start lacked these modes: its refusals may not stand
         modes, shapes, refinement = refined_modes(diagram, modes, shapes, refit, *limits, relaxed=True)
-    return modes, shapes, refinement, check_modes(diagram.recording, modes.freq_hz, modes.damping, band)
+    check = check_modes(diagram.recording, modes.freq_hz, modes.damping, band)
+    return modes, shapes, refinement, check, notes
 
 
 def modes_the_check_adds(diagram, modes: pd.DataFrame, shapes: np.ndarray, band, nas, check, clustering):

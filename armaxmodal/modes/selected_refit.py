@@ -5,6 +5,7 @@ together over the worker processes, and the refit's values applied within their 
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
@@ -19,6 +20,7 @@ from armaxmodal.modes.spread import (
     segment_poles,
     split_segments,
 )
+from armaxmodal.notes import QualityWarning
 from armaxmodal.prepare.frf import excited_band
 from armaxmodal.recording import Recording
 
@@ -50,15 +52,34 @@ def selection_job(recording: Recording, parts: list, modes: pd.DataFrame, job):
         return segment_poles(parts, what)
     try:
         return refine_modes(recording, modes.freq_hz, modes.damping, band_hz=what)
-    except (OrderError, np.linalg.LinAlgError):
-        return None  # too few lines or a degenerate basis: the ARMAX values stand
+    except (OrderError, np.linalg.LinAlgError) as exc:
+        return RefitFailure(str(exc))  # too few lines or a degenerate basis: the ARMAX values stand, said
+
+
+@dataclass(frozen=True)
+class RefitFailure:
+    """The frequency-domain refit could not be made; ``reason`` says why."""
+
+    reason: str
+
+    def notes(self, which: str = "the selected modes") -> list[QualityWarning]:
+        """The note that says so (the ARMAX fit's values, or an earlier refit's, stand)."""
+        return [
+            QualityWarning(
+                "refit_failed",
+                (),
+                f"the frequency-domain refit of {which} could not be made ({self.reason.rstrip('.')}); "
+                "the values reported are the ARMAX fit's or an earlier refit's",
+            )
+        ]
 
 
 def refined_modes(diagram, modes, shapes, refinement, cluster_freq, cluster_damping, merge_mac, relaxed=False):
-    """The frequency-domain refit (:func:`armaxmodal.modes.refine.refine_modes`, or None when it
-    could not be made), reported for a band-limited record; ``(modes, shapes, refinement)``.
+    """The frequency-domain refit (:func:`armaxmodal.modes.refine.refine_modes`, or a
+    :class:`RefitFailure` when it could not be made), reported for a band-limited record;
+    ``(modes, shapes, refinement)``.
     ``relaxed``: the refit may move a mode by :func:`_refit_reach`, not ``cluster_freq``."""
-    if refinement is None:
+    if refinement is None or isinstance(refinement, RefitFailure):
         return modes, shapes, None
     if refinement.hold == "bandlimited":
         modes, shapes = _apply_refinement(modes, shapes, refinement, cluster_freq, cluster_damping, relaxed)

@@ -23,7 +23,7 @@ from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.modal_check import ModalCheck, check_modes
 from armaxmodal.modes.per_sensor import per_sensor_table
 from armaxmodal.modes.refine import ModalRefinement
-from armaxmodal.modes.selected_refit import refined_modes, refit_and_segment_fits
+from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_and_segment_fits
 from armaxmodal.modes.spread import (
     N_SEGMENTS,
     apply_segment_spread,
@@ -213,12 +213,13 @@ def select_modes(
         # the segment refits are ARMAX fits: their spread is judged against the ARMAX intervals
         modes["freq_sd_armax"] = (modes.freq_ci95_hi - modes.freq_ci95_lo) / (2 * 1.96)
         modes["damping_sd_armax"] = (modes.damping_ci95_hi - modes.damping_ci95_lo) / (2 * 1.96)
-        refinement = None
+        refinement, refit_notes = None, []
         orders = {o[0]: o for o in diagram.orders}
         fitted = refit_and_segment_fits(diagram, modes, band, refine, segments, orders, n_jobs)
         if refine:
             refit, limits = fitted.pop("refit"), (cluster_freq, cluster_damping, merge_mac)
             modes, shapes, refinement = refined_modes(diagram, modes, shapes, refit, *limits)
+            refit_notes = refit.notes() if isinstance(refit, RefitFailure) else []
         if n_modes is None:
             modes, shapes, notes, check = modes_the_record_needs(diagram.recording, modes, shapes, band)
             clustering, n_before = (cluster_freq, cluster_damping), len(modes)
@@ -228,7 +229,9 @@ def select_modes(
                 notes += more
             if refine and len(modes) > n_before:  # the refit saw fewer modes than are reported
                 limits = (cluster_freq, cluster_damping, merge_mac)
-                modes, shapes, refinement, check = refit_with_added(diagram, modes, shapes, band, limits, refinement)
+                again = refit_with_added(diagram, modes, shapes, band, limits, refinement)
+                modes, shapes, refinement, check, more = again
+                refit_notes += more
         else:  # the user fixed the number of modes: the check judges them, it does not choose
             notes, check = [], check_modes(diagram.recording, modes.freq_hz, modes.damping, band)
         if segments >= 2:
@@ -236,6 +239,7 @@ def select_modes(
             spread = segment_spread(diagram.recording, modes, orders_of, segments, n_jobs, fitted)
             modes, spread_notes = apply_segment_spread(modes, spread, segments)
             notes += spread_notes
+        notes += refit_notes
         per_sensor, weighted = per_sensor_table(diagram, modes, shapes, cluster_freq)
         from armaxmodal.modes.frf_check import unexplained_peaks
 

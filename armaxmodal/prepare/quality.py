@@ -41,7 +41,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from armaxmodal.notes import QualityWarning
+from armaxmodal.notes import QualityWarning, not_run
 from armaxmodal.prepare.frf import coherence, welch_segments, welch_spectra
 from armaxmodal.recording import Recording
 
@@ -133,7 +133,7 @@ def input_coherence(u: np.ndarray, y: np.ndarray, fs: float) -> np.ndarray:
 def incoherent_outputs(recording: Recording) -> list[QualityWarning]:
     """Outputs whose coherence with the input (:func:`input_coherence`) is below ``INCOHERENT``."""
     if recording.n_samples < 128:
-        return []
+        return [not_run("incoherent_output", recording.sensors, f"{recording.n_samples} samples, fewer than 128")]
     levels = input_coherence(recording.base, recording.response, recording.fs)
     low = [(name, float(c)) for name, c in zip(recording.sensors, levels, strict=True) if c < INCOHERENT]
     if not low:
@@ -299,9 +299,22 @@ def _quasi_static_fit(f, h, coh, excited, n_segments):
 
 
 def delay_and_inversion(recording: Recording) -> list[QualityWarning]:
-    """``inverted_sensor`` and ``sensor_delay`` warnings from :func:`estimate_delays`."""
+    """``inverted_sensor`` and ``sensor_delay`` warnings from :func:`estimate_delays`, and a
+    ``check_not_run`` note for the outputs it could not test."""
     estimates = estimate_delays(recording)
+    tested = {e.channel for e in estimates}
+    untested = tuple(s for s in recording.sensors if s not in tested)
     found = []
+    if untested:
+        found.append(
+            not_run(
+                "sensor_delay and inverted_sensor",
+                untested,
+                "no quasi-static lines where the transmissibility to the input is near +-1 (a force input, an "
+                "output that does not move with its base below the first mode, or a record too short for lines "
+                "below it)",
+            )
+        )
     inverted = [e.channel for e in estimates if e.sign < 0]
     if len(inverted) > 1 and len(inverted) == len(recording.sensors):
         # every output reads -1: one sign flip on the input explains it, not one per sensor
@@ -363,7 +376,7 @@ def narrowband_input(recording: Recording) -> list[QualityWarning]:
     n = recording.n_samples
     nperseg = int(min(n // 4, 2 ** int(np.ceil(np.log2(recording.fs * 20)))))
     if nperseg < 16:
-        return []
+        return [not_run("narrowband_input", (recording.input_name,), f"{n} samples, too few for the input's spectrum")]
     f, puu, _, _ = welch_spectra(recording.base, recording.base[:, None], recording.fs, nperseg)
     peak = float(f[int(np.argmax(puu))])
     live = puu >= 0.1 * puu.max()

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from armaxmodal.notes import QualityWarning
+from armaxmodal.notes import QualityWarning, not_run
 from armaxmodal.prepare.quality import MIN_COHERENCE, QUASI_STATIC_MAGNITUDE, transmissibility_spectra
 from armaxmodal.recording import Recording
 
@@ -89,7 +89,8 @@ def unit_mismatch(recording: Recording) -> list[QualityWarning]:
     ``value`` is the measured ratio."""
     lines = _quasi_static_lines(recording)
     if lines is None:
-        return []
+        why = f"fewer than {QUASI_STATIC_LINES} excited lines below the first mode coherent on most outputs"
+        return [not_run("unit_mismatch", recording.sensors, why)]
     gains = np.median(lines, axis=0)
     found = _input_in_other_units(recording, lines, gains)
     if found or len(recording.sensors) < 2:

@@ -107,9 +107,6 @@ def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[st
 
 
 def _thumbnail(diagram, selection) -> str:
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     ax, _ = diagram.plot(selection)

@@ -44,9 +44,6 @@ def write_study(study: Study, out: str | Path, report: str | Path | None = None)
     list of Path
         The files written.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     out = Path(out)
