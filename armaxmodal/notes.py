@@ -64,4 +64,4 @@ class QualityWarning:
 def not_run(check: str, channels: tuple[str, ...], why: str) -> QualityWarning:
     """The note that a check could not run on ``channels`` (a check that says nothing has run
     and found nothing)."""
-    return QualityWarning("check_not_run", tuple(channels), f"{check} not tested: {why}")
+    return QualityWarning("check_not_run", tuple(channels), f"{check} not tested on {', '.join(channels)}: {why}")

@@ -371,6 +371,63 @@ MUTANTS = [
         "bad = peak > MAX_AMPLITUDE",
         "tiny amplitudes pass (loop delay)",
     ),
+    # issue 28's shared numbers and fallbacks (run with --match "(layout)" --tests tests/test_frf.py
+    # tests/test_prepare.py tests/test_inverse.py tests/test_lumping.py
+    # tests/test_stabilisation.py::test_a_refit_that_cannot_be_made_is_said_not_taken_for_refine_false)
+    (
+        "armaxmodal/stats.py",
+        "2 ** int(np.ceil(np.log2(fs * seconds)))",
+        "2 ** int(np.log2(fs * seconds))",
+        "Welch rule rounds down (layout)",
+    ),
+    (
+        "armaxmodal/prepare/frf.py",
+        "float(fs), int(nperseg))",
+        "float(fs), 0)",
+        "spectra cache ignores the segment (layout)",
+    ),
+    (
+        "armaxmodal/prepare/frf.py",
+        "return x.shape, x.dtype.str, hashlib",
+        "return x.shape, x.dtype.str, len",
+        "spectra cache ignores the content (layout)",
+    ),
+    (
+        "armaxmodal/modes/selection.py",
+        "refit.notes() if isinstance(refit, RefitFailure) else []",
+        "[]",
+        "failed refit not said (layout)",
+    ),
+    (
+        "armaxmodal/prepare/quality.py",
+        "    if untested:\n",
+        "    if False:\n",
+        "untested delay check not said (layout)",
+    ),
+    (
+        "armaxmodal/prepare/units.py",
+        '        return [not_run("unit_mismatch", recording.sensors, why)]',
+        "        return []",
+        "untested unit check not said (layout)",
+    ),
+    (
+        "armaxmodal/inverse/phase_correction.py",
+        "    if not count:",
+        "    if True:",
+        "infeasible EVPHC phases not counted (layout)",
+    ),
+    (
+        "armaxmodal/cli/invert.py",
+        "            sd[missing] = DEFAULT_SIGMA[key]",
+        "            sd[:] = DEFAULT_SIGMA[key]",
+        "one missing interval drops the block (layout)",
+    ),
+    (
+        "armaxmodal/lumping/check.py",
+        "max_fraction=16)",
+        "max_fraction=2)",
+        "lumping averages too few segments (layout)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/test_guards.py",

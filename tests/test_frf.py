@@ -85,3 +85,26 @@ def test_segment_longer_than_the_record_is_a_clear_error(fixtures_dir):
     rec = am.read_recording(fixtures_dir / "supine_random.csv")
     with pytest.raises(DataError, match="nperseg"):
         measured_frf(rec, nperseg=rec.n_samples + 1)
+
+
+def test_welch_spectra_are_computed_once_per_signals_and_segment():
+    """The cache keys the spectra by content: the same signals give the very same (read-only)
+    arrays, a one-sample change or another segment length gives new ones, equal to a fresh
+    computation."""
+    from armaxmodal.prepare import frf
+
+    rng = np.random.default_rng(4)
+    u, y = rng.standard_normal(4000), rng.standard_normal((4000, 3))
+    first = frf.welch_spectra(u, y, 50.0, 256)
+    again = frf.welch_spectra(u.copy(), y.copy(), 50.0, 256)
+    assert all(a is b for a, b in zip(first, again, strict=True))
+    assert not any(a.flags.writeable for a in first)
+    changed = y.copy()
+    changed[1000, 2] += 1e-9
+    other = frf.welch_spectra(u, changed, 50.0, 256)
+    assert other[2] is not first[2] and not np.array_equal(other[2], first[2])
+    longer = frf.welch_spectra(u, y, 50.0, 512)
+    assert longer[0].size == 257
+    f, uf, yf, scale = frf.welch_segments(u, y, 50.0, 256)
+    np.testing.assert_array_equal(first[1], scale * np.mean(np.abs(uf) ** 2, axis=0))
+    np.testing.assert_array_equal(first[2], scale[:, None] * np.mean(np.conj(uf)[:, :, None] * yf, axis=0))

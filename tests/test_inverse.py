@@ -294,3 +294,25 @@ def test_evphc_says_when_the_inner_problem_had_no_solution(monkeypatch):
     assert "at 2 of" in flag
     clean = module.evphc(m.eigenvalues, m.shapes, (f, s.transmissibility(f)), m1=6.0, starts=1)
     assert not [x for x in clean.flags if "no solution" in x]
+
+
+def test_invert_weights_a_mode_without_an_interval_by_the_default_alone_and_says_so():
+    """One mode's missing interval no longer drops its whole block to the default noise level."""
+    from armaxmodal.cli.invert import _modal_noise_levels
+    from armaxmodal.inverse.update import DEFAULT_SIGMA
+    from armaxmodal.stats import Z95
+
+    modes = [
+        {"freq_hz": 5.0, "damping": 0.2, "freq_ci95": [4.9, 5.1], "damping_ci95": [0.18, 0.22]},
+        {"freq_hz": 8.0, "damping": 0.3, "damping_ci95": [0.27, 0.33]},  # no frequency interval
+        {"freq_hz": 13.0, "damping": 0.3, "freq_ci95": [12.0, 14.0], "damping_ci95": None},
+    ]
+    sigma, notes = _modal_noise_levels({"modes": modes})
+    np.testing.assert_allclose(sigma["freq"], [0.2 / (2 * Z95 * 5.0), DEFAULT_SIGMA["freq"], 2.0 / (2 * Z95 * 13.0)])
+    damping = [0.04 / (2 * Z95 * 0.2), 0.06 / (2 * Z95 * 0.3), DEFAULT_SIGMA["damping"]]
+    np.testing.assert_allclose(sigma["damping"], damping)
+    assert len(notes) == 2
+    assert notes[0].startswith("mode(s) 2: no usable freq_ci95") and "1 %" in notes[0]
+    assert notes[1].startswith("mode(s) 3: no usable damping_ci95") and "5 %" in notes[1]
+    complete, none = _modal_noise_levels({"modes": modes[:1]})
+    assert none == [] and complete["freq"].shape == (1,)

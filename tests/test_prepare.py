@@ -215,8 +215,9 @@ def test_a_sine_ride_is_narrowband(clean):
     assert [w.code for w in found] == ["check_not_run", "narrowband_input", "check_not_run"]
     assert "3.00 Hz" in found[1].message
     # a sine has no quasi-static lines: the checks that need them say they did not run
-    assert found[0].message.startswith("sensor_delay and inverted_sensor not tested")
-    assert found[2].message.startswith("unit_mismatch not tested")
+    outputs = ", ".join(rec.sensors)
+    assert found[0].message.startswith(f"sensor_delay and inverted_sensor not tested on {outputs}:")
+    assert found[2].message.startswith(f"unit_mismatch not tested on {outputs}:")
 
 
 def test_offsets_and_drift_are_removed_and_reported(clean):

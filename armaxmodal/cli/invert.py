@@ -8,6 +8,7 @@ from armaxmodal.cli.common import POSITIVE, output_format, write_outputs
 from armaxmodal.exceptions import DataError
 from armaxmodal.io.read import read_recording
 from armaxmodal.io.write import write_json
+from armaxmodal.stats import H1_COHERENCE, Z95
 from armaxmodal.systems import datasets
 
 
@@ -91,7 +92,7 @@ def _measured_transmissibility(args, sensors: list, sigma: dict) -> tuple:
             "give the recording the modes were identified from."
         )
     f, h, coh = measured_frf(rec)
-    keep = (f > 0.5) & (np.min(coh, axis=1) >= 0.8)
+    keep = (f > 0.5) & (np.min(coh, axis=1) >= H1_COHERENCE)
     sigma["frf"] = h1_relative_error(coh[keep], rec.n_samples, default_nperseg(rec))
     return rec, (f[keep], h[keep])
 
@@ -145,7 +146,7 @@ def _modal_noise_levels(data: dict) -> tuple[dict, list[str]]:
 
     sigma, notes = {}, []
     for key, value, interval in (("freq", "freq_hz", "freq_ci95"), ("damping", "damping", "damping_ci95")):
-        sd = np.array([_relative_sd(m, value, interval, 1.96) for m in data["modes"]])
+        sd = np.array([_relative_sd(m, value, interval, Z95) for m in data["modes"]])
         missing = ~(np.isfinite(sd) & (sd > 0))
         if missing.any():
             numbers = ", ".join(str(i + 1) for i in np.flatnonzero(missing))

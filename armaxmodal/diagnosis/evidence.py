@@ -36,6 +36,7 @@ from armaxmodal.diagnosis.model import lagged as _lag
 from armaxmodal.diagnosis.spectral import harmonic_f_test
 from armaxmodal.prepare.quality import input_coherence
 from armaxmodal.recording import Recording
+from armaxmodal.stats import MAX_DAMPING, SECOND_INPUT_COHERENCE
 
 __all__ = ["Finding", "run_tests", "whiteness_p", "EFFECT_TESTS"]
 
@@ -54,12 +55,6 @@ EFFECT_TESTS = (
     "stiffness_nonlinearity",
     "second_input",
 )
-#: A recorded channel whose coherence with the base, averaged over the base's spectrum, is
-#: below this is a candidate input: a response sensor on a structure the base drives is far
-#: more coherent (0.63-1.00 on the measured records, :data:`~armaxmodal.prepare.quality.INCOHERENT`). Coherence, not the
-#: simulation fit: an offset or a drift the diagnosis has not yet removed ruins the fit of a
-#: response sensor (-180 % with 0.3 on chest) and once made it a "second input".
-SECOND_INPUT_COHERENCE = 0.5
 #: Windows of the windowed re-identification (time variation).
 N_WINDOWS = 6
 #: A line in the residual is the input's (model error), not a disturbance, when the input
@@ -347,7 +342,7 @@ def deflections(fitted: FittedModel) -> dict[tuple[str, str], np.ndarray]:
     # below the first mode the relative motion is quasi-static and a double integral only
     # amplifies the model's low-frequency error: integrate from half the lowest mode up
     _, f_modes, xi, _ = fitted.fit.models[0].modal_parameters()
-    physical = f_modes[(xi > 0) & (xi < 0.6)]
+    physical = f_modes[(xi > 0) & (xi < MAX_DAMPING)]
     f_first = float(physical.min()) if physical.size else 0.0
     f_lo = max(excited_band(Recording(s.fs, s.u, s.y, s.sensors, s.input_name))[0], 0.5 * f_first, 3 * s.fs / s.n)
     f = np.fft.rfftfreq(s.n, 1 / s.fs)
@@ -413,7 +408,7 @@ def _window_modes(fitted: FittedModel, mask: np.ndarray):
     from armaxmodal.modes.poles import SHARED, pole_rows
 
     def modes_of(fit):
-        rows = [r for r in pole_rows(fit, SHARED) if 0 < r["damping"] < 0.6]
+        rows = [r for r in pole_rows(fit, SHARED) if 0 < r["damping"] < MAX_DAMPING]
         return np.array([[r["freq_hz"], r["freq_sd"]] for r in rows]).reshape(-1, 2)
 
     s = fitted.signals

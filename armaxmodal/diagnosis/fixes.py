@@ -9,6 +9,7 @@ from scipy.optimize import minimize_scalar
 
 from armaxmodal.diagnosis.finding import Finding
 from armaxmodal.diagnosis.model import FittedModel, ModelSpec, response_free_of, usable
+from armaxmodal.stats import MAX_DAMPING, Z95
 
 __all__ = ["add_effect", "effect_parameters"]
 
@@ -88,9 +89,9 @@ def effect_parameters(finding: Finding, fitted) -> dict:
             # tau runs -1..1 over the record: the offset is the value mid-record, drift per s
             out[name] = {
                 "offset": float(th[0]),
-                "offset_ci95": [float(th[0] - 1.96 * sd[0]), float(th[0] + 1.96 * sd[0])],
+                "offset_ci95": [float(th[0] - Z95 * sd[0]), float(th[0] + Z95 * sd[0])],
                 "drift_per_s": float(th[1] * 2 / dur),
-                "drift_ci95_per_s": [float((th[1] - 1.96 * sd[1]) * 2 / dur), float((th[1] + 1.96 * sd[1]) * 2 / dur)],
+                "drift_ci95_per_s": [float((th[1] - Z95 * sd[1]) * 2 / dur), float((th[1] + Z95 * sd[1]) * 2 / dur)],
             }
         return {"trend_degree": spec.trend_degree, "per_channel": out}
     if finding.effect == "periodic_disturbance":
@@ -103,7 +104,7 @@ def effect_parameters(finding: Finding, fitted) -> dict:
             amp = float(np.hypot(a, b))
             grad = np.array([a, b]) / max(amp, 1e-300)
             sd = float(np.sqrt(max(grad @ cov @ grad, 0.0)))
-            amps[name] = {"amp": amp, "amp_ci95": [amp - 1.96 * sd, amp + 1.96 * sd]}
+            amps[name] = {"amp": amp, "amp_ci95": [amp - Z95 * sd, amp + Z95 * sd]}
         first = amps[finding.channels[0]]
         return {"freq_hz": spec.lines_hz[-1], "amp": first["amp"], "amp_ci95": first["amp_ci95"], "per_channel": amps}
     if finding.effect == "stiffness_nonlinearity":
@@ -140,7 +141,7 @@ def _modes_each_side(piecewise) -> list[dict]:
     from armaxmodal.modes.poles import SHARED, pole_rows
 
     def modes(fit):
-        return [r for r in pole_rows(fit, SHARED) if 0 < r["damping"] < 0.6]
+        return [r for r in pole_rows(fit, SHARED) if 0 < r["damping"] < MAX_DAMPING]
 
     after = modes(piecewise.after.fit)
     out = []

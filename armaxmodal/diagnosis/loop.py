@@ -34,6 +34,7 @@ from armaxmodal.exceptions import DataError
 from armaxmodal.prepare.frf import coherence, welch_spectra
 from armaxmodal.prepare.preparation import prepare
 from armaxmodal.recording import Recording
+from armaxmodal.stats import welch_nperseg
 
 __all__ = ["diagnose", "Diagnosis", "EFFECTS", "TESTED_EFFECTS"]
 
@@ -294,7 +295,7 @@ def _noise_floor(s: Signals, mask: np.ndarray, linear_error: dict | None = None)
     Nor is one above ``linear_error`` (``{output: RMS}``, a linear model's held-out simulation
     error, which the floor bounds from below): both segments may be far too short."""
     u, y = s.u[mask], s.y[mask]
-    nperseg = min(2 ** int(np.ceil(np.log2(s.fs * 10))), u.size // 8)
+    nperseg = welch_nperseg(u.size, s.fs)
     floor = _welch_floor(u, y, s.fs, nperseg)
     settled = np.zeros(floor.size, bool)
     while not settled.all() and 2 * nperseg <= u.size // 4:

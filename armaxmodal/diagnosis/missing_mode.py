@@ -7,6 +7,7 @@ import numpy as np
 
 from armaxmodal.diagnosis.model import FittedModel, usable
 from armaxmodal.prepare.frf import coherence, h1_relative_error, welch_spectra
+from armaxmodal.stats import MISFIT_COHERENCE, welch_nperseg
 
 __all__ = ["mode_findings", "added_modes", "MODEL_CLASS_FLOOR"]
 
@@ -14,7 +15,6 @@ __all__ = ["mode_findings", "added_modes", "MODEL_CLASS_FLOOR"]
 #: band-limited data by a few per cent near the band edge (the reason the stabilise refit
 #: exists). A missing mode misses its peak by tens of per cent.
 MODEL_CLASS_FLOOR = 0.05
-MIN_COHERENCE = 0.5
 
 
 def _misfit(fitted: FittedModel):
@@ -24,7 +24,7 @@ def _misfit(fitted: FittedModel):
     s = fitted.signals
     mask = usable(s.n, fitted.spec)
     u, y = s.u[mask], (s.y - fitted.disturbance())[mask]
-    nperseg = int(min(u.size // 8, 2 ** int(np.ceil(np.log2(s.fs * 10)))))
+    nperseg = welch_nperseg(u.size, s.fs)
     f, puu, puy, pyy = welch_spectra(u, y, s.fs, nperseg)
     h1 = puy / puu[:, None]
     coh = coherence(puu, puy, pyy)
@@ -32,7 +32,7 @@ def _misfit(fitted: FittedModel):
     model = np.column_stack([m.frf(f)[:, 0] for m in fitted.fit.models])
     rel = np.abs(model - h1) / np.maximum(np.abs(h1), 1e-300)
     z = rel**2 / (sigma**2 + MODEL_CLASS_FLOOR**2)
-    live = (coh >= MIN_COHERENCE) & (f[:, None] > 0) & (f[:, None] < 0.45 * s.fs)
+    live = (coh >= MISFIT_COHERENCE) & (f[:, None] > 0) & (f[:, None] < 0.45 * s.fs)
     keep = slice(None, None, 2)
     return f[keep], np.where(live, z, 0.0)[keep], rel[keep], sigma[keep], live[keep]
 

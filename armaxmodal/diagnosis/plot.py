@@ -8,6 +8,7 @@ from scipy import stats
 
 from armaxmodal.diagnosis.model import usable
 from armaxmodal.prepare.frf import measured_frf
+from armaxmodal.stats import welch_nperseg
 
 __all__ = ["plot_diagnosis"]
 
@@ -59,7 +60,7 @@ def _cross_correlation(ax, cc, names):
 def _psd(x, fs):
     from scipy.signal import welch
 
-    return welch(x, fs, nperseg=min(x.shape[0], int(2 ** np.ceil(np.log2(20 * fs)))), axis=0)  # samples, not n x K
+    return welch(x, fs, nperseg=welch_nperseg(x.shape[0], fs, seconds=20.0, max_fraction=1), axis=0)
 
 
 def _spectra(ax, diagnosis, mask):

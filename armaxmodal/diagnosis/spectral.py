@@ -20,6 +20,8 @@ import numpy as np
 from scipy import stats
 from scipy.signal.windows import dpss
 
+from armaxmodal.stats import Z95
+
 __all__ = ["harmonic_f_test", "LineTest"]
 
 #: Time-bandwidth product and number of tapers (2NW - 1).
@@ -53,7 +55,7 @@ class LineTest:
         """Line amplitude at the bin nearest ``freq_hz`` with its 95 % interval."""
         i = int(np.argmin(np.abs(self.freqs - freq_hz)))
         a, sd = float(self.amps[i]), float(self.amp_sd[i])
-        return a, (a - 1.96 * sd, a + 1.96 * sd)
+        return a, (a - Z95 * sd, a + Z95 * sd)
 
     def p_at(self, freq_hz: float) -> float:
         """Uncorrected p-value of the line test at the frequency bin nearest ``freq_hz``."""
@@ -98,5 +100,5 @@ def harmonic_f_test(x: np.ndarray, fs: float) -> LineTest:
     amps = 2 * np.abs(mu)
     amp_sd = 2 * np.sqrt(den / (2 * (N_TAPERS - 1) * u0sq))
     amp, sd = float(amps[i]), float(amp_sd[i])
-    ci = (amp - 1.96 * sd, amp + 1.96 * sd)
+    ci = (amp - Z95 * sd, amp + Z95 * sd)
     return LineTest(freqs, f_stat, p_min, float(f_stat[i]), float(freqs[i]), amp, ci, amps, amp_sd)

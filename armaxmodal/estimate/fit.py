@@ -48,6 +48,7 @@ from armaxmodal.estimate._gauss_newton import (
 from armaxmodal.exceptions import ConvergenceWarning, DataError, OrderError
 from armaxmodal.modal import pole_uncertainty
 from armaxmodal.recording import Recording
+from armaxmodal.stats import Z95
 
 __all__ = ["fit_armax", "ArmaxFit", "covariance_at"]
 
@@ -55,7 +56,6 @@ __all__ = ["fit_armax", "ArmaxFit", "covariance_at"]
 _MIN_SAMPLES_PER_PARAMETER = 5
 # Largest root radius allowed for C (keeps 1/C filtering stable and well conditioned).
 _MAX_C_RADIUS = 0.995
-_Z95 = 1.959963984540054
 _MODE_COLUMNS = [
     "sensor", "freq_hz", "damping", "damped_freq_hz", "freq_ci95_lo", "freq_ci95_hi", "damping_ci95_lo",
     "damping_ci95_hi", "freq_sd", "damping_sd", "pole", "residue", "residue_mag", "residue_phase_deg",
@@ -127,10 +127,10 @@ class ArmaxFit:
                         "freq_hz": f[i],
                         "damping": xi[i],
                         "damped_freq_hz": fd[i],
-                        "freq_ci95_lo": f[i] - _Z95 * sd_f[i],
-                        "freq_ci95_hi": f[i] + _Z95 * sd_f[i],
-                        "damping_ci95_lo": xi[i] - _Z95 * sd_xi[i],
-                        "damping_ci95_hi": xi[i] + _Z95 * sd_xi[i],
+                        "freq_ci95_lo": f[i] - Z95 * sd_f[i],
+                        "freq_ci95_hi": f[i] + Z95 * sd_f[i],
+                        "damping_ci95_lo": xi[i] - Z95 * sd_xi[i],
+                        "damping_ci95_hi": xi[i] + Z95 * sd_xi[i],
                         "freq_sd": sd_f[i],
                         "damping_sd": sd_xi[i],
                         "pole": mu[i],

@@ -16,13 +16,14 @@ from armaxmodal.exceptions import DataError
 from armaxmodal.lumping.wavelet import WaveletCoherence, scalogram, wavelet_coherence
 from armaxmodal.prepare.frf import excited_band, welch_spectra
 from armaxmodal.recording import Recording
+from armaxmodal.stats import H1_COHERENCE, welch_nperseg
 
 __all__ = ["LumpCheck", "lump_check", "relative_transmissibility", "LIMITS"]
 
 #: what "moves as one" means: |T| within [1/gain, gain] and phase within phase_deg, judged
 #: where both relative motions are coherent with the base at least ``measurable`` (elsewhere
 #: sensor noise dominates them and T says nothing).
-LIMITS = {"gain": 1.25, "phase_deg": 15.0, "measurable": 0.8, "agree_fraction": 0.9}
+LIMITS = {"gain": 1.25, "phase_deg": 15.0, "measurable": H1_COHERENCE, "agree_fraction": 0.9}
 
 
 def relative_transmissibility(rec: Recording, a: str, b: str, nperseg: int | None = None):
@@ -48,7 +49,8 @@ def relative_transmissibility(rec: Recording, a: str, b: str, nperseg: int | Non
             raise DataError(f"no sensor {s!r} in the recording; its sensors are {list(rec.sensors)}.")
     if a == b:
         raise DataError(f"a segment cannot be lumped with itself ({a!r}); name two different sensors.")
-    n = nperseg or int(min(rec.n_samples // 8, 2 ** int(np.log2(rec.fs * 10))))
+    # a ratio of two noisy relative motions wants averages more than resolution: 30 segments or more
+    n = nperseg or welch_nperseg(rec.n_samples, rec.fs, max_fraction=16)
     rel = np.column_stack([rec.channel(a) - rec.base, rec.channel(b) - rec.base])
     f, puu, pur, prr = welch_spectra(rec.base, rel, rec.fs, n)
     t = pur[:, 1] / np.where(np.abs(pur[:, 0]) > 0, pur[:, 0], np.nan)

@@ -17,6 +17,7 @@ from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.frf_check import peak_support
 from armaxmodal.modes.poles import SHARED, UNRESOLVED_DAMPING, mac, pole_rows
 from armaxmodal.recording import Recording
+from armaxmodal.stats import Z95
 
 #: a finished fit's pole farther than this (relative frequency) is another pole, not this one finished
 FINISHED_MAX_SHIFT = 0.05
@@ -130,7 +131,7 @@ def _rescued_clusters(diagram, rest: pd.DataFrame, nas, cluster_freq: float, min
     grouped by frequency alone. A group is a mode when it has the usual support, a positive
     estimate at some order, and the measured FRF a clear, coherent peak there -- the data's
     own evidence, which noise poles lack."""
-    light = rest[rest.damping - 1.96 * rest.damping_sd <= 0]
+    light = rest[rest.damping - Z95 * rest.damping_sd <= 0]
     found = []
     for members in cluster_poles(light, nas, cluster_freq, None):
         sub = light.loc[members]

@@ -9,6 +9,7 @@ import numpy as np
 from armaxmodal.notes import QualityWarning
 from armaxmodal.prepare.frf import coherence, excited_band, welch_spectra
 from armaxmodal.recording import Recording
+from armaxmodal.stats import H1_COHERENCE
 
 __all__ = ["resolving_nperseg", "unexplained_peaks", "coherent_peaks", "peak_support"]
 
@@ -16,7 +17,6 @@ __all__ = ["resolving_nperseg", "unexplained_peaks", "coherent_peaks", "peak_sup
 LINES_PER_BANDWIDTH = 4
 #: fewest Welch segments kept (the H1's random error grows as segments get fewer)
 MIN_SEGMENTS = 4
-MIN_COHERENCE = 0.8
 
 
 def resolving_nperseg(
@@ -95,7 +95,7 @@ def coherent_peaks(recording: Recording, nperseg: int, band=None) -> list[tuple[
     out = []
     for k, sensor in enumerate(recording.sensors):
         mag = np.abs(h[:, k])
-        ok = (coh[:, k] >= MIN_COHERENCE) & (f >= lo) & (f <= hi)
+        ok = (coh[:, k] >= H1_COHERENCE) & (f >= lo) & (f <= hi)
         if not ok.any():
             continue
         peaks, prominences = peak_prominences(np.where(ok, mag, 0.0))

@@ -23,11 +23,10 @@ from armaxmodal.modes.modal_check import ModalCheck, check_modes, finite_or_none
 from armaxmodal.modes.poles import POLE_COLUMNS, SHARED, Tolerances, pole_rows, rejection_reasons
 from armaxmodal.prepare.preparation import Preparation, oversampling_note, prepare
 from armaxmodal.recording import Recording
+from armaxmodal.stats import MAX_DAMPING
 
-__all__ = ["identify", "Identification", "DEFAULT_MAX_DAMPING"]
+__all__ = ["identify", "Identification"]
 
-#: Heavily damped biomechanical modes reach 0.4-0.5; 0.6 keeps them and drops filter poles.
-DEFAULT_MAX_DAMPING = 0.6
 
 
 @dataclass(frozen=True)
@@ -127,7 +126,7 @@ def identify(
     orders: tuple[int, int, int, int] | None = None,
     *,
     band: tuple[float, float] | None = None,
-    max_damping: float = DEFAULT_MAX_DAMPING,
+    max_damping: float = MAX_DAMPING,
     progress: bool = False,
     detrend: str = "mean",
     resample: bool | None = None,

@@ -2,7 +2,7 @@
 
 Least-squares frequency-domain (LSFD) fit of each output's H1 with the selected poles held
 fixed, on the lines of the band where that output's coherence is at least
-:data:`MIN_COHERENCE` (Heylen, Lammens & Sas, *Modal Analysis Theory and Testing*, Sec. A.3;
+:data:`H1_COHERENCE` (Heylen, Lammens & Sas, *Modal Analysis Theory and Testing*, Sec. A.3;
 the residual terms as in Peeters et al.'s PolyMAX)::
 
     H_k(w) = exp(-i w tau_k) [ sum_m r_mk / (iw - l_m) + conj(r_mk) / (iw - conj(l_m))
@@ -36,11 +36,11 @@ import numpy as np
 from armaxmodal.notes import QualityWarning
 from armaxmodal.prepare.frf import coherence, excited_band, h1_relative_error, welch_spectra
 from armaxmodal.recording import Recording
+from armaxmodal.stats import H1_COHERENCE
 
 __all__ = ["ModalCheck", "check_modes", "confirmed_modes", "mode_support", "MODEL_ERROR_LIMIT", "MODEL_ERROR_RISE"]
 
 #: lines of the band an output's H1 must be this coherent on to enter the check
-MIN_COHERENCE = 0.8
 #: Welch lines per half-power bandwidth of the narrowest mode (the H1's bias at a peak is
 #: about -(line / bandwidth)^2 / 3 with a Hann window: -8 % at two lines)
 LINES_PER_BANDWIDTH = 2
@@ -161,7 +161,7 @@ class ModalCheck:
             found.append(QualityWarning(
                 "modes_do_not_explain_frf", tuple(self.sensors),
                 f"the record does not confirm the mode(s) at {where} Hz: no output's H1 is coherent "
-                f"({MIN_COHERENCE:g}) near them, so the check cannot test them (another "
+                f"({H1_COHERENCE:g}) near them, so the check cannot test them (another "
                 "excitation, several moving supports, or noise dominate there). Treat them as unconfirmed",
                 float(self.unconfirmed_hz[0]),
             ))  # fmt: skip
@@ -252,13 +252,13 @@ class _Spectra:
 
 def measured_lines(recording: Recording, nperseg: int, band=None) -> list[_Spectra]:
     """Each output's H1 on the lines of ``band`` (default: the input's excited band) where
-    its coherence is at least :data:`MIN_COHERENCE`, with the H1's random error there."""
+    its coherence is at least :data:`H1_COHERENCE`, with the H1's random error there."""
     f, puu, puy, pyy = welch_spectra(recording.base, recording.response, recording.fs, nperseg)
     h, coh = puy / puu[:, None], coherence(puu, puy, pyy)
     lo, hi = band if band is not None else excited_band(recording)
     out = []
     for k in range(h.shape[1]):
-        good = (coh[:, k] >= MIN_COHERENCE) & (f > 0) & (f >= lo) & (f <= hi)
+        good = (coh[:, k] >= H1_COHERENCE) & (f > 0) & (f >= lo) & (f <= hi)
         sigma = h1_relative_error(coh[good, k], recording.n_samples, nperseg) * np.abs(h[good, k])
         out.append(_Spectra(f[good], h[good, k], sigma))
     return out

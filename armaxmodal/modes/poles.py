@@ -16,6 +16,7 @@ import pandas as pd
 from armaxmodal.estimate.fit import ArmaxFit
 from armaxmodal.prepare.frf import excited_band
 from armaxmodal.recording import Recording
+from armaxmodal.stats import MAX_DAMPING, Z95
 
 SHARED = "shared"
 
@@ -36,7 +37,7 @@ class Tolerances:
     freq: float = 0.01  #: relative frequency change
     damping: float = 0.05  #: relative damping change
     shape: float = 0.02  #: 1 - MAC for shared shapes; relative residue change per sensor
-    max_damping: float = 0.6  #: heavier damping is not a vibration mode here
+    max_damping: float = MAX_DAMPING  #: heavier damping is not a vibration mode here
     min_freq_hz: float | None = None  #: default: 3 / record length
     max_freq_fraction: float = 0.45  #: of fs; poles near Nyquist are filter artefacts
     min_energy: float = 0.01  #: residue energy relative to the largest pole at that order (lower it
@@ -128,7 +129,7 @@ def rejection_reasons(poles: pd.DataFrame, tol: Tolerances, recording: Recording
     for row, e_max in zip(poles.itertuples(index=False), top, strict=True):
         if row.damping <= 0:
             sd = getattr(row, "damping_sd", 0.0)
-            reasons.append(UNRESOLVED_DAMPING if row.damping + 1.96 * sd > 0 else "negative damping")
+            reasons.append(UNRESOLVED_DAMPING if row.damping + Z95 * sd > 0 else "negative damping")
         elif row.damping > tol.max_damping:
             reasons.append("over-damped")
         elif row.freq_hz < f_min:

@@ -23,6 +23,7 @@ from armaxmodal.modes.spread import (
 from armaxmodal.notes import QualityWarning
 from armaxmodal.prepare.frf import excited_band
 from armaxmodal.recording import Recording
+from armaxmodal.stats import Z95
 
 
 def refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, orders: dict, n_jobs) -> dict:
@@ -121,10 +122,10 @@ def _apply_refinement(modes, shapes, ref, max_freq_change, max_damping_change, r
             f * np.sqrt(1 - x**2),
             "fd-bandlimited",
         ]
-        modes.loc[i, ["freq_ci95_lo", "freq_ci95_hi"]] = [f - 1.96 * ref.freq_sd[i], f + 1.96 * ref.freq_sd[i]]
+        modes.loc[i, ["freq_ci95_lo", "freq_ci95_hi"]] = [f - Z95 * ref.freq_sd[i], f + Z95 * ref.freq_sd[i]]
         modes.loc[i, ["damping_ci95_lo", "damping_ci95_hi"]] = [
-            x - 1.96 * ref.damping_sd[i],
-            x + 1.96 * ref.damping_sd[i],
+            x - Z95 * ref.damping_sd[i],
+            x + Z95 * ref.damping_sd[i],
         ]
         shapes[:, i] = ref.shapes[:, i]
     return modes, shapes

@@ -31,6 +31,7 @@ from armaxmodal.modes.spread import (
 )
 from armaxmodal.notes import QualityWarning
 from armaxmodal.prepare.preparation import oversampling_note
+from armaxmodal.stats import Z95
 
 
 # -- automatic selection -----------------------------------------------------------------------
@@ -211,8 +212,8 @@ def select_modes(
         shapes = np.column_stack([vectors[i] for i in order])
         modes["estimator"] = "armax"
         # the segment refits are ARMAX fits: their spread is judged against the ARMAX intervals
-        modes["freq_sd_armax"] = (modes.freq_ci95_hi - modes.freq_ci95_lo) / (2 * 1.96)
-        modes["damping_sd_armax"] = (modes.damping_ci95_hi - modes.damping_ci95_lo) / (2 * 1.96)
+        modes["freq_sd_armax"] = (modes.freq_ci95_hi - modes.freq_ci95_lo) / (2 * Z95)
+        modes["damping_sd_armax"] = (modes.damping_ci95_hi - modes.damping_ci95_lo) / (2 * Z95)
         refinement, refit_notes = None, []
         orders = {o[0]: o for o in diagram.orders}
         fitted = refit_and_segment_fits(diagram, modes, band, refine, segments, orders, n_jobs)

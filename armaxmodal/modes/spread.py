@@ -19,6 +19,7 @@ import pandas as pd
 
 from armaxmodal.notes import QualityWarning
 from armaxmodal.recording import Recording
+from armaxmodal.stats import Z95
 
 __all__ = ["segment_spread", "apply_segment_spread", "segment_jobs", "segment_poles", "split_segments", "N_SEGMENTS"]
 
@@ -143,7 +144,7 @@ def apply_segment_spread(modes: pd.DataFrame, spread: pd.DataFrame, n_segments: 
         ):
             # judged against the interval of the estimator the segments use (ARMAX) when the
             # reported one is another's (the band-limited refit)
-            sigma = m[model_sd] if model_sd in m else (m[hi] - m[lo]) / (2 * 1.96)
+            sigma = m[model_sd] if model_sd in m else (m[hi] - m[lo]) / (2 * Z95)
             s = m[sd_col]
             if not (np.isfinite(s) and sigma > 0) or m.segments_found < n_segments:
                 continue

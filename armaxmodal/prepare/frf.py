@@ -8,11 +8,15 @@
 
 from __future__ import annotations
 
+import hashlib
+import threading
+from collections import OrderedDict
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from armaxmodal.exceptions import DataError
+from armaxmodal.stats import welch_nperseg
 
 if TYPE_CHECKING:
     from armaxmodal.recording import Recording
@@ -23,7 +27,16 @@ __all__ = ["excited_band", "measured_frf", "modal_frf", "welch_segments", "welch
 def default_nperseg(recording) -> int:
     """Welch segment length of :func:`measured_frf`: about 10 s (a power of two), at most an
     eighth of the record."""
-    return int(min(recording.n_samples // 8, 2 ** int(np.log2(recording.fs * 10))))
+    return welch_nperseg(recording.n_samples, recording.fs)
+
+
+#: spectra of the last few (signals, rate, segment) sets, kept read-only: one ``stabilise`` run
+#: asked for the input's PSD ten times and for the outputs' 256-sample H1 five times (the
+#: preparation's checks, the band of the refit, the rejection rules, the modal-model check,
+#: the peak check); each is now computed once
+_SPECTRA: OrderedDict = OrderedDict()
+_SPECTRA_KEPT = 8
+_SPECTRA_LOCK = threading.Lock()
 
 
 def welch_spectra(u: np.ndarray, y: np.ndarray, fs: float, nperseg: int):
@@ -56,11 +69,29 @@ def welch_spectra(u: np.ndarray, y: np.ndarray, fs: float, nperseg: int):
     pyy : (n_freq, k) ndarray
         Output PSDs.
     """
+    key = (_digest(u), _digest(y), float(fs), int(nperseg))
+    with _SPECTRA_LOCK:
+        if key in _SPECTRA:
+            _SPECTRA.move_to_end(key)
+            return _SPECTRA[key]
     f, uf, yf, scale = welch_segments(u, y, fs, nperseg)
     puu = scale * np.mean(np.abs(uf) ** 2, axis=0)
     puy = scale[:, None] * np.mean(np.conj(uf)[:, :, None] * yf, axis=0)
     pyy = scale[:, None] * np.mean(np.abs(yf) ** 2, axis=0)
-    return f, puu, puy, pyy
+    spectra = (f, puu, puy, pyy)
+    for array in spectra:
+        array.flags.writeable = False  # shared by every caller of the same spectra
+    with _SPECTRA_LOCK:
+        _SPECTRA[key] = spectra
+        while len(_SPECTRA) > _SPECTRA_KEPT:
+            _SPECTRA.popitem(last=False)
+    return spectra
+
+
+def _digest(x: np.ndarray) -> tuple:
+    """A signal's identity by content (shape, type and a 128-bit hash of its bytes)."""
+    x = np.ascontiguousarray(x)
+    return x.shape, x.dtype.str, hashlib.blake2b(x.view(np.uint8).data, digest_size=16).digest()
 
 
 def welch_segments(u: np.ndarray, y: np.ndarray, fs: float, nperseg: int):

@@ -44,6 +44,7 @@ import numpy as np
 from armaxmodal.notes import QualityWarning, not_run
 from armaxmodal.prepare.frf import coherence, welch_segments, welch_spectra
 from armaxmodal.recording import Recording
+from armaxmodal.stats import QUASI_STATIC_COHERENCE, welch_nperseg
 
 __all__ = ["estimate_delays", "DelayEstimate"]
 
@@ -56,9 +57,8 @@ INCOHERENT = 0.3
 #: |correlation| above 1 - this is a copy: two physical sensors never agree this well
 #: (16-bit quantisation of a proportional copy leaves ~1e-9).
 DUPLICATE_TOLERANCE = 1e-6
-#: quasi-static band: |T| within these bounds of 1 and coherence at least MIN_COHERENCE
+#: quasi-static band: |T| within these bounds of 1 and coherence at least QUASI_STATIC_COHERENCE
 QUASI_STATIC_MAGNITUDE = (0.8, 1.25)
-MIN_COHERENCE = 0.9
 #: Shortest run of equal samples tested (two in a row happen on any quantised channel).
 STUCK_MIN_RUN = 3
 #: family-wise level of the stuck-samples warning over the channels
@@ -124,7 +124,7 @@ def input_coherence(u: np.ndarray, y: np.ndarray, fs: float) -> np.ndarray:
     an eighth of the record), averaged with the input's power as weight: the share of the
     output, at the frequencies the input drives, that a linear response to it explains, (K,)."""
     y = np.asarray(y, float).reshape(len(u), -1)
-    nperseg = int(min(len(u) // 8, 2 ** int(np.ceil(np.log2(fs * 10)))))
+    nperseg = welch_nperseg(len(u), fs)
     _, puu, puy, pyy = welch_spectra(u, y, fs, nperseg)
     coh = coherence(puu, puy, pyy)
     return puu @ coh / max(float(puu.sum()), 1e-300)
@@ -194,7 +194,7 @@ def duplicate_channels(recording: Recording) -> list[QualityWarning]:
 
 def _quasi_static_nperseg(recording: Recording) -> int:
     """Welch segment of the quasi-static checks: 20 s at most, an eighth of the record."""
-    return int(min(recording.n_samples // 8, 2 ** int(np.ceil(np.log2(recording.fs * 20)))))
+    return welch_nperseg(recording.n_samples, recording.fs, seconds=20.0)
 
 
 def transmissibility_spectra(recording: Recording):
@@ -263,7 +263,7 @@ def _fit_segments(f, puu, puy, pyy):
 def _quasi_static_fit(f, h, coh, excited, n_segments):
     """``(delay_s, sd_s, sign, n_lines, f_max)`` from the lowest contiguous run of excited,
     coherent lines with |T| near 1, or None when there are fewer than 4 such lines."""
-    ok = excited & (coh >= MIN_COHERENCE) & (f > 0)
+    ok = excited & (coh >= QUASI_STATIC_COHERENCE) & (f > 0)
     ok &= (np.abs(h) >= QUASI_STATIC_MAGNITUDE[0]) & (np.abs(h) <= QUASI_STATIC_MAGNITUDE[1])
     if not ok.any():
         return None
@@ -271,7 +271,7 @@ def _quasi_static_fit(f, h, coh, excited, n_segments):
     # quasi-static means below the first resonance: a run found only above the coherent rise
     # of |T| (low lines drowned in noise) is past a mode, where the phase is not a delay;
     # incoherent lines below the excited band do not count as a rise
-    rise = np.flatnonzero(excited & (coh >= MIN_COHERENCE) & (f > 0) & (np.abs(h) > QUASI_STATIC_MAGNITUDE[1]))
+    rise = np.flatnonzero(excited & (coh >= QUASI_STATIC_COHERENCE) & (f > 0) & (np.abs(h) > QUASI_STATIC_MAGNITUDE[1]))
     if rise.size and rise[0] < start:
         return None
     stop = start
@@ -374,7 +374,7 @@ def delay_and_inversion(recording: Recording) -> list[QualityWarning]:
 def narrowband_input(recording: Recording) -> list[QualityWarning]:
     """The width of the lines within 10 dB of the input's PSD peak against the peak frequency."""
     n = recording.n_samples
-    nperseg = int(min(n // 4, 2 ** int(np.ceil(np.log2(recording.fs * 20)))))
+    nperseg = welch_nperseg(n, recording.fs, seconds=20.0, max_fraction=4)
     if nperseg < 16:
         return [not_run("narrowband_input", (recording.input_name,), f"{n} samples, too few for the input's spectrum")]
     f, puu, _, _ = welch_spectra(recording.base, recording.base[:, None], recording.fs, nperseg)

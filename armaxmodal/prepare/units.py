@@ -22,8 +22,9 @@ from __future__ import annotations
 import numpy as np
 
 from armaxmodal.notes import QualityWarning, not_run
-from armaxmodal.prepare.quality import MIN_COHERENCE, QUASI_STATIC_MAGNITUDE, transmissibility_spectra
+from armaxmodal.prepare.quality import QUASI_STATIC_MAGNITUDE, transmissibility_spectra
 from armaxmodal.recording import Recording
+from armaxmodal.stats import QUASI_STATIC_COHERENCE
 
 __all__ = ["unit_mismatch", "unit_conversion", "UNIT_CONVERSIONS"]
 
@@ -75,7 +76,7 @@ def _quasi_static_lines(recording: Recording) -> np.ndarray | None:
     if spectra is None:
         return None
     f, h, coh, excited, _ = spectra
-    lines = np.flatnonzero(excited & (f > 0) & (np.median(coh, axis=1) >= MIN_COHERENCE))
+    lines = np.flatnonzero(excited & (f > 0) & (np.median(coh, axis=1) >= QUASI_STATIC_COHERENCE))
     if lines.size < QUASI_STATIC_LINES:
         return None
     return np.abs(h[lines[:QUASI_STATIC_LINES]])

@@ -1,0 +1,68 @@
+"""Shared statistics and thresholds: the numbers several stages use, in one place.
+
+* :data:`Z95` -- the 95 % two-sided normal quantile, for every interval and its inverse.
+* :func:`welch_nperseg` -- the Welch segment rule of the spectra the checks and figures use.
+* The coherence levels, each named by what it admits: :data:`H1_COHERENCE`,
+  :data:`QUASI_STATIC_COHERENCE`, :data:`MISFIT_COHERENCE`, :data:`SECOND_INPUT_COHERENCE`.
+* :data:`MAX_DAMPING` -- the damping above which a pole is no vibration mode here.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "H1_COHERENCE",
+    "MAX_DAMPING",
+    "MISFIT_COHERENCE",
+    "QUASI_STATIC_COHERENCE",
+    "SECOND_INPUT_COHERENCE",
+    "Z95",
+    "welch_nperseg",
+]
+
+#: the normal distribution's 97.5 % quantile (scipy.special.ndtri(0.975)), written out so that
+#: no stage imports scipy.stats for it: intervals are estimate +- Z95 sd, and an interval's
+#: half-width over Z95 is its standard deviation
+Z95 = 1.959963984540054
+
+#: an H1 line is trusted where the coherence is at least this (Heylen, Lammens & Sas, Sec. A.3):
+#: the modal-model check, the unexplained-peak check, the inverse problem's transmissibility
+#: block and the figures' shading
+H1_COHERENCE = 0.8
+#: quasi-static lines (below the first mode, where a base-excited structure moves with its
+#: base) on which the delay, inversion and unit checks measure: nearly perfect coherence
+QUASI_STATIC_COHERENCE = 0.9
+#: lines on which the diagnosis judges a model's FRF misfit for a missing mode: every line the
+#: input drives the output on, short of noise
+MISFIT_COHERENCE = 0.5
+#: a recorded channel less coherent with the base than this (averaged over the base's
+#: spectrum) is a candidate second input: response sensors read 0.63-1.00 on the measured records
+SECOND_INPUT_COHERENCE = 0.5
+
+#: heavier damping is no vibration mode here: heavily damped biomechanical modes reach 0.4-0.5,
+#: anti-alias filter poles lie above
+MAX_DAMPING = 0.6
+
+
+def welch_nperseg(n_samples: int, fs: float, seconds: float = 10.0, max_fraction: int = 8) -> int:
+    """The Welch segment length of the checks' and figures' spectra.
+
+    Parameters
+    ----------
+    n_samples : int
+        Samples in the record.
+    fs : float
+        Sampling rate, Hz.
+    seconds : float
+        The segment covers at least this long: the next power of two of ``fs * seconds``
+        samples (1,024 at 60 Hz for 10 s), for the resolution the checks need.
+    max_fraction : int
+        ... but at most ``n_samples // max_fraction`` samples, so that enough segments average.
+
+    Returns
+    -------
+    int
+        Samples per segment.
+    """
+    return int(min(n_samples // max_fraction, 2 ** int(np.ceil(np.log2(fs * seconds)))))
