@@ -21,7 +21,7 @@ from armaxmodal.estimate.orders import OrderChoice, choose_orders
 from armaxmodal.modal import mode_record
 from armaxmodal.modes.modal_check import ModalCheck, check_modes, finite_or_none
 from armaxmodal.modes.poles import POLE_COLUMNS, SHARED, Tolerances, pole_rows, rejection_reasons
-from armaxmodal.prepare.preparation import Preparation, oversampling_note, prepare
+from armaxmodal.prepare.preparation import Preparation, oversampling_note, prepare, record_header
 from armaxmodal.recording import Recording
 from armaxmodal.stats import MAX_DAMPING
 
@@ -103,12 +103,7 @@ class Identification:
         na, nb, nc, nk = self.fit.orders
         prep = self.preparation
         return {
-            "fs": rec.fs if prep is None else prep.original_fs,
-            "analysis_fs": rec.fs,
-            "preprocessing": None if prep is None else prep.to_dict(),
-            "warnings": [w.to_dict() for w in self.warnings],
-            "input": rec.input_name,
-            "outputs": list(rec.sensors),
+            **record_header(rec, prep, self.warnings),
             "orders": {"na": na, "nb": nb, "nc": nc, "nk": nk, "shared_poles": self.fit.shared_poles},
             "converged": bool(np.all(self.fit.converged)),
             "fit_percent": dict(zip(rec.sensors, map(float, self.fit.fit_percent), strict=True)),

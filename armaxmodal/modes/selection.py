@@ -30,7 +30,7 @@ from armaxmodal.modes.spread import (
     segment_spread,
 )
 from armaxmodal.notes import QualityWarning
-from armaxmodal.prepare.preparation import oversampling_note
+from armaxmodal.prepare.preparation import oversampling_note, record_header
 from armaxmodal.stats import Z95
 
 
@@ -126,12 +126,7 @@ class ModeSelection:
         t = self.diagram.tolerances
         prep = self.diagram.preparation
         return {
-            "fs": rec.fs if prep is None else prep.original_fs,
-            "analysis_fs": rec.fs,
-            "preprocessing": None if prep is None else prep.to_dict(),
-            "warnings": [w.to_dict() for w in self.warnings],
-            "input": rec.input_name,
-            "outputs": list(rec.sensors),
+            **record_header(rec, prep, self.warnings),
             "nk": self.diagram.orders[0][3],
             "orders_na": [o[0] for o in self.diagram.orders],
             "tolerances": {"freq": t.freq, "damping": t.damping, "shape": t.shape, "max_damping": t.max_damping},

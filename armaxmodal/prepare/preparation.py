@@ -540,3 +540,22 @@ def decimate(data: np.ndarray, factor: int) -> np.ndarray:
     return np.column_stack(
         [np.convolve(col, h, mode="valid")[::factor][:n_out] for col in np.asarray(data, dtype=float).T]
     )
+
+
+def record_header(recording: Recording, preparation: Preparation | None, warnings) -> dict:
+    """The opening keys of every result's JSON: the rates, what the preparation did, the
+    warnings, and the channels.
+
+    Returns
+    -------
+    dict
+        ``fs`` (as recorded), ``analysis_fs``, ``preprocessing``, ``warnings``, ``input``, ``outputs``.
+    """
+    return {
+        "fs": recording.fs if preparation is None else preparation.original_fs,
+        "analysis_fs": recording.fs,
+        "preprocessing": None if preparation is None else preparation.to_dict(),
+        "warnings": [w.to_dict() for w in warnings],
+        "input": recording.input_name,
+        "outputs": list(recording.sensors),
+    }
