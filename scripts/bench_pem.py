@@ -32,7 +32,7 @@ import scipy.signal
 
 import armaxmodal as am
 from armaxmodal.armax import ArmaxModel
-from armaxmodal.estimate import fit as fitmod
+from armaxmodal.estimate import starts as starts_mod
 
 ROOT = Path(__file__).resolve().parents[1]
 NA, NB, NC, NK = 8, 9, 4, 0
@@ -62,7 +62,7 @@ def ours(y, u):
 def scipy_pem(y, u, t0):
     """Plain LM PEM: lfilter residuals and an lfilter Jacobian (what one writes with scipy)."""
     u_t = np.ascontiguousarray(u[None])
-    start = fitmod._hannan_rissanen(np.ascontiguousarray(y), u_t, NA, NB, NC, NK, t0, y.size)
+    start = starts_mod.hannan_rissanen(np.ascontiguousarray(y), u_t, NA, NB, NC, NK, t0, y.size)
 
     def residual(theta):
         a, b, c = np.r_[1.0, theta[:NA]], theta[NA : NA + NB], np.r_[1.0, theta[NA + NB :]]

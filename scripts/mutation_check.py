@@ -119,7 +119,7 @@ MUTANTS = [
         "return float(abs(np.dot(a, b)) ** 2 / den)",
         "MAC without conjugation",
     ),
-    ("armaxmodal/modes/poles.py", "max_damping: float = 0.6", "max_damping: float = 1.0", "damping ceiling 1.0"),
+    ("armaxmodal/stats.py", "MAX_DAMPING = 0.6", "MAX_DAMPING = 1.0", "damping ceiling 1.0"),
     (
         "armaxmodal/estimate/orders.py",
         "return na + 1 - min(nk, 0)",
@@ -150,7 +150,7 @@ MUTANTS = [
         "continued fit restarts its iteration count (perf)",
     ),
     (
-        "armaxmodal/estimate/fit.py",
+        "armaxmodal/estimate/pem.py",
         "paused = _Checkpoint(theta, variances, total_iterations, progress, False)",
         "paused = _Checkpoint(theta, losses / n_eff, total_iterations, progress, False)",
         "checkpoint keeps the updated variances, not the run's weights (perf)",

@@ -7,7 +7,8 @@ import pytest
 import armaxmodal as am
 import armaxmodal.estimate._gauss_newton as gn
 from armaxmodal._kernels import armax_residual, inverse_filter, lagged_cross, lagged_gram
-from armaxmodal.estimate import fit as fitmod
+from armaxmodal.estimate import pem as pem_mod
+from armaxmodal.estimate import starts as starts_mod
 from armaxmodal.estimate.fit import covariance_at, fit_armax
 from armaxmodal.estimate.orders import choose_orders
 from armaxmodal.exceptions import ConvergenceWarning, DataError, OrderError
@@ -100,14 +101,14 @@ def test_kernels_match_references_at_sweep_orders_and_short_records():
 
 def test_lagged_input_sum_matches_the_residual_reference():
     """The Steiglitz-McBride reweighting's ``B u`` (every delay sign, lags past the record)."""
-    from armaxmodal.estimate.fit import _lagged_sum
+    from armaxmodal.estimate.starts import lagged_sum
 
     rng = np.random.default_rng(4)
     one = np.array([1.0])
     for n, nb, nk in ((50, 5, -3), (50, 5, 0), (50, 5, 4), (6, 9, -2), (6, 9, 8), (6, 3, -8)):
         u, b, y = rng.standard_normal((2, n)), rng.standard_normal((2, nb)), rng.standard_normal(n)
         expected = y - naive.armax_residual(y, u, one, b, nk, one)
-        np.testing.assert_allclose(_lagged_sum(u, b, nk), expected, rtol=KERNEL_RTOL, atol=1e-12)
+        np.testing.assert_allclose(lagged_sum(u, b, nk), expected, rtol=KERNEL_RTOL, atol=1e-12)
 
 
 def test_lagged_gram_and_cross_match_explicit_design():
@@ -132,16 +133,16 @@ def test_gradient_is_exact(nk):
     u_t = np.ascontiguousarray(rec.base[None, :1500])
     na, nb, nc = 4, 5, 3
     t0, t1 = max(na, nc, nk + nb - 1), y.size
-    theta = fitmod._hannan_rissanen(y, u_t, na, nb, nc, nk, t0, t1)
-    eps, _, c = fitmod._residual_and_loss(y, u_t, theta, na, nb, nc, nk, t0, t1)
+    theta = starts_mod.hannan_rissanen(y, u_t, na, nb, nc, nk, t0, t1)
+    eps, _, c = pem_mod.residual_and_loss(y, u_t, theta, na, nb, nc, nk, t0, t1)
     _, g = gn.normal_equations(y, u_t, eps, c, gn.columns(na, nb, nc, nk, 1), t0, t1)
     numeric = np.zeros_like(theta)
     h = 1e-7
     for i in range(theta.size):
         step = np.zeros_like(theta)
         step[i] = h
-        up = fitmod._residual_and_loss(y, u_t, theta + step, na, nb, nc, nk, t0, t1)[1]
-        down = fitmod._residual_and_loss(y, u_t, theta - step, na, nb, nc, nk, t0, t1)[1]
+        up = pem_mod.residual_and_loss(y, u_t, theta + step, na, nb, nc, nk, t0, t1)[1]
+        down = pem_mod.residual_and_loss(y, u_t, theta - step, na, nb, nc, nk, t0, t1)[1]
         numeric[i] = (up - down) / (2 * h)
     np.testing.assert_allclose(-2 * g, numeric, rtol=0, atol=GRADIENT_RTOL * np.abs(numeric).max())
 

@@ -11,6 +11,9 @@ import pytest
 import armaxmodal as am
 import armaxmodal.estimate._gauss_newton as gn
 import armaxmodal.estimate.fit as fitmod
+import armaxmodal.estimate.parameters as parameters_mod
+import armaxmodal.estimate.pem as pem_mod
+import armaxmodal.estimate.starts as starts_mod
 from armaxmodal.estimate.orders import default_nb
 from armaxmodal.modal import discrete_modal_parameters, pole_uncertainty
 from armaxmodal.modes.poles import Tolerances, mac, rejection_reasons
@@ -56,16 +59,16 @@ def test_output_error_gradient_is_exact(fixtures_dir):
     u_t = np.ascontiguousarray(rec.base[None, :1500])
     na, nb, nc, nk = 4, 5, 0, 0
     t0, t1 = na + nb, y.size
-    theta = fitmod._hannan_rissanen(y, u_t, na, nb, 2, nk, t0, t1)[: na + nb]
-    eps, _, c = fitmod._residual_and_loss(y, u_t, theta, na, nb, nc, nk, t0, t1, oe=True)
+    theta = starts_mod.hannan_rissanen(y, u_t, na, nb, 2, nk, t0, t1)[: na + nb]
+    eps, _, c = pem_mod.residual_and_loss(y, u_t, theta, na, nb, nc, nk, t0, t1, oe=True)
     _, g = gn.normal_equations(y, u_t, eps, c, gn.columns(na, nb, nc, nk, 1), t0, t1, oe=True)
     numeric = np.zeros_like(theta)
     h = 1e-7
     for i in range(theta.size):
         step = np.zeros_like(theta)
         step[i] = h
-        up = fitmod._residual_and_loss(y, u_t, theta + step, na, nb, nc, nk, t0, t1, oe=True)[1]
-        down = fitmod._residual_and_loss(y, u_t, theta - step, na, nb, nc, nk, t0, t1, oe=True)[1]
+        up = pem_mod.residual_and_loss(y, u_t, theta + step, na, nb, nc, nk, t0, t1, oe=True)[1]
+        down = pem_mod.residual_and_loss(y, u_t, theta - step, na, nb, nc, nk, t0, t1, oe=True)[1]
         numeric[i] = (up - down) / (2 * h)
     np.testing.assert_allclose(-2 * g, numeric, rtol=0, atol=1e-4 * np.abs(numeric).max())
 
@@ -174,12 +177,15 @@ def _shared_problem(fixtures_dir, oe=False):
     t0, t1 = max(na, nc, nk + nb - 1), 1200
     p_k = nb + nc
     cols = gn.columns(na, nb, nc, nk, 1)
-    parts = [fitmod._hannan_rissanen(y, u_t, na, nb, 3, nk, t0, t1)[: na + p_k] for y in ys]
-    theta = fitmod._project_shared(np.concatenate([parts[0][:na]] + [p[na:] for p in parts]), na, nb, nc, 1, 3, oe)
+    parts = [starts_mod.hannan_rissanen(y, u_t, na, nb, 3, nk, t0, t1)[: na + p_k] for y in ys]
+    start = np.concatenate([parts[0][:na]] + [p[na:] for p in parts])
+    theta = parameters_mod.project_shared_stable(start, na, nb, nc, 1, 3, oe)
 
     def residuals(th):
         return [
-            fitmod._residual_and_loss(ys[k], u_t, fitmod._local(th, k, na, p_k), na, nb, nc, nk, t0, t1, oe)
+            pem_mod.residual_and_loss(
+                ys[k], u_t, parameters_mod.local_parameters(th, k, na, p_k), na, nb, nc, nk, t0, t1, oe
+            )
             for k in range(3)
         ]
 

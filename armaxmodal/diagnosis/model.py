@@ -26,7 +26,8 @@ import numpy as np
 from scipy.signal import lfilter
 
 from armaxmodal.diagnosis.clipping import IMPUTE_PASSES, clipped_mask, fill_by_prediction
-from armaxmodal.estimate.fit import ArmaxFit, fit_armax
+from armaxmodal.estimate.fit import fit_armax
+from armaxmodal.estimate.result import ArmaxFit
 
 __all__ = ["Signals", "ModelSpec", "FittedModel", "fit_model", "held_out", "HeldOut", "counted", "as_inputs"]
 

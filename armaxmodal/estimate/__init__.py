@@ -6,7 +6,8 @@
 * :mod:`.pool` -- the worker processes every sweep runs on.
 """
 
-from armaxmodal.estimate.fit import ArmaxFit, fit_armax
+from armaxmodal.estimate.fit import fit_armax
 from armaxmodal.estimate.orders import OrderChoice, choose_orders, default_nb, default_nc, information_criterion
+from armaxmodal.estimate.result import ArmaxFit
 
 __all__ = ["ArmaxFit", "OrderChoice", "choose_orders", "default_nb", "default_nc", "fit_armax", "information_criterion"]

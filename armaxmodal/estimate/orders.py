@@ -19,8 +19,9 @@ from functools import partial
 import numpy as np
 import pandas as pd
 
-from armaxmodal.estimate.fit import ArmaxFit, fit_armax
+from armaxmodal.estimate.fit import fit_armax
 from armaxmodal.estimate.pool import parallel_map
+from armaxmodal.estimate.result import ArmaxFit
 from armaxmodal.exceptions import OrderError
 from armaxmodal.recording import Recording
 

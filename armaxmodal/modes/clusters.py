@@ -10,9 +10,10 @@ from functools import partial
 import numpy as np
 import pandas as pd
 
-from armaxmodal.estimate.fit import ArmaxFit, fit_armax
+from armaxmodal.estimate.fit import fit_armax
 from armaxmodal.estimate.orders import information_criterion
 from armaxmodal.estimate.pool import parallel_map
+from armaxmodal.estimate.result import ArmaxFit
 from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.frf_check import peak_support
 from armaxmodal.modes.poles import SHARED, UNRESOLVED_DAMPING, mac, pole_rows

@@ -26,6 +26,8 @@ from armaxmodal.prepare.disturbance import disturbance_lines
 from armaxmodal.prepare.preparation import Preparation, prepare
 from armaxmodal.recording import Recording
 
+__all__ = ["stabilisation_diagram", "StabilisationDiagram", "choose_nk"]
+
 # A sweep fit stops when an iteration lowers the loss by less than this fraction (a tenth of
 # its statistical resolution, 1/N, for records up to 10^4 samples): enough to place poles.
 # The fits whose estimates are reported are finished to fit_armax's default criterion.

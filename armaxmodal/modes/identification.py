@@ -16,8 +16,9 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal._threads import single_blas_thread
-from armaxmodal.estimate.fit import ArmaxFit, fit_armax
+from armaxmodal.estimate.fit import fit_armax
 from armaxmodal.estimate.orders import OrderChoice, choose_orders
+from armaxmodal.estimate.result import ArmaxFit
 from armaxmodal.modal import mode_record
 from armaxmodal.modes.modal_check import ModalCheck, check_modes, finite_or_none
 from armaxmodal.modes.poles import POLE_COLUMNS, SHARED, Tolerances, pole_rows, rejection_reasons

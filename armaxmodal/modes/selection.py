@@ -33,6 +33,8 @@ from armaxmodal.notes import QualityWarning
 from armaxmodal.prepare.preparation import oversampling_note, record_header
 from armaxmodal.stats import Z95
 
+__all__ = ["select_modes", "ModeSelection"]
+
 
 # -- automatic selection -----------------------------------------------------------------------
 @dataclass(frozen=True)

@@ -1,0 +1,81 @@
+"""Issue 29's first ratio: the CPU work of a whole ``stabilise`` against its own shared-pole
+sweep, both measured in one process on the same record, one after the other.
+
+A  what ``armaxmodal stabilise`` runs after reading the file: the preparation, the delay
+   choice, the sweep (shared poles and every sensor alone) and the selection (finishing fits,
+   frequency-domain refit, segment refits), on the worker pool as the command does;
+B  its shared-pole sweep alone: the orders A swept, at the delay A chose, each fitted from
+   scratch with the sweep's own cap and tolerance, one after another in this process.
+
+CPU time is user + system time of this process and of its reaped children (the forked
+workers); process start, imports, reading and numba's first load are outside both. The
+record is ``scripts/bench_size.py``'s five-mass chain at 100 Hz (20,000 x 5 by default).
+Goal (issue 29): A / B at most 2.
+
+    python scripts/bench_ratio.py [--samples 20000] [--repeat 2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import resource
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_size import recording  # noqa: E402  (the same chain record as the size benchmark)
+
+import armaxmodal as am  # noqa: E402
+from armaxmodal._threads import one_blas_thread  # noqa: E402
+from armaxmodal.estimate.fit import fit_resumable, load_kernels  # noqa: E402
+from armaxmodal.modes.diagram import SWEEP_TOL  # noqa: E402
+
+
+def cpu_seconds() -> float:
+    """User + system CPU of this process and of its children that have ended."""
+    me, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return me.ru_utime + me.ru_stime + children.ru_utime + children.ru_stime
+
+
+def whole_command(rec: am.Recording):
+    """A: the command's work after reading (preparation included); the diagram it made."""
+    diagram = am.stabilisation_diagram(rec)
+    am.select_modes(diagram)
+    return diagram
+
+
+def shared_sweep(diagram) -> None:
+    """B: the shared-pole fits of the diagram's orders, from scratch, one after another, with
+    one BLAS thread as the sweep's (spinning BLAS threads make small fits 3-4 times slower)."""
+    with one_blas_thread():
+        for orders in diagram.orders:
+            fit_resumable(
+                diagram.recording, orders, shared_poles=True, max_iter=30, tol=SWEEP_TOL, stop="decrease", warn=False
+            )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--samples", type=int, default=20_000)
+    parser.add_argument("--repeat", type=int, default=2)
+    args = parser.parse_args()
+    rec = recording(args.samples)
+    load_kernels()
+    fit_resumable(rec, (4, 5, 4, 0), shared_poles=True, max_iter=2, warn=False)  # numba's first call
+    print(f"{rec.n_samples} samples x {len(rec.sensors)} sensors at {rec.fs:g} Hz")
+    for run in range(args.repeat):
+        t0, w0 = cpu_seconds(), time.perf_counter()
+        diagram = whole_command(rec)
+        t1, w1 = cpu_seconds(), time.perf_counter()
+        shared_sweep(diagram)
+        t2, w2 = cpu_seconds(), time.perf_counter()
+        a, b = t1 - t0, t2 - t1
+        print(
+            f"run {run + 1}: stabilise {a:.2f} CPU-s ({w1 - w0:.2f} s wall), its shared sweep {b:.2f} CPU-s "
+            f"({w2 - w1:.2f} s wall, {len(diagram.orders)} orders, nk {diagram.orders[0][3]}): ratio {a / b:.2f}"
+        )
+
+
+if __name__ == "__main__":
+    main()
