@@ -317,8 +317,16 @@ def test_start_must_match_the_fit(supine_zoh):
     fit = fit_armax(supine_zoh, 6, 7, 6, 0, shared_poles=True, max_iter=3, warn=False)
     with pytest.raises(OrderError, match="cannot start"):
         fit_armax(supine_zoh, 8, 9, 8, 0, shared_poles=True, start=fit)
+    # a shared fit starts each sensor's own model (the sweep's per-sensor fits): LM only lowers
+    # each sensor's loss from the shared model's
+    per = fit_armax(supine_zoh, 6, 7, 6, 0, start=fit, max_iter=3, warn=False)
+    assert np.all(per.loss <= fit.loss * (1 + 1e-12))
+    one = fit_armax(supine_zoh.select(["chest"]), 6, 7, 6, 0, start=fit, max_iter=3, warn=False)
+    assert one.loss[0] <= fit.loss[supine_zoh.sensors.index("chest")] * (1 + 1e-12)
     with pytest.raises(OrderError, match="cannot start"):
-        fit_armax(supine_zoh, 6, 7, 6, 0, start=fit)
+        fit_armax(supine_zoh, 6, 7, 6, 0, shared_poles=True, start=per)
+    with pytest.raises(OrderError, match="cannot start"):
+        fit_armax(supine_zoh, 8, 9, 8, 0, start=fit)
     with pytest.raises(TypeError, match="ArmaxFit"):
         fit_armax(supine_zoh, 6, 7, 6, 0, start=np.zeros(3))
     with pytest.raises(ValueError, match="stop"):

@@ -461,3 +461,26 @@ def test_identify_names_the_peak_its_order_leaves_out(ride):
     full = am.identify(rec, (4, 5, 4, 0))
     assert full.modes.freq_hz.to_numpy() == pytest.approx(exact, rel=0.005)
     assert not [w for w in full.warnings if w.code == "unexplained_peak"]
+
+
+def test_each_sensor_fit_starts_from_the_shared_fit_of_its_order(monkeypatch, fixtures_dir):
+    """Issue 29: the per-sensor sweep starts every sensor's fit from the shared fit of the same
+    order (its A, the sensor's B and C), not from scratch; the shared fits are unchanged."""
+    import armaxmodal.modes.diagram as diagram_module
+
+    seen = []
+    real = diagram_module.fit_resumable
+
+    def recording_start(rec, orders, **kwargs):
+        seen.append((rec.sensors, tuple(orders), kwargs.get("start")))
+        return real(rec, orders, **kwargs)
+
+    monkeypatch.setattr(diagram_module, "fit_resumable", recording_start)
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    diagram = stabilisation_diagram(rec, range(4, 9, 2), nk=-3, n_jobs=1)
+    singles = [(sensors, orders, start) for sensors, orders, start in seen if len(sensors) == 1]
+    assert len(singles) == 3 * len(rec.sensors)
+    for sensors, orders, start in singles:
+        assert start is diagram.fits[(SHARED, orders[0])], (sensors, orders)
+        assert start.shared_poles and tuple(start.orders) == orders
+    assert all(start is None for sensors, _, start in seen if len(sensors) > 1)

@@ -85,7 +85,9 @@ def fit_armax(
     start : ArmaxFit, optional
         Continue from this fit of the same data, orders and form instead of computing a
         start: a sweep's fit stopped at a loose ``tol`` is finished for the price of its
-        last iterations. ``iterations`` then counts the new ones only.
+        last iterations. ``iterations`` then counts the new ones only. A shared-pole fit of
+        the same orders also starts a per-sensor fit of any of its sensors: from its A and
+        that sensor's B and C.
 
     Returns
     -------
@@ -266,13 +268,18 @@ def _start_parameters(start, orders, shared_poles, sensors) -> list[np.ndarray]:
     """Per-sensor parameter vectors ``[a, b (row-major), c]`` of a fit to continue from."""
     if not isinstance(start, ArmaxFit):
         raise TypeError(f"start: expected an ArmaxFit, got {type(start).__name__}.")
+    nc = orders[2]
+    from_shared = start.shared_poles and not shared_poles and set(sensors) <= set(start.sensors)
+    if from_shared and tuple(start.orders) == tuple(orders):
+        # a shared-pole fit starts each sensor's own model: its A, and that sensor's B and C
+        models = [start.models[start.sensors.index(s)] for s in sensors]
+        return [np.concatenate([m.a[1:], m.b.ravel(), m.c[1 : nc + 1]]) for m in models]
     if tuple(start.orders) != tuple(orders) or start.shared_poles != shared_poles or start.sensors != tuple(sensors):
         raise OrderError(
             f"start: a fit with orders {tuple(start.orders)}, shared_poles={start.shared_poles} and sensors "
             f"{start.sensors} cannot start one with orders {tuple(orders)}, shared_poles={shared_poles} and "
             f"sensors {tuple(sensors)}; fit again without start."
         )
-    nc = orders[2]
     return [np.concatenate([m.a[1:], m.b.ravel(), m.c[1 : nc + 1]]) for m in start.models]
 
 

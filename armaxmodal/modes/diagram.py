@@ -110,10 +110,12 @@ def sweep_fit(recording: Recording, job, max_iter: int, tol: float, covariance: 
     support the orders."""
     source, orders = job[:2]
     rec = recording if source == SHARED else recording.select([source])
+    extra = job[2] if len(job) > 2 else None
+    resume, start = (extra, None) if source == SHARED else (None, extra)
     try:
         return fit_resumable(
             rec, orders, shared_poles=source == SHARED, max_iter=max_iter, tol=tol, stop="decrease", warn=False,
-            resume=job[2] if len(job) > 2 else None, covariance=covariance,
+            resume=resume, start=start, covariance=covariance,
         )  # fmt: skip
     except OrderError:
         return None, None
@@ -236,18 +238,19 @@ def stabilisation_diagram(
         # as if fitted here from the start (unless this sweep's cap is below theirs)
         if max_iter < DELAY_CHOICE_ITERATIONS:
             known = {}
-        todo = [job + ((known[job],) if job in known else ()) for job in jobs]
         from tqdm import tqdm
 
+        task = partial(_fit_and_poles, recording, max_iter=max_iter, tol=tol)
+        cost = partial(_job_cost, n_sensors=len(recording.sensors))
         with tqdm(total=len(jobs), desc="stabilisation sweep", unit="fit", disable=not progress) as bar:
-            fitted = parallel_map(
-                partial(_fit_and_poles, recording, max_iter=max_iter, tol=tol),
-                todo,
-                n_jobs,
-                bar,
-                cost=partial(_job_cost, n_sensors=len(recording.sensors)),
-            )
-        done = dict(zip(jobs, fitted, strict=True))
+            shared = [job for job in jobs if job[0] == SHARED]
+            todo = [job + ((known[job],) if job in known else ()) for job in shared]
+            done = dict(zip(shared, parallel_map(task, todo, n_jobs, bar, cost=cost), strict=True))
+            # each sensor's own fit starts from the shared fit of its order (its A, its B and C)
+            single = [job for job in jobs if job[0] != SHARED]
+            starts = [done[(SHARED, job[1])][0] for job in single]
+            todo = [job + ((fit,) if fit is not None else ()) for job, fit in zip(single, starts, strict=True)]
+            done.update(zip(single, parallel_map(task, todo, n_jobs, bar, cost=cost), strict=True))
         rows, kept = [], {}
         for source, o in jobs:
             fit, fit_rows = done[(source, o)]
