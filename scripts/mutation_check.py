@@ -428,6 +428,20 @@ MUTANTS = [
         "max_fraction=2)",
         "lumping averages too few segments (layout)",
     ),
+    # issue 29's per-sensor start (run with --match "(warm)" --tests tests/test_fit.py
+    # tests/test_sweep_in_process.py)
+    (
+        "armaxmodal/estimate/fit.py",
+        "models = [start.models[start.sensors.index(s)] for s in sensors]",
+        "models = [start.models[0] for s in sensors]",
+        "every sensor starts from the first sensor's model (warm)",
+    ),
+    (
+        "armaxmodal/modes/diagram.py",
+        "todo = [job + ((fit,) if fit is not None else ()) for job, fit in zip(single, starts, strict=True)]",
+        "todo = single",
+        "per-sensor fits start from scratch (warm)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/test_guards.py",
