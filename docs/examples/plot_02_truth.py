@@ -24,7 +24,7 @@ rec = am.simulate_recording(human, ride, 60.0, noise=0.05, hold="bandlimited", s
 # The measured H1 follows the exact transmissibility where the coherence is high.
 f, h1, coherence = measured_frf(rec)
 exact = human.transmissibility(f)
-fig, ax = plt.subplots(figsize=(7, 4))
+fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
 for k, name in enumerate(rec.sensors):
     line = ax.semilogy(f, np.abs(h1[:, k]), lw=1, label=f"{name}, H1")[0]
     ax.semilogy(f, np.abs(exact[:, k]), "--", color=line.get_color(), lw=1)

@@ -60,7 +60,7 @@ print(f"model error {100 * lean.overall_error:.0f} %")
 # %%
 # Model error against the second mode's damping ratio.
 rows = np.array(rows)
-fig, ax = plt.subplots(figsize=(6.5, 3.8))
+fig, ax = plt.subplots(figsize=(6.5, 3.8), layout="constrained")
 for column, label in ((1, "exact modes"), (2, "mode 2 left out"), (3, "mode 2 3 % high")):
     ax.semilogx(rows[:, 0], rows[:, column], "o-", label=label)
 supine = "supine chain, mode 2 left out"

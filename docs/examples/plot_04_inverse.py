@@ -38,7 +38,7 @@ values = {
     "model updating": np.r_[updated.components.k, updated.components.k_s],
 }
 errors = np.r_[updated.std.k, updated.std.k_s]
-fig, ax = plt.subplots(figsize=(7, 3.5))
+fig, ax = plt.subplots(figsize=(7, 3.5), layout="constrained")
 x = np.arange(len(labels))
 for i, (name, v) in enumerate(values.items()):
     ax.bar(x + (i - 1) * 0.27, v / 1000, 0.27, label=name, yerr=errors / 1000 if name == "model updating" else None)
