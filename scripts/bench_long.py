@@ -3,8 +3,9 @@
 A supine-human ride at 120 Hz with four sensors (random base acceleration 0.5-40 Hz,
 band-limited, 5 % sensor noise) is written to CSV at two lengths; ``armaxmodal stabilise`` runs
 on each in a new process under ``/usr/bin/time -v``. Reported: wall time per sample (long over
-short: the goal is at most 1) and the peak resident memory per sample and sensor of the long
-run (goal: at most 100 bytes).
+short: the goal is at most 1), the peak resident memory per sample and sensor of the long
+run (goal: at most 100 bytes), and what a sample adds: the slope of the peak between the
+two lengths, which leaves out the fixed 0.25 GB of the interpreter and its libraries.
 
     python scripts/bench_long.py [--short 20000] [--long 432000]
 """
@@ -51,17 +52,25 @@ def main() -> None:
     parser.add_argument("--long", type=int, default=432_000)
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
-        results = {}
+        results, peaks = {}, {}
         for n in (args.short, args.long):
             path = Path(tmp) / f"ride_{n}.csv"
             ride(n, path)
             wall, rss, modes = run(path)
-            results[n] = wall / n
+            results[n], peaks[n] = wall / n, rss
             print(
                 f"{n} samples x 4 sensors: {wall:.1f} s, {1e6 * wall / n:.1f} us/sample, peak RSS "
                 f"{rss / 2**20:.0f} MB ({rss / (4 * n):.0f} bytes per sample and sensor); modes (Hz, damping): {modes}"
             )
         print(f"time per sample, long over short: {results[args.long] / results[args.short]:.2f} (goal <= 1)")
+        # the peak holds a fixed part (the interpreter, numpy, scipy, numba's kernels: about
+        # 0.25 GB before any data), so the slope between the two lengths is what a sample costs
+        slope = (peaks[args.long] - peaks[args.short]) / (4 * (args.long - args.short))
+        ten_hours = peaks[args.short] + slope * 4 * (36_000 * FS - args.short)
+        print(
+            f"memory a sample and sensor adds: {slope:.0f} bytes; fixed part {peaks[args.short] / 2**20:.0f} MB; "
+            f"ten hours at {FS:g} Hz would peak near {ten_hours / 2**30:.1f} GB"
+        )
 
 
 if __name__ == "__main__":

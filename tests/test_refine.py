@@ -68,6 +68,14 @@ def test_too_few_lines_for_the_modes_is_a_clear_error(fixtures_dir):
 def test_variable_projection_jacobian_matches_finite_differences(fixtures_dir, hold):
     from scipy.optimize._numdiff import approx_derivative
 
+    model = _supine_model(fixtures_dir, hold)
+    x = np.ravel(np.column_stack([np.log(2 * np.pi * np.array([5.8, 8.3, 13.5, 16.2])), [0.25, 0.33, 0.3, 0.27]]))
+    analytic = model.jacobian(x)
+    numeric = approx_derivative(model.residual, x, method="3-point")
+    assert np.max(np.abs(analytic - numeric)) < 1e-6 * np.max(np.abs(numeric))
+
+
+def _supine_model(fixtures_dir, hold):
     from armaxmodal.modes.refine import _SeparableModel
 
     rec = am.read_recording(fixtures_dir / "supine_random.csv")
@@ -76,11 +84,39 @@ def test_variable_projection_jacobian_matches_finite_differences(fixtures_dir, h
     lines = (freq >= 0.5) & (freq <= 28)
     w = 2 * np.pi * freq[lines]
     y = np.fft.rfft(rec.response, axis=0)[lines]
-    model = _SeparableModel(1j * w, np.exp(-1j * w * dt), np.fft.rfft(rec.base)[lines], y / np.abs(y).mean(0), dt, hold)
-    x = np.ravel(np.column_stack([np.log(2 * np.pi * np.array([5.8, 8.3, 13.5, 16.2])), [0.25, 0.33, 0.3, 0.27]]))
-    analytic = model.jacobian(x)
-    numeric = approx_derivative(model.residual, x, method="3-point")
-    assert np.max(np.abs(analytic - numeric)) < 1e-6 * np.max(np.abs(numeric))
+    return _SeparableModel(1j * w, np.exp(-1j * w * dt), np.fft.rfft(rec.base)[lines], y / np.abs(y).mean(0), dt, hold)
+
+
+@pytest.mark.parametrize("hold", ["bandlimited", "zoh"])
+def test_the_compressed_refit_takes_the_full_problems_steps(fixtures_dir, hold):
+    """The refit hands scipy the QR factor of [J r] instead of one row per line (issue 29's
+    memory): the normal equations, the gradient and the cost are the full problem's at every
+    point, so the solver lands where the full problem's does, from a start 3 % off."""
+    import scipy.optimize
+
+    from armaxmodal.modes.refine import _Compressed
+
+    model = _supine_model(fixtures_dir, hold)
+    small = _Compressed(model)
+    log_wn = np.log(2 * np.pi * np.array([5.83, 8.31, 13.50, 16.25]))
+    truth = np.ravel(np.column_stack([log_wn, [0.26, 0.35, 0.3, 0.27]]))
+    start = truth * np.array([1.005, 0.9, 0.995, 1.1, 1.005, 0.9, 0.995, 1.1])
+    j, r = model.jacobian(start), model.residual(start).copy()
+    jc, rc = small.jacobian(start), small.residual(start)
+    assert jc.shape == (start.size + 1, start.size) and rc.shape == (start.size + 1,)
+    assert np.allclose(jc.T @ jc, j.T @ j, rtol=1e-10, atol=1e-10 * np.abs(j.T @ j).max())
+    assert np.allclose(jc.T @ rc, j.T @ r, rtol=1e-9, atol=1e-9 * np.abs(j.T @ r).max())
+    assert rc @ rc == pytest.approx(r @ r, rel=1e-12)
+    # the buffer the factor fills holds the Jacobian the plain call returns
+    out = np.empty((r.size, start.size), order="F")
+    model.jacobian(start, out=out)
+    assert np.array_equal(out, j)
+    bounds = (np.tile([np.log(2 * np.pi * 0.5), 1e-4], 4), np.tile([np.log(2 * np.pi * 30.0), 0.95], 4))
+    options = {"x_scale": "jac", "max_nfev": 60, "xtol": 1e-12, "ftol": 1e-12, "bounds": bounds}
+    full = scipy.optimize.least_squares(model.residual, start, jac=model.jacobian, **options)
+    compressed = scipy.optimize.least_squares(small.residual, start, jac=small.jacobian, **options)
+    assert np.allclose(compressed.x, full.x, rtol=0, atol=1e-7)
+    assert compressed.cost == pytest.approx(full.cost, rel=1e-10)
 
 
 def test_sandwich_errors_equal_statsmodels_hc1_on_a_linear_regression():

@@ -21,6 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 import scipy.optimize
 
 from armaxmodal._threads import single_blas_thread
@@ -76,6 +77,34 @@ def _pair(h: np.ndarray, h_conj: np.ndarray) -> np.ndarray:
     return np.column_stack([h + h_conj, 1j * (h - h_conj)])
 
 
+class _Compressed:
+    """A separable model's residual and Jacobian rotated onto ``n + 1`` rows: the QR factor
+    ``R`` of ``[J r]`` at each point. ``J_c' J_c = J' J``, ``J_c' r_c = J' r`` and
+    ``|r_c| = |r|``, so a trust-region solver takes the same steps, while it holds
+    (n + 1) x n numbers instead of one row per DFT line, sensor and real or imaginary part
+    (scipy keeps about seven copies of the Jacobian: 0.4 GB for a one-hour ride). Each
+    residual costs a Jacobian too, so ``r_c`` and ``J_c`` always come from one factor."""
+
+    def __init__(self, model: _SeparableModel):
+        self.model = model
+        self._x = None
+
+    def _factor(self, x):
+        if self._x is None or not np.array_equal(x, self._x):
+            full = np.empty((self.model.b.size, x.size + 1), order="F")
+            self.model.jacobian(x, out=full[:, :-1])
+            full[:, -1] = self.model.residual(x)
+            # factored in place: the R factor is all that is kept
+            self._x, self._r = x.copy(), scipy.linalg.qr(full, mode="raw", overwrite_a=True, check_finite=False)[1]
+        return self._r
+
+    def residual(self, x):
+        return self._factor(x)[:, -1]
+
+    def jacobian(self, x):
+        return self._factor(x)[:, :-1]
+
+
 class _SeparableModel:
     """``Y = Phi(x) coef`` over DFT lines, with ``coef`` (residues, direct and transient terms)
     projected out: residual and Golub-Pereyra Jacobian in the frequencies and dampings only.
@@ -106,14 +135,22 @@ class _SeparableModel:
         if self._x is not None and np.array_equal(x, self._x):
             return
         lam = _poles(x)
-        phi = np.hstack(
+        columns = (
             [_pair(self._plant(p, 0), self._plant(np.conj(p), 0)) for p in lam]
             + [self.u[:, None]]
             + [_pair(self._held(p, 0), self._held(np.conj(p), 0)) for p in lam]
             + [np.ones_like(self.s)[:, None]]
         )
-        a = np.vstack([phi.real, phi.imag])
-        q, r = np.linalg.qr(a)
+        # the real parts of the lines over their imaginary parts, filled in place (a one-hour
+        # ride has 10^5 lines or more: no complex copy of the basis, no copy for the QR)
+        lines = self.s.size
+        a = np.empty((2 * lines, sum(c.shape[1] for c in columns)), order="F")
+        at = 0
+        for c in columns:
+            a[:lines, at : at + c.shape[1]], a[lines:, at : at + c.shape[1]] = c.real, c.imag
+            at += c.shape[1]
+        del columns
+        q, r = scipy.linalg.qr(a, mode="economic", overwrite_a=True, check_finite=False)
         qtb = q.T @ self.b
         self._x, self.lam, self.q, self.r = x.copy(), lam, q, r
         self.coef = np.linalg.solve(r, qtb)
@@ -123,12 +160,13 @@ class _SeparableModel:
         self._solve(x)
         return self.resid.ravel()
 
-    def jacobian(self, x):
-        """``d resid / d x`` = ``-P_perp dA coef - A^+' dA' resid`` (Golub & Pereyra, 1973)."""
+    def jacobian(self, x, out=None):
+        """``d resid / d x`` = ``-P_perp dA coef - A^+' dA' resid`` (Golub & Pereyra, 1973),
+        written into ``out`` when given."""
         self._solve(x)
         n = self.lam.size
         d_lam = _pole_derivatives(x)
-        jac = np.empty((self.resid.size, x.size))
+        jac = np.empty((self.resid.size, x.size)) if out is None else out
         for j, p in enumerate(self.lam):
             cols = [2 * j, 2 * j + 1, 2 * n + 1 + 2 * j, 2 * n + 2 + 2 * j]
             for k, g in enumerate(d_lam[j]):
@@ -214,11 +252,12 @@ def refine_modes(
     start_model = model("zoh", np.ones(y.shape[1]))
     start_model.residual(start)
     sd = np.sqrt(np.mean(start_model.resid**2, axis=0))
+    del start_model  # its basis and factors are the size of the data
     weights = 1.0 / np.where(sd > 0, sd, 1.0)
     models = {h: model(h, weights) for h in HOLDS}
 
     def fit(hold_, x, n_eval):
-        m = models[hold_]
+        m = _Compressed(models[hold_])
         return scipy.optimize.least_squares(
             m.residual, x, jac=m.jacobian, bounds=(lo, hi), x_scale="jac", max_nfev=n_eval
         )
@@ -227,12 +266,13 @@ def refine_modes(
     # chosen one is then iterated to convergence
     fits = {h: fit(h, start, 4 if hold == "auto" else max_nfev) for h in (HOLDS if hold == "auto" else (hold,))}
     best = min(fits, key=lambda h: fits[h].cost)
+    models = {best: models[best]}  # the other assumption's factors are freed
     res = fits[best] if hold != "auto" else fit(best, fits[best].x, max_nfev)
     lam = _poles(res.x)
-    models[best].residual(res.x)
+    resid = models[best].residual(res.x)  # the sandwich needs the residual of every line
     coef = models[best].coef
     n_par = coef.shape[0] * coef.shape[1] + res.x.size
-    sd_par = _sandwich_sd(res.jac, res.fun, n_par)
+    sd_par = _sandwich_sd(models[best].jacobian(res.x), resid, n_par)
     r = (coef[0 : 2 * f0.size : 2] + 1j * coef[1 : 2 * f0.size : 2]).T / weights[:, None]
     if best == "zoh":  # R / (1 - mu z^-1) = R + R mu z^-1 / (1 - mu z^-1); zoh of r / (s - lambda)
         mu = np.exp(lam * dt)  # is r (mu - 1) / lambda z^-1 / (1 - mu z^-1), so r = R mu lambda / (mu - 1)
