@@ -107,16 +107,19 @@ def test_the_compressed_refit_takes_the_full_problems_steps(fixtures_dir, hold):
     assert np.allclose(jc.T @ jc, j.T @ j, rtol=1e-10, atol=1e-10 * np.abs(j.T @ j).max())
     assert np.allclose(jc.T @ rc, j.T @ r, rtol=1e-9, atol=1e-9 * np.abs(j.T @ r).max())
     assert rc @ rc == pytest.approx(r @ r, rel=1e-12)
-    # the buffer the factor fills holds the Jacobian the plain call returns
-    out = np.empty((r.size, start.size), order="F")
-    model.jacobian(start, out=out)
-    assert np.array_equal(out, j)
+    # the factor is built a sensor at a time: those rows, interleaved, are the full Jacobian's
+    rows = list(model.sensor_rows(start))
+    interleaved = np.stack([jk for jk, _ in rows], axis=1).reshape(j.shape)
+    assert np.allclose(interleaved, j, rtol=0, atol=1e-12 * np.abs(j).max())
+    assert np.array_equal(np.column_stack([rk for _, rk in rows]).ravel(), r)
     bounds = (np.tile([np.log(2 * np.pi * 0.5), 1e-4], 4), np.tile([np.log(2 * np.pi * 30.0), 0.95], 4))
     options = {"x_scale": "jac", "max_nfev": 60, "xtol": 1e-12, "ftol": 1e-12, "bounds": bounds}
     full = scipy.optimize.least_squares(model.residual, start, jac=model.jacobian, **options)
     compressed = scipy.optimize.least_squares(small.residual, start, jac=small.jacobian, **options)
-    assert np.allclose(compressed.x, full.x, rtol=0, atol=1e-7)
-    assert compressed.cost == pytest.approx(full.cost, rel=1e-10)
+    # (to 1e-5 in log frequency and damping: on the zoh assumption one damping sits at its
+    # bound and its mode's frequency is flat to 1e-5 there, where rounding decides)
+    assert np.allclose(compressed.x, full.x, rtol=0, atol=1e-5)
+    assert compressed.cost == pytest.approx(full.cost, rel=1e-9)
 
 
 def test_sandwich_errors_equal_statsmodels_hc1_on_a_linear_regression():
@@ -129,7 +132,7 @@ def test_sandwich_errors_equal_statsmodels_hc1_on_a_linear_regression():
     x = np.column_stack([np.ones(400), rng.standard_normal(400), rng.uniform(0, 3, 400)])
     y = x @ [0.5, -1.0, 2.0] + rng.standard_normal(400) * (0.1 + x[:, 2])  # noise grows with x3
     fit = sm.OLS(y, x).fit(cov_type="HC1")
-    got = _sandwich_sd(x, fit.resid, 3)
+    got = _sandwich_sd([(x[:20], fit.resid[:20]), (x[20:], fit.resid[20:])], 3)
     np.testing.assert_allclose(got, fit.bse, rtol=1e-10)
     # the pooled-variance errors differ here: the test can tell the two apart
     assert np.max(np.abs(sm.OLS(y, x).fit().bse / fit.bse - 1)) > 0.1

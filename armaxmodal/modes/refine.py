@@ -82,7 +82,8 @@ class _Compressed:
     ``R`` of ``[J r]`` at each point. ``J_c' J_c = J' J``, ``J_c' r_c = J' r`` and
     ``|r_c| = |r|``, so a trust-region solver takes the same steps, while it holds
     (n + 1) x n numbers instead of one row per DFT line, sensor and real or imaginary part
-    (scipy keeps about seven copies of the Jacobian: 0.4 GB for a one-hour ride). Each
+    (scipy keeps about seven copies of the Jacobian: 0.9 GB for a one-hour ride). The factor
+    is built one sensor's rows at a time (the order of rows does not change it). Each
     residual costs a Jacobian too, so ``r_c`` and ``J_c`` always come from one factor."""
 
     def __init__(self, model: _SeparableModel):
@@ -91,11 +92,11 @@ class _Compressed:
 
     def _factor(self, x):
         if self._x is None or not np.array_equal(x, self._x):
-            full = np.empty((self.model.b.size, x.size + 1), order="F")
-            self.model.jacobian(x, out=full[:, :-1])
-            full[:, -1] = self.model.residual(x)
-            # factored in place: the R factor is all that is kept
-            self._x, self._r = x.copy(), scipy.linalg.qr(full, mode="raw", overwrite_a=True, check_finite=False)[1]
+            factor = np.zeros((0, x.size + 1))
+            for jac, resid in self.model.sensor_rows(x):
+                rows = np.vstack([factor, np.column_stack([jac, resid])])
+                factor = scipy.linalg.qr(rows, mode="raw", overwrite_a=True, check_finite=False)[1]
+            self._x, self._r = x.copy(), factor
         return self._r
 
     def residual(self, x):
@@ -131,25 +132,33 @@ class _SeparableModel:
         den = 1 - mu * self.z_inv
         return 1 / den if order == 0 else self.dt * mu * self.z_inv / den**2
 
+    def release(self) -> None:
+        """Let go of the factors of the last point (the size of the data)."""
+        self._x = self.q = self.resid = None
+
+    def _basis_blocks(self, lam):
+        """The columns of ``Phi`` in order, a block at a time (complex, lines x 1 or 2)."""
+        for p in lam:
+            yield _pair(self._plant(p, 0), self._plant(np.conj(p), 0))
+        yield self.u[:, None]
+        for p in lam:
+            yield _pair(self._held(p, 0), self._held(np.conj(p), 0))
+        yield np.ones_like(self.s)[:, None]
+
     def _solve(self, x):
         if self._x is not None and np.array_equal(x, self._x):
             return
         lam = _poles(x)
-        columns = (
-            [_pair(self._plant(p, 0), self._plant(np.conj(p), 0)) for p in lam]
-            + [self.u[:, None]]
-            + [_pair(self._held(p, 0), self._held(np.conj(p), 0)) for p in lam]
-            + [np.ones_like(self.s)[:, None]]
-        )
-        # the real parts of the lines over their imaginary parts, filled in place (a one-hour
-        # ride has 10^5 lines or more: no complex copy of the basis, no copy for the QR)
+        # the real parts of the lines over their imaginary parts, filled in place a block at a
+        # time (a one-hour ride has 10^5 lines or more: no complex copy of the basis, no copy
+        # for the QR, and the last point's factors are let go first)
+        self.release()
         lines = self.s.size
-        a = np.empty((2 * lines, sum(c.shape[1] for c in columns)), order="F")
+        a = np.empty((2 * lines, 4 * lam.size + 2), order="F")
         at = 0
-        for c in columns:
-            a[:lines, at : at + c.shape[1]], a[lines:, at : at + c.shape[1]] = c.real, c.imag
-            at += c.shape[1]
-        del columns
+        for block in self._basis_blocks(lam):
+            a[:lines, at : at + block.shape[1]], a[lines:, at : at + block.shape[1]] = block.real, block.imag
+            at += block.shape[1]
         q, r = scipy.linalg.qr(a, mode="economic", overwrite_a=True, check_finite=False)
         qtb = q.T @ self.b
         self._x, self.lam, self.q, self.r = x.copy(), lam, q, r
@@ -160,42 +169,52 @@ class _SeparableModel:
         self._solve(x)
         return self.resid.ravel()
 
-    def jacobian(self, x, out=None):
-        """``d resid / d x`` = ``-P_perp dA coef - A^+' dA' resid`` (Golub & Pereyra, 1973),
-        written into ``out`` when given."""
+    def sensor_rows(self, x):
+        """Per sensor, its rows of the Jacobian and of the residual, ``(2 L, n)`` and ``(2 L,)``."""
+        self._solve(x)
+        for k in range(self.b.shape[1]):
+            yield self.jacobian(x, sensors=[k]), self.resid[:, k]
+
+    def jacobian(self, x, sensors=None):
+        """``d resid / d x`` = ``-P_perp dA coef - A^+' dA' resid`` (Golub & Pereyra, 1973):
+        the rows of ``sensors`` (a list of indices; default all)."""
         self._solve(x)
         n = self.lam.size
         d_lam = _pole_derivatives(x)
-        jac = np.empty((self.resid.size, x.size)) if out is None else out
+        sensors = slice(None) if sensors is None else sensors
+        coef, resid = self.coef[:, sensors], self.resid[:, sensors]
+        moved = np.empty((resid.shape[0], resid.shape[1], x.size))
+        back = np.zeros((coef.shape[0], resid.shape[1], x.size))
         for j, p in enumerate(self.lam):
             cols = [2 * j, 2 * j + 1, 2 * n + 1 + 2 * j, 2 * n + 2 + 2 * j]
+            plant, plant_conj = self._plant(p, 1), self._plant(np.conj(p), 1)
+            held, held_conj = self._held(p, 1), self._held(np.conj(p), 1)
             for k, g in enumerate(d_lam[j]):
                 # the conjugate partner's column moves with conj(d lambda)
                 d_phi = np.hstack(
-                    [
-                        _pair(self._plant(p, 1) * g, self._plant(np.conj(p), 1) * np.conj(g)),
-                        _pair(self._held(p, 1) * g, self._held(np.conj(p), 1) * np.conj(g)),
-                    ]
+                    [_pair(plant * g, plant_conj * np.conj(g)), _pair(held * g, held_conj * np.conj(g))]
                 )
                 d_a = np.vstack([d_phi.real, d_phi.imag])
-                moved = d_a @ self.coef[cols]
-                term = moved - self.q @ (self.q.T @ moved)
-                back = np.zeros_like(self.coef)
-                back[cols] = d_a.T @ self.resid
-                term += self.q @ np.linalg.solve(self.r.T, back)
-                jac[:, 2 * j + k] = -term.ravel()
-        return jac
+                moved[:, :, 2 * j + k] = d_a @ coef[cols]
+                back[cols, :, 2 * j + k] = d_a.T @ resid
+        # every column at once: two passes over Q instead of three per column
+        moved = moved.reshape(resid.shape[0], -1)
+        moved -= self.q @ (self.q.T @ moved - np.linalg.solve(self.r.T, back.reshape(coef.shape[0], -1)))
+        return np.negative(moved, out=moved).reshape(resid.size, x.size)
 
 
-def _sandwich_sd(jac: np.ndarray, resid: np.ndarray, n_par: int) -> np.ndarray:
+def _sandwich_sd(blocks, n_par: int) -> np.ndarray:
     """Standard errors of the nonlinear parameters from the variable-projection Jacobian,
     heteroscedasticity-consistent (White's HC1 sandwich). The residual's variance is not
     the same on every DFT line: input noise and the model-class gap grow with |H| near the
     resonances, so one pooled variance understated the spread of the refit's first mode
-    2-3 times on band-limited rides (scripts/mc_coverage.py: 78 % coverage)."""
-    bread = np.linalg.pinv(jac.T @ jac)
-    meat = (jac * resid[:, None] ** 2).T @ jac
-    scale = resid.size / max(resid.size - n_par, 1)
+    2-3 times on band-limited rides (scripts/mc_coverage.py: 78 % coverage). ``blocks``
+    yields ``(jacobian rows, residual rows)``: the sums are taken a block at a time."""
+    gram, meat, rows = 0.0, 0.0, 0
+    for jac, resid in blocks:
+        gram, meat, rows = gram + jac.T @ jac, meat + (jac * resid[:, None] ** 2).T @ jac, rows + resid.size
+    bread = np.linalg.pinv(gram)
+    scale = rows / max(rows - n_par, 1)
     return np.sqrt(np.clip(np.diag(bread @ meat @ bread) * scale, 0, None))
 
 
@@ -258,21 +277,22 @@ def refine_modes(
 
     def fit(hold_, x, n_eval):
         m = _Compressed(models[hold_])
-        return scipy.optimize.least_squares(
+        result = scipy.optimize.least_squares(
             m.residual, x, jac=m.jacobian, bounds=(lo, hi), x_scale="jac", max_nfev=n_eval
         )
+        models[hold_].release()  # one assumption's factors in memory at a time
+        return result
 
     # a few steps of each assumption tell them apart (the wrong one stays well above); the
     # chosen one is then iterated to convergence
     fits = {h: fit(h, start, 4 if hold == "auto" else max_nfev) for h in (HOLDS if hold == "auto" else (hold,))}
     best = min(fits, key=lambda h: fits[h].cost)
-    models = {best: models[best]}  # the other assumption's factors are freed
     res = fits[best] if hold != "auto" else fit(best, fits[best].x, max_nfev)
     lam = _poles(res.x)
-    resid = models[best].residual(res.x)  # the sandwich needs the residual of every line
+    models[best].residual(res.x)  # the sandwich needs the residual of every line
     coef = models[best].coef
     n_par = coef.shape[0] * coef.shape[1] + res.x.size
-    sd_par = _sandwich_sd(models[best].jacobian(res.x), resid, n_par)
+    sd_par = _sandwich_sd(models[best].sensor_rows(res.x), n_par)
     r = (coef[0 : 2 * f0.size : 2] + 1j * coef[1 : 2 * f0.size : 2]).T / weights[:, None]
     if best == "zoh":  # R / (1 - mu z^-1) = R + R mu z^-1 / (1 - mu z^-1); zoh of r / (s - lambda)
         mu = np.exp(lam * dt)  # is r (mu - 1) / lambda z^-1 / (1 - mu z^-1), so r = R mu lambda / (mu - 1)
