@@ -82,7 +82,7 @@ class _Compressed:
     ``R`` of ``[J r]`` at each point. ``J_c' J_c = J' J``, ``J_c' r_c = J' r`` and
     ``|r_c| = |r|``, so a trust-region solver takes the same steps, while it holds
     (n + 1) x n numbers instead of one row per DFT line, sensor and real or imaginary part
-    (scipy keeps about seven copies of the Jacobian: 0.9 GB for a one-hour ride). The factor
+    (scipy keeps about seven copies of the Jacobian: 0.5 GB for a one-hour ride). The factor
     is built one sensor's rows at a time (the order of rows does not change it). Each
     residual costs a Jacobian too, so ``r_c`` and ``J_c`` always come from one factor."""
 
@@ -289,7 +289,7 @@ def refine_modes(
     best = min(fits, key=lambda h: fits[h].cost)
     res = fits[best] if hold != "auto" else fit(best, fits[best].x, max_nfev)
     lam = _poles(res.x)
-    models[best].residual(res.x)  # the sandwich needs the residual of every line
+    models[best].residual(res.x)  # the factors at the solution (released after the fit)
     coef = models[best].coef
     n_par = coef.shape[0] * coef.shape[1] + res.x.size
     sd_par = _sandwich_sd(models[best].sensor_rows(res.x), n_par)
