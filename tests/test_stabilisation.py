@@ -374,17 +374,11 @@ def test_rescue_rules_each_decide(light_diagram):
     assert rescued(group(f2, [0.01] * 10, 0.006)) == [[f2]]  # 0.01 - 1.96 x 0.006 < 0
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="known, left for issue 29's delay choice: BIC over windows of different lengths depends on the unit",
-)
 def test_the_delay_and_order_choices_do_not_depend_on_the_data_unit(fixtures_dir):
-    """The same ride in m/s^2, cm/s^2 and km/s^2 (every channel scaled alike) must choose the
-    same delay and orders. It does not: BIC over fits whose windows differ by a few samples
-    carries n K log(scale^2), so cm/s^2 chose nk = -9 where m/s^2 chose -5 (the modes agreed
-    to 4 digits). Scoring every candidate on the samples all share fixes the unit but moved
-    three records and lost the five-segment chain's modes (7 for 5), so it waits for the
-    delay choice's rework (issue 29), judged by the modes it gives."""
+    """The same ride in m/s^2, cm/s^2 and km/s^2 (every channel scaled alike) chooses the same
+    delay and orders. BIC over fits whose windows differ by a few samples carries
+    n K log(scale^2); before the criterion measured prediction errors in each output's mean
+    square, cm/s^2 chose nk = -9 where m/s^2 chose -5."""
     from dataclasses import replace
 
     from armaxmodal.estimate.orders import choose_orders
@@ -395,6 +389,25 @@ def test_the_delay_and_order_choices_do_not_depend_on_the_data_unit(fixtures_dir
     assert len({choose_nk(r, n_jobs=1) for r in scaled}) == 1
     orders = {choose_orders(r, na_values=(8, 10), nk_values=(-3, -5, -7), n_jobs=1).orders for r in scaled}
     assert len(orders) == 1
+
+
+def test_the_bridge_gives_the_same_modes_in_any_unit(realdata_dir):
+    """A record in cm/s^2 (the Capistrano bridge under the Calexico earthquake, mean squares
+    about 150) against the same in m/s^2: the delay, each cluster's representative order
+    (its lowest-BIC fit, orders fitting windows a few samples apart) and so the modes are the
+    same. Before the criterion measured errors in each output's mean square, the bridge took
+    nk = -9 at the edge of the search and 4 modes in cm/s^2."""
+    from dataclasses import replace
+
+    rec = am.read_recording(realdata_dir / "bridge_capistrano" / "capistrano_calexico.csv")
+    found = []
+    for scale in (1.0, 0.01):
+        scaled = replace(rec, base=rec.base * scale, response=rec.response * scale)
+        diagram = stabilisation_diagram(scaled, per_sensor=False, n_jobs=1)
+        modes = select_modes(diagram, segments=0, n_jobs=1).modes
+        found.append((diagram.orders[0][3], list(modes.na), modes.freq_hz.to_numpy()))
+    assert found[0][:2] == found[1][:2]
+    np.testing.assert_allclose(found[1][2], found[0][2], rtol=1e-6)
 
 
 def test_a_refit_that_cannot_be_made_is_said_not_taken_for_refine_false(monkeypatch, fixtures_dir):

@@ -50,16 +50,31 @@ class OrderChoice:
         return self.fit.orders
 
 
-def information_criterion(fit: ArmaxFit, kind: str = "bic") -> float:
-    """BIC (or AIC) of a fit from its per-sensor mean squared prediction errors."""
+def information_criterion(fit: ArmaxFit, kind: str = "bic", unit: np.ndarray | None = None) -> float:
+    """BIC (or AIC) of a fit from its per-sensor mean squared prediction errors.
+
+    ``unit`` (per sensor, e.g. :func:`output_mean_squares`) divides each sensor's prediction
+    error variance. Candidates whose delays differ are fitted on windows a few samples apart,
+    and ``n log V`` then carries ``n log s^2`` when the data are scaled by ``s``: a record in
+    cm/s^2 chose a wider delay than the same record in m/s^2. Measured in the outputs' own
+    mean square, the criterion is the same in every unit.
+    """
     n = fit.n_samples
     k = len(fit.models)
     na, nb, nc, _ = fit.orders
     n_in = fit.models[0].b.shape[0]
     p = na + k * (n_in * nb + nc) if fit.shared_poles else k * (na + n_in * nb + nc)
-    fit_term = n * float(np.sum(np.log(fit.loss)))
+    loss = fit.loss if unit is None else fit.loss / np.asarray(unit, dtype=float)
+    fit_term = n * float(np.sum(np.log(loss)))
     penalty = p * np.log(n * k) if kind == "bic" else 2.0 * p
     return fit_term + penalty
+
+
+def output_mean_squares(recording: Recording) -> np.ndarray:
+    """Each output's mean square over the record, the unit :func:`information_criterion`
+    measures prediction errors in when candidates' windows differ (``(n_sensors,)``)."""
+    ms = np.mean(np.square(recording.response), axis=0)
+    return np.where(ms > 0, ms, 1.0)
 
 
 def fit_or_none(recording, orders, **options):
@@ -101,6 +116,9 @@ def choose_orders(
     shared_poles : bool
         Choose for the shared-pole form (default) or the per-sensor form.
     criterion : {"bic", "aic"}
+        Computed with each sensor's prediction errors in units of its mean square
+        (:func:`information_criterion`'s ``unit``), so that the choice does not depend on
+        the data's unit.
     n_jobs : int, optional
         Worker processes (default: all cores; 1 runs in this process). Workers are forked,
         so they reuse the compiled kernels.
@@ -120,10 +138,11 @@ def choose_orders(
     with tqdm(total=len(candidates), desc="order search", unit="fit", disable=not progress) as bar:
         fits = parallel_map(run, candidates, n_jobs, bar, cost=lambda orders: orders[0])
     rows, best, best_value = [], None, np.inf
+    unit = output_mean_squares(recording)
     for (na, nb, nc, nk), fit in zip(candidates, fits, strict=True):
         if fit is None:
             continue
-        value = information_criterion(fit, criterion)
+        value = information_criterion(fit, criterion, unit=unit)
         rows.append(
             {"na": na, "nb": nb, "nc": nc, "nk": nk, criterion: value, "converged": bool(np.all(fit.converged))}
         )

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.estimate.fit import fit_armax
-from armaxmodal.estimate.orders import information_criterion
+from armaxmodal.estimate.orders import information_criterion, output_mean_squares
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.estimate.result import ArmaxFit
 from armaxmodal.modes.diagram import StabilisationDiagram
@@ -24,6 +24,13 @@ from armaxmodal.stats import Z95
 FINISHED_MAX_SHIFT = 0.05
 
 
+def order_criteria(diagram: StabilisationDiagram) -> dict[int, float]:
+    """``{na: BIC}`` of the sweep's shared fits, each output's errors in its mean square: the
+    orders fit windows a few samples apart, where a plain BIC depends on the data's unit."""
+    unit = output_mean_squares(diagram.recording)
+    return {na: information_criterion(fit, unit=unit) for (src, na), fit in diagram.fits.items() if src == SHARED}
+
+
 def clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs):
     """One mode per supported cluster (the kept poles', then the rescued lightly damped
     ones), each from its representative fit: ``(modes, shape vectors)``."""
@@ -32,7 +39,7 @@ def clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_dampi
     clusters = [c for c in clusters if _supported(len(c), len(nas), min_support)]
     left = cand.drop(index=[m for c in clusters for m in c])
     clusters += _rescued_clusters(diagram, left, nas, cluster_freq, min_support, band)
-    bic = {na: information_criterion(fit) for (src, na), fit in diagram.fits.items() if src == SHARED}
+    bic = order_criteria(diagram)
     firsts = [_ranked(cand.loc[c][cand.loc[c].damping > 0], bic) for c in clusters]
     finished = _finish_fits(diagram, {ranked[0] for ranked in firsts if ranked}, n_jobs)
     rows, vectors = [], []

@@ -8,10 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from armaxmodal.estimate.orders import information_criterion
-from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, representative_pole
+from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, order_criteria, representative_pole
 from armaxmodal.modes.modal_check import check_modes
-from armaxmodal.modes.poles import SHARED
 from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_band, selection_job
 from armaxmodal.notes import QualityWarning
 from armaxmodal.recording import Recording
@@ -111,7 +109,7 @@ def modes_the_check_adds(diagram, modes: pd.DataFrame, shapes: np.ndarray, band,
     before. Returns ``(modes, shapes, check)``."""
     from armaxmodal.modes.modal_check import mode_support
 
-    bic = {na: information_criterion(fit) for (src, na), fit in diagram.fits.items() if src == SHARED}
+    bic = order_criteria(diagram)
     for sub, at_peak in _left_out_clusters(diagram, modes, band, nas, clustering):
         # the cluster's centre is tried: its lowest-BIC pole may sit at its edge
         centre = float(sub.freq_hz.median()), float(sub.damping.median())

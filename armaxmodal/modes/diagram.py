@@ -17,7 +17,7 @@ import pandas as pd
 
 from armaxmodal._threads import one_blas_thread
 from armaxmodal.estimate.fit import fit_resumable
-from armaxmodal.estimate.orders import default_nb, default_nc, information_criterion
+from armaxmodal.estimate.orders import default_nb, default_nc, information_criterion, output_mean_squares
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.poles import SHARED, Tolerances, pole_rows, rejection_reasons, stability_classes
@@ -156,7 +156,8 @@ def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=Tr
         n_jobs,
         cost=partial(_job_cost, n_sensors=len(recording.sensors)),
     )
-    scores = [information_criterion(f) if f is not None else np.inf for f, _ in fits]
+    unit = output_mean_squares(recording)
+    scores = [information_criterion(f, unit=unit) if f is not None else np.inf for f, _ in fits]
     nk = int(jobs[int(np.argmin(scores))][1][3])
     if extend and nk == min(nk_values):
         # the best delay is the most non-causal one searched: look NK_EXTENSION further, once
