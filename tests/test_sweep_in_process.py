@@ -371,6 +371,32 @@ def test_the_diagram_plots_the_selection(diagram):
     plt.close("all")
 
 
+def test_the_figure_draws_the_h1_and_coherence_the_check_judged(diagram, monkeypatch):
+    """The figure's H1 curves and its low-coherence shading use the check's Welch segments:
+    with the default ones, a short bridge record was shaded below 0.8 everywhere while the
+    check's caption said it used lines of coherence 0.8 or more. Without a check, the default."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    import armaxmodal.modes.plot as plot
+    from armaxmodal.prepare.frf import measured_frf
+
+    asked = []
+
+    def spy(rec, nperseg=None):
+        asked.append(nperseg)
+        return measured_frf(rec, nperseg)
+
+    monkeypatch.setattr(plot, "measured_frf", spy)
+    selection = select_modes(diagram, n_jobs=1, segments=0)
+    diagram.plot(selection)
+    diagram.plot()
+    assert asked == [selection.check.nperseg, None]
+    plt.close("all")
+
+
 def test_the_frf_axis_spans_the_curves_inside_the_input_band():
     """Beyond the input's excited band an H1 is noise over noise and may rise far above the
     structure's response: the axis is set by the curves inside the band (twice their peak),
@@ -387,8 +413,9 @@ def test_the_frf_axis_spans_the_curves_inside_the_input_band():
     ride = am.simulate_recording(s, am.random_vibration(50.0, 30.0, (0.5, 16.0), seed=3), 50.0, noise=0.05, seed=4)
     diagram = _diagram(ride)
     rec = diagram.recording
-    f, h, _ = measured_frf(rec)
-    top, _ = diagram.plot(select_modes(diagram, n_jobs=1, segments=0))
+    selection = select_modes(diagram, n_jobs=1, segments=0)
+    f, h, _ = measured_frf(rec, selection.check.nperseg)  # the curves the check judged
+    top, _ = diagram.plot(selection)
     (frf_axis,) = [a for a in top.figure.axes if a.get_yscale() == "log"]
     inside = (f > 0) & (f <= excited_band(rec)[1])
     assert top.get_xlim()[1] > excited_band(rec)[1]  # the span reaches past the band ...

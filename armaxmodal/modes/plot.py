@@ -64,7 +64,9 @@ def plot_stabilisation(diagram, selection=None, ax=None):
         pad=28,
     )
 
-    f, h, coh = measured_frf(rec)
+    # the H1 and the coherence the check judged (its segments), when there is a check
+    check = None if selection is None else selection.check
+    f, h, coh = measured_frf(rec, None if check is None else check.nperseg)
     ax_f = ax.twinx()
     for k, s in enumerate(rec.sensors):
         ax_f.semilogy(f, np.abs(h[:, k]), lw=1.0, alpha=0.7, label=f"|H1| {s}")
