@@ -16,7 +16,8 @@ recording:
   Recordings whose low-frequency transmissibility is not near +-1 (a force input, no
   quasi-static band) are not tested, and the check says nothing.
 * ``narrowband_input`` -- the input's power sits in a narrow band (a sine ride): modes
-  outside it are not identifiable.
+  outside it rest on the input's weaker content (the shake-table sine rides still give the
+  broadband rides' modes), so the modal-model check's coherent lines decide.
 * ``clipping`` -- samples piled up at a channel's extreme value (the sensor's rail): more
   than the values just inside it occur (Poisson; a looser p when two are in a row).
 * ``stuck_samples`` -- a run of equal samples elsewhere, longer than the channel's own rate
@@ -388,8 +389,9 @@ def narrowband_input(recording: Recording) -> list[QualityWarning]:
             "narrowband_input",
             (recording.input_name,),
             f"the input's power within 10 dB of its peak covers {width:.2f} Hz around {peak:.2f} Hz "
-            f"({f[live].min():.2f}-{f[live].max():.2f} Hz): a sine-like ride; modes away from it are not "
-            "excited and cannot be identified from this record.",
+            f"({f[live].min():.2f}-{f[live].max():.2f} Hz): a sine-like ride. Modes away from it rest on the "
+            "input's weaker content; the modal-model check marks a mode no coherent H1 line confirms as "
+            "unconfirmed (quality: poor).",
             width,
         )
     ]
