@@ -163,11 +163,30 @@ MUTANTS = [
     ),
     # kernel speed-ups of the same round (tiles, unsigned indices)
     ("armaxmodal/_kernels.py", "lo = max(tile0, i)", "lo = max(tile0, i - 1)", "FIR tile starts one lag early (perf)"),
+    # the 1/C recursions with the two newest outputs in registers (issue 29's kernel round)
     (
         "armaxmodal/_kernels.py",
-        "a3 += c[uint64(i + 3)] * out[lag - uint64(3)]",
-        "a3 += c[uint64(i + 3)] * out[lag - uint64(2)]",
-        "1/C recursion reads the wrong lag (perf)",
+        "        for i in range(nc, 2, -1):\n            acc -= c[uint64(i)] * out[uint64(t - i)]",
+        "        for i in range(nc, 3, -1):\n            acc -= c[uint64(i)] * out[uint64(t - i)]",
+        "1/C recursion drops the oldest term held in memory (kernel)",
+    ),
+    (
+        "armaxmodal/_kernels.py",
+        "        second = newest\n        newest = acc",
+        "        newest = acc\n        second = newest",
+        "1/C recursion shifts its registers in the wrong order (kernel)",
+    ),
+    (
+        "armaxmodal/_kernels.py",
+        "a1 = a1 - c2 * sec1 - c1 * new1",
+        "a1 = a1 - c2 * new1 - c1 * new1",
+        "filter lane reads its newest output for the second newest (kernel)",
+    ),
+    (
+        "armaxmodal/_kernels.py",
+        "for i in range(min(nc, t), 2, -1):",
+        "for i in range(nc, 2, -1):",
+        "filter reads before the record's start (kernel)",
     ),
     (
         "armaxmodal/_kernels.py",

@@ -55,9 +55,11 @@ def _damped(g_mat, damping):
             "the fit's normal equations became non-finite: the model orders are far above what this record "
             "supports (or the data are degenerate). Lower the orders."
         )
-    d = np.diag(g_mat).copy()
+    d = g_mat.diagonal().copy()
     d[d <= 0] = 1.0
-    return g_mat + np.diag(damping * d + 1e-13 * d)
+    out = g_mat.copy()
+    out.flat[:: g_mat.shape[0] + 1] += damping * d + 1e-13 * d  # no second full matrix for the diagonal
+    return out
 
 
 # LAPACK's Cholesky factor and solve, called directly. These are the routines scipy's
