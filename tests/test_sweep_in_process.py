@@ -13,9 +13,19 @@ import pytest
 
 import armaxmodal as am
 from armaxmodal.estimate.orders import default_nb, default_nc, information_criterion
-from armaxmodal.modes.diagram import NK_SEARCH, SWEEP_TOL, _job_cost, choose_nk, stabilisation_diagram, sweep_fit
+from armaxmodal.modes.diagram import (
+    DELAY_CHOICE_ORDERS,
+    NK_EXTENSION,
+    NK_SEARCH,
+    SWEEP_TOL,
+    _job_cost,
+    choose_nk,
+    stabilisation_diagram,
+    sweep_fit,
+)
 from armaxmodal.modes.poles import SHARED
 from armaxmodal.modes.selection import select_modes
+from armaxmodal.modes.spread import N_SEGMENTS
 from armaxmodal.recording import Recording
 
 ORDERS = range(2, 11, 2)
@@ -161,6 +171,28 @@ def test_a_late_input_past_the_search_range_is_found_by_the_extension(ride):
     assert choose_nk(_late_input(ride[1], 10), n_jobs=1) == min(NK_SEARCH) - 3 == 1 - 10
     # a narrower search that does not reach the edge is not extended
     assert choose_nk(_late_input(ride[1], 2), nk_values=range(0, -5, -1), n_jobs=1) == 1 - 2
+
+
+def test_the_delay_choice_and_the_selection_show_their_progress(ride, capsys):
+    """On a long ride the delay choice and the selection take as long as the sweep: each
+    shows its own bar. The delay choice counts its extension too (the input 8 samples late
+    sends it past the searched edge, left unaligned: 21 fits, then 12 more)."""
+    late = _late_input(ride[1], 8)
+    d = stabilisation_diagram(late, ORDERS, per_sensor=False, align=False, n_jobs=1, progress=True)
+    searched = len(NK_SEARCH) * len(DELAY_CHOICE_ORDERS)
+    extended = searched + (NK_EXTENSION + 1) * len(DELAY_CHOICE_ORDERS)
+    bars = capsys.readouterr().err
+    assert "input delay choice: 100%" in bars and f"{extended}/{extended}" in bars
+    assert f"/{searched}" in bars  # the total grew when the extension began
+    select_modes(d, n_jobs=1, progress=True)
+    counts = [line for line in bars_of(capsys.readouterr().err) if line.startswith("mode selection:")]
+    # at least one finishing fit, the refit and a representative order's segment refits
+    assert counts and int(counts[-1].split(":")[1].split("fit")[0]) >= 2 + N_SEGMENTS
+
+
+def bars_of(err: str) -> list[str]:
+    """The lines a tqdm bar drew (it redraws in place with carriage returns)."""
+    return [line.strip() for line in err.replace("\r", "\n").splitlines() if line.strip()]
 
 
 def test_the_sweep_fits_every_source_and_order_it_should(ride, diagram):

@@ -63,7 +63,7 @@ def run(args) -> int:
         print(f"{args.data}: input {rec.input_name}; outputs {outputs}; {rec.n_samples} samples at {rec.fs:g} Hz")
     diagram = stabilisation_diagram(rec, orders, band=band, detrend=args.detrend, progress=not args.quiet)
     try:
-        selection = select_modes(diagram, args.modes, band)
+        selection = select_modes(diagram, args.modes, band, progress=not args.quiet)
     except OrderError:
         # no mode: the diagram and the pole table still show the user why
         print_warnings(diagram.warnings)

@@ -31,9 +31,10 @@ def order_criteria(diagram: StabilisationDiagram) -> dict[int, float]:
     return {na: information_criterion(fit, unit=unit) for (src, na), fit in diagram.fits.items() if src == SHARED}
 
 
-def clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs):
+def clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs, bar=None):
     """One mode per supported cluster (the kept poles', then the rescued lightly damped
-    ones), each from its representative fit: ``(modes, shape vectors)``."""
+    ones), each from its representative fit: ``(modes, shape vectors)``. ``bar`` (tqdm)
+    counts the finishing fits."""
     cand = candidate_poles(diagram.poles, band)
     clusters = cluster_poles(cand[cand.rejected == ""], nas, cluster_freq, cluster_damping)
     clusters = [c for c in clusters if _supported(len(c), len(nas), min_support)]
@@ -41,7 +42,7 @@ def clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_dampi
     clusters += _rescued_clusters(diagram, left, nas, cluster_freq, min_support, band)
     bic = order_criteria(diagram)
     firsts = [_ranked(cand.loc[c][cand.loc[c].damping > 0], bic) for c in clusters]
-    finished = _finish_fits(diagram, {ranked[0] for ranked in firsts if ranked}, n_jobs)
+    finished = _finish_fits(diagram, {ranked[0] for ranked in firsts if ranked}, n_jobs, bar)
     rows, vectors = [], []
     for members in clusters:
         sub = cand.loc[members]
@@ -69,13 +70,13 @@ def _ranked(poles: pd.DataFrame, bic: dict) -> list[int]:
     return sorted((int(na) for na in poles.na), key=lambda na: (bic.get(na, np.inf), na))
 
 
-def _finish_fits(diagram: StabilisationDiagram, nas, n_jobs: int | None) -> dict:
+def _finish_fits(diagram: StabilisationDiagram, nas, n_jobs: int | None, bar=None) -> dict:
     """``{na: poles}`` of the shared fits of orders ``nas`` continued to :func:`fit_armax`'s
     default tolerance (the sweep stops its fits early), over the worker processes."""
     nas = sorted(nas)
     fits = [diagram.fits[(SHARED, na)] for na in nas]
     finish = partial(_finished_poles, diagram.recording)
-    done = parallel_map(finish, fits, n_jobs, cost=lambda fit: fit.orders[0], min_items=2)
+    done = parallel_map(finish, fits, n_jobs, bar, cost=lambda fit: fit.orders[0], min_items=2)
     return dict(zip(nas, done, strict=True))
 
 

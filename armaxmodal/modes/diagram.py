@@ -42,6 +42,10 @@ NK_SEARCH = range(0, -7, -1)
 NK_EXTENSION = 3
 
 
+#: the middle orders at which the delay is chosen (jointly with the order, see choose_nk)
+DELAY_CHOICE_ORDERS = (8, 10, 12)
+
+
 #: iteration cap of the delay choice's fits; the sweep continues those of the chosen delay
 DELAY_CHOICE_ITERATIONS = 8
 
@@ -134,7 +138,7 @@ def _job_cost(job, n_sensors: int) -> float:
     return orders[0] * (n_sensors if source == SHARED else 1)
 
 
-def choose_nk(recording: Recording, nk_values=range(0, -7, -1), na_values=(8, 10, 12), n_jobs=None) -> int:
+def choose_nk(recording: Recording, nk_values=NK_SEARCH, na_values=DELAY_CHOICE_ORDERS, n_jobs=None) -> int:
     """The input delay of the lowest-BIC shared-pole model over a few middle orders.
 
     The delay and the order interact (band-limited data trade non-causal taps for poles), so
@@ -143,10 +147,14 @@ def choose_nk(recording: Recording, nk_values=range(0, -7, -1), na_values=(8, 10
     return _choose_nk(recording, nk_values, na_values, n_jobs)[0]
 
 
-def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=True):
+def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=True, bar=None):
     """``(nk, {(SHARED, orders): checkpoint})``: the chosen delay and where its fits stopped,
-    which the sweep continues instead of fitting those orders again."""
+    which the sweep continues instead of fitting those orders again. ``bar`` (tqdm) counts
+    the fits."""
     jobs = [(SHARED, (na, default_nb(na, nk), default_nc(na), nk)) for na in na_values for nk in nk_values]
+    if bar is not None and not extend:  # the first search's fits are in the bar's total
+        bar.total += len(jobs)
+        bar.refresh()
     # BIC differences between delays are large; 8 iterations settle the choice (checked on
     # every fixture, a lightly damped structure and the real recordings against 20 and 50).
     # Only the criterion is needed here: no covariances.
@@ -154,6 +162,7 @@ def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=Tr
         partial(sweep_fit, recording, max_iter=DELAY_CHOICE_ITERATIONS, tol=tol, covariance=False),
         jobs,
         n_jobs,
+        bar,
         cost=partial(_job_cost, n_sensors=len(recording.sensors)),
     )
     unit = output_mean_squares(recording)
@@ -161,7 +170,8 @@ def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=Tr
     nk = int(jobs[int(np.argmin(scores))][1][3])
     if extend and nk == min(nk_values):
         # the best delay is the most non-causal one searched: look NK_EXTENSION further, once
-        return _choose_nk(recording, range(nk, nk - NK_EXTENSION - 1, -1), na_values, n_jobs, tol, extend=False)
+        further = range(nk, nk - NK_EXTENSION - 1, -1)
+        return _choose_nk(recording, further, na_values, n_jobs, tol, extend=False, bar=bar)
     return nk, {job: ck for job, (_, ck) in zip(jobs, fits, strict=True) if job[1][3] == nk and ck is not None}
 
 
@@ -216,7 +226,7 @@ def stabilisation_diagram(
     n_jobs : int, optional
         Worker processes (default: all cores).
     progress : bool
-        Show a progress bar.
+        Show progress bars (the delay choice's fits, then the sweep's).
     """
     with one_blas_thread():  # a with block, not a decorator: mutmut skips decorated functions
         limits = tolerances or Tolerances()
@@ -229,8 +239,12 @@ def stabilisation_diagram(
             orders, notes = _default_orders(recording, preparation)
         _check_top_order(max(orders), recording, preparation)
         known: dict = {}
+        from tqdm import tqdm
+
         if nk is None:
-            nk, known = _choose_nk(recording, NK_SEARCH, (8, 10, 12), n_jobs, tol)
+            first = len(NK_SEARCH) * len(DELAY_CHOICE_ORDERS)
+            with tqdm(total=first, desc="input delay choice", unit="fit", disable=not progress) as bar:
+                nk, known = _choose_nk(recording, NK_SEARCH, DELAY_CHOICE_ORDERS, n_jobs, tol, bar=bar)
         sources = [SHARED] + (list(recording.sensors) if per_sensor else [])
         order_list = [(na, default_nb(na, nk), default_nc(na), nk) for na in orders]
         # single sensors cannot support high orders (their bounds are wide): stop them earlier
@@ -239,8 +253,6 @@ def stabilisation_diagram(
         # as if fitted here from the start (unless this sweep's cap is below theirs)
         if max_iter < DELAY_CHOICE_ITERATIONS:
             known = {}
-        from tqdm import tqdm
-
         task = partial(_fit_and_poles, recording, max_iter=max_iter, tol=tol)
         cost = partial(_job_cost, n_sensors=len(recording.sensors))
         with tqdm(total=len(jobs), desc="stabilisation sweep", unit="fit", disable=not progress) as bar:

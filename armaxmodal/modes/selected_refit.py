@@ -26,17 +26,19 @@ from armaxmodal.recording import Recording
 from armaxmodal.stats import Z95
 
 
-def refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, orders: dict, n_jobs) -> dict:
+def refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, orders: dict, n_jobs, bar=None) -> dict:
     """The frequency-domain refit (key ``"refit"``) and the segment refits of every mode's
     representative orders (keys ``(orders, k)``), run together over the worker processes:
-    the refit ran alone in this process before, while the workers waited."""
+    the refit ran alone in this process before, while the workers waited. ``bar`` (tqdm)
+    counts them."""
     jobs: list = [("refit", refit_band(diagram.recording, band))] if refine else []
     if segments >= 2:
         jobs += [("segment", job) for job in segment_jobs(sorted({orders[int(na)] for na in modes.na}), segments)]
     parts = split_segments(diagram.recording, segments) if segments >= 2 else []
     task = partial(selection_job, diagram.recording, parts, modes)
     # the refit first: it is the longest job (a frequency-domain fit of every mode)
-    done = parallel_map(task, jobs, n_jobs, cost=lambda job: np.inf if job[0] == "refit" else job[1][0][0], min_items=2)
+    cost = lambda job: np.inf if job[0] == "refit" else job[1][0][0]  # noqa: E731
+    done = parallel_map(task, jobs, n_jobs, bar, cost=cost, min_items=2)
     return {("refit" if kind == "refit" else job): result for (kind, job), result in zip(jobs, done, strict=True)}
 
 

@@ -154,6 +154,7 @@ def select_modes(
     refine: bool = True,
     segments: int = N_SEGMENTS,
     n_jobs: int | None = None,
+    progress: bool = False,
 ) -> ModeSelection:
     """Pick the physical modes from the shared-pole poles of a diagram.
 
@@ -186,12 +187,18 @@ def select_modes(
     n_jobs : int, optional
         Worker processes for the finishing and segment fits (default: all cores; 1 inside a
         process that may not start its own, e.g. a dask worker).
+    progress : bool
+        Show a count of the fits the selection runs (finishing fits, the refit and the
+        segment refits: on a long record they take as long as the sweep). A count, not a
+        fraction: how many there are is known only as the selection goes.
     """
-    with one_blas_thread():
+    from tqdm import tqdm
+
+    with one_blas_thread(), tqdm(desc="mode selection", unit="fit", disable=not progress) as bar:
         if band is None and diagram.preparation is not None:
             band = diagram.preparation.band
         nas = sorted({o[0] for o in diagram.orders})
-        modes, vectors = clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs)
+        modes, vectors = clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs, bar)
         if not modes.empty:
             keep = merge_duplicates(modes, vectors, merge_mac, diagram.recording.duration)
             modes, vectors = modes.loc[keep].reset_index(drop=True), [vectors[i] for i in keep]
@@ -213,7 +220,7 @@ def select_modes(
         modes["damping_sd_armax"] = (modes.damping_ci95_hi - modes.damping_ci95_lo) / (2 * Z95)
         refinement, refit_notes = None, []
         orders = {o[0]: o for o in diagram.orders}
-        fitted = refit_and_segment_fits(diagram, modes, band, refine, segments, orders, n_jobs)
+        fitted = refit_and_segment_fits(diagram, modes, band, refine, segments, orders, n_jobs, bar)
         if refine:
             refit, limits = fitted.pop("refit"), (cluster_freq, cluster_damping, merge_mac)
             modes, shapes, refinement = refined_modes(diagram, modes, shapes, refit, *limits)
