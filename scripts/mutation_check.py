@@ -184,14 +184,20 @@ MUTANTS = [
     ),
     (
         "armaxmodal/_kernels.py",
-        "for i in range(min(nc, t), 2, -1):",
-        "for i in range(nc, 2, -1):",
-        "filter reads before the record's start (kernel)",
+        "buf[r] = buf[4 * m + r]",
+        "buf[r] = buf[4 * (m - 1) + r]",
+        "filter hands the next block a history one sample old (kernel)",
     ),
     (
         "armaxmodal/_kernels.py",
-        "out[s0 + j, :] = buf[j::4]",
-        "out[s0 + j, :] = buf[j::4][::-1]",
+        "    divide_by_c(w, c, w)  # in place",
+        "    divide_by_c(y.copy(), c, w)  # in place",
+        "residual divides the output, not A y - B u, by C (kernel)",
+    ),
+    (
+        "armaxmodal/_kernels.py",
+        "out[s0 + j, b0:b1] = buf[4 * nc + j : 4 * (nc + m) : 4]",
+        "out[s0 + j, b0:b1] = buf[4 * nc + j : 4 * (nc + m) : 4][::-1]",
         "filter lanes unpacked backwards (perf)",
     ),
     # periodic disturbances seen by the sweep

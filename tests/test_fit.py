@@ -87,10 +87,11 @@ def test_inverse_filter_kernel_matches_lfilter():
 def test_kernels_match_references_at_sweep_orders_and_short_records():
     """Orders of the sweep (C of one and two coefficients, whose terms all sit in the
     registers of the two newest outputs; four-signal groups with a partial last group),
-    records shorter than the filter, and records over several of the residual's time tiles
-    (a partial last tile, lags across tile edges)."""
+    records shorter than the filter, records over several of the filter's blocks, and over
+    several of the residual's time tiles (a partial last tile, lags across tile edges)."""
     rng = np.random.default_rng(3)
-    cases = ((600, 11, 3), (600, 30, 6), (600, 4, 5), (7, 9, 2), (2500, 12, 3), (1030, 30, 1), (600, 1, 3), (600, 2, 2))
+    cases = ((600, 11, 3), (600, 30, 6), (600, 4, 5), (7, 9, 2), (2500, 12, 3), (1030, 30, 1), (600, 1, 3), (600, 2, 2),
+             (5000, 30, 5))  # the last: the filter's buffer blocks, a partial one at the end
     for n, order, n_sig in cases:
         c = np.concatenate([[1.0], 0.4 * rng.standard_normal(order) / order])
         a = np.concatenate([[1.0], 0.4 * rng.standard_normal(order + 2) / order])

@@ -155,9 +155,10 @@ def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=Tr
     if bar is not None and not extend:  # the first search's fits are in the bar's total
         bar.total += len(jobs)
         bar.refresh()
-    # BIC differences between delays are large; 8 iterations settle the choice (checked on
-    # every fixture, a lightly damped structure and the real recordings against 20 and 50).
-    # Only the criterion is needed here: no covariances.
+    # 8 iterations settle the choice where delays differ by tens of BIC units or more (checked
+    # on every fixture, a lightly damped structure and the real recordings against 20 and 50);
+    # where BIC is flatter the cap decides between delays the record does not tell apart
+    # (docs/performance.md). Only the criterion is needed here: no covariances.
     fits = parallel_map(
         partial(sweep_fit, recording, max_iter=DELAY_CHOICE_ITERATIONS, tol=tol, covariance=False),
         jobs,
