@@ -108,9 +108,18 @@ def inverse_filter(x, c):
     ``c`` is monic (``c[0] == 1``); shape (nc + 1,). ``x`` is (n_sig, n) and every row is
     filtered.
     """
+    out = np.empty_like(x)
+    inverse_filter_into(x, c, out)
+    return out
+
+
+@njit(**JIT_OPTIONS)
+def inverse_filter_into(x, c, out):
+    """:func:`inverse_filter` written into ``out`` (the shape of ``x``, not ``x`` itself): a
+    fit reuses one array instead of a fresh one per step, which on records of millions of
+    samples costs fresh pages every time."""
     n_sig, n = x.shape
     nc = c.size - 1
-    out = np.empty_like(x)
     c1 = c[1] if nc >= 1 else 0.0
     c2 = c[2] if nc >= 2 else 0.0
     # Four signals at a time, time-major: their four independent sums share each load of
@@ -157,7 +166,6 @@ def inverse_filter(x, c):
                 out[s0 + j, b0:b1] = buf[4 * nc + j : 4 * (nc + m) : 4]
             for r in range(4 * nc):  # the block's last nc outputs: the next block's history
                 buf[r] = buf[4 * m + r]  # (forward copy: the source lies after the target)
-    return out
 
 
 @njit(**JIT_OPTIONS)

@@ -183,6 +183,12 @@ MUTANTS = [
         "filter lane reads its newest output for the second newest (kernel)",
     ),
     (
+        "armaxmodal/estimate/_gauss_newton.py",
+        "    stacked[1:-1] = uT\n    stacked[-1] = eps\n",
+        "    stacked[1:-1] = uT\n",
+        "normal equations keep the last step's prediction errors in their workspace (kernel)",
+    ),
+    (
         "armaxmodal/_kernels.py",
         "buf[r] = buf[4 * m + r]",
         "buf[r] = buf[4 * (m - 1) + r]",

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from armaxmodal._kernels import inverse_filter, lagged_cross, lagged_gram
+from armaxmodal._kernels import inverse_filter_into, lagged_cross, lagged_gram
 from armaxmodal.exceptions import OrderError
 
 # A crawl: CRAWL_STEPS Gauss-Newton steps in a row (Levenberg-Marquardt damping at its
@@ -101,9 +101,21 @@ def inverse(g_mat):
         return np.linalg.pinv(g_mat)
 
 
-def normal_equations(y, uT, eps, c, cols, t0, t1, oe=False):
+def workspace(n_in: int, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Arrays :func:`normal_equations` fills at every step: the stacked signals and their
+    filtered copies, ``(n_in + 2, n)`` each. A fit keeps one pair for all its steps: fresh
+    record-length arrays at every step cost fresh pages on records of millions of samples."""
+    return np.empty((n_in + 2, n)), np.empty((n_in + 2, n))
+
+
+def normal_equations(y, uT, eps, c, cols, t0, t1, oe=False, work=None):
+    """Gauss-Newton matrix and gradient; ``work`` (from :func:`workspace`) is overwritten."""
+    stacked, filtered = work if work is not None else workspace(uT.shape[0], y.size)
     # Output error: d eps / d a_i is the simulated output y - eps, filtered by 1/A, lagged.
-    filtered = inverse_filter(signals(y - eps if oe else y, uT, eps), c)
+    stacked[0] = y - eps if oe else y
+    stacked[1:-1] = uT
+    stacked[-1] = eps
+    inverse_filter_into(stacked, c, filtered)
     return lagged_gram(filtered, *cols, t0, t1), lagged_cross(filtered, *cols, eps, t0, t1)
 
 
@@ -177,11 +189,12 @@ class _Arrow:
         return out
 
 
-def shared_normal_equations(ys, uT, state, variances, cols, na, p_k, t0, t1, oe=False):
+def shared_normal_equations(ys, uT, state, variances, cols, na, p_k, t0, t1, oe=False, work=None):
     aa, ga = np.zeros((na, na)), np.zeros(na)
     ab, bb, gb = [], [], []
+    work = work if work is not None else workspace(uT.shape[0], ys[0].size)  # one pair for every sensor
     for k, (eps, _, c) in enumerate(state):
-        gk, vk = normal_equations(ys[k], uT, eps, c, cols, t0, t1, oe)
+        gk, vk = normal_equations(ys[k], uT, eps, c, cols, t0, t1, oe, work)
         gk, vk = gk / variances[k], vk / variances[k]
         aa += gk[:na, :na]
         ga += vk[:na]

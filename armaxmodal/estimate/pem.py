@@ -18,6 +18,7 @@ from armaxmodal.estimate._gauss_newton import (
     levenberg_marquardt,
     normal_equations,
     shared_normal_equations,
+    workspace,
 )
 from armaxmodal.estimate.parameters import (
     local_parameters,
@@ -59,8 +60,10 @@ def fit_single(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=No
         state = residual_and_loss(y, uT, th, na, nb, nc, nk, t0, t1, oe)
         return state, state[1]
 
+    work = workspace(n_in, y.size)
+
     def linearise(state):
-        return Dense(*normal_equations(y, uT, state[0], state[2], cols, t0, t1, oe))
+        return Dense(*normal_equations(y, uT, state[0], state[2], cols, t0, t1, oe, work))
 
     state, _ = evaluate(theta)
     unit = state[1] / (t1 - t0)  # 2 log L = -N log V: a unit is a change of V by V / N
@@ -150,6 +153,7 @@ def fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=No
             theta, state, losses = shared_start(ys, uT, na, nb, nc, nk, t0, t1, oe, evaluate)
         variances, total_iterations, progress, converged = losses / n_eff, 0, None, False
     paused = None
+    work = workspace(n_in, y.shape[0])  # the normal equations' arrays, reused at every step
     while not converged and total_iterations < max_iter:
         weights = 1.0 / variances
 
@@ -159,7 +163,7 @@ def fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=No
                 return (per_sensor, losses_t), float(weights @ losses_t)
 
         def linearise(st, variances=variances):
-            return shared_normal_equations(ys, uT, st[0], variances, cols, na, p_k, t0, t1, oe)
+            return shared_normal_equations(ys, uT, st[0], variances, cols, na, p_k, t0, t1, oe, work)
 
         theta, (state, losses), used, inner_converged, progress = levenberg_marquardt(
             theta,
