@@ -3,9 +3,9 @@
 Every matrix in a fit is small (at most a few hundred columns) and the long loops are numba
 kernels, so BLAS threads do not speed anything up here; on a 2-core machine they slowed a
 serial 20,000-sample sweep 3.6x (26.6 s against 7.3 s; the threads spin between the many
-short BLAS calls and take the core from the kernel). Parallel work runs in worker processes
-(``orders.parallel_map``) instead. The limit holds only while a decorated function runs: a user's
-own numpy keeps its threads.
+short BLAS calls and take the core from the kernel). Parallel work runs on worker threads
+(``pool.parallel_map``) instead, each with one BLAS thread. The limit holds only while a
+decorated function runs: a user's own numpy keeps its threads.
 """
 
 from __future__ import annotations

@@ -127,7 +127,7 @@ def sweep(rec, quick):
             iters += int(fit.iterations.sum())
         label = "shared poles, 4 sensors jointly" if shared else "per sensor, 4 sensors"
         print(f"  {label:32s} {time.perf_counter() - t:8.2f} s  ({iters} LM iterations)")
-    print("Stabilisation sweep as `stabilise` runs it (even na, shared + 4 sensors, 2 worker processes):")
+    print("Stabilisation sweep as `stabilise` runs it (even na, shared + 4 sensors, 2 worker threads):")
     for top in (30, 40):
         t = time.perf_counter()
         diagram = stabilisation_diagram(rec, range(2, top + 1, 2), nk=-5)

@@ -7,8 +7,8 @@ A  what ``armaxmodal stabilise`` runs after reading the file: the preparation, t
 B  its shared-pole sweep alone: the orders A swept, at the delay A chose, each fitted from
    scratch with the sweep's own cap and tolerance, one after another in this process.
 
-CPU time is user + system time of this process and of its reaped children (the forked
-workers); process start, imports, reading and numba's first load are outside both. The
+CPU time is user + system time of this process (all its threads, the pool's workers among
+them) and of any children it has reaped; process start, imports, reading and numba's first load are outside both. The
 record is ``scripts/bench_size.py``'s five-mass chain at 100 Hz (20,000 x 5 by default).
 Goal (issue 29): A / B at most 2.
 

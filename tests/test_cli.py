@@ -1,6 +1,7 @@
 import json
 
 import numpy as np
+import pytest
 
 import armaxmodal as am
 from armaxmodal.cli import main
@@ -125,3 +126,44 @@ def test_invert_from_stabilise_json(fixtures_dir, tmp_path, capsys):
     np.testing.assert_allclose([m["freq_hz"] for m in data["modes"]], truth.modes().freq_hz, rtol=0.01)
     assert main(["--quiet", "invert", str(modes), "--method", "evphc"]) == 2
     assert "--recording" in capsys.readouterr().err
+
+
+_ARENAS_AFTER_TWO_THREADS = """
+import ctypes, os, sys, tempfile, threading
+import numpy as np
+from armaxmodal.cli.main import _one_malloc_arena
+if sys.argv[1] == "one":
+    _one_malloc_arena()
+def churn():
+    for _ in range(200):
+        np.ones(20_000).sum()  # 160 kB: below the mmap threshold, so from an arena
+threads = [threading.Thread(target=churn) for _ in range(2)]
+[t.start() for t in threads]
+[t.join() for t in threads]
+libc = ctypes.CDLL("libc.so.6")
+libc.fdopen.restype = ctypes.c_void_p
+with tempfile.TemporaryFile() as f:
+    stream = libc.fdopen(os.dup(f.fileno()), b"w")
+    libc.malloc_info(0, ctypes.c_void_p(stream))
+    libc.fclose(ctypes.c_void_p(stream))
+    f.seek(0)
+    print(f.read().decode().count("<heap nr="))
+"""
+
+
+def test_the_command_keeps_one_malloc_arena_for_its_worker_threads():
+    import ctypes
+    import subprocess
+    import sys
+
+    try:
+        if not hasattr(ctypes.CDLL("libc.so.6"), "malloc_info"):
+            pytest.skip("a libc without malloc_info")
+    except OSError:
+        pytest.skip("not glibc")
+    heaps = {
+        mode: int(subprocess.run([sys.executable, "-c", _ARENAS_AFTER_TWO_THREADS, mode], capture_output=True,
+                                 text=True, check=True).stdout)
+        for mode in ("one", "default")
+    }  # fmt: skip
+    assert heaps["one"] == 1 and heaps["default"] > 1, heaps

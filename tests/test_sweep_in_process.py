@@ -1,10 +1,10 @@
 """The sweep and the selection run in this process (``n_jobs=1``) on a short two-mode ride.
 
-Fast (about a second each), so a mutation tool can see which test reaches the delay choice,
-the sweep's jobs, the finishing fits and the segment refits -- with worker processes it
-cannot. Each test runs its own sweep (a shared fixture would credit only the first test with
-reaching the sweep). Every check is against the structure's exact modes, a slow reference
-written out here with :func:`fit_armax`, or the same sweep over worker processes.
+Fast (about a second each), and one thread, so a mutation tool can tell which test reaches
+the delay choice, the sweep's jobs, the finishing fits and the segment refits. Each test
+runs its own sweep (a shared fixture would credit only the first test with reaching the
+sweep). Every check is against the structure's exact modes, a slow reference
+written out here with :func:`fit_armax`, or the same sweep over worker threads.
 """
 
 import numpy as np
@@ -221,9 +221,9 @@ def test_the_sweep_fits_every_source_and_order_it_should(ride, diagram):
 
 
 def test_workers_and_this_process_give_the_same_diagram(ride, diagram):
-    forked = stabilisation_diagram(ride[1], ORDERS, per_sensor_max_order=PER_SENSOR_MAX, n_jobs=2)
+    threaded = stabilisation_diagram(ride[1], ORDERS, per_sensor_max_order=PER_SENSOR_MAX, n_jobs=2)
     cols = ["source", "na", "freq_hz", "damping", "cls", "rejected"]
-    pd.testing.assert_frame_equal(forked.poles[cols], diagram.poles[cols])
+    pd.testing.assert_frame_equal(threaded.poles[cols], diagram.poles[cols])
 
 
 def test_the_in_process_selection_gives_the_exact_modes(ride, diagram):

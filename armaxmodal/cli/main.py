@@ -11,6 +11,7 @@ armaxmodal lump DATA A B [--json OUT] [--plot OUT]
 from __future__ import annotations
 
 import argparse
+import ctypes
 import gc
 import os
 import sys
@@ -57,8 +58,26 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
 
 
+def _one_malloc_arena() -> None:
+    """Let glibc's malloc keep one heap for every thread of this process.
+
+    By default glibc gives each thread that allocates its own heap ("arena"), so the
+    record-length arrays that the two worker threads free stay in two heaps: a one-hour
+    ride (432,000 x 4) peaked at 738 MB with them and at 587 MB with one, in the same time.
+    Only the command's own process is tuned: a program that calls the library keeps its
+    allocator as it is. Other C libraries have no such setting and are left alone.
+    """
+    try:
+        libc = ctypes.CDLL("libc.so.6")
+    except OSError:  # not glibc (macOS, Windows, musl): nothing of this kind to set
+        return
+    m_arena_max = -8  # from glibc's malloc.h
+    libc.mallopt(m_arena_max, 1)
+
+
 def run() -> None:
     """Console entry point: :func:`main`, then exit with its status."""
+    _one_malloc_arena()  # before any worker thread allocates
     status = main()
     # The process ends here with every output written and closed. Moving the live objects
     # (the imported libraries, the fits) out of the collector's reach spares the

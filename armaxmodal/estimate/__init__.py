@@ -3,7 +3,7 @@
 * :func:`fit_armax` -- one model per sensor (the thesis's diagonal A) or all sensors sharing
   the poles, by Levenberg-Marquardt on numba kernels; :class:`ArmaxFit` the result.
 * :func:`choose_orders` -- orders and delay by an information criterion.
-* :mod:`.pool` -- the worker processes every sweep runs on.
+* :mod:`.pool` -- the worker threads every sweep runs on.
 """
 
 from armaxmodal.estimate.fit import fit_armax

@@ -228,8 +228,8 @@ def load_kernels() -> None:
     """Load the compiled kernels into this process with one tiny fit.
 
     Numba reads them from its on-disk cache at first use, about 0.3 s per process. Called
-    before worker processes are forked, so that they inherit the kernels instead of each
-    loading them again.
+    before the worker threads start, so that they do not all wait on numba's lock to load
+    the same kernels.
     """
     rng = np.random.default_rng(0)
     u = rng.standard_normal(400)

@@ -120,8 +120,7 @@ def choose_orders(
         (:func:`information_criterion`'s ``unit``), so that the choice does not depend on
         the data's unit.
     n_jobs : int, optional
-        Worker processes (default: all cores; 1 runs in this process). Workers are forked,
-        so they reuse the compiled kernels.
+        Worker threads (default: all cores; 1 runs in this thread).
     progress : bool
         Show a progress bar.
 

@@ -72,7 +72,7 @@ def _ranked(poles: pd.DataFrame, bic: dict) -> list[int]:
 
 def _finish_fits(diagram: StabilisationDiagram, nas, n_jobs: int | None, bar=None) -> dict:
     """``{na: poles}`` of the shared fits of orders ``nas`` continued to :func:`fit_armax`'s
-    default tolerance (the sweep stops its fits early), over the worker processes."""
+    default tolerance (the sweep stops its fits early), over the worker threads."""
     nas = sorted(nas)
     fits = [diagram.fits[(SHARED, na)] for na in nas]
     finish = partial(_finished_poles, diagram.recording)

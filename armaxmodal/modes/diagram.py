@@ -225,7 +225,7 @@ def stabilisation_diagram(
         Relative loss decrease at which a sweep fit stops; looser than :func:`fit_armax`'s
         default for the same reason. :func:`select_modes` finishes the fits it reports.
     n_jobs : int, optional
-        Worker processes (default: all cores).
+        Worker threads (default: all cores).
     progress : bool
         Show progress bars (the delay choice's fits, then the sweep's).
     """

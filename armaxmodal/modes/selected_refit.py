@@ -1,6 +1,6 @@
 """The fits run for the selected modes: the frequency-domain refit
 (:mod:`armaxmodal.modes.refine`) and the segment refits (:mod:`armaxmodal.modes.spread`), run
-together over the worker processes, and the refit's values applied within their limits.
+together over the worker threads, and the refit's values applied within their limits.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from armaxmodal.stats import Z95
 
 def refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, orders: dict, n_jobs, bar=None) -> dict:
     """The frequency-domain refit (key ``"refit"``) and the segment refits of every mode's
-    representative orders (keys ``(orders, k)``), run together over the worker processes:
+    representative orders (keys ``(orders, k)``), run together over the worker threads:
     the refit ran alone in this process before, while the workers waited. ``bar`` (tqdm)
     counts them."""
     jobs: list = [("refit", refit_band(diagram.recording, band))] if refine else []

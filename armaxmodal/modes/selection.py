@@ -185,8 +185,8 @@ def select_modes(
         Refit each mode's representative orders on this many disjoint segments and widen
         the intervals where their spread exceeds them (:mod:`armaxmodal.modes.spread`); 0 skips.
     n_jobs : int, optional
-        Worker processes for the finishing and segment fits (default: all cores; 1 inside a
-        process that may not start its own, e.g. a dask worker).
+        Worker threads for the finishing and segment fits (default: all cores; 1 inside a
+        worker that has one core already, e.g. a study's).
     progress : bool
         Show a count of the fits the selection runs (finishing fits, the refit and the
         segment refits: on a long record they take as long as the sweep). A count, not a

@@ -60,7 +60,7 @@ def segment_spread(
         ``orders_of(i) -> (na, nb, nc, nk)``: the orders of mode ``i``'s representative fit.
     n_segments : int
     n_jobs : int, optional
-        Worker processes for the segment fits (default: all cores).
+        Worker threads for the segment fits (default: all cores).
     fitted : dict, optional
         Segment poles already computed, ``{(orders, k): poles}`` (:func:`segment_poles`);
         the jobs not in it are fitted here.
@@ -78,7 +78,7 @@ def segment_spread(
     fitted = dict(fitted or {})
     todo = [job for job in jobs if job not in fitted]
     if todo:
-        # every segment refit of every representative order at once, over the worker processes
+        # every segment refit of every representative order at once, over the worker threads
         parts = split_segments(recording, n_segments)
         found = parallel_map(partial(segment_poles, parts), todo, n_jobs, cost=lambda job: job[0][0], min_items=2)
         fitted.update(zip(todo, found, strict=True))
