@@ -172,8 +172,6 @@ def inverse_filter_into(x, c, out):
 def armax_residual(y, u, a, b, nk, c):
     """One-step prediction errors ``eps = (A y - q^-nk B u) / C`` with zero padding.
 
-    In a new array; :func:`armax_residual_into` writes them into one the caller keeps.
-
     Parameters
     ----------
     y : (n,) output
@@ -187,12 +185,6 @@ def armax_residual(y, u, a, b, nk, c):
     -------
     (n,) prediction errors; samples outside [0, n) count as zero.
     """
-    return armax_residual_into(y, u, a, b, nk, c, np.empty_like(y))
-
-
-@njit(**JIT_OPTIONS)
-def armax_residual_into(y, u, a, b, nk, c, out):
-    """:func:`armax_residual` written into ``out`` ((n,), not ``y``), which it returns."""
     n = y.size
     n_in, nb = b.shape
     # A y - q^-nk B u one lag at a time over slices: the time loop has no recursion and no
@@ -200,8 +192,7 @@ def armax_residual_into(y, u, a, b, nk, c, out):
     # Done tile by tile: every lag then reads the tile from L1 cache instead of streaming the
     # whole record through L2 once per lag (2x faster at n = 20,000); each sample still gets
     # its terms in the same order, so the result is bit-identical to one pass per lag.
-    w = out
-    w[:] = y
+    w = y.copy()
     for tile0 in range(0, n, _TILE):
         tile1 = min(n, tile0 + _TILE)
         for i in range(1, a.size):

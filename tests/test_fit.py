@@ -502,33 +502,3 @@ def test_a_fit_flagged_not_converged_says_why(stopped, valid, said, not_said):
         _warn_not_converged(["a", "b"], np.array(stopped), np.array(valid), 100, (8, 9, 4, 0))
     message = str(record[0].message)
     assert said in message and not_said not in message
-
-
-def test_the_fits_reuse_their_residual_arrays_and_give_the_bits_of_fresh_ones(supine_zoh, monkeypatch):
-    # the slow reference: every evaluation writes a fresh array (nothing handed back is kept)
-    fits = {}
-    for mode in ("recycled", "fresh"):
-        reused, take = [], pem_mod._Residuals.take
-
-        def counting_take(self, take=take, reused=reused):
-            reused.append(bool(self.free))
-            return take(self)
-
-        monkeypatch.setattr(pem_mod._Residuals, "take", counting_take)
-        if mode == "fresh":
-            monkeypatch.setattr(pem_mod._Residuals, "give", lambda self, eps: None)
-        # per sensor, then shared poles: both loops, with rejected trials (damping grows at
-        # this over-parameterised order) as well as accepted ones
-        fits[mode] = [fit_armax(supine_zoh, 10, 11, 10, 0, shared_poles=shared, warn=False) for shared in (False, True)]
-        fits[mode + " reused"] = sum(reused)
-        monkeypatch.undo()
-    assert fits["recycled reused"] > 20 and fits["fresh reused"] == 0
-    for recycled, fresh in zip(fits["recycled"], fits["fresh"], strict=True):
-        assert np.array_equal(recycled.iterations, fresh.iterations)
-        assert np.array_equal(recycled.loss, fresh.loss)
-        # the intervals: the covariance comes from the errors of the state the loop returned
-        assert all(np.array_equal(x, y) for x, y in zip(recycled.covariance, fresh.covariance, strict=True))
-        if fresh.joint_covariance is not None:
-            assert np.array_equal(recycled.joint_covariance, fresh.joint_covariance)
-        for x, y in zip(recycled.models, fresh.models, strict=True):
-            assert all(np.array_equal(getattr(x, name), getattr(y, name)) for name in ("a", "b", "c"))

@@ -217,7 +217,7 @@ class Progress:
 
 
 def levenberg_marquardt(
-    theta, state, evaluate, linearise, project, max_iter, tol, stop="expected", unit=None, progress=None, release=None
+    theta, state, evaluate, linearise, project, max_iter, tol, stop="expected", unit=None, progress=None
 ):
     """Levenberg-Marquardt on a Gauss-Newton model, shared by every fit.
 
@@ -236,15 +236,11 @@ def levenberg_marquardt(
     is one unit of 2 log-likelihood) adds the crawl rule: CRAWL_STEPS floor-damped steps in
     a row each worth less than CRAWL_LOGLIK units end the fit as converged. ``progress``
     (a :class:`Progress` this function returned at its cap, with the ``theta`` and ``state``
-    it returned) continues that run; ``max_iter`` then counts its iterations too. ``release``,
-    if given, is handed every state the loop drops (a rejected trial's, the one an accepted
-    trial replaces), never the one it returns: ``evaluate`` may then reuse its arrays. Returns
+    it returned) continues that run; ``max_iter`` then counts its iterations too. Returns
     ``(theta, state, iterations, converged, progress)``; ``progress`` is None unless the cap
     stopped the run.
     """
-    release = release or (lambda dropped: None)
-    first, objective = evaluate(theta)
-    release(first)
+    objective = evaluate(theta)[1]
     start = progress or Progress()
     lm, grow, crawling = start.damping, start.grow, start.crawling
     for it in range(start.iterations + 1, max_iter + 1):
@@ -257,7 +253,6 @@ def levenberg_marquardt(
             state_t, objective_t = evaluate(trial)
             if objective_t < objective:
                 break
-            release(state_t)
             lm, grow = lm * grow, grow * 2.0
         else:
             return theta, state, it, True, None
@@ -268,7 +263,6 @@ def levenberg_marquardt(
         decrease = (objective - objective_t) / objective
         small = unit is not None and gauss_newton and objective - objective_t < CRAWL_LOGLIK * unit
         crawling = crawling + 1 if small else 0
-        release(state)
         theta, state, objective = trial, state_t, objective_t
         if (stop == "decrease" and decrease < tol) or crawling >= CRAWL_STEPS:
             return theta, state, it, True, None

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from armaxmodal._kernels import armax_residual, armax_residual_into
+from armaxmodal._kernels import armax_residual
 from armaxmodal.estimate._gauss_newton import (
     Dense,
     Progress,
@@ -30,29 +30,12 @@ from armaxmodal.estimate.parameters import (
 from armaxmodal.estimate.starts import hannan_rissanen, output_error_start, shared_start
 
 
-class _Residuals:
-    """Record-length arrays for one fit's prediction errors: taken by every evaluation and
-    given back when the Levenberg-Marquardt loop drops a state (its ``release``). On a
-    record of millions of samples a fresh array at every evaluation maps fresh pages."""
-
-    def __init__(self, n: int) -> None:
-        self.n, self.free = n, []
-
-    def take(self) -> np.ndarray:
-        return self.free.pop() if self.free else np.empty(self.n)
-
-    def give(self, eps: np.ndarray) -> None:
-        self.free.append(eps)
-
-
 # -- single-output PEM ------------------------------------------------------------------------
-def residual_and_loss(y, uT, theta, na, nb, nc, nk, t0, t1, oe=False, out=None):
-    """``(eps, loss, c)``: the prediction errors (written into ``out`` if given), their sum of
-    squares over ``[t0, t1)`` (inf if not finite), and the C (A for output error) used."""
+def residual_and_loss(y, uT, theta, na, nb, nc, nk, t0, t1, oe=False):
     a, b, c = unpack_theta(theta, na, nb, nc, uT.shape[0])
     if oe:  # output error: C = A, so eps = y - (B / A) u
         c = a
-    eps = armax_residual(y, uT, a, b, nk, c) if out is None else armax_residual_into(y, uT, a, b, nk, c, out)
+    eps = armax_residual(y, uT, a, b, nk, c)
     with np.errstate(over="ignore", invalid="ignore"):  # an unstable trial step is rejected
         loss = float(eps[t0:t1] @ eps[t0:t1])
     return eps, (loss if np.isfinite(loss) else np.inf), c
@@ -73,10 +56,8 @@ def fit_single(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=No
         except np.linalg.LinAlgError:  # degenerate input: keep the Hannan-Rissanen start
             theta = project_stable(theta, na, nb, nc, n_in, oe=True)
 
-    residuals = _Residuals(y.size)
-
     def evaluate(th):
-        state = residual_and_loss(y, uT, th, na, nb, nc, nk, t0, t1, oe, residuals.take())
+        state = residual_and_loss(y, uT, th, na, nb, nc, nk, t0, t1, oe)
         return state, state[1]
 
     work = workspace(n_in, y.size)
@@ -96,7 +77,6 @@ def fit_single(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=No
         tol,
         stop,
         unit,
-        release=lambda dropped: residuals.give(dropped[0]),
     )
     eps, loss, c = state
     g_mat, _ = normal_equations(y, uT, eps, c, cols, t0, t1, oe)
@@ -154,20 +134,12 @@ def fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=No
     ys = [np.ascontiguousarray(y[:, k]) for k in range(n_out)]
     n_eff = t1 - t0
 
-    residuals = _Residuals(y.shape[0])
-
     def evaluate(th):
         out = [
-            residual_and_loss(
-                ys[k], uT, local_parameters(th, k, na, p_k), na, nb, nc, nk, t0, t1, oe, residuals.take()
-            )
+            residual_and_loss(ys[k], uT, local_parameters(th, k, na, p_k), na, nb, nc, nk, t0, t1, oe)
             for k in range(n_out)
         ]
         return out, np.array([o[1] for o in out])
-
-    def release(dropped):
-        for eps, _, _ in dropped[0]:
-            residuals.give(eps)
 
     if resume is not None:
         theta, variances, total_iterations = resume.theta, resume.variances, resume.iterations
@@ -204,7 +176,6 @@ def fit_shared(y, uT, na, nb, nc, nk, t0, t1, max_iter, tol, oe=False, theta0=No
             stop,
             1.0,  # the objective sum_k V_k / lambda_k changes with 2 log L one for one
             progress,
-            release,
         )
         if progress is not None:  # the cap stopped this run mid-way: continue it from here
             paused = _Checkpoint(theta, variances, total_iterations, progress, False)
