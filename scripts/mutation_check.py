@@ -473,6 +473,25 @@ MUTANTS = [
         "todo = single",
         "per-sensor fits start from scratch (warm)",
     ),
+    # the worker threads (run with --match "(pool)" --tests tests/test_pool.py)
+    (
+        "armaxmodal/estimate/pool.py",
+        "key=lambda i: -cost(items[i])",
+        "key=lambda i: cost(items[i])",
+        "the cheapest items start first (pool)",
+    ),
+    (
+        "armaxmodal/estimate/pool.py",
+        "    with one_blas_thread(), ThreadPoolExecutor(",
+        "    with ThreadPoolExecutor(",
+        "the workers run with every BLAS thread (pool)",
+    ),
+    (
+        "armaxmodal/estimate/pool.py",
+        "            out[i] = result",
+        "            out[order.index(i)] = result",
+        "results put back in the order they ran (pool)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/test_guards.py",

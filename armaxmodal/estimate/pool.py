@@ -14,7 +14,7 @@ def parallel_map(func, items, n_jobs, bar=None, cost=None, min_items: int = 4):
 
     The fits spend their time in numba kernels compiled with ``nogil``, so threads run them
     in parallel. Threads, not forked processes: on the 20,000 x 5 bench ride the whole
-    ``stabilise`` took the same wall time with 0.6 CPU-s (11 %) less work (no page faults in
+    ``stabilise`` took the same wall time with 0.7 CPU-s (13 %) less work (no page faults in
     copied memory, no results pickled back), threads work where ``fork`` does not (Windows,
     a process that already runs threads), and the results are the same bits.
 
