@@ -94,7 +94,7 @@ def run(args) -> int:
         report = selection.to_dict(args.shapes.replace("-", "_"))
         outputs.append((args.json, lambda tmp: write_json(report, tmp)))
     write_outputs(outputs)
-    print(verdict(selection.check, len(selection.modes)))
+    print(verdict(selection.check, len(selection.modes), selection.uncertain_because))
     return 0
 
 
@@ -117,8 +117,14 @@ def print_check(check) -> None:
         )
 
 
-def verdict(check, n_modes: int) -> str:
-    """The closing line: whether the modes explain the record."""
+def verdict(check, n_modes: int, uncertain_because: list[str] = ()) -> str:
+    """The closing line: whether the modes explain the record, and whether the record decides them
+    (``uncertain_because``: the codes of the warnings that leave it undecided)."""
+    if check is not None and check.passed and uncertain_because:
+        return (
+            f"quality: UNCERTAIN -- the {n_modes} selected mode(s) explain the measured FRF, but the record does not "
+            f"settle them: {', '.join(uncertain_because)} (see the notes)"
+        )
     if check is not None and check.passed:
         return f"quality: good -- the {n_modes} selected mode(s) explain the measured FRF of every checked output"
     if check is not None and check.unconfirmed_hz and not check.failing:

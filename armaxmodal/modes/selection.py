@@ -19,8 +19,10 @@ from armaxmodal.exceptions import OrderError
 from armaxmodal.modal import mode_record
 from armaxmodal.modes.clusters import clustered_modes, merge_duplicates
 from armaxmodal.modes.completeness import modes_the_check_adds, modes_the_record_needs, refit_with_added
+from armaxmodal.modes.counted import counted_modes
 from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.modal_check import ModalCheck, check_modes
+from armaxmodal.modes.mode_count import ModeCount
 from armaxmodal.modes.per_sensor import per_sensor_table
 from armaxmodal.modes.refine import ModalRefinement
 from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_and_segment_fits
@@ -29,7 +31,7 @@ from armaxmodal.modes.spread import (
     apply_segment_spread,
     segment_spread,
 )
-from armaxmodal.notes import QualityWarning
+from armaxmodal.notes import UNCERTAIN_CODES, QualityWarning
 from armaxmodal.prepare.preparation import oversampling_note, record_header
 from armaxmodal.stats import Z95
 
@@ -70,6 +72,7 @@ class ModeSelection:
     refinement: ModalRefinement | None = None
     notes: tuple[QualityWarning, ...] = ()
     check: ModalCheck | None = None
+    count: ModeCount | None = None
 
     @property
     def reconstruction_error(self) -> float:
@@ -81,8 +84,18 @@ class ModeSelection:
 
     @property
     def quality(self) -> str:
-        """``"good"`` when the modal-model check passes, else ``"poor"``."""
-        return "good" if self.check is not None and self.check.passed else "poor"
+        """``"poor"`` when the modal-model check fails; ``"uncertain"`` when it passes but a
+        warning of :data:`armaxmodal.notes.UNCERTAIN_CODES` stands (the record does not decide
+        the number of modes, two modes are closer than it separates, or the preparation found a
+        fault that moves modes); else ``"good"``."""
+        if self.check is None or not self.check.passed:
+            return "poor"
+        return "uncertain" if self.uncertain_because else "good"
+
+    @property
+    def uncertain_because(self) -> list[str]:
+        """The codes of the warnings that make a passing selection uncertain, sorted."""
+        return sorted({w.code for w in self.warnings if w.code in UNCERTAIN_CODES})
 
     @property
     def warnings(self) -> list[QualityWarning]:
@@ -239,6 +252,15 @@ def select_modes(
                 refit_notes += more
         else:  # the user fixed the number of modes: the check judges them, it does not choose
             notes, check = [], check_modes(diagram.recording, modes.freq_hz, modes.damping, band)
+        count = None
+        if n_modes is None and refinement is not None and len(modes):
+            # the last word on the number of modes: nested tests of the modal model with every pole free
+            modes, shapes, count, more = counted_modes(
+                diagram, modes, refinement.band_hz, refinement.hold, nas, (cluster_freq, cluster_damping), band
+            )
+            notes += more + _not_separated(modes)
+            bar.update(count.trials)
+            check = check_modes(diagram.recording, modes.freq_hz, modes.damping, band)
         if segments >= 2:
             orders_of = lambda i: orders[int(modes.at[i, "na"])]  # noqa: E731
             spread = segment_spread(diagram.recording, modes, orders_of, segments, n_jobs, fitted)
@@ -252,7 +274,30 @@ def select_modes(
         notes += oversampling_note(modes.freq_hz.to_numpy(), diagram.recording.fs)
         notes += _unresolved_damping_notes(modes, len(nas))
         notes += check.warnings()
-        return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement, tuple(notes), check)
+        return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement, tuple(notes), check, count)
+
+
+#: two modes closer than this many standard deviations of their difference are not separated
+#: by the record (a difference 3 SD from zero is the usual resolution rule; the issue's bound)
+SEPARATION_SD = 3.0
+
+
+def _not_separated(modes: pd.DataFrame) -> list[QualityWarning]:
+    """A ``modes_not_separated`` note for each pair of neighbouring modes whose frequencies
+    differ by less than :data:`SEPARATION_SD` standard deviations of the difference."""
+    notes = []
+    f = modes.freq_hz.to_numpy()
+    sd = (modes.freq_ci95_hi.to_numpy() - modes.freq_ci95_lo.to_numpy()) / (2 * Z95)
+    for i in range(len(f) - 1):
+        gap, sd_gap = f[i + 1] - f[i], float(np.hypot(sd[i], sd[i + 1]))
+        if gap < SEPARATION_SD * sd_gap:
+            notes.append(QualityWarning(
+                "modes_not_separated", (),
+                f"modes at {f[i]:.3f} and {f[i + 1]:.3f} Hz are {gap / sd_gap:.1f} standard deviations of their "
+                f"difference apart (under {SEPARATION_SD:g}): the record does not separate them; they may be one mode",
+                float(f[i]),
+            ))  # fmt: skip
+    return notes
 
 
 def _unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[QualityWarning]:

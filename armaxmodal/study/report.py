@@ -112,12 +112,15 @@ def render_report(study, shape_figures: dict, lump_rows: pd.DataFrame | None = N
     settings = pd.DataFrame([{"setting": k, "value": str(v)} for k, v in study.to_dict()["settings"].items()])
     fails = "".join(f"<li class=fail><b>{esc(f['file'])}</b>: {esc(str(f['reason']))}</li>" for f in study.failures)
     notes = "".join(f"<li class=note>{esc(n)}</li>" for n in study.notes)
+    from armaxmodal.notes import UNCERTAIN_CODES
+
+    flagged = {"poor": ("modes_do_not_explain_frf",), "uncertain": UNCERTAIN_CODES}
     poor = "".join(
-        f"<li class=fail><b>{esc(r['file'])}</b>: "
-        + esc("; ".join(w["message"] for w in r.get("warnings", []) if w["code"] == "modes_do_not_explain_frf"))
+        f"<li class=fail><b>{esc(r['file'])}</b> ({r['quality']}): "
+        + esc("; ".join(w["message"] for w in r.get("warnings", []) if w["code"] in flagged[r["quality"]]))
         + "</li>"
         for r in study.recordings
-        if r.get("quality") == "poor"
+        if r.get("quality") in flagged
     )
     poor = "<ul>" + poor + "</ul>" if poor else "<p>none</p>"
     thumbs = "".join(
@@ -147,7 +150,7 @@ def render_report(study, shape_figures: dict, lump_rows: pd.DataFrame | None = N
 {_models(study)}
 {lump}
 <h2>Failures</h2>{"<ul>" + fails + "</ul>" if fails else "<p>none</p>"}
-<h2>Recordings whose modes do not explain their FRF (quality: poor)</h2>{poor}
+<h2>Recordings whose modes do not explain their FRF (quality: poor) or that do not settle them (uncertain)</h2>{poor}
 <h2>Stabilisation diagrams (click to enlarge)</h2><div class=thumbs>{thumbs}</div>
 <details><summary><b>Per sensor (Table 3.2 form; X: the sensor's own model does not show the mode)</b></summary>
 {_table_3_2(study)}</details>

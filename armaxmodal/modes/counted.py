@@ -1,0 +1,142 @@
+"""The selection's last step: the modes counted by nested tests of the maximum-likelihood modal
+model (:mod:`armaxmodal.modes.mode_count`), written back as the selection's rows, shapes and notes.
+
+Poles the model needs but that are no modes of the band -- above the fitted band (they stand
+for the modes above it, an upper residual) or damped beyond :data:`armaxmodal.stats.MAX_DAMPING`
+-- stay in the model and are not reported.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from armaxmodal.modes.clusters import candidate_poles, cluster_poles
+from armaxmodal.modes.modal_model import DftLines, fit_modal_model
+from armaxmodal.modes.mode_count import DECISIVE_BIC, ModeCount, count_modes
+from armaxmodal.notes import QualityWarning
+from armaxmodal.stats import MAX_DAMPING, Z95
+
+__all__ = ["counted_modes", "reported"]
+
+#: a counted mode within this relative frequency of a selected one keeps that row's cluster
+#: facts (orders, support, spread); the clustering's own reach
+SAME_ROW_FREQ = 0.05
+#: left-out clusters of the diagram tried as additions: the largest few (each costs a fit)
+MAX_CANDIDATES = 3
+#: a left-out cluster is a candidate when it holds poles of at least this many orders
+CANDIDATE_MIN_ORDERS = 3
+
+
+def reported(model, band_hz) -> np.ndarray:
+    """Which of a model's poles are modes of the band (bool per pole)."""
+    f, x = model.freq_hz, model.damping
+    return (f >= band_hz[0]) & (f <= band_hz[1]) & (x <= MAX_DAMPING)
+
+
+def _candidates(diagram, modes: pd.DataFrame, band, nas, cluster_freq, cluster_damping) -> list[tuple[float, float]]:
+    """The diagram's stable clusters the selection left out, largest first: (Hz, ratio)."""
+    cand = candidate_poles(diagram.poles, band)
+    kept = cand[(cand.rejected == "") & (cand.damping > 0) & (cand.damping <= MAX_DAMPING)]
+    found = []
+    for members in cluster_poles(kept, nas, cluster_freq, cluster_damping):
+        sub = kept.loc[members]
+        f = float(sub.freq_hz.median())
+        if len(members) >= CANDIDATE_MIN_ORDERS and np.min(np.abs(modes.freq_hz.to_numpy() / f - 1)) > cluster_freq:
+            found.append((len(members), f, float(sub.damping.median())))
+    return [(f, x) for _, f, x in sorted(found, reverse=True)[:MAX_CANDIDATES]]
+
+
+def counted_modes(diagram, modes: pd.DataFrame, band_hz, hold: str, nas, clustering, band=None):
+    """Count the modes from the selection's and return them as the selection reports modes.
+
+    Parameters
+    ----------
+    diagram : StabilisationDiagram
+    modes : DataFrame
+        The selection so far (one row per mode, as :func:`armaxmodal.select_modes` builds).
+    band_hz : (float, float)
+        The band the model is fitted in (Hz).
+    hold : {"bandlimited", "zoh"}
+        The inter-sample assumption the refit chose.
+    nas : list of int
+        The diagram's orders.
+    clustering : (float, float)
+        The clustering's relative frequency and damping reach.
+    band : (float, float), optional
+        The user's band, for the left-out clusters.
+
+    Returns
+    -------
+    modes : DataFrame
+    shapes : (n_sensors, n_modes) complex ndarray
+    count : ModeCount
+    notes : list of QualityWarning
+    """
+    data = DftLines.from_recording(diagram.recording, band_hz)
+    start = fit_modal_model(data, modes.freq_hz, modes.damping, hold, max_nfev=1)  # the noise levels at the start
+    data = data.weighted(1.0 / np.sqrt(np.where(start.rss > 0, start.rss, 1.0) / start.n_real))
+    candidates = _candidates(diagram, modes, band, nas, *clustering)
+    count = count_modes(data, modes.freq_hz, modes.damping, candidates, hold=hold)
+    keep = reported(count.model, data.band_hz)
+    rows = [_row(modes, count, i, hold) for i in np.flatnonzero(keep)]
+    out = pd.DataFrame(rows) if rows else modes.iloc[0:0].copy()
+    return out, count.model.shapes[:, keep], count, _notes(count, keep, data.band_hz)
+
+
+def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str) -> dict:
+    """Mode ``i`` of the counted model as a selection row: the nearest selected row's cluster
+    facts when it lies within :data:`SAME_ROW_FREQ`, else none (``count`` 0)."""
+    m = count.model
+    f, x, sf, sx = m.freq_hz[i], m.damping[i], m.freq_sd[i], m.damping_sd[i]
+    dist = np.abs(modes.freq_hz.to_numpy() / f - 1)
+    j = int(np.argmin(dist))
+    row = modes.iloc[j].to_dict()
+    if dist[j] > SAME_ROW_FREQ:  # a mode the diagram's clusters did not hold
+        row.update(count=0, support=0.0, freq_spread=np.nan, damping_spread=np.nan, medoid_freq_hz=np.nan,
+                   medoid_damping=np.nan, orders_damping_unresolved=0)  # fmt: skip
+    row.update(
+        freq_hz=f, damping=x, damped_freq_hz=f * np.sqrt(1 - x**2),
+        freq_ci95_lo=f - Z95 * sf, freq_ci95_hi=f + Z95 * sf,
+        damping_ci95_lo=x - Z95 * sx, damping_ci95_hi=x + Z95 * sx,
+        estimator=f"ml-{hold}", count_undecided=bool(count.removal_rise[i] < DECISIVE_BIC),
+    )  # fmt: skip
+    return row
+
+
+def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
+    notes = []
+    words = {"remove": "left out", "add": "added", "split": "split in two"}
+    for step in count.steps:
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"the maximum-likelihood modal model with every pole free: the mode at {step.freq_hz:.3f} Hz "
+            f"{words[step.action]}, the information criterion (BIC) falls by {step.bic_fall:.1f}",
+            float(step.freq_hz),
+        ))  # fmt: skip
+    rise = float(count.removal_rise.min()) if count.removal_rise.size else np.inf
+    if rise < DECISIVE_BIC:
+        notes.append(QualityWarning(
+            "count_undecided", (),
+            f"the record does not decide the number of modes: with one mode fewer (the rest refitted free) the "
+            f"criterion rises by only {rise:.1f} (under {DECISIVE_BIC:g}, Kass & Raftery's 'very strong'); "
+            "treat the weakest mode as tentative", rise,
+        ))  # fmt: skip
+    if count.best_addition > -DECISIVE_BIC and np.isfinite(count.best_addition_hz):
+        f = count.best_addition_hz
+        notes.append(QualityWarning(
+            "count_undecided", (),
+            f"the record does not rule out one mode more (near {f:.3f} Hz): adding it changes the criterion by "
+            f"{-count.best_addition:+.1f}, less than {DECISIVE_BIC:g} either way", f,
+        ))  # fmt: skip
+    hidden = int((~keep).sum())
+    if hidden:
+        out = ", ".join(f"{f:.3g} Hz (damping {x:.2f})" for f, x in zip(count.model.freq_hz[~keep],
+                                                                      count.model.damping[~keep], strict=True))
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"{hidden} pole(s) of the modal model lie outside the band {band_hz[0]:.3g}-{band_hz[1]:.3g} Hz or are "
+            f"damped beyond {MAX_DAMPING:g}: {out}. They stand for what lies beyond the band and are not reported",
+            float(hidden),
+        ))  # fmt: skip
+    return notes
