@@ -135,11 +135,20 @@ def main() -> None:
     parser.add_argument("--four", type=int, default=8)
     parser.add_argument("--light", type=int, default=8)
     parser.add_argument("--seed", type=int, default=2026)
+    parser.add_argument("--only", type=int, nargs="*", help="run these cases only (0-based, in the order printed)")
+    parser.add_argument("--save", help="pickle each case's (structure, recording) into this folder")
     args = parser.parse_args()
     tally = {"cases": 0, "right": 0, "wrong_flagged": 0, "right_flagged": 0}
-    for name, s, fs, top, rng in cases(args):
+    for index, (name, s, fs, top, rng) in enumerate(cases(args)):
         u = ride(rng, fs, top_hz=top)
         rec = am.simulate_recording(s, u, fs, noise=0.03, seed=int(rng.integers(1 << 30)))
+        if args.only and index not in args.only:
+            continue  # drawn all the same, so that every case is the one the full run sees
+        if args.save:
+            import pickle
+
+            with open(f"{args.save}/case{index}.pkl", "wb") as fh:
+                pickle.dump((s, rec), fh)
         t0 = time.process_time()
         sel = am.select_modes(am.stabilisation_diagram(rec))
         cpu = time.process_time() - t0

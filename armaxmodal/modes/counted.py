@@ -12,8 +12,9 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
-from armaxmodal.modes.modal_model import DftLines, fit_modal_model
+from armaxmodal.modes.modal_model import DftLines
 from armaxmodal.modes.mode_count import DECISIVE_BIC, ModeCount, count_modes
+from armaxmodal.modes.spread import split_segments
 from armaxmodal.notes import QualityWarning
 from armaxmodal.stats import MAX_DAMPING, Z95
 
@@ -74,10 +75,9 @@ def counted_modes(diagram, modes: pd.DataFrame, band_hz, hold: str, nas, cluster
     notes : list of QualityWarning
     """
     data = DftLines.from_recording(diagram.recording, band_hz)
-    start = fit_modal_model(data, modes.freq_hz, modes.damping, hold, max_nfev=1)  # the noise levels at the start
-    data = data.weighted(1.0 / np.sqrt(np.where(start.rss > 0, start.rss, 1.0) / start.n_real))
     candidates = _candidates(diagram, modes, band, nas, *clustering)
-    count = count_modes(data, modes.freq_hz, modes.damping, candidates, hold=hold)
+    halves = tuple(DftLines.from_recording(half, band_hz) for half in split_segments(diagram.recording, 2))
+    count = count_modes(data, modes.freq_hz, modes.damping, candidates, hold=hold, halves=halves)
     keep = reported(count.model, data.band_hz)
     rows = [_row(modes, count, i, hold) for i in np.flatnonzero(keep)]
     out = pd.DataFrame(rows) if rows else modes.iloc[0:0].copy()
@@ -128,6 +128,12 @@ def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
             "count_undecided", (),
             f"the record does not rule out one mode more (near {f:.3f} Hz): adding it changes the criterion by "
             f"{-count.best_addition:+.1f}, less than {DECISIVE_BIC:g} either way", f,
+        ))  # fmt: skip
+    for f in count.unconfirmed_hz:
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"one mode more near {f:.3f} Hz fits the whole record better but not each of its halves: a change "
+            "during the record (a drifting frequency, a transient, a nonlinearity), not a mode; left out", f,
         ))  # fmt: skip
     hidden = int((~keep).sum())
     if hidden:

@@ -118,7 +118,8 @@ class ModalModel:
     shapes : (n_sensors, n_modes) complex ndarray
         EPFRF modal constants (Eq. 3.24), ``-r / lambda^2`` from the continuous residues.
     rss : (n_sensors,) ndarray
-        Each sensor's weighted residual sum of squares.
+        Each sensor's residual sum of squares, in the data's units (not weighted): the
+        likelihood of fits under different weights compare.
     n_real : int
         Real numbers per sensor the model was fitted to.
     hold : str
@@ -238,7 +239,7 @@ def fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited",
     )
     model.residual(res.x)
     coef, resid = model.coef, model.resid
-    rss = np.sum(resid**2, axis=0)
+    rss = np.sum(resid**2, axis=0) / data.weights**2  # in the data's units: fits under other weights compare
     n = start.size // 2
     sd = _sandwich_sd(model.sensor_rows(res.x), coef.size + res.x.size)
     lam = _poles(res.x)
