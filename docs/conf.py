@@ -33,6 +33,8 @@ source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 templates_path = ["_templates"]
 exclude_patterns = ["_build", "examples", "auto_examples/*.ipynb", "auto_examples/*.py", "auto_examples/*.zip"]
 myst_heading_anchors = 3
+# $...$ and $$...$$ for the method page's equations (rendered by MathJax)
+myst_enable_extensions = ["dollarmath"]
 suppress_warnings = ["myst.header"]
 
 autosummary_generate = True

@@ -492,6 +492,74 @@ MUTANTS = [
         "            out[order.index(i)] = result",
         "results put back in the order they ran (pool)",
     ),
+    # the maximum-likelihood modal model and the count of modes (issue: the seed's own bodies); run with
+    # --match "(count)" --tests tests/test_mode_count.py
+    (
+        "armaxmodal/modes/modal_model.py",
+        "return self.neg2_loglik * n_eff / n_total + self.n_params * np.log(n_eff)",
+        "return self.neg2_loglik * n_eff / n_total + 2 * self.n_params",
+        "AIC's fixed penalty for BIC's (count)",
+    ),
+    (
+        "armaxmodal/modes/modal_model.py",
+        "return self.n_modes * (2 + 4 * self.rss.size)",
+        "return self.n_modes * (2 + 2 * self.rss.size)",
+        "the transient terms not counted as parameters (count)",
+    ),
+    (
+        "armaxmodal/modes/modal_model.py",
+        "rss = np.sum(resid**2, axis=0) / data.weights**2",
+        "rss = np.sum(resid**2, axis=0)",
+        "residual sums in weighted units (count)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "return 1.0 / (1.0 + 2.0 * total)",
+        "return 1.0 / (1.0 + total)",
+        "Bartlett's factor 2 dropped (count)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "if t is not None and search.bic(t[2]) < here]",
+        "if t is not None and search.bic(t[2]) < here + DECISIVE_BIC]",
+        "a step taken that does not lower the criterion (count)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "            if not large.bic(n_eff) < small.bic(n_eff):\n                return False",
+        "            if not large.bic(n_eff) < small.bic(n_eff):\n                pass",
+        "the halves' test ignored (count)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "return self.removal_rise < DECISIVE_BIC",
+        "return self.removal_rise > DECISIVE_BIC",
+        "undecided flag inverted (count)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "if rise < DECISIVE_BIC:",
+        "if rise < -DECISIVE_BIC:",
+        "an undecided removal not said (count)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "return (f >= band_hz[0]) & (f <= band_hz[1]) & (x <= MAX_DAMPING)",
+        "return (f >= band_hz[0]) & (x <= MAX_DAMPING)",
+        "poles above the band reported (count)",
+    ),
+    (
+        "armaxmodal/modes/selection.py",
+        'return "uncertain" if self.uncertain_because else "good"',
+        'return "good"',
+        "the verdict never uncertain (count)",
+    ),
+    (
+        "armaxmodal/modes/selection.py",
+        "if gap < SEPARATION_SD * sd_gap:",
+        "if gap < sd_gap:",
+        "separation at one deviation (count)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/test_guards.py",

@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
-from armaxmodal.modes.modal_model import DftLines
+from armaxmodal.modes.modal_model import DAMPING_BOUNDS, DftLines
 from armaxmodal.modes.mode_count import DECISIVE_BIC, ModeCount, count_modes
 from armaxmodal.modes.spread import split_segments
 from armaxmodal.notes import QualityWarning
@@ -23,6 +23,10 @@ __all__ = ["counted_modes", "reported"]
 #: a counted mode within this relative frequency of a selected one keeps that row's cluster
 #: facts (orders, support, spread); the clustering's own reach
 SAME_ROW_FREQ = 0.05
+#: a pole damped this little sits at the fit's floor (:data:`~armaxmodal.modes.modal_model.DAMPING_BOUNDS`):
+#: a line, a periodic disturbance or a frequency that moves, not a mode (the supine ride's 0.3 m/s^2
+#: hum at 12.5 Hz came out at 12.500 Hz, damping 1e-4; the bodies' modes are damped 0.3 % and more)
+LINE_DAMPING = 2 * DAMPING_BOUNDS[0]
 #: left-out clusters of the diagram tried as additions: the largest few (each costs a fit)
 MAX_CANDIDATES = 3
 #: a left-out cluster is a candidate when it holds poles of at least this many orders
@@ -30,9 +34,10 @@ CANDIDATE_MIN_ORDERS = 3
 
 
 def reported(model, band_hz) -> np.ndarray:
-    """Which of a model's poles are modes of the band (bool per pole)."""
+    """Which of a model's poles are modes of the band (bool per pole): not beyond it, not damped
+    beyond :data:`~armaxmodal.stats.MAX_DAMPING`, and not a line (damping at the fit's floor)."""
     f, x = model.freq_hz, model.damping
-    return (f >= band_hz[0]) & (f <= band_hz[1]) & (x <= MAX_DAMPING)
+    return (f >= band_hz[0]) & (f <= band_hz[1]) & (x <= MAX_DAMPING) & (x > LINE_DAMPING)
 
 
 def _candidates(diagram, modes: pd.DataFrame, band, nas, cluster_freq, cluster_damping) -> list[tuple[float, float]]:
@@ -141,8 +146,9 @@ def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
                                                                       count.model.damping[~keep], strict=True))
         notes.append(QualityWarning(
             "mode_count", (),
-            f"{hidden} pole(s) of the modal model lie outside the band {band_hz[0]:.3g}-{band_hz[1]:.3g} Hz or are "
-            f"damped beyond {MAX_DAMPING:g}: {out}. They stand for what lies beyond the band and are not reported",
+            f"{hidden} pole(s) of the modal model lie outside the band {band_hz[0]:.3g}-{band_hz[1]:.3g} Hz, are "
+            f"damped beyond {MAX_DAMPING:g} or are lines (damping at the fit's floor): {out}. They stand for what lies "
+            "beyond the band or for a periodic disturbance, and are not reported as modes",
             float(hidden),
         ))  # fmt: skip
     return notes

@@ -51,6 +51,9 @@ MAX_STEPS = 6
 #: residual evaluations of a screening fit: the candidates are compared after this many steps
 #: from their starts, and the best of each kind is then iterated to convergence
 SCREEN_NFEV = 10
+#: a new pole's frequency and damping in the record's two halves may differ by this many
+#: standard deviations of their difference (a two-sided 1 % test would take 2.6)
+HALVES_SD = 3.0
 #: residual evaluations of the chosen model's last fit, to convergence
 FINAL_NFEV = 200
 #: a candidate addition within this relative frequency of a mode is that mode
@@ -192,10 +195,13 @@ class _Search:
         return bool(np.all(model.damping[physical] - Z95 * model.damping_sd[physical] > 0))
 
     def in_both_halves(self, current: ModalModel, trial: ModalModel, halves) -> bool:
-        """The larger model is preferred on each half of the record too, each fitted there
-        from the whole record's values: a mode of the structure is in both halves, while a
-        pole that soaks up a change during the record (a drifting frequency, a transient) is
-        not."""
+        """The larger model is preferred on each half of the record too, each fitted there from
+        the whole record's values, and its new poles have the same frequency and damping in
+        both halves (within :data:`HALVES_SD` standard deviations of the difference): a mode
+        of the structure is the same mode in both halves, while a pole that soaks up a change
+        during the record or a nonlinearity (a drifting frequency, a doublet beside a real
+        mode) lands elsewhere in each."""
+        fits = []
         for half in halves:
             half = half.weighted(self.data.weights)
             n_eff = self.n_eff * half.n_real / self.data.n_real
@@ -204,6 +210,16 @@ class _Search:
             self.trials += 2
             if not large.bic(n_eff) < small.bic(n_eff):
                 return False
+            fits.append(large)
+        if len(fits) != 2:
+            return True
+        a, b = fits
+        for i in _new_poles(current.freq_hz, trial.freq_hz):
+            j, k = _nearest(a.freq_hz, trial.freq_hz[i]), _nearest(b.freq_hz, trial.freq_hz[i])
+            for one, two in ((a.freq_hz, b.freq_hz), (a.damping, b.damping)):
+                sd_one, sd_two = (a.freq_sd, b.freq_sd) if one is a.freq_hz else (a.damping_sd, b.damping_sd)
+                if abs(one[j] - two[k]) > HALVES_SD * np.hypot(sd_one[j], sd_two[k]):
+                    return False
         return True
 
     def removals(self, current: ModalModel) -> list[tuple[str, float, ModalModel | None]]:
@@ -228,6 +244,22 @@ class _Search:
             pair_x = np.r_[np.delete(current.damping, m), x / 2, x / 2]
             out.append(("split", float(f), self.fit(pair_f, pair_x, SCREEN_NFEV)))
         return out
+
+
+def _nearest(freq_hz: np.ndarray, f: float) -> int:
+    return int(np.argmin(np.abs(np.log(freq_hz / f))))
+
+
+def _new_poles(old_hz: np.ndarray, new_hz: np.ndarray) -> list[int]:
+    """The poles of ``new_hz`` (indices) left over when each of ``old_hz`` takes its nearest
+    (one to one, nearest pairs first)."""
+    pairs = sorted((abs(np.log(n / o)), i, j) for i, n in enumerate(new_hz) for j, o in enumerate(old_hz))
+    taken_new, taken_old = set(), set()
+    for _, i, j in pairs:
+        if i not in taken_new and j not in taken_old:
+            taken_new.add(i)
+            taken_old.add(j)
+    return [i for i in range(len(new_hz)) if i not in taken_new]
 
 
 def _noise_weighted(data: DftLines, model: ModalModel) -> DftLines:
