@@ -53,6 +53,20 @@ def _candidates(diagram, modes: pd.DataFrame, band, nas, cluster_freq, cluster_d
     return [(f, x) for _, f, x in sorted(found, reverse=True)[:MAX_CANDIDATES]]
 
 
+def _stable_in_diagram(diagram, band, cluster_freq: float, cluster_damping: float):
+    """``supported(f, x)``: kept poles of at least :data:`CANDIDATE_MIN_ORDERS` orders of the
+    diagram lie within the clustering's reach of frequency ``f`` (Hz) and damping ``x``."""
+    cand = candidate_poles(diagram.poles, band)
+    kept = cand[(cand.rejected == "") & (cand.damping > 0)]
+    f, x, na = kept.freq_hz.to_numpy(), kept.damping.to_numpy(), kept.na.to_numpy()
+
+    def supported(freq_hz: float, damping: float) -> bool:
+        near = (np.abs(f / freq_hz - 1) <= cluster_freq) & (np.abs(x / damping - 1) <= cluster_damping)
+        return len(set(na[near].tolist())) >= CANDIDATE_MIN_ORDERS
+
+    return supported
+
+
 def counted_modes(diagram, modes: pd.DataFrame, band_hz, hold: str, nas, clustering, band=None):
     """Count the modes from the selection's and return them as the selection reports modes.
 
@@ -82,7 +96,10 @@ def counted_modes(diagram, modes: pd.DataFrame, band_hz, hold: str, nas, cluster
     data = DftLines.from_recording(diagram.recording, band_hz)
     candidates = _candidates(diagram, modes, band, nas, *clustering)
     halves = tuple(DftLines.from_recording(half, band_hz) for half in split_segments(diagram.recording, 2))
-    count = count_modes(data, modes.freq_hz, modes.damping, candidates, hold=hold, halves=halves)
+    supported = _stable_in_diagram(diagram, band, *clustering)
+    count = count_modes(
+        data, modes.freq_hz, modes.damping, candidates, hold=hold, halves=halves, supported=supported
+    )
     keep = reported(count.model, data.band_hz)
     rows = [_row(modes, count, i, hold) for i in np.flatnonzero(keep)]
     out = pd.DataFrame(rows) if rows else modes.iloc[0:0].copy()

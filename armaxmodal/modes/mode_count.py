@@ -29,6 +29,7 @@ that number. On a simulated record with white noise it is 1 and the criterion is
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -190,9 +191,13 @@ class _Search:
         doublet standing for a frequency that moves during the record, not a mode."""
         if model is None:
             return False
-        band = (model.freq_hz >= self.data.band_hz[0]) & (model.freq_hz <= self.data.band_hz[1])
-        physical = band & (model.damping <= MAX_DAMPING)
+        physical = self.physical(model)
         return bool(np.all(model.damping[physical] - Z95 * model.damping_sd[physical] > 0))
+
+    def physical(self, model: ModalModel) -> np.ndarray:
+        """Per pole: in the band and damped as a vibration mode can be."""
+        band = (model.freq_hz >= self.data.band_hz[0]) & (model.freq_hz <= self.data.band_hz[1])
+        return band & (model.damping <= MAX_DAMPING)
 
     def in_both_halves(self, current: ModalModel, trial: ModalModel, halves) -> bool:
         """The larger model is preferred on each half of the record too, each fitted there from
@@ -295,6 +300,7 @@ def count_modes(
     hold: str = "bandlimited",
     max_nfev: int = 40,
     halves: tuple[DftLines, ...] = (),
+    supported: Callable[[float, float], bool] | None = None,
 ) -> ModeCount:
     """Choose the number of modes by nested tests of free refits (see the module notes).
 
@@ -313,6 +319,10 @@ def count_modes(
     halves : tuple of DftLines
         The lines of the record's two halves: an addition the whole record accepts must be
         preferred on each (:meth:`_Search.in_both_halves`). Empty: not asked.
+    supported : callable, optional
+        ``supported(freq_hz, damping)``: is a pole there stable across the model orders of the
+        diagram? An addition's new poles must be (a ghost that soaks up a nonlinearity beside a
+        real mode is no stable pole of any ARMAX order). None: not asked.
 
     Returns
     -------
@@ -325,12 +335,25 @@ def count_modes(
     start_model = fit_modal_model(data, start_model.freq_hz, start_model.damping, hold, max_nfev)
     fraction = effective_fraction(start_model.residual)
     search = _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev)
-    current, steps, candidates, unconfirmed = start_model, [], list(candidates), []
+    # a starting mode the free fit carried away (a weak mode's pole to beyond the band) is tried
+    # again as an addition
+    lost = [(f, x) for f, x in zip(np.atleast_1d(freq_hz), np.atleast_1d(damping), strict=True)
+            if np.min(np.abs(np.log(start_model.freq_hz / f))) > SAME_MODE_FREQ]  # fmt: skip
+    current, steps, candidates, unconfirmed = start_model, [], list(candidates) + lost, []
+
+    def admissible(model: ModalModel | None) -> bool:
+        """A larger model's new poles are modes: damping resolved, and stable across the diagram's
+        orders where the caller says what is (``supported``)."""
+        if not search.resolved(model):
+            return False
+        new = [i for i in _new_poles(current.freq_hz, model.freq_hz) if search.physical(model)[i]]
+        return supported is None or all(supported(model.freq_hz[i], model.damping[i]) for i in new)
+
     while True:
         here = search.bic(current)
         removed = search.removals(current)
         added = search.additions(current, candidates + [residual_peak(current, data)])
-        best_removal, best_addition = search.best(removed), search.best(added, search.resolved)
+        best_removal, best_addition = search.best(removed), search.best(added, admissible)
         if best_addition is not None and search.bic(best_addition[2]) < here and halves:
             if not search.in_both_halves(current, best_addition[2], halves):
                 unconfirmed.append(best_addition[1])
