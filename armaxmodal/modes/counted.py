@@ -14,6 +14,7 @@ import pandas as pd
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
 from armaxmodal.modes.modal_model import DAMPING_BOUNDS, DftLines
 from armaxmodal.modes.mode_count import DECISIVE_BIC, ModeCount, count_modes
+from armaxmodal.modes.poles import SHARED
 from armaxmodal.modes.spread import split_segments
 from armaxmodal.notes import QualityWarning
 from armaxmodal.stats import MAX_DAMPING, Z95
@@ -54,10 +55,14 @@ def _candidates(diagram, modes: pd.DataFrame, band, nas, cluster_freq, cluster_d
 
 
 def _stable_in_diagram(diagram, band, cluster_freq: float, cluster_damping: float):
-    """``supported(f, x)``: kept poles of at least :data:`CANDIDATE_MIN_ORDERS` orders of the
-    diagram lie within the clustering's reach of frequency ``f`` (Hz) and damping ``x``."""
-    cand = candidate_poles(diagram.poles, band)
-    kept = cand[(cand.rejected == "") & (cand.damping > 0)]
+    """``supported(f, x)``: poles of at least :data:`CANDIDATE_MIN_ORDERS` orders of the diagram
+    lie within the clustering's reach of frequency ``f`` (Hz) and damping ``x``. Poles rejected
+    for their residue count: stability across orders is the pole's, and a weakly driven mode (a
+    light chain's 9.32 Hz, rejected as a negligible residue at every order) is still a mode."""
+    poles = diagram.poles[diagram.poles.source == SHARED]
+    if band is not None:
+        poles = poles[(poles.freq_hz >= band[0]) & (poles.freq_hz <= band[1])]
+    kept = poles[poles.damping > 0]
     f, x, na = kept.freq_hz.to_numpy(), kept.damping.to_numpy(), kept.na.to_numpy()
 
     def supported(freq_hz: float, damping: float) -> bool:
