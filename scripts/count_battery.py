@@ -186,8 +186,9 @@ def main() -> None:
         tally["wrong_flagged"] += (not ok) and sel.quality != "good"
         tally["right_flagged"] += ok and sel.quality != "good"
         print(f"{name}: exact {np.round(truth.freq_hz, 2).tolist()} (bounds {np.round(100 * crb_f, 1).tolist()} %)")
+        because = getattr(sel, "uncertain_because", [])  # the verdict's reasons (absent before the ML step)
         print(f"    found {np.round(sel.modes.freq_hz, 2).tolist()} damping {np.round(sel.modes.damping, 3).tolist()}"
-              f" quality {sel.quality} {sel.uncertain_because} | {'right' if ok else 'WRONG: ' + '; '.join(why)}"
+              f" quality {sel.quality} {because} | {'right' if ok else 'WRONG: ' + '; '.join(why)}"
               f" | {cpu:.1f} CPU-s", flush=True)  # fmt: skip
     wrong = tally["cases"] - tally["right"]
     print(f"\n{tally['right']}/{tally['cases']} right; of {wrong} wrong, {tally['wrong_flagged']} say poor or "

@@ -55,7 +55,7 @@ def test_chapter2_system(fixtures_dir):
     df, dx = _errors(selection, am.chapter2_system())
     assert np.all(np.abs(df) < FREQ_RTOL) and np.all(np.abs(dx) < DAMPING_RTOL), (df, dx)
     # a held input: the data choose the zero-order hold and the exact ARMAX values stay
-    assert selection.refinement.hold == "zoh" and set(selection.modes.estimator) == {"armax"}
+    assert selection.refinement.hold == "zoh" and set(selection.modes.estimator) == {"ml-zoh"}
     # the reported values are those of a converged fit at the representative order (the
     # sweep stops its fits early): a fit from scratch agrees within a tenth of an SE
     for m in selection.modes.itertuples():

@@ -345,7 +345,7 @@ def test_the_selection_reports_what_it_should(ride, diagram):
     s, _ = ride
     sel = select_modes(diagram, n_jobs=1, segments=2)
     assert "index" not in sel.modes.columns and list(sel.modes.index) == [0, 1]
-    assert set(sel.modes.estimator) == {"armax"} and sel.refinement.hold == "zoh"  # a held input
+    assert set(sel.modes.estimator) == {"ml-zoh"} and sel.refinement.hold == "zoh"  # a held input: its exact class
     assert (sel.modes.segments_found == 2).all() and sel.modes.freq_segment_sd.notna().all()
     # the ARMAX standard deviations are the converged fit's, taken from its 95 % intervals
     rec = diagram.recording
