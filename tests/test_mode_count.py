@@ -184,3 +184,23 @@ def test_the_likelihood_does_not_depend_on_the_weights(supine):
                         max_nfev=1)  # fmt: skip
     assert b.neg2_loglik == pytest.approx(a.neg2_loglik, abs=1e-6 * abs(a.neg2_loglik))
     np.testing.assert_allclose(b.rss, a.rss, rtol=1e-9)
+
+
+def test_a_long_record_is_counted_on_its_start_and_fitted_whole(monkeypatch, fixtures_dir):
+    """Past :data:`COUNT_MAX_SAMPLES` the search runs on the record's start and the chosen model
+    is fitted to the whole record: the bundled ride counted on its first half gives the exact
+    modes, with intervals from all of it (narrower than the half's own)."""
+    import armaxmodal.modes.counted as counted
+
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    diagram = am.stabilisation_diagram(rec, range(2, 21, 2), per_sensor=False)
+    whole = am.select_modes(diagram, segments=0)
+    monkeypatch.setattr(counted, "COUNT_MAX_SAMPLES", rec.n_samples // 2)
+    part = am.select_modes(diagram, segments=0)
+    exact = am.supine_human().modes()
+    assert len(part.modes) == 4
+    assert np.all(np.abs(part.modes.freq_hz / exact.freq_hz - 1) < FREQ_TOL)
+    # the same whole-record fit from a start the half chose: the same modes, the same intervals
+    np.testing.assert_allclose(part.modes.freq_hz, whole.modes.freq_hz, rtol=2e-3)
+    width = lambda s: (s.modes.freq_ci95_hi - s.modes.freq_ci95_lo).to_numpy()  # noqa: E731
+    np.testing.assert_allclose(width(part), width(whole), rtol=0.05)

@@ -12,8 +12,8 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
-from armaxmodal.modes.modal_model import DAMPING_BOUNDS, DftLines
-from armaxmodal.modes.mode_count import DECISIVE_BIC, ModeCount, count_modes
+from armaxmodal.modes.modal_model import DAMPING_BOUNDS, DftLines, fit_modal_model
+from armaxmodal.modes.mode_count import DECISIVE_BIC, FINAL_NFEV, ModeCount, count_modes
 from armaxmodal.modes.poles import SHARED
 from armaxmodal.modes.spread import split_segments
 from armaxmodal.notes import QualityWarning
@@ -28,6 +28,9 @@ SAME_ROW_FREQ = 0.05
 #: a line, a periodic disturbance or a frequency that moves, not a mode (the supine ride's 0.3 m/s^2
 #: hum at 12.5 Hz came out at 12.500 Hz, damping 1e-4; the bodies' modes are damped 0.3 % and more)
 LINE_DAMPING = 2 * DAMPING_BOUNDS[0]
+#: the nested tests run on at most this many samples of a record (18 min at 60 Hz, 9 at 120 Hz:
+#: every body's modes are counted on less); a longer record's chosen model is fitted whole
+COUNT_MAX_SAMPLES = 65_536
 #: left-out clusters of the diagram tried as additions: the largest few (each costs a fit)
 MAX_CANDIDATES = 3
 #: a left-out cluster is a candidate when it holds poles of at least this many orders
@@ -72,6 +75,17 @@ def _stable_in_diagram(diagram, band, cluster_freq: float, cluster_damping: floa
     return supported
 
 
+def _on_whole_record(count: ModeCount, rec, band_hz, hold: str) -> ModeCount:
+    """The counted model fitted to the whole record from where the search left it."""
+    from dataclasses import replace
+
+    whole = DftLines.from_recording(rec, band_hz)
+    start = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, max_nfev=1)
+    level = np.sqrt(start.rss / start.n_real)
+    whole = whole.weighted(1.0 / np.where(level > 0, level, 1.0))
+    return replace(count, model=fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, FINAL_NFEV))
+
+
 def counted_modes(diagram, modes: pd.DataFrame, band_hz, hold: str, nas, clustering, band=None):
     """Count the modes from the selection's and return them as the selection reports modes.
 
@@ -98,13 +112,19 @@ def counted_modes(diagram, modes: pd.DataFrame, band_hz, hold: str, nas, cluster
     count : ModeCount
     notes : list of QualityWarning
     """
-    data = DftLines.from_recording(diagram.recording, band_hz)
+    rec = diagram.recording
+    # the search runs on the record's first COUNT_MAX_SAMPLES; the chosen model is then fitted
+    # to the whole record, so a long ride costs one fit more, not a search more
+    part = rec if rec.n_samples <= COUNT_MAX_SAMPLES else split_segments(rec, rec.n_samples // COUNT_MAX_SAMPLES)[0]
+    data = DftLines.from_recording(part, band_hz)
     candidates = _candidates(diagram, modes, band, nas, *clustering)
-    halves = tuple(DftLines.from_recording(half, band_hz) for half in split_segments(diagram.recording, 2))
+    halves = tuple(DftLines.from_recording(half, band_hz) for half in split_segments(part, 2))
     supported = _stable_in_diagram(diagram, band, *clustering)
     count = count_modes(
         data, modes.freq_hz, modes.damping, candidates, hold=hold, halves=halves, supported=supported
     )
+    if part is not rec:
+        count = _on_whole_record(count, rec, band_hz, hold)
     keep = reported(count.model, data.band_hz)
     rows = [_row(modes, count, i, hold) for i in np.flatnonzero(keep)]
     out = pd.DataFrame(rows) if rows else modes.iloc[0:0].copy()

@@ -46,6 +46,9 @@ DAMPING_BOUNDS = (1e-4, 0.95)
 #: 120 s ride of five sensors, far below the criterion's decisive 10, and the parameters by
 #: a thousandth of their standard error (0.1-2 % of a frequency)
 FIT_TOL = 1e-6
+#: up to this many real numbers (lines x 2 x sensors) a fit's Jacobian is built for every sensor
+#: at once (2 MB a parameter at the limit); beyond, a sensor at a time
+ALL_ROWS_AT_ONCE = 250_000
 
 
 @dataclass(frozen=True)
@@ -178,10 +181,14 @@ class _GramCompressed:
 
     def _factor(self, x):
         if self._x is None or not np.array_equal(x, self._x):
-            # all sensors' rows at once: the derivative of the basis is built once, not per sensor
-            # as refine's memory-bound rows are (a one-hour ride's are 20 MB a mode here)
-            jac, resid = self.model.jacobian(x), self.model.residual(x)
-            gram, grad, power = jac.T @ jac, jac.T @ resid, resid @ resid
+            if self.model.b.size <= ALL_ROWS_AT_ONCE:
+                # all sensors' rows at once: the basis's derivative is built once, not per sensor
+                rows = [(self.model.jacobian(x), self.model.residual(x))]
+            else:  # a long record: one sensor's rows at a time (memory), as refine's fits do
+                rows = self.model.sensor_rows(x)
+            gram, grad, power = 0.0, 0.0, 0.0
+            for jac, resid in rows:
+                gram, grad, power = gram + jac.T @ jac, grad + jac.T @ resid, power + resid @ resid
             gram = gram + 1e-12 * np.trace(gram) * np.eye(x.size) / x.size  # a null direction stays solvable
             r = scipy.linalg.cholesky(gram, lower=False, check_finite=False)
             top = scipy.linalg.solve_triangular(r, grad, trans="T", check_finite=False)
