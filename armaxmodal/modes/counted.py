@@ -126,27 +126,9 @@ def counted_modes(diagram, modes: pd.DataFrame, band_hz, hold: str, nas, cluster
     if part is not rec:
         count = _on_whole_record(count, rec, band_hz, hold)
     keep = reported(count.model, data.band_hz)
-    m = count.model
-    unstable = keep & ~np.array([supported(f, x) for f, x in zip(m.freq_hz, m.damping, strict=True)], dtype=bool)
-    keep &= ~unstable
     rows = [_row(modes, count, i, hold) for i in np.flatnonzero(keep)]
     out = pd.DataFrame(rows) if rows else modes.iloc[0:0].copy()
-    return out, m.shapes[:, keep], count, _notes(count, keep, data.band_hz) + _unstable_notes(m, unstable)
-
-
-def _unstable_notes(model, unstable: np.ndarray) -> list[QualityWarning]:
-    """A note for the poles the modal model needs that no order of the diagram holds."""
-    if not unstable.any():
-        return []
-    listed = ", ".join(f"{f:.3g} Hz (damping {x:.3f})" for f, x in zip(model.freq_hz[unstable],
-                                                                     model.damping[unstable], strict=True))
-    return [QualityWarning(
-        "mode_count", (),
-        f"{int(unstable.sum())} pole(s) of the modal model are stable at no {CANDIDATE_MIN_ORDERS} orders of the "
-        f"diagram: {listed}. They stand for what the modal sum lacks (a nonlinearity, a second input, a "
-        "time change) and are not reported as modes",
-        float(unstable.sum()),
-    )]  # fmt: skip
+    return out, count.model.shapes[:, keep], count, _notes(count, keep, data.band_hz)
 
 
 def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str) -> dict:
@@ -200,11 +182,10 @@ def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
             f"one mode more near {f:.3f} Hz fits the whole record better but not each of its halves: a change "
             "during the record (a drifting frequency, a transient, a nonlinearity), not a mode; left out", f,
         ))  # fmt: skip
-    beyond = ~reported(count.model, band_hz)
-    hidden = int(beyond.sum())
+    hidden = int((~keep).sum())
     if hidden:
-        out = ", ".join(f"{f:.3g} Hz (damping {x:.2f})" for f, x in zip(count.model.freq_hz[beyond],
-                                                                      count.model.damping[beyond], strict=True))
+        out = ", ".join(f"{f:.3g} Hz (damping {x:.2f})" for f, x in zip(count.model.freq_hz[~keep],
+                                                                      count.model.damping[~keep], strict=True))
         notes.append(QualityWarning(
             "mode_count", (),
             f"{hidden} pole(s) of the modal model lie outside the band {band_hz[0]:.3g}-{band_hz[1]:.3g} Hz, are "
