@@ -186,14 +186,30 @@ def test_the_likelihood_does_not_depend_on_the_weights(supine):
     np.testing.assert_allclose(b.rss, a.rss, rtol=1e-9)
 
 
-def test_a_long_record_is_counted_on_its_start_and_fitted_whole(monkeypatch, fixtures_dir):
+@pytest.fixture(scope="module")
+def bundled_diagram(fixtures_dir):
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    return am.stabilisation_diagram(rec, range(2, 21, 2), per_sensor=False)
+
+
+def test_a_model_that_keeps_no_mode_leaves_the_selection_and_says_so(monkeypatch, bundled_diagram):
+    import armaxmodal.modes.counted as counted
+
+    before = am.select_modes(bundled_diagram, segments=0)
+    monkeypatch.setattr(counted, "reported", lambda model, band: np.zeros(model.freq_hz.size, dtype=bool))
+    sel = am.select_modes(bundled_diagram, segments=0)
+    assert len(sel.modes) == len(before.modes) == 4 and sel.quality == "uncertain"
+    assert "count_undecided" in sel.uncertain_because
+
+
+def test_a_long_record_is_counted_on_its_start_and_fitted_whole(monkeypatch, bundled_diagram):
     """Past :data:`COUNT_MAX_SAMPLES` the search runs on the record's start and the chosen model
     is fitted to the whole record: the bundled ride counted on its first half gives the exact
     modes, with intervals from all of it (narrower than the half's own)."""
     import armaxmodal.modes.counted as counted
 
-    rec = am.read_recording(fixtures_dir / "supine_random.csv")
-    diagram = am.stabilisation_diagram(rec, range(2, 21, 2), per_sensor=False)
+    diagram = bundled_diagram
+    rec = diagram.recording
     whole = am.select_modes(diagram, segments=0)
     monkeypatch.setattr(counted, "COUNT_MAX_SAMPLES", rec.n_samples // 2)
     part = am.select_modes(diagram, segments=0)

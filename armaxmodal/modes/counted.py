@@ -108,7 +108,9 @@ def counted_modes(diagram, modes: pd.DataFrame, band_hz, hold: str, nas, cluster
     Returns
     -------
     modes : DataFrame
-    shapes : (n_sensors, n_modes) complex ndarray
+    shapes : (n_sensors, n_modes) complex ndarray, or None
+        None when the model keeps no mode in the band: ``modes`` is then the selection's, and
+        the note says so (``count_undecided``).
     count : ModeCount
     notes : list of QualityWarning
     """
@@ -126,9 +128,21 @@ def counted_modes(diagram, modes: pd.DataFrame, band_hz, hold: str, nas, cluster
     if part is not rec:
         count = _on_whole_record(count, rec, band_hz, hold)
     keep = reported(count.model, data.band_hz)
+    if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
+        return modes, None, count, [_no_mode_kept(count, modes, data.band_hz)]
     rows = [_row(modes, count, i, hold) for i in np.flatnonzero(keep)]
-    out = pd.DataFrame(rows) if rows else modes.iloc[0:0].copy()
-    return out, count.model.shapes[:, keep], count, _notes(count, keep, data.band_hz)
+    return pd.DataFrame(rows), count.model.shapes[:, keep], count, _notes(count, keep, data.band_hz)
+
+
+def _no_mode_kept(count: ModeCount, modes: pd.DataFrame, band_hz) -> QualityWarning:
+    poles = ", ".join(f"{f:.3g} Hz (damping {x:.2f})" for f, x in zip(count.model.freq_hz, count.model.damping,
+                                                                    strict=True))
+    return QualityWarning(
+        "count_undecided", (),
+        f"the maximum-likelihood modal model keeps no mode in {band_hz[0]:.3g}-{band_hz[1]:.3g} Hz (its poles: "
+        f"{poles or 'none'}); the {len(modes)} mode(s) of the diagram's selection are reported, unconfirmed by it",
+        float(len(modes)),
+    )
 
 
 def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str) -> dict:

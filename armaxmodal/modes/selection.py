@@ -255,9 +255,11 @@ def select_modes(
         count = None
         if n_modes is None and refinement is not None and len(modes):
             # the last word on the number of modes: nested tests of the modal model with every pole free
-            modes, shapes, count, more = counted_modes(
+            counted, counted_shapes, count, more = counted_modes(
                 diagram, modes, refinement.band_hz, refinement.hold, nas, (cluster_freq, cluster_damping), band
             )
+            if counted_shapes is not None:
+                modes, shapes = counted, counted_shapes
             notes += more + _not_separated(modes)
             bar.update(count.trials)
             check = check_modes(diagram.recording, modes.freq_hz, modes.damping, band)
