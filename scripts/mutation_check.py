@@ -526,15 +526,15 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/mode_count.py",
-        "            if not large.bic(n_eff) < small.bic(n_eff):\n                return False",
-        "            if not large.bic(n_eff) < small.bic(n_eff):\n                pass",
-        "the halves' test ignored (count)",
+        "if abs(one[j] - two[k]) > HALVES_SD * np.hypot(sd_one[j], sd_two[k]):",
+        "if abs(one[j] - two[k]) > 1e9 * HALVES_SD * np.hypot(sd_one[j], sd_two[k]):",
+        "the halves' agreement ignored (count)",
     ),
     (
         "armaxmodal/modes/mode_count.py",
-        "return self.removal_rise < DECISIVE_BIC",
-        "return self.removal_rise > DECISIVE_BIC",
-        "undecided flag inverted (count)",
+        "rise = np.array([search.bic(t[2]) - here for t in removed])",
+        "rise = np.array([here - search.bic(t[2]) for t in removed])",
+        "the removal rise's sign (count)",
     ),
     (
         "armaxmodal/modes/counted.py",

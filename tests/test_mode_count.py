@@ -220,3 +220,40 @@ def test_a_long_record_is_counted_on_its_start_and_fitted_whole(monkeypatch, bun
     np.testing.assert_allclose(part.modes.freq_hz, whole.modes.freq_hz, rtol=2e-3)
     width = lambda s: (s.modes.freq_ci95_hi - s.modes.freq_ci95_lo).to_numpy()  # noqa: E731
     np.testing.assert_allclose(width(part), width(whole), rtol=0.05)
+
+
+class _Scored:
+    """A stand-in fit whose criterion depends on its number of modes only: the search's own
+    rules, apart from the fits, against a known answer."""
+
+    def __init__(self, freq_hz, damping, table):
+        order = np.argsort(freq_hz)
+        self.freq_hz, self.damping = np.asarray(freq_hz, float)[order], np.asarray(damping, float)[order]
+        self.freq_sd, self.damping_sd = 1e-3 * self.freq_hz, 1e-3 * np.ones_like(self.freq_hz)
+        self.n_real, self.rss, self.table = 100, np.ones(4), table  # the supine ride: 4 sensors
+        self.residual = np.random.default_rng(0).standard_normal((50, 2)) + 0j
+
+    @property
+    def n_modes(self):
+        return self.freq_hz.size
+
+    def bic(self, n_effective=None):
+        return self.table[self.n_modes]
+
+
+@pytest.mark.parametrize("start", [2, 3, 4])
+def test_the_search_takes_only_steps_that_lower_the_criterion(monkeypatch, supine, start):
+    """Criterion 100, 95, 97 for 2, 3, 4 modes: from any start the search ends at 3, having
+    taken only steps that lower the criterion; the removal and the addition from 3 are 5 and 2
+    units worse, so both are undecided (under 10)."""
+    import armaxmodal.modes.mode_count as mode_count
+
+    table = {1: 120.0, 2: 100.0, 3: 95.0, 4: 97.0, 5: 99.0}
+    monkeypatch.setattr(mode_count, "fit_modal_model", lambda data, f, x, hold, n=40: _Scored(f, x, table))
+    data, _ = supine
+    f, x = np.array([5.0, 9.0, 13.0, 17.0][:start]), np.full(start, 0.3)
+    count = count_modes(data, f, x, hold="zoh")
+    assert count.model.n_modes == 3
+    assert len(count.steps) == abs(start - 3) and all(s.bic_fall > 0 for s in count.steps)
+    np.testing.assert_allclose(count.removal_rise, 5.0)
+    assert count.best_addition == pytest.approx(-2.0)

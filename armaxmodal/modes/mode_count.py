@@ -109,17 +109,6 @@ class ModeCount:
     trials: int = field(default=0)
     unconfirmed_hz: tuple[float, ...] = ()
 
-    @property
-    def undecided(self) -> np.ndarray:
-        """Per mode: the record does not decide whether it is there (removal rise below
-        :data:`DECISIVE_BIC`)."""
-        return self.removal_rise < DECISIVE_BIC
-
-    @property
-    def addition_undecided(self) -> bool:
-        """A candidate mode the record neither needs nor rules out."""
-        return bool(-DECISIVE_BIC < self.best_addition <= 0) or bool(self.best_addition > 0)
-
 
 def effective_fraction(residual: np.ndarray, max_lag: int = MAX_CORRELATION_LAG) -> float:
     """The fraction of DFT lines that are independent, from the residual's correlation across
@@ -199,30 +188,19 @@ class _Search:
         band = (model.freq_hz >= self.data.band_hz[0]) & (model.freq_hz <= self.data.band_hz[1])
         return band & (model.damping <= MAX_DAMPING)
 
-    def in_both_halves(self, current: ModalModel, trial: ModalModel, halves) -> bool:
-        """The larger model is preferred on each half of the record too, each fitted there from
-        the whole record's values, and its new poles have the same frequency and damping in
-        both halves (within :data:`HALVES_SD` standard deviations of the difference): a mode
-        of the structure is the same mode in both halves, while a pole that soaks up a change
-        during the record or a nonlinearity (a drifting frequency, a doublet beside a real
-        mode) lands elsewhere in each."""
-        fits = []
-        for half in halves:
-            half = half.weighted(self.data.weights)
-            n_eff = self.n_eff * half.n_real / self.data.n_real
-            small = fit_modal_model(half, current.freq_hz, current.damping, self.hold, self.max_nfev)
-            large = fit_modal_model(half, trial.freq_hz, trial.damping, self.hold, self.max_nfev)
-            self.trials += 2
-            if not large.bic(n_eff) < small.bic(n_eff):
-                return False
-            fits.append(large)
-        if len(fits) != 2:
-            return True
-        a, b = fits
-        for i in _new_poles(current.freq_hz, trial.freq_hz):
+    def in_both_halves(self, trial: ModalModel, new: list[int], halves) -> bool:
+        """The new poles of ``trial`` (indices ``new``) have the same frequency and damping in
+        each half of the record, the model fitted there from the whole record's values, within
+        :data:`HALVES_SD` standard deviations of the difference: a mode of the structure is the
+        same mode in both halves, while a pole that soaks up a change during the record or a
+        nonlinearity (a drifting frequency, a doublet beside a real mode) lands elsewhere."""
+        a, b = (fit_modal_model(h.weighted(self.data.weights), trial.freq_hz, trial.damping, self.hold,
+                                self.max_nfev) for h in halves)  # fmt: skip
+        self.trials += 2
+        for i in new:
             j, k = _nearest(a.freq_hz, trial.freq_hz[i]), _nearest(b.freq_hz, trial.freq_hz[i])
-            for one, two in ((a.freq_hz, b.freq_hz), (a.damping, b.damping)):
-                sd_one, sd_two = (a.freq_sd, b.freq_sd) if one is a.freq_hz else (a.damping_sd, b.damping_sd)
+            for one, two, sd_one, sd_two in ((a.freq_hz, b.freq_hz, a.freq_sd, b.freq_sd),
+                                             (a.damping, b.damping, a.damping_sd, b.damping_sd)):  # fmt: skip
                 if abs(one[j] - two[k]) > HALVES_SD * np.hypot(sd_one[j], sd_two[k]):
                     return False
         return True
@@ -320,8 +298,8 @@ def count_modes(
     max_nfev : int
         Cap on residual evaluations per fit.
     halves : tuple of DftLines
-        The lines of the record's two halves: an addition the whole record accepts must be
-        preferred on each (:meth:`_Search.in_both_halves`). Empty: not asked.
+        The lines of the record's two halves: the new poles of an addition the whole record
+        accepts must be the same in each (:meth:`_Search.in_both_halves`). Empty: not asked.
     supported : callable, optional
         ``supported(freq_hz, damping)``: is a pole there stable across the model orders of the
         diagram? An addition's new poles must be (a ghost that soaks up a nonlinearity beside a
@@ -358,8 +336,9 @@ def count_modes(
         peak = residual_peak(current, data)
         added = search.additions(current, candidates + [peak], peak[0])
         best_removal, best_addition = search.best(removed), search.best(added, admissible)
-        if best_addition is not None and search.bic(best_addition[2]) < here and halves:
-            if not search.in_both_halves(current, best_addition[2], halves):
+        if best_addition is not None and search.bic(best_addition[2]) < here and len(halves) == 2:
+            new = _new_poles(current.freq_hz, best_addition[2].freq_hz)
+            if not search.in_both_halves(best_addition[2], new, halves):
                 unconfirmed.append(best_addition[1])
                 best_addition = None
         better = [t for t in (best_removal, best_addition) if t is not None and search.bic(t[2]) < here]
