@@ -183,6 +183,14 @@ class _Search:
         physical = self.physical(model)
         return bool(np.all(model.damping[physical] - Z95 * model.damping_sd[physical] > 0))
 
+    def admissible(self, model: ModalModel | None, current: ModalModel, supported) -> bool:
+        """A larger model's new poles are modes: damping resolved, and stable across the diagram's
+        orders where the caller says what is (``supported``)."""
+        if not self.resolved(model):
+            return False
+        new = [i for i in _new_poles(current.freq_hz, model.freq_hz) if self.physical(model)[i]]
+        return supported is None or all(supported(model.freq_hz[i], model.damping[i]) for i in new)
+
     def physical(self, model: ModalModel) -> np.ndarray:
         """Per pole: in the band and damped as a vibration mode can be."""
         band = (model.freq_hz >= self.data.band_hz[0]) & (model.freq_hz <= self.data.band_hz[1])
@@ -230,6 +238,24 @@ class _Search:
             pair_x = np.r_[np.delete(current.damping, m), x / 2, x / 2]
             out.append(("split", float(f), self.fit(pair_f, pair_x, SCREEN_NFEV)))
         return out
+
+
+def _margins(search: _Search, here: float, current: ModalModel, removed, best_removal, best_addition):
+    """``(rise, gain, new_hz)``: each removal's rise of the criterion (the screened one, or the
+    best one's converged: screening stops short, so a screened rise is at least the converged
+    one), the best addition's fall, and where its new pole settled (the one farthest from the
+    current modes)."""
+    rise = np.array([search.bic(t[2]) - here for t in removed])
+    if best_removal is not None:
+        at = int(np.argmin(rise))
+        rise[at] = min(rise[at], search.bic(best_removal[2]) - here)
+    gain, new_hz = -np.inf, np.nan
+    if best_addition is not None and best_addition[2] is not None:
+        gain = here - search.bic(best_addition[2])
+        model = best_addition[2]
+        dist = [np.min(np.abs(current.freq_hz / f - 1)) if current.n_modes else 1.0 for f in model.freq_hz]
+        new_hz = float(model.freq_hz[int(np.argmax(dist))])
+    return rise, gain, new_hz
 
 
 def _nearest(freq_hz: np.ndarray, f: float) -> int:
@@ -323,12 +349,7 @@ def count_modes(
     current, steps, candidates, unconfirmed = start_model, [], list(candidates) + lost, []
 
     def admissible(model: ModalModel | None) -> bool:
-        """A larger model's new poles are modes: damping resolved, and stable across the diagram's
-        orders where the caller says what is (``supported``)."""
-        if not search.resolved(model):
-            return False
-        new = [i for i in _new_poles(current.freq_hz, model.freq_hz) if search.physical(model)[i]]
-        return supported is None or all(supported(model.freq_hz[i], model.damping[i]) for i in new)
+        return search.admissible(model, current, supported)
 
     while True:
         here = search.bic(current)
@@ -347,18 +368,7 @@ def count_modes(
         step = min(better, key=lambda t: search.bic(t[2]))
         steps.append(Step(step[0], step[1], here - search.bic(step[2])))
         current = step[2]
-    # the margins: each removal's screened rise, the best one's converged (screening stops
-    # short, so a screened rise is at least the converged one)
-    rise = np.array([search.bic(t[2]) - here for t in removed])
-    if best_removal is not None:
-        at = int(np.argmin(rise))
-        rise[at] = min(rise[at], search.bic(best_removal[2]) - here)
-    gain, new_hz = -np.inf, np.nan
-    if best_addition is not None and best_addition[2] is not None:
-        gain = here - search.bic(best_addition[2])
-        model = best_addition[2]  # the new pole: the one farthest from the current modes
-        dist = [np.min(np.abs(current.freq_hz / f - 1)) if current.n_modes else 1.0 for f in model.freq_hz]
-        new_hz = float(model.freq_hz[int(np.argmax(dist))])
+    rise, gain, new_hz = _margins(search, here, current, removed, best_removal, best_addition)
     # the reported model is the likelihood's maximum, not where the search's cap left it (a body's
     # fifth mode stood at 23.73 Hz after the search and 24.35 Hz converged, for the exact 25.48)
     search.data = _noise_weighted(data, current)  # the weights the chosen model's own levels give
