@@ -87,7 +87,8 @@ def run(args) -> int:
                 ]
             ].to_string(float_format=lambda v: f"{v:.4f}")
         )
-        print_check(selection.check)
+        if selection.check is not None:
+            print_check(selection.check)
     print_warnings(selection.warnings)
     outputs = _diagram_outputs(args, diagram, selection, plot_format)
     if args.json:
@@ -120,6 +121,8 @@ def print_check(check) -> None:
 def verdict(check, n_modes: int, uncertain_because: list[str] = ()) -> str:
     """The closing line: whether the modes explain the record, and whether the record decides them
     (``uncertain_because``: the codes of the warnings that leave it undecided)."""
+    if n_modes == 0:
+        return "quality: POOR -- no stable mode found: the no_modes note says why each cluster was rejected"
     if check is not None and check.passed and uncertain_because:
         return (
             f"quality: UNCERTAIN -- the {n_modes} selected mode(s) explain the measured FRF, but the record does not "

@@ -91,6 +91,31 @@ def _supported(count: int, n_orders: int, min_support: float) -> bool:
     return count >= 3 and count / n_orders >= min_support
 
 
+def why_no_mode(diagram: StabilisationDiagram, band, nas, min_support: float, cluster_freq: float,
+                cluster_damping: float) -> str:
+    """Why no cluster of the diagram is a mode, in a sentence: the shared poles in the band,
+    those rejected and for what, and how many orders the best-supported cluster of the rest
+    holds against the support a mode needs."""
+    shared = diagram.poles[diagram.poles.source == SHARED]
+    if band is not None:
+        shared = shared[(shared.freq_hz >= band[0]) & (shared.freq_hz <= band[1])]
+    where = f" in {band[0]:g}-{band[1]:g} Hz" if band else ""
+    if shared.empty:
+        return f"no stable mode found{where}: the sweep has no shared pole there"
+    reasons = shared.rejected[shared.rejected != ""].value_counts()
+    said = "; ".join(f"{why}: {n}" for why, n in reasons.items())
+    facts = [f"of {len(shared)} shared poles{where}, {int(reasons.sum())} were rejected{f' ({said})' if said else ''}"]
+    cand = candidate_poles(diagram.poles, band)
+    clusters = cluster_poles(cand[cand.rejected == ""], nas, cluster_freq, cluster_damping)
+    need = max(3, int(np.ceil(min_support * len(nas))))
+    if clusters:
+        best = max(clusters, key=len)
+        f = float(cand.loc[best].freq_hz.median())
+        facts.append(f"the best-supported cluster of the rest ({len(clusters)} in all), at {f:.3g} Hz, holds "
+                     f"poles of {len(best)} of {len(nas)} orders, where a mode needs {need}")  # fmt: skip
+    return f"no stable mode found{where}: " + "; ".join(facts)
+
+
 def candidate_poles(poles: pd.DataFrame, band) -> pd.DataFrame:
     """Shared-pole poles that may form a mode: the kept ones and those whose damping the
     record does not resolve (they count towards support, see :func:`select_modes`)."""

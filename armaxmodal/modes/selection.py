@@ -15,9 +15,8 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal._threads import one_blas_thread
-from armaxmodal.exceptions import OrderError
 from armaxmodal.modal import mode_record
-from armaxmodal.modes.clusters import clustered_modes, merge_duplicates
+from armaxmodal.modes.clusters import clustered_modes, merge_duplicates, why_no_mode
 from armaxmodal.modes.completeness import modes_the_check_adds, modes_the_record_needs, refit_with_added
 from armaxmodal.modes.counted import counted_modes
 from armaxmodal.modes.diagram import StabilisationDiagram
@@ -215,12 +214,9 @@ def select_modes(
         if not modes.empty:
             keep = merge_duplicates(modes, vectors, merge_mac, diagram.recording.duration)
             modes, vectors = modes.loc[keep].reset_index(drop=True), [vectors[i] for i in keep]
-        if modes.empty:
-            raise OrderError(
-                "no stable mode found"
-                + (f" in {band[0]:g}-{band[1]:g} Hz" if band else "")
-                + "; widen the band, extend the order range, or check that the input excites the structure."
-            )
+        if modes.empty:  # a result, not a stop: the diagram, its poles and why each cluster failed
+            why = why_no_mode(diagram, band, nas, min_support, cluster_freq, cluster_damping)
+            return _no_mode_selection(diagram, why)
         order = modes.sort_values(["support", "count", "energy"], ascending=False).index
         if n_modes is not None:
             order = order[:n_modes]
@@ -277,6 +273,23 @@ def select_modes(
         notes += _unresolved_damping_notes(modes, len(nas))
         notes += check.warnings()
         return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement, tuple(notes), check, count)
+
+
+#: the columns of an empty selection (what the command line and the JSON read of a mode)
+_MODE_COLUMNS = ("freq_hz", "damping", "damped_freq_hz", "freq_ci95_lo", "freq_ci95_hi", "damping_ci95_lo",
+                 "damping_ci95_hi", "na", "count", "support", "freq_spread", "damping_spread", "estimator")  # fmt: skip
+
+
+def _no_mode_selection(diagram: StabilisationDiagram, why: str) -> ModeSelection:
+    """The selection of a diagram with no stable mode: no modes, quality ``poor``, and a
+    ``no_modes`` note that says why every cluster was rejected and what to do."""
+    note = QualityWarning(
+        "no_modes", (), f"{why}. Widen the band, extend the order range, or check that the input excites the structure."
+    )
+    empty = pd.DataFrame(columns=list(_MODE_COLUMNS))
+    per_sensor = pd.DataFrame(columns=["sensor", "mode", "own_modal_constant"])
+    shapes = np.zeros((len(diagram.recording.sensors), 0), dtype=complex)
+    return ModeSelection(empty, shapes, per_sensor, pd.DataFrame(columns=["mode"]), diagram, None, (note,), None)
 
 
 #: two modes closer than this many standard deviations of their difference are not separated

@@ -13,6 +13,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from armaxmodal._version import __version__
+from armaxmodal.exceptions import OrderError
 from armaxmodal.recording import Recording
 
 __all__ = ["StudySettings", "analyse_recording"]
@@ -81,6 +82,8 @@ def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[st
             rec.select(sensors), orders, band=settings.band, detrend=settings.detrend, n_jobs=1
         )
         selection = select_modes(diagram, settings.modes, settings.band, n_jobs=1)
+        if selection.modes.empty:  # a recording with no mode is a study's failure row, as before
+            raise OrderError(selection.notes[0].message)
         report = selection.to_dict("per_sensor")
         figure = _thumbnail(diagram, selection)
         lump = _lump(rec, settings)
