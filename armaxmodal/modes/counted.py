@@ -2,8 +2,8 @@
 model (:mod:`armaxmodal.modes.mode_count`), written back as the selection's rows, shapes and notes.
 
 Poles the model needs but that are no modes of the band -- above the fitted band (they stand
-for the modes above it, an upper residual) or damped beyond :data:`armaxmodal.stats.MAX_DAMPING`
--- stay in the model and are not reported.
+for the modes above it, an upper residual), damped beyond :data:`armaxmodal.stats.MAX_DAMPING`,
+or lines at the damping floor -- stay in the model and are not reported.
 """
 
 from __future__ import annotations
@@ -81,8 +81,7 @@ def _on_whole_record(count: ModeCount, rec, band_hz, hold: str) -> ModeCount:
 
     whole = DftLines.from_recording(rec, band_hz)
     start = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, max_nfev=1)
-    level = np.sqrt(start.rss / start.n_real)
-    whole = whole.weighted(1.0 / np.where(level > 0, level, 1.0))
+    whole = whole.noise_weighted(start)
     return replace(count, model=fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, FINAL_NFEV))
 
 

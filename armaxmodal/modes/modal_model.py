@@ -103,6 +103,12 @@ class DftLines:
         band = (float(freq[lines][0]), float(freq[lines][-1]))
         return cls(1j * w, np.exp(-1j * w * dt), u, y, np.ones(y.shape[1]), dt, band)
 
+    def noise_weighted(self, model: ModalModel) -> DftLines:
+        """The same lines with each sensor weighted by one over its noise level as ``model``
+        leaves it (its residual's RMS per real number)."""
+        level = np.sqrt(model.rss / model.n_real)
+        return self.weighted(1.0 / np.where(level > 0, level, 1.0))
+
     def weighted(self, weights: np.ndarray) -> DftLines:
         """The same lines with each sensor multiplied by ``weights`` (replacing the old ones)."""
         y = self.y / self.weights * weights

@@ -274,12 +274,6 @@ def _new_poles(old_hz: np.ndarray, new_hz: np.ndarray) -> list[int]:
     return [i for i in range(len(new_hz)) if i not in taken_new]
 
 
-def _noise_weighted(data: DftLines, model: ModalModel) -> DftLines:
-    """The lines weighted by one over each sensor's noise level as ``model`` leaves it."""
-    level = np.sqrt(model.rss / model.n_real)
-    return data.weighted(1.0 / np.where(level > 0, level, 1.0))
-
-
 def residual_peak(model: ModalModel, data: DftLines, width_lines: int = 9) -> tuple[float, float]:
     """Where the model misses most: the line of the largest residual power (summed over
     sensors, smoothed over ``width_lines``), with a damping from its width; (Hz, ratio)."""
@@ -338,7 +332,7 @@ def count_modes(
     start_model = fit_modal_model(data, freq_hz, damping, hold, max_nfev)
     # each sensor weighted by its noise level as the fitted start leaves it (the likelihood is
     # concentrated over those levels; the weights only steer the fits)
-    data = _noise_weighted(data, start_model)
+    data = data.noise_weighted(start_model)
     start_model = fit_modal_model(data, start_model.freq_hz, start_model.damping, hold, max_nfev)
     fraction = effective_fraction(start_model.residual)
     search = _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev)
@@ -371,7 +365,7 @@ def count_modes(
     rise, gain, new_hz = _margins(search, here, current, removed, best_removal, best_addition)
     # the reported model is the likelihood's maximum, not where the search's cap left it (a body's
     # fifth mode stood at 23.73 Hz after the search and 24.35 Hz converged, for the exact 25.48)
-    search.data = _noise_weighted(data, current)  # the weights the chosen model's own levels give
+    search.data = data.noise_weighted(current)  # the weights the chosen model's own levels give
     final = search.fit(current.freq_hz, current.damping, FINAL_NFEV)
     if search.bic(final) < here:
         rise, gain, current = rise + here - search.bic(final), gain - (here - search.bic(final)), final
