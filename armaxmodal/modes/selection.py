@@ -114,7 +114,7 @@ class ModeSelection:
         if shapes == "shared":
             matrix, flags = self.shapes, np.zeros(self.shapes.shape, dtype=bool)
         else:
-            from armaxmodal.modes.merge import supplement_shapes
+            from armaxmodal.modes.per_sensor import supplement_shapes
 
             matrix, flags = supplement_shapes(self)
         modes = []

@@ -13,7 +13,7 @@ from armaxmodal.study.manifest import Entry, read_manifest
 from armaxmodal.study.output import write_study
 from armaxmodal.study.run import Study, run_study
 from armaxmodal.study.synthetic import make_study
-from armaxmodal.study.tables import StudyTables, build_tables, match_modes
+from armaxmodal.study.tables import StudyTables, build_tables, match_modes, summarise_subjects
 
 __all__ = [
     "Entry",
@@ -26,5 +26,6 @@ __all__ = [
     "match_modes",
     "read_manifest",
     "run_study",
+    "summarise_subjects",
     "write_study",
 ]

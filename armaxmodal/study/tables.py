@@ -1,15 +1,22 @@
 """A study's tables: modes matched across recordings, Table 3.2 per sensor, Table 3.3 per
-subject and across subjects, and the Fig. 3.7 geometric-mean mode shapes."""
+subject and across subjects, and the Fig. 3.7 geometric-mean mode shapes.
+
+:func:`summarise_subjects` is Table 3.3 from per-subject results the caller already has: per
+subject the |M|-weighted frequency and damping (Eqs. 3.35-3.36), then the mean and standard
+deviation over subjects, and the geometric-mean mode-shape magnitudes (Fig. 3.7)."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 from scipy.optimize import linear_sum_assignment
 
-__all__ = ["StudyTables", "build_tables", "match_modes"]
+from armaxmodal.exceptions import DataError
+
+__all__ = ["StudyTables", "build_tables", "match_modes", "summarise_subjects"]
 
 #: a recording's mode is the ride's mode r when their frequencies are within this ratio
 MATCH_RATIO = 1.25
@@ -195,3 +202,44 @@ def _geomean(shapes: pd.DataFrame, sensors) -> pd.DataFrame:
     return out.sort_values(["ride", "mode", "sensor"]).reset_index(drop=True)[
         ["ride", "mode", "sensor", "geomean", "n"]
     ]
+
+
+def summarise_subjects(
+    weighted: Sequence[pd.DataFrame], shapes: Sequence[np.ndarray] | None = None, subjects: Sequence[str] | None = None
+) -> dict:
+    """Table 3.3 and the Fig. 3.7 geometric-mean shapes over subjects.
+
+    Parameters
+    ----------
+    weighted : sequence of DataFrame
+        Per subject, one row per mode with ``freq_hz`` and ``damping`` (the Eq. 3.35-3.36
+        weighted values, e.g. ``ModeSelection.weighted``); every subject must have the
+        same modes in the same order.
+    shapes : sequence of (n_sensors, n_modes) arrays, optional
+        Per subject mode shapes; magnitudes are normalised to a unit largest component.
+    subjects : sequence of str, optional
+
+    Returns
+    -------
+    dict with ``table`` (one row per subject plus ``Average`` and ``SD`` rows, sample SD)
+    and ``shape_geomean`` ((n_sensors, n_modes), when shapes are given).
+    """
+    counts = {len(w) for w in weighted}
+    if len(counts) != 1:
+        raise DataError(
+            f"subjects have different numbers of modes {sorted(counts)}; select the same number "
+            "for each (select_modes(..., n_modes=N), CLI --modes N) before summarising."
+        )
+    names = list(subjects) if subjects is not None else [f"Sub{i + 1}" for i in range(len(weighted))]
+    n_modes = counts.pop()
+    f = np.array([w.freq_hz.to_numpy() for w in weighted], dtype=float)
+    x = np.array([w.damping.to_numpy() for w in weighted], dtype=float)
+    cols = [f"f{i + 1}_hz" for i in range(n_modes)] + [f"damping{i + 1}" for i in range(n_modes)]
+    table = pd.DataFrame(np.hstack([f, x]), index=names, columns=cols)
+    table.loc["Average"] = np.hstack([f.mean(axis=0), x.mean(axis=0)])
+    table.loc["SD"] = np.hstack([f.std(axis=0, ddof=1), x.std(axis=0, ddof=1)])
+    out = {"table": table}
+    if shapes is not None:
+        mags = np.array([np.abs(s) / np.abs(s).max(axis=0, keepdims=True) for s in shapes])
+        out["shape_geomean"] = np.exp(np.mean(np.log(mags), axis=0))
+    return out

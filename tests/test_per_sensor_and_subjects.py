@@ -6,8 +6,9 @@ import pytest
 import armaxmodal as am
 from armaxmodal.exceptions import DataError
 from armaxmodal.modes.diagram import stabilisation_diagram
-from armaxmodal.modes.merge import summarise_subjects, supplement_shapes
+from armaxmodal.modes.per_sensor import supplement_shapes
 from armaxmodal.modes.selection import select_modes
+from armaxmodal.study.tables import summarise_subjects
 from armaxmodal.systems import datasets
 
 # Table 3.3 prints four decimals.
