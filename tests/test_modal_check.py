@@ -124,13 +124,14 @@ def test_a_mode_where_no_h1_is_coherent_is_unconfirmed_and_fails_the_verdict(lig
     """A mode at 24.8 Hz, at the edge of the ride's band where no output responds
     coherently (as the bridge's 20.7 Hz 'mode' inside a low-coherence band): the fit cannot
     see it, so the check cannot pass it."""
-    from armaxmodal.modes.modal_check import confirmed_modes, measured_lines
+    from armaxmodal.modes.lines import coherent_lines
+    from armaxmodal.modes.modal_check import confirmed_modes
 
     s, rec = light_ride
     m = s.modes()
     f, x = np.r_[m.freq_hz, 24.8], np.r_[m.damping, 0.01]
     check = check_modes(rec, f, x)
-    lines = measured_lines(rec, check.nperseg)
+    lines = coherent_lines(rec, check.nperseg)
     assert not any(np.any(np.abs(ln.freq_hz - 24.8) <= 0.5) for ln in lines)  # the premise (4 lines: 0.2 Hz)
     assert confirmed_modes(lines, f, x, rec.fs / check.nperseg).tolist() == [True, True, False]
     assert check.unconfirmed_hz == (24.8,) and not check.passed
@@ -166,10 +167,11 @@ def test_a_refit_may_move_a_mode_halfway_to_its_neighbour_within_twice_the_clust
 
 
 def test_a_mode_is_confirmed_by_a_coherent_line_within_its_half_width_and_four_lines():
-    from armaxmodal.modes.modal_check import CONFIRM_LINES, ModeSupport, _Spectra, confirmed_modes
+    from armaxmodal.modes.lines import CoherentLines
+    from armaxmodal.modes.modal_check import CONFIRM_LINES, ModeSupport, confirmed_modes
 
     f = np.arange(1.0, 2.0001, 0.1)  # coherent lines 1.0-2.0 Hz, 0.1 Hz apart
-    lines = [_Spectra(f, np.ones(f.size, complex), np.full(f.size, 0.01))]
+    lines = [CoherentLines(f, np.ones(f.size, complex), np.full(f.size, 0.01))]
     assert CONFIRM_LINES == 4
     # 0.39 and 0.41 Hz past the last line with no damping: four lines reach 0.40 Hz; a 5 %-damped
     # mode at 2.50 Hz adds its half-power half-width, 0.125 Hz

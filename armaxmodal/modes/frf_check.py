@@ -6,38 +6,17 @@ from __future__ import annotations
 
 import numpy as np
 
+from armaxmodal.modes.lines import PEAK_RESOLUTION, measured_h1, resolving_nperseg
 from armaxmodal.notes import QualityWarning
-from armaxmodal.prepare.frf import coherence, excited_band, welch_spectra
+from armaxmodal.prepare.frf import excited_band
 from armaxmodal.recording import Recording
 from armaxmodal.stats import H1_COHERENCE
 
-__all__ = ["resolving_nperseg", "unexplained_peaks", "coherent_peaks", "peak_support"]
+__all__ = ["unexplained_peaks", "coherent_peaks", "peak_support"]
 
-#: lines per half-power bandwidth of the narrowest mode the comparison needs
-LINES_PER_BANDWIDTH = 4
-#: fewest Welch segments kept (the H1's random error grows as segments get fewer)
-MIN_SEGMENTS = 4
-
-
-def resolving_nperseg(
-    recording: Recording,
-    freq_hz,
-    damping,
-    lines_per_bandwidth: int = LINES_PER_BANDWIDTH,
-    min_segments: int = MIN_SEGMENTS,
-) -> int:
-    """Welch segment length whose line spacing puts ``lines_per_bandwidth`` lines in the
-    half-power bandwidth ``2 xi f`` of the narrowest mode (a power of two, at least 256
-    samples), within the record's ``min_segments`` half-overlapping segments."""
-    bw = 2 * np.min(np.asarray(damping, float) * np.asarray(freq_hz, float)) if len(freq_hz) else 0.0
-    longest = 2 * recording.n_samples // (min_segments + 1)
-    want = recording.fs * lines_per_bandwidth / bw if bw > 0 else longest
-    return int(np.clip(2 ** int(np.ceil(np.log2(max(want, 16)))), min(256, longest), longest))
-
-
-def _measured(recording: Recording, nperseg: int):
-    f, puu, puy, pyy = welch_spectra(recording.base, recording.response, recording.fs, nperseg)
-    return f, puy / puu[:, None], coherence(puu, puy, pyy)
+#: a clear peak is the highest within this many lines either side: the narrowest mode spans
+#: that many at :data:`~armaxmodal.modes.lines.PEAK_RESOLUTION`, a noise bump a line or two
+PEAK_SPAN_LINES = PEAK_RESOLUTION.lines_per_bandwidth
 
 
 def peak_prominences(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -85,12 +64,12 @@ def coherent_peaks(recording: Recording, nperseg: int, band=None) -> list[tuple[
     """Clear, coherent peaks of each sensor's measured FRF: ``(freq_hz, sensor, |H1|)``.
 
     A clear peak: coherence at least 0.8 on it and two lines either side, a third of its
-    height above both neighbouring valleys, the highest within :data:`LINES_PER_BANDWIDTH`
+    height above both neighbouring valleys, the highest within :data:`PEAK_SPAN_LINES`
     lines either side (a mode spans that many lines at the resolution of
     :func:`resolving_nperseg`; a noise bump is a line or two wide), and at least 5 % of the
     sensor's strongest coherent response.
     """
-    f, h, coh = _measured(recording, nperseg)
+    f, h, coh = measured_h1(recording, nperseg)
     lo, hi = band if band is not None else excited_band(recording)
     out = []
     for k, sensor in enumerate(recording.sensors):
@@ -100,7 +79,7 @@ def coherent_peaks(recording: Recording, nperseg: int, band=None) -> list[tuple[
             continue
         peaks, prominences = peak_prominences(np.where(ok, mag, 0.0))
         for i, prom in zip(peaks, prominences, strict=True):
-            span = slice(max(i - LINES_PER_BANDWIDTH, 0), i + LINES_PER_BANDWIDTH + 1)
+            span = slice(max(i - PEAK_SPAN_LINES, 0), i + PEAK_SPAN_LINES + 1)
             if prom < 0.33 * mag[i] or mag[i] < 0.05 * mag[ok].max() or mag[i] < mag[span].max():
                 continue
             if ok[max(i - 2, 0) : i + 3].all():

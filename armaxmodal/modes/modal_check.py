@@ -33,20 +33,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from armaxmodal.modes.lines import CHECK_RESOLUTION, CoherentLines, coherent_lines, resolving_nperseg
 from armaxmodal.notes import QualityWarning
-from armaxmodal.prepare.frf import coherence, excited_band, h1_relative_error, welch_spectra
 from armaxmodal.recording import Recording
 from armaxmodal.stats import H1_COHERENCE
 
 __all__ = ["ModalCheck", "check_modes", "confirmed_modes", "mode_support", "MODEL_ERROR_LIMIT", "MODEL_ERROR_RISE"]
 
-#: lines of the band an output's H1 must be this coherent on to enter the check
-#: Welch lines per half-power bandwidth of the narrowest mode (the H1's bias at a peak is
-#: about -(line / bandwidth)^2 / 3 with a Hann window: -8 % at two lines)
-LINES_PER_BANDWIDTH = 2
-#: fewest Welch segments: fewer, and the coherence of an unrelated line reaches 0.8 by
-#: chance (its estimate is biased by about 1 / segments) and the H1's random error grows
-MIN_SEGMENTS = 8
 #: delays searched, samples either way, in steps of :data:`DELAY_STEP_SAMPLES`: channels
 #: are aligned by whole samples before the fit, so what is left is a few samples at most
 MAX_DELAY_SAMPLES = 4.0
@@ -241,39 +234,12 @@ def _coefficients_to_terms(coef: np.ndarray, n_modes: int) -> tuple[np.ndarray, 
     return residues, np.array([rest[0] + 1j * rest[1], rest[2] + 1j * rest[3]])
 
 
-@dataclass(frozen=True)
-class _Spectra:
-    """One output's coherent lines: frequencies, H1, its random error (absolute)."""
-
-    freq_hz: np.ndarray
-    h: np.ndarray
-    sigma: np.ndarray
-
-
-def measured_lines(recording: Recording, nperseg: int, band=None) -> list[_Spectra]:
-    """Each output's H1 on the lines of ``band`` (default: the input's excited band) where
-    its coherence is at least :data:`H1_COHERENCE`, with the H1's random error there."""
-    f, puu, puy, pyy = welch_spectra(recording.base, recording.response, recording.fs, nperseg)
-    h, coh = puy / puu[:, None], coherence(puu, puy, pyy)
-    lo, hi = band if band is not None else excited_band(recording)
-    out = []
-    for k in range(h.shape[1]):
-        good = (coh[:, k] >= H1_COHERENCE) & (f > 0) & (f >= lo) & (f <= hi)
-        sigma = h1_relative_error(coh[good, k], recording.n_samples, nperseg) * np.abs(h[good, k])
-        out.append(_Spectra(f[good], h[good, k], sigma))
-    return out
-
-
 def check_nperseg(recording: Recording, freq_hz, damping) -> int:
-    """Welch segment length of the check: :data:`LINES_PER_BANDWIDTH` lines in the
-    narrowest mode's half-power bandwidth ``2 xi f``, a power of two, at least 256 samples
-    and :data:`MIN_SEGMENTS` half-overlapping segments (whichever the record allows)."""
-    from armaxmodal.modes.frf_check import resolving_nperseg
-
-    return resolving_nperseg(recording, freq_hz, damping, LINES_PER_BANDWIDTH, MIN_SEGMENTS)
+    """Welch segment length of the check (:data:`~armaxmodal.modes.lines.CHECK_RESOLUTION`)."""
+    return resolving_nperseg(recording, freq_hz, damping, CHECK_RESOLUTION)
 
 
-def _fit_delays(lines: _Spectra, basis: np.ndarray, fs: float, search: bool) -> tuple[float, np.ndarray, float]:
+def _fit_delays(lines: CoherentLines, basis: np.ndarray, fs: float, search: bool) -> tuple[float, np.ndarray, float]:
     """The delay (s) of the grid (or zero without ``search``) whose fit leaves the least
     misfit, its coefficients and residual sum of squares. All delays are solved at once
     through one QR of the basis."""
@@ -289,7 +255,7 @@ def _fit_delays(lines: _Spectra, basis: np.ndarray, fs: float, search: bool) -> 
     return float(taus[best]), coef, float(max(rss[best], 0.0))
 
 
-def _rss_at(lines: _Spectra, poles: np.ndarray, delay_s: float) -> float:
+def _rss_at(lines: CoherentLines, poles: np.ndarray, delay_s: float) -> float:
     """Residual sum of squares of the fit with these poles at a fixed delay."""
     basis = _basis(lines.freq_hz, poles)
     a = np.vstack([basis.real, basis.imag])
@@ -326,7 +292,7 @@ def check_modes(recording: Recording, freq_hz, damping, band=None, *, fit_delay:
     error, rand, delay = (np.full(k_out, np.nan) for _ in range(3))
     residues = np.full((k_out, poles.size), np.nan + 0j)
     terms = np.full((k_out, 2), np.nan + 0j)
-    all_lines = measured_lines(recording, nperseg, band)
+    all_lines = coherent_lines(recording, nperseg, band)
     n_params = 2 * poles.size + 5
     for k, lines in enumerate(all_lines):
         if lines.freq_hz.size < n_params:
@@ -348,8 +314,8 @@ def check_modes(recording: Recording, freq_hz, damping, band=None, *, fit_delay:
     return ModalCheck(**{**check.__dict__, "bands": _misfit_bands(check, all_lines)})
 
 
-def confirmed_modes(all_lines: list[_Spectra], freq_hz, damping, line_hz: float) -> np.ndarray:
-    """Per mode: does some output have a coherent line (:func:`measured_lines`) within
+def confirmed_modes(all_lines: list[CoherentLines], freq_hz, damping, line_hz: float) -> np.ndarray:
+    """Per mode: does some output have a coherent line (:func:`~armaxmodal.modes.lines.coherent_lines`) within
     ``|f - f_m| <= xi_m f_m +`` :data:`CONFIRM_LINES` lines? A mode where no H1 is coherent is
     one the record cannot confirm: the check's fit never sees it. (The lines next to a sharp
     peak lose coherence to the H1's own bias: right modes on the measured records have their
@@ -361,7 +327,7 @@ def confirmed_modes(all_lines: list[_Spectra], freq_hz, damping, line_hz: float)
     return np.array([bool(np.any(np.abs(lines - fm) <= r)) for fm, r in zip(f, reach, strict=True)], dtype=bool)
 
 
-def _misfit_bands(check: ModalCheck, all_lines: list[_Spectra]) -> tuple:
+def _misfit_bands(check: ModalCheck, all_lines: list[CoherentLines]) -> tuple:
     """Runs of at least :data:`BAND_MIN_LINES` lines (gaps of up to two lines bridged) of a
     failing output where the misfit exceeds half the H1 and three times its random error:
     ``(sensor, lo_hz, hi_hz)``, the three with the most misfit."""
@@ -447,7 +413,7 @@ def mode_support(
     from scipy.special import fdtrc  # F survival function without scipy.stats' import
 
     f, x = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)
-    all_lines = measured_lines(recording, check.nperseg, band)
+    all_lines = coherent_lines(recording, check.nperseg, band)
     used = [k for k, lines in enumerate(all_lines) if np.isfinite(check.error[k])]
     norms = {k: float(np.sum(np.abs(all_lines[k].h) ** 2)) for k in used}
 
