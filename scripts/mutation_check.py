@@ -53,13 +53,13 @@ MUTANTS = [
         "lower residual dropped (check)",
     ),
     (
-        "armaxmodal/modes/modal_check.py",
+        "armaxmodal/modes/support.py",
         "return bool(self.rise >= MODEL_ERROR_RISE and self.p_value <= SUPPORT_ALPHA)",
         "return bool(self.rise >= MODEL_ERROR_RISE or self.p_value <= SUPPORT_ALPHA)",
         "a mode needed by either criterion (check)",
     ),
     (
-        "armaxmodal/modes/modal_check.py",
+        "armaxmodal/modes/support.py",
         'j = (nearest_neighbour if reach == "nearest" else overlapping_neighbour)(f, x, m)',
         "j = None",
         "no neighbour refitted when a mode is left out (check)",
@@ -71,7 +71,7 @@ MUTANTS = [
         "a mode confirmed by a far line (check)",
     ),
     (
-        "armaxmodal/modes/modal_check.py",
+        "armaxmodal/modes/support.py",
         "if abs(np.exp(best.x[0]) - 1) <= NEIGHBOUR_MAX_SHIFT:",
         "if True:",
         "a neighbour takes over from anywhere (check)",
@@ -109,8 +109,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/estimate/_gauss_newton.py",
-        "signals(y - eps if oe else y, uT, eps)",
-        "signals(y, uT, eps)",
+        "stacked[0] = y - eps if oe else y",
+        "stacked[0] = y",
         "output-error gradient of the ARMAX form",
     ),
     (

@@ -15,8 +15,8 @@ from armaxmodal.estimate.orders import information_criterion, output_mean_square
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.estimate.result import ArmaxFit
 from armaxmodal.modes.diagram import StabilisationDiagram
-from armaxmodal.modes.frf_check import peak_support
 from armaxmodal.modes.poles import SHARED, UNRESOLVED_DAMPING, mac, pole_rows
+from armaxmodal.modes.support import peak_support
 from armaxmodal.recording import Recording
 from armaxmodal.stats import Z95
 

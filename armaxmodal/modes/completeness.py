@@ -36,12 +36,12 @@ DUPLICATE_FREQ = 0.01
 
 def modes_the_record_needs(recording: Recording, modes: pd.DataFrame, shapes: np.ndarray, band):
     """Selection by the data: drop, one at a time and least supported first, every mode the
-    modal-model check does not need (:func:`armaxmodal.modes.modal_check.mode_support`: leaving it
+    modal-model check does not need (:func:`armaxmodal.modes.support.mode_support`: leaving it
     out, a neighbour inside its half-power band refitted in its place, raises no output's
-    misfit by :data:`~armaxmodal.modes.modal_check.MODEL_ERROR_RISE` significantly). A dropped half
+    misfit by :data:`~armaxmodal.modes.support.MODEL_ERROR_RISE` significantly). A dropped half
     of a split peak is a ``split_merged`` note, any other a ``mode_not_needed`` note.
     Returns ``(modes, shapes, notes, check)`` with the check of the modes kept."""
-    from armaxmodal.modes.modal_check import MODEL_ERROR_RISE, mode_support
+    from armaxmodal.modes.support import MODEL_ERROR_RISE, mode_support
 
     notes: list[QualityWarning] = []
     while True:
@@ -107,7 +107,7 @@ def modes_the_check_adds(diagram, modes: pd.DataFrame, shapes: np.ndarray, band,
     no clear peak, and their poles scatter over the orders; these need a damping the record
     resolves, as a peak's cluster does not). A peak left unexplained is listed at the end as
     before. Returns ``(modes, shapes, check)``."""
-    from armaxmodal.modes.modal_check import mode_support
+    from armaxmodal.modes.support import mode_support
 
     bic = order_criteria(diagram)
     for sub, at_peak in _left_out_clusters(diagram, modes, band, nas, clustering):

@@ -12,7 +12,7 @@ from armaxmodal.prepare.frf import excited_band
 from armaxmodal.recording import Recording
 from armaxmodal.stats import H1_COHERENCE
 
-__all__ = ["unexplained_peaks", "coherent_peaks", "peak_support"]
+__all__ = ["unexplained_peaks", "coherent_peaks", "explains"]
 
 #: a clear peak is the highest within this many lines either side: the narrowest mode spans
 #: that many at :data:`~armaxmodal.modes.lines.PEAK_RESOLUTION`, a noise bump a line or two
@@ -87,7 +87,7 @@ def coherent_peaks(recording: Recording, nperseg: int, band=None) -> list[tuple[
     return out
 
 
-def _explains(freq_hz: float, line_hz: float, modes_hz, damping) -> bool:
+def explains(freq_hz: float, line_hz: float, modes_hz, damping) -> bool:
     """A mode lies within the peak's half-power bandwidth ``2 xi f`` (at least 1 % or 3 lines)."""
     return any(
         abs(freq_hz - fm) <= max(2 * fm * x, 0.01 * fm, 3 * line_hz) for fm, x in zip(modes_hz, damping, strict=True)
@@ -100,17 +100,7 @@ def unexplained_peaks(recording: Recording, freq_hz, damping, band=None) -> list
     n = resolving_nperseg(recording, freq_hz, damping)
     df = recording.fs / n
     peaks = coherent_peaks(recording, n, band)
-    return _merged([p for p in peaks if not _explains(p[0], df, freq_hz, damping)], df)
-
-
-def peak_support(recording: Recording, freq_hz: float, damping: float, band=None) -> float | None:
-    """Frequency of the clear, coherent FRF peak (:func:`coherent_peaks`) that a mode at
-    ``freq_hz`` explains, or None: the data's own evidence for a mode whose poles alone are
-    not conclusive (a lightly damped pole whose damping estimate crosses zero)."""
-    n = resolving_nperseg(recording, [freq_hz], [max(damping, 1e-6)])
-    df = recording.fs / n
-    near = [p for p in coherent_peaks(recording, n, band) if _explains(p[0], df, [freq_hz], [max(damping, 0.0)])]
-    return max(near, key=lambda p: p[2])[0] if near else None
+    return _merged([p for p in peaks if not explains(p[0], df, freq_hz, damping)], df)
 
 
 def _merged(peaks, df) -> list[QualityWarning]:

@@ -21,8 +21,8 @@ lines, reported beside the H1's own random error in the same norm (Bendat & Pier
 does not account for, ``sqrt(max(e^2 - e_random^2, 0))``, is the *model error*; the modes
 explain the record when it is at most :data:`MODEL_ERROR_LIMIT` on every output.
 
-:func:`mode_support` gives the evidence :func:`armaxmodal.modes.stabilisation.select_modes` keeps
-a mode by: how much the check worsens without it (with a neighbour inside its half-power
+:func:`armaxmodal.modes.support.mode_support` gives the evidence :func:`armaxmodal.select_modes`
+keeps a mode by: how much this check worsens without it (with a neighbour inside its half-power
 band refitted in its place, so that one half of a split peak is not needed when the other
 can take the whole peak).
 """
@@ -38,7 +38,7 @@ from armaxmodal.notes import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.stats import H1_COHERENCE
 
-__all__ = ["ModalCheck", "check_modes", "confirmed_modes", "mode_support", "MODEL_ERROR_LIMIT", "MODEL_ERROR_RISE"]
+__all__ = ["ModalCheck", "check_modes", "confirmed_modes", "poles_of", "rss_at", "MODEL_ERROR_LIMIT"]
 
 #: delays searched, samples either way, in steps of :data:`DELAY_STEP_SAMPLES`: channels
 #: are aligned by whole samples before the fit, so what is left is a few samples at most
@@ -51,23 +51,8 @@ DELAY_STEP_SAMPLES = 0.25
 #: ARMAX fit carries as doublets. The same records with their strongest mode left out read
 #: 0.50-0.96 on the output that shows it. The limit sits between the two.
 MODEL_ERROR_LIMIT = 0.5
-#: a mode is kept when leaving it out raises the misfit of some output by at least this
-#: fraction (the relative RMS; 10 % in the residual sum of squares) and the rise is
-#: significant (:data:`SUPPORT_ALPHA`). Measured with the product's own selections: the
-#: spurious poles and halves of split peaks on the measured records (stiff 1-storey 42.9 Hz,
-#: stiff 3-storey 9.0 Hz beside 8.0, flex 3-storey 36.8 and 38.0 Hz, a bridge's 6.6 Hz)
-#: raise it by 0.5-4 %; the weakest real modes (the F-16's 3.96 and 6.61 Hz at level 1)
-#: by 6-7 %, and the others by 12 % to several times.
-MODEL_ERROR_RISE = 0.05
-SUPPORT_ALPHA = 0.01
 #: a mode is confirmed by a coherent line within its half-power half-width and this many lines
 CONFIRM_LINES = 4
-#: the nearest mode within this many half-power bandwidths is refitted when a mode is left out
-NEIGHBOUR_BANDWIDTHS = 3.0
-#: ... and may take over only from within this relative frequency of its own place: on the
-#: supine ride, heavily damped modes overlap, and a neighbour free to move 30 % took over
-#: 5.8 Hz, then 7.6 and 8.3 Hz in turn, leaving two of four modes
-NEIGHBOUR_MAX_SHIFT = 0.05
 #: a band is named where the misfit of a line exceeds half the H1 there and three times
 #: its random error, over at least this many neighbouring lines
 BAND_MIN_LINES = 3
@@ -255,7 +240,7 @@ def _fit_delays(lines: CoherentLines, basis: np.ndarray, fs: float, search: bool
     return float(taus[best]), coef, float(max(rss[best], 0.0))
 
 
-def _rss_at(lines: CoherentLines, poles: np.ndarray, delay_s: float) -> float:
+def rss_at(lines: CoherentLines, poles: np.ndarray, delay_s: float) -> float:
     """Residual sum of squares of the fit with these poles at a fixed delay."""
     basis = _basis(lines.freq_hz, poles)
     a = np.vstack([basis.real, basis.imag])
@@ -345,104 +330,3 @@ def _misfit_bands(check: ModalCheck, all_lines: list[CoherentLines]) -> tuple:
                 energy = float(np.sum(res[run[0] : run[-1] + 1] ** 2))
                 found.append((energy, check.sensors[k], float(lines.freq_hz[run[0]]), float(lines.freq_hz[run[-1]])))
     return tuple(item[1:] for item in sorted(found, reverse=True)[:3])
-
-
-@dataclass(frozen=True)
-class ModeSupport:
-    """How much the check needs one mode: each output's relative misfit with and without it
-    (a neighbour within its half-power band refitted in its place), and the F-test's p."""
-
-    error_with: np.ndarray
-    error_without: np.ndarray
-    p_value: float
-    refitted_neighbour: int | None
-
-    @property
-    def rise(self) -> float:
-        """The largest relative rise of an output's misfit without the mode."""
-        ratio = self.error_without / np.maximum(self.error_with, 1e-300)
-        finite = ratio[np.isfinite(ratio)]
-        return float(finite.max() - 1) if finite.size else float("nan")
-
-    @property
-    def needed(self) -> bool:
-        """The rise is at least :data:`MODEL_ERROR_RISE` and significant at :data:`SUPPORT_ALPHA`."""
-        return bool(self.rise >= MODEL_ERROR_RISE and self.p_value <= SUPPORT_ALPHA)
-
-
-def overlapping_neighbour(freq_hz, damping, m: int) -> int | None:
-    """The nearest mode whose half-power band overlaps mode ``m``'s
-    (``|f_i - f_m| < xi_i f_i + xi_m f_m``), or None."""
-    f, x = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)
-    gap = np.abs(f - f[m])
-    close = [i for i in range(f.size) if i != m and gap[i] < x[i] * f[i] + x[m] * f[m]]
-    return min(close, key=lambda i: gap[i]) if close else None
-
-
-def nearest_neighbour(freq_hz, damping, m: int) -> int | None:
-    """The mode nearest mode ``m`` within :data:`NEIGHBOUR_BANDWIDTHS` half-power bandwidths
-    (``2 xi f``, the wider of the two), or None: the mode whose pole may take over what
-    ``m`` fits. A spurious pole beside a lightly damped mode corrects that mode's slightly
-    biased pole at the peak; with the neighbour's pole refitted it is not needed."""
-    f, x = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)
-    gap = np.abs(f - f[m])
-    reach = NEIGHBOUR_BANDWIDTHS * np.maximum(2 * x * f, 2 * x[m] * f[m])
-    close = [i for i in range(f.size) if i != m and gap[i] <= reach[i]]
-    return min(close, key=lambda i: gap[i]) if close else None
-
-
-def mode_support(
-    recording: Recording, freq_hz, damping, m: int, check: ModalCheck, band=None, *, reach: str = "overlapping"
-) -> ModeSupport:
-    """How much the check of ``check`` needs mode ``m`` (see :class:`ModeSupport`).
-
-    The fit without the mode keeps each output's delay. A neighbour -- ``reach="overlapping"``:
-    a mode whose half-power band overlaps this one's (:func:`overlapping_neighbour`);
-    ``"nearest"``: the nearest within :data:`NEIGHBOUR_BANDWIDTHS` (:func:`nearest_neighbour`),
-    the stricter test a mode the diagram supports weakly must pass to enter -- has its
-    frequency and damping refitted (Nelder-Mead on the summed relative residual, residues
-    projected out) so it may take over: two poles always fit one peak at least as well as
-    one, so only a refitted single pole shows whether the record needs both. A neighbour
-    that moves more than :data:`NEIGHBOUR_MAX_SHIFT` to take over is not refitted. The F-test
-    compares the summed relative residual sums with ``q = 2 n_outputs`` (the residues)
-    ``+ 2`` (the pole, unless the neighbour's refit spends them) over ``sum(lines) -
-    parameters`` degrees of freedom (one per complex line: the Hann-windowed,
-    half-overlapped lines are correlated in pairs).
-    """
-    from scipy.optimize import minimize
-    from scipy.special import fdtrc  # F survival function without scipy.stats' import
-
-    f, x = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)
-    all_lines = coherent_lines(recording, check.nperseg, band)
-    used = [k for k, lines in enumerate(all_lines) if np.isfinite(check.error[k])]
-    norms = {k: float(np.sum(np.abs(all_lines[k].h) ** 2)) for k in used}
-
-    def relative_rss(poles) -> np.ndarray:
-        return np.array([_rss_at(all_lines[k], poles, check.delay_s[k]) / norms[k] for k in used])
-
-    keep = [i for i in range(f.size) if i != m]
-    with_m = relative_rss(poles_of(f, x))
-    j = (nearest_neighbour if reach == "nearest" else overlapping_neighbour)(f, x, m)
-    fk, xk = f[keep], x[keep]
-    if j is not None:
-        at = keep.index(j)
-
-        def cost(p):
-            fj, xj = fk.copy(), xk.copy()
-            fj[at], xj[at] = f[j] * np.exp(p[0]), min(x[j] * np.exp(p[1]), 0.9)
-            return float(np.sum(relative_rss(poles_of(fj, xj))))
-
-        best = minimize(cost, np.zeros(2), method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-9, "maxiter": 200})
-        if abs(np.exp(best.x[0]) - 1) <= NEIGHBOUR_MAX_SHIFT:
-            fk, xk = fk.copy(), xk.copy()
-            fk[at], xk[at] = f[j] * np.exp(best.x[0]), min(x[j] * np.exp(best.x[1]), 0.9)
-        else:  # it took over only by leaving its own place: the two are distinct modes
-            j = None
-    without = relative_rss(poles_of(fk, xk))
-    n_obs = sum(all_lines[k].freq_hz.size for k in used)
-    q = 2 * len(used) + (0 if j is not None else 2)
-    dof = n_obs - len(used) * (2 * f.size + 5) - 2 * f.size
-    s1, s0 = float(with_m.sum()), float(without.sum())
-    stat = ((s0 - s1) / q) / (s1 / dof) if dof > 0 and s1 > 0 else float("nan")
-    p = float(fdtrc(q, dof, stat)) if np.isfinite(stat) and stat > 0 else 1.0
-    return ModeSupport(np.sqrt(with_m), np.sqrt(without), p, j)
