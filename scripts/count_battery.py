@@ -25,6 +25,7 @@ import argparse
 import time
 
 import numpy as np
+import pandas as pd
 from scipy import signal
 
 import armaxmodal as am
@@ -162,7 +163,7 @@ def main() -> None:
     parser.add_argument("--only", type=int, nargs="*", help="run these cases only (0-based, in the order printed)")
     parser.add_argument("--save", help="pickle each case's (structure, recording) into this folder")
     args = parser.parse_args()
-    tally = {"cases": 0, "right": 0, "wrong_flagged": 0, "right_flagged": 0}
+    tally = {"cases": 0, "right": 0, "wrong_flagged": 0, "right_flagged": 0, "modes": 0, "covered": 0, "widened": 0}
     for index, (name, s, fs, top, rng) in enumerate(cases(args)):
         u = ride(rng, fs, top_hz=top)
         rec = am.simulate_recording(s, u, fs, noise=0.03, seed=int(rng.integers(1 << 30)))
@@ -186,6 +187,10 @@ def main() -> None:
         tally["wrong_flagged"] += (not ok) and sel.quality != "good"
         tally["right_flagged"] += ok and sel.quality != "good"
         print(f"{name}: exact {np.round(truth.freq_hz, 2).tolist()} (bounds {np.round(100 * crb_f, 1).tolist()} %)")
+        covered, widened = _interval_coverage(truth, sel)
+        tally["modes"] += len(sel.modes)
+        tally["covered"] += covered
+        tally["widened"] += widened
         because = getattr(sel, "uncertain_because", [])  # the verdict's reasons (absent before the ML step)
         print(f"    found {np.round(sel.modes.freq_hz, 2).tolist()} damping {np.round(sel.modes.damping, 3).tolist()}"
               f" quality {sel.quality} {because} | {'right' if ok else 'WRONG: ' + '; '.join(why)}"
@@ -193,6 +198,20 @@ def main() -> None:
     wrong = tally["cases"] - tally["right"]
     print(f"\n{tally['right']}/{tally['cases']} right; of {wrong} wrong, {tally['wrong_flagged']} say poor or "
           f"uncertain; {tally['right_flagged']} right ones say poor or uncertain")  # fmt: skip
+    print(f"{tally['covered']} of {tally['modes']} reported frequency intervals hold the nearest exact mode; "
+          f"{tally['widened']} were widened to other equally good counts")  # fmt: skip
+
+
+def _interval_coverage(truth, sel) -> tuple[int, int]:
+    """(reported modes whose 95 % frequency interval holds the nearest exact frequency, reported
+    modes whose interval covers another equally good count)."""
+    exact = np.asarray(truth.freq_hz)
+    covered = sum(
+        int(m.freq_ci95_lo <= exact[np.argmin(np.abs(exact - m.freq_hz))] <= m.freq_ci95_hi)
+        for m in sel.modes.itertuples()
+    )
+    widened = int(sel.modes.get("structure_widened", pd.Series(dtype=bool)).fillna(False).astype(bool).sum())
+    return covered, widened
 
 
 if __name__ == "__main__":

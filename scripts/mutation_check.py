@@ -514,6 +514,30 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/mode_count.py",
+        "if model is not None and abs(search.bic(model) - here) < DECISIVE_BIC:",
+        "if model is not None and abs(search.bic(model) - here) < 0:",
+        "no other count kept as equally good (count)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "for m in np.flatnonzero(rise < DECISIVE_BIC)]",
+        "for m in np.flatnonzero(rise < 0)]",
+        "the undecided removals not refitted as alternatives (count)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "if j != i or abs(np.log(alt.freq_hz[k] / m.freq_hz[i])) > SAME_ROW_FREQ:",
+        "if j != i:",
+        "a merged mode taken as the same mode (count)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "ci[:] = [min(ci[0], lo), max(ci[1], hi)]",
+        "ci[:] = [min(ci[0], value), max(ci[1], value)]",
+        "the hull of the point values, not of the intervals (count)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
         "return 1.0 / (1.0 + 2.0 * total)",
         "return 1.0 / (1.0 + total)",
         "Bartlett's factor 2 dropped (count)",

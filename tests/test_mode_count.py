@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 import armaxmodal as am
-from armaxmodal.modes.counted import _notes, reported
+from armaxmodal.modes.counted import _notes, _structure_hull, reported
 from armaxmodal.modes.modal_model import DftLines, fit_modal_model
 from armaxmodal.modes.mode_count import DECISIVE_BIC, ModeCount, count_modes, effective_fraction
 from armaxmodal.modes.selection import ModeSelection, _not_separated
@@ -104,9 +104,15 @@ def test_effective_fraction_is_bartletts_for_white_and_smoothed_noise():
     assert effective_fraction(smooth) == pytest.approx(1 / w, rel=0.15)
 
 
-def _count(rise, best_addition, best_hz=12.0, freq=(5.0, 30.0), damping=(0.2, 0.9)):
-    model = SimpleNamespace(freq_hz=np.array(freq), damping=np.array(damping))
-    return ModeCount(model, model, (), np.array(rise), best_addition, best_hz, 1.0)
+def _model(freq, damping, sd=0.01):
+    freq, damping = np.array(freq, float), np.array(damping, float)
+    return SimpleNamespace(freq_hz=freq, damping=damping, freq_sd=sd * freq, damping_sd=sd * damping,
+                           n_modes=freq.size)  # fmt: skip
+
+
+def _count(rise, best_addition, best_hz=12.0, freq=(5.0, 30.0), damping=(0.2, 0.9), alternatives=()):
+    model = _model(freq, damping)
+    return ModeCount(model, model, (), np.array(rise), best_addition, best_hz, 1.0, alternatives=alternatives)
 
 
 def test_undecided_counts_and_out_of_band_poles_are_said():
@@ -118,6 +124,25 @@ def test_undecided_counts_and_out_of_band_poles_are_said():
     assert "count_undecided" in [n.code for n in removal]
     addition = _notes(_count([50.0, 60.0], -DECISIVE_BIC + 1), np.array([True, False]), (1.0, 25.0))
     assert [n.value for n in addition if n.code == "count_undecided"] == [12.0]
+
+
+def test_intervals_cover_the_equally_good_models():
+    # the chosen 5 and 10 Hz; the model with one mode fewer (undecided) holds the 10 Hz mode at
+    # 10.4 Hz and damping 0.06: its interval takes in that model's; the 5 Hz mode it lacks keeps its own
+    fewer = _model([10.4], [0.06])
+    count = _count([DECISIVE_BIC - 2, 80.0], -40.0, freq=(5.0, 10.0), damping=(0.2, 0.05), alternatives=((2.0, fewer),))
+    freq, damping, widened = _structure_hull(count, 1)
+    assert widened
+    assert freq == pytest.approx((10.0 - Z95 * 0.1, 10.4 + Z95 * 0.104))
+    assert damping == pytest.approx((0.05 - Z95 * 0.0005, 0.06 + Z95 * 0.0006))
+    assert _structure_hull(count, 0) == (pytest.approx((5 - Z95 * 0.05, 5 + Z95 * 0.05)),
+                                         pytest.approx((0.2 - Z95 * 0.002, 0.2 + Z95 * 0.002)), False)  # fmt: skip
+    # a counterpart beyond the clustering's reach (two modes merged into one) is another mode
+    merged = ((2.0, _model([10.8], [0.05])),)
+    far = _count([1.0, 80.0], -40.0, freq=(5.0, 10.0), damping=(0.2, 0.05), alternatives=merged)
+    assert _structure_hull(far, 1)[2] is False
+    codes = [n.message for n in _notes(count, np.array([True, True]), (1.0, 25.0)) if "also cover" in n.message]
+    assert len(codes) == 1 and "10.000 Hz" in codes[0] and "5.000" not in codes[0]
 
 
 def _modes(f, sd):
@@ -257,3 +282,16 @@ def test_the_search_takes_only_steps_that_lower_the_criterion(monkeypatch, supin
     assert len(count.steps) == abs(start - 3) and all(s.bic_fall > 0 for s in count.steps)
     np.testing.assert_allclose(count.removal_rise, 5.0)
     assert count.best_addition == pytest.approx(-2.0)
+    # the models the record cannot tell from the chosen one: each removal (+5) and the addition (+2)
+    assert sorted((d, alt.n_modes) for d, alt in count.alternatives) == [(2.0, 4), (5.0, 2), (5.0, 2), (5.0, 2)]
+
+
+def test_a_decided_count_has_no_equally_good_model(monkeypatch, supine):
+    """Criterion 130, 95, 120 for 2, 3, 4 modes: every neighbour is worse by more than
+    DECISIVE_BIC, so no other count enters the intervals."""
+    import armaxmodal.modes.mode_count as mode_count
+
+    table = {1: 150.0, 2: 130.0, 3: 95.0, 4: 120.0, 5: 140.0}
+    monkeypatch.setattr(mode_count, "fit_modal_model", lambda data, f, x, hold, n=40: _Scored(f, x, table))
+    count = count_modes(supine[0], [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], hold="zoh")
+    assert count.model.n_modes == 3 and count.alternatives == ()

@@ -13,9 +13,9 @@ import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
 from armaxmodal.modes.modal_model import DAMPING_BOUNDS, DftLines, fit_modal_model
-from armaxmodal.modes.mode_count import DECISIVE_BIC, FINAL_NFEV, ModeCount, count_modes
-from armaxmodal.modes.poles import SHARED
+from armaxmodal.modes.mode_count import DECISIVE_BIC, FINAL_NFEV, ModeCount, count_modes, matched_poles
 from armaxmodal.modes.spread import split_segments
+from armaxmodal.modes.support import CANDIDATE_MIN_ORDERS, stable_in_diagram
 from armaxmodal.notes import QualityWarning
 from armaxmodal.stats import MAX_DAMPING, Z95
 
@@ -33,8 +33,6 @@ LINE_DAMPING = 2 * DAMPING_BOUNDS[0]
 COUNT_MAX_SAMPLES = 65_536
 #: left-out clusters of the diagram tried as additions: the largest few (each costs a fit)
 MAX_CANDIDATES = 3
-#: a left-out cluster is a candidate when it holds poles of at least this many orders
-CANDIDATE_MIN_ORDERS = 3
 
 
 def reported(model, band_hz) -> np.ndarray:
@@ -55,24 +53,6 @@ def _candidates(diagram, modes: pd.DataFrame, band, nas, cluster_freq, cluster_d
         if len(members) >= CANDIDATE_MIN_ORDERS and np.min(np.abs(modes.freq_hz.to_numpy() / f - 1)) > cluster_freq:
             found.append((len(members), f, float(sub.damping.median())))
     return [(f, x) for _, f, x in sorted(found, reverse=True)[:MAX_CANDIDATES]]
-
-
-def _stable_in_diagram(diagram, band, cluster_freq: float, cluster_damping: float):
-    """``supported(f, x)``: poles of at least :data:`CANDIDATE_MIN_ORDERS` orders of the diagram
-    lie within the clustering's reach of frequency ``f`` (Hz) and damping ``x``. Poles rejected
-    for their residue count: stability across orders is the pole's, and a weakly driven mode (a
-    light chain's 9.32 Hz, rejected as a negligible residue at every order) is still a mode."""
-    poles = diagram.poles[diagram.poles.source == SHARED]
-    if band is not None:
-        poles = poles[(poles.freq_hz >= band[0]) & (poles.freq_hz <= band[1])]
-    kept = poles[poles.damping > 0]
-    f, x, na = kept.freq_hz.to_numpy(), kept.damping.to_numpy(), kept.na.to_numpy()
-
-    def supported(freq_hz: float, damping: float) -> bool:
-        near = (np.abs(f / freq_hz - 1) <= cluster_freq) & (np.abs(x / damping - 1) <= cluster_damping)
-        return len(set(na[near].tolist())) >= CANDIDATE_MIN_ORDERS
-
-    return supported
 
 
 def _on_whole_record(count: ModeCount, rec, band_hz, hold: str) -> ModeCount:
@@ -120,7 +100,7 @@ def counted_modes(diagram, modes: pd.DataFrame, band_hz, hold: str, nas, cluster
     data = DftLines.from_recording(part, band_hz)
     candidates = _candidates(diagram, modes, band, nas, *clustering)
     halves = tuple(DftLines.from_recording(half, band_hz) for half in split_segments(part, 2))
-    supported = _stable_in_diagram(diagram, band, *clustering)
+    supported = stable_in_diagram(diagram, band, *clustering)
     count = count_modes(
         data, modes.freq_hz, modes.damping, candidates, hold=hold, halves=halves, supported=supported
     )
@@ -148,20 +128,42 @@ def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str) -> dict:
     """Mode ``i`` of the counted model as a selection row: the nearest selected row's cluster
     facts when it lies within :data:`SAME_ROW_FREQ`, else none (``count`` 0)."""
     m = count.model
-    f, x, sf, sx = m.freq_hz[i], m.damping[i], m.freq_sd[i], m.damping_sd[i]
+    f, x = m.freq_hz[i], m.damping[i]
     dist = np.abs(modes.freq_hz.to_numpy() / f - 1)
     j = int(np.argmin(dist))
     row = modes.iloc[j].to_dict()
     if dist[j] > SAME_ROW_FREQ:  # a mode the diagram's clusters did not hold
         row.update(count=0, support=0.0, freq_spread=np.nan, damping_spread=np.nan, medoid_freq_hz=np.nan,
                    medoid_damping=np.nan, orders_damping_unresolved=0)  # fmt: skip
+    freq_ci, damping_ci, widened = _structure_hull(count, i)
     row.update(
         freq_hz=f, damping=x, damped_freq_hz=f * np.sqrt(1 - x**2),
-        freq_ci95_lo=f - Z95 * sf, freq_ci95_hi=f + Z95 * sf,
-        damping_ci95_lo=x - Z95 * sx, damping_ci95_hi=x + Z95 * sx,
-        estimator=f"ml-{hold}", count_undecided=bool(count.removal_rise[i] < DECISIVE_BIC),
+        freq_ci95_lo=freq_ci[0], freq_ci95_hi=freq_ci[1], damping_ci95_lo=damping_ci[0], damping_ci95_hi=damping_ci[1],
+        estimator=f"ml-{hold}", count_undecided=bool(count.removal_rise[i] < DECISIVE_BIC), structure_widened=widened,
     )  # fmt: skip
     return row
+
+
+def _structure_hull(count: ModeCount, i: int):
+    """Mode ``i``'s 95 % intervals of frequency and damping, widened to the hull of its
+    counterparts' intervals in the equally good models (``count.alternatives``): where the record
+    cannot tell the number of modes, it cannot tell which model's values hold either. A
+    counterpart is the alternative's pole paired with mode ``i`` one to one, within
+    :data:`SAME_ROW_FREQ`; a mode the alternative lacks, or that moved farther (two merged into
+    one), has none. Returns ``((lo, hi), (lo, hi), widened)``."""
+    m = count.model
+    freq = [m.freq_hz[i] - Z95 * m.freq_sd[i], m.freq_hz[i] + Z95 * m.freq_sd[i]]
+    damping = [m.damping[i] - Z95 * m.damping_sd[i], m.damping[i] + Z95 * m.damping_sd[i]]
+    widened = False
+    for _, alt in count.alternatives:
+        for k, j in matched_poles(m.freq_hz, alt.freq_hz):
+            if j != i or abs(np.log(alt.freq_hz[k] / m.freq_hz[i])) > SAME_ROW_FREQ:
+                continue
+            for ci, value, sd in ((freq, alt.freq_hz[k], alt.freq_sd[k]), (damping, alt.damping[k], alt.damping_sd[k])):
+                lo, hi = value - Z95 * sd, value + Z95 * sd
+                widened |= bool(lo < ci[0] or hi > ci[1])
+                ci[:] = [min(ci[0], lo), max(ci[1], hi)]
+    return tuple(freq), tuple(damping), widened
 
 
 def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
@@ -194,6 +196,15 @@ def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
             "mode_count", (),
             f"one mode more near {f:.3f} Hz fits the whole record better but not each of its halves: a change "
             "during the record (a drifting frequency, a transient, a nonlinearity), not a mode; left out", f,
+        ))  # fmt: skip
+    widened = [count.model.freq_hz[i] for i in np.flatnonzero(keep) if _structure_hull(count, i)[2]]
+    if widened:
+        sizes = ", ".join(f"{alt.n_modes} modes ({d:+.1f})" for d, alt in count.alternatives)
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"the 95 % intervals of the mode(s) at {', '.join(f'{f:.3f}' for f in widened)} Hz also cover their values "
+            f"in the models the record cannot tell from the chosen one ({sizes} in the criterion): the number of modes "
+            "is part of their uncertainty", float(len(widened)),
         ))  # fmt: skip
     hidden = int((~keep).sum())
     if hidden:

@@ -38,7 +38,7 @@ from armaxmodal._threads import single_blas_thread
 from armaxmodal.modes.modal_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.stats import MAX_DAMPING, Z95
 
-__all__ = ["DECISIVE_BIC", "ModeCount", "Step", "count_modes", "effective_fraction"]
+__all__ = ["DECISIVE_BIC", "ModeCount", "Step", "count_modes", "effective_fraction", "matched_poles"]
 
 #: a change of the criterion this large is "very strong" evidence (Kass & Raftery 1995): a
 #: mode's removal, or a candidate's addition, that moves it less leaves the count undecided
@@ -97,6 +97,11 @@ class ModeCount:
         Fits the search ran.
     unconfirmed_hz : tuple of float
         Additions the whole record accepted but one of its halves did not (Hz, the start).
+    alternatives : tuple of (float, ModalModel)
+        The models with one mode fewer or more that the record cannot tell from the chosen one:
+        each converged, with its criterion's difference from the chosen model's (under
+        :data:`DECISIVE_BIC`). The reported intervals cover their modes
+        (:func:`armaxmodal.modes.counted.counted_modes`).
     """
 
     model: ModalModel
@@ -108,6 +113,7 @@ class ModeCount:
     effective_fraction: float
     trials: int = field(default=0)
     unconfirmed_hz: tuple[float, ...] = ()
+    alternatives: tuple[tuple[float, ModalModel], ...] = ()
 
 
 def effective_fraction(residual: np.ndarray, max_lag: int = MAX_CORRELATION_LAG) -> float:
@@ -258,20 +264,43 @@ def _margins(search: _Search, here: float, current: ModalModel, removed, best_re
     return rise, gain, new_hz
 
 
+def _equally_good(search: _Search, chosen: ModalModel, rise: np.ndarray, addition: ModalModel | None):
+    """The models with one mode fewer (each mode whose removal the criterion barely resists) or
+    one more (the best addition, when it barely loses), converged on the chosen model's weights
+    and kept when their criterion stays within :data:`DECISIVE_BIC` of the chosen one's:
+    ``[(difference, model), ...]``. Only an undecided count costs these fits."""
+    here, out = search.bic(chosen), []
+    starts = [(np.delete(chosen.freq_hz, m), np.delete(chosen.damping, m)) for m in np.flatnonzero(rise < DECISIVE_BIC)]
+    if addition is not None:
+        starts.append((addition.freq_hz, addition.damping))
+    for freq_hz, damping in starts:
+        model = search.fit(freq_hz, damping, FINAL_NFEV)
+        if model is not None and abs(search.bic(model) - here) < DECISIVE_BIC:
+            out.append((float(search.bic(model) - here), model))
+    return tuple(out)
+
+
 def _nearest(freq_hz: np.ndarray, f: float) -> int:
     return int(np.argmin(np.abs(np.log(freq_hz / f))))
 
 
-def _new_poles(old_hz: np.ndarray, new_hz: np.ndarray) -> list[int]:
-    """The poles of ``new_hz`` (indices) left over when each of ``old_hz`` takes its nearest
-    (one to one, nearest pairs first)."""
+def matched_poles(old_hz: np.ndarray, new_hz: np.ndarray) -> list[tuple[int, int]]:
+    """One-to-one pairs ``(i_new, j_old)`` of two pole sets' frequencies (Hz), nearest pairs
+    first (by log ratio); the larger set's surplus poles stay unpaired."""
     pairs = sorted((abs(np.log(n / o)), i, j) for i, n in enumerate(new_hz) for j, o in enumerate(old_hz))
-    taken_new, taken_old = set(), set()
+    taken_new, taken_old, out = set(), set(), []
     for _, i, j in pairs:
         if i not in taken_new and j not in taken_old:
             taken_new.add(i)
             taken_old.add(j)
-    return [i for i in range(len(new_hz)) if i not in taken_new]
+            out.append((i, j))
+    return out
+
+
+def _new_poles(old_hz: np.ndarray, new_hz: np.ndarray) -> list[int]:
+    """The poles of ``new_hz`` (indices) left over when each of ``old_hz`` takes its nearest."""
+    paired = {i for i, _ in matched_poles(old_hz, new_hz)}
+    return [i for i in range(len(new_hz)) if i not in paired]
 
 
 def residual_peak(model: ModalModel, data: DftLines, width_lines: int = 9) -> tuple[float, float]:
@@ -369,6 +398,7 @@ def count_modes(
     final = search.fit(current.freq_hz, current.damping, FINAL_NFEV)
     if search.bic(final) < here:
         rise, gain, current = rise + here - search.bic(final), gain - (here - search.bic(final)), final
-    return ModeCount(
-        current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials, tuple(unconfirmed)
-    )
+    close = best_addition[2] if best_addition is not None and gain > -DECISIVE_BIC else None
+    alternatives = _equally_good(search, current, rise, close)
+    return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
+                     tuple(unconfirmed), alternatives)  # fmt: skip

@@ -132,6 +132,9 @@ class ModeSelection:
                     "damping_sd": _finite_or_none(row.damping_segment_sd),
                 }
                 record["model_error_dominates"] = bool(row.model_error_dominates)
+            if "structure_widened" in self.modes:  # the modal model's count (modes/counted.py)
+                record["count_undecided"] = bool(row.count_undecided)
+                record["interval_covers_other_counts"] = bool(row.structure_widened)
             modes.append(record)
         per_sensor = [
             {k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in r.items()}

@@ -150,8 +150,10 @@ def apply_segment_spread(modes: pd.DataFrame, spread: pd.DataFrame, n_segments: 
                 continue
             if (n_segments - 1) * s**2 / (n_segments * sigma**2) > crit:
                 dominates[i] = True
-                half = max(t_k * s / np.sqrt(n_segments), (m[hi] - m[lo]) / 2)
-                modes.loc[i, [lo, hi]] = [m[value] - half, m[value] + half]
+                # the segments' interval, or the one already there where it is wider on a side (it
+                # may cover other equally good model structures, modes/counted.py)
+                half = t_k * s / np.sqrt(n_segments)
+                modes.loc[i, [lo, hi]] = [min(m[value] - half, m[lo]), max(m[value] + half, m[hi])]
         if dominates[i]:
             flagged.append(i)
     modes["model_error_dominates"] = dominates
