@@ -90,18 +90,20 @@ def test_the_verdict_is_the_limit_on_every_checked_output():
 
 def test_a_cluster_the_support_rule_left_out_enters_when_the_check_needs_it(light_ride):
     from armaxmodal.modes.completeness import modes_the_check_adds
+    from armaxmodal.modes.working import WorkingSelection
 
     s, rec = light_ride
     diagram = stabilisation_diagram(rec, range(2, 21, 2), per_sensor=False)
     sel = select_modes(diagram, segments=0)
     truth = s.modes().freq_hz
     np.testing.assert_allclose(sel.modes.freq_hz, truth, rtol=0.01)
-    nas = sorted(o[0] for o in diagram.orders)
+    nas = sorted(o.na for o in diagram.orders)
     one = sel.modes.iloc[[0]].reset_index(drop=True)
     check = check_modes(rec, one.freq_hz, one.damping)
-    modes, shapes, again = modes_the_check_adds(diagram, one, sel.shapes[:, [0]], None, nas, check, (0.05, 0.5))
-    np.testing.assert_allclose(modes.freq_hz, truth, rtol=0.01)
-    assert shapes.shape == (2, 2) and again.passed
+    start = WorkingSelection(one, sel.shapes[:, [0]], check=check)
+    added = modes_the_check_adds(diagram, start, None, nas, (0.05, 0.5))
+    np.testing.assert_allclose(added.modes.freq_hz, truth, rtol=0.01)
+    assert added.shapes.shape == (2, 2) and added.check.passed
 
 
 def test_default_orders_adapt_to_a_short_record_and_typed_ones_are_refused(fixtures_dir):

@@ -16,6 +16,7 @@ from armaxmodal.modes.clusters import _supported, cluster_poles, merge_duplicate
 from armaxmodal.modes.diagram import SAMPLES_PER_PARAMETER, _check_top_order, _nk_edge_warning
 from armaxmodal.modes.poles import Tolerances, stability_classes
 from armaxmodal.modes.selected_refit import _apply_refinement
+from armaxmodal.modes.working import WorkingSelection
 
 SHAPE = np.array([1.0 + 0.2j, 0.5 - 0.1j, -0.3 + 0.05j])
 
@@ -426,8 +427,10 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     hold = "zoh"
     ref = st.selection_job(rec, [], modes, ("refit", (4.0, 12.0)))
     assert seen[-1] == (4.0, 12.0) and ref.hold == "zoh"
-    out, out_shapes, kept = st.refined_modes(diagram, modes, shapes, ref, 0.05, 0.5, 0.8)
-    assert kept is ref and out is modes and out_shapes is shapes  # a held input: the ARMAX values are reported
+    work = WorkingSelection(modes, shapes)
+    out = st.refined_modes(diagram, work, ref, 0.05, 0.5, 0.8)
+    # a held input: the ARMAX values are reported
+    assert out.refinement is ref and out.modes is modes and out.shapes is shapes
 
     def failing(recording, freq_hz, damping, band_hz):
         raise OrderError("too few lines")
@@ -437,13 +440,14 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     assert isinstance(failed, st.RefitFailure) and failed.reason == "too few lines"  # said, not silent
     (note,) = failed.notes()
     assert note.code == "refit_failed" and "too few lines" in note.message
-    out, out_shapes, kept = st.refined_modes(diagram, modes, shapes, failed, 0.05, 0.5, 0.8)
-    assert kept is None and out is modes and out_shapes is shapes  # the ARMAX values stand
+    out = st.refined_modes(diagram, work, failed, 0.05, 0.5, 0.8)
+    assert out.refinement is None and out.modes is modes and out.shapes is shapes  # the ARMAX values stand
     monkeypatch.setattr(st, "refine_modes", refit)
     hold = "bandlimited"
     calls = []
     monkeypatch.setattr(st, "_apply_refinement", lambda m, s, r, f, x, relaxed=False: (calls.append((f, x)) or (m, s)))
     monkeypatch.setattr(st, "merge_duplicates", lambda m, v, mac, dur: (calls.append((len(v), mac, dur)) or [1]))
-    out, out_shapes, _ = st.refined_modes(diagram, modes, shapes, SimpleNamespace(hold=hold), 0.05, 0.5, 0.8)
+    out = st.refined_modes(diagram, work, SimpleNamespace(hold=hold), 0.05, 0.5, 0.8)
     assert calls == [(0.05, 0.5), (2, 0.8, rec.duration)]
-    assert out.freq_hz.tolist() == [9.0] and out.index.tolist() == [0] and out_shapes.tolist() == [[0.0], [1.0]]
+    assert out.modes.freq_hz.tolist() == [9.0] and out.modes.index.tolist() == [0]
+    assert out.shapes.tolist() == [[0.0], [1.0]]

@@ -238,6 +238,7 @@ def test_poles_crossing_zero_without_an_frf_peak_stay_rejected(light_diagram):
 
 def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
     from armaxmodal.modes.completeness import modes_the_record_needs
+    from armaxmodal.modes.working import WorkingSelection
 
     s, diagram = light_diagram
     m = s.modes()
@@ -251,16 +252,17 @@ def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
         }
     )
     shapes = np.column_stack([m.modal_constants[:, 0], 0.3 * m.modal_constants[:, 0], m.modal_constants[:, 1]])
-    kept, kept_shapes, notes, check = modes_the_record_needs(diagram.recording, modes, shapes, None)
-    assert kept.freq_hz.tolist() == [m.freq_hz[0], m.freq_hz[1]]  # the better-supported one stays
-    np.testing.assert_array_equal(kept_shapes, shapes[:, [0, 2]])
-    (note,) = notes
+    kept = modes_the_record_needs(diagram.recording, WorkingSelection(modes, shapes), None)
+    assert kept.modes.freq_hz.tolist() == [m.freq_hz[0], m.freq_hz[1]]  # the better-supported one stays
+    np.testing.assert_array_equal(kept.shapes, shapes[:, [0, 2]])
+    (note,) = kept.notes
     assert note.code == "split_merged" and note.value == pytest.approx(1.01 * m.freq_hz[0])
-    assert check.passed and check.model_error.max() < 0.15  # the check of what is kept (lightly damped: H1 bias)
+    # the check of what is kept (lightly damped: H1 bias)
+    assert kept.check.passed and kept.check.model_error.max() < 0.15
     # the true modes alone: nothing to merge
     true = modes.iloc[[0, 2]].reset_index(drop=True)
-    again, _, none, _ = modes_the_record_needs(diagram.recording, true, shapes[:, [0, 2]], None)
-    assert len(again) == 2 and none == []
+    again = modes_the_record_needs(diagram.recording, WorkingSelection(true, shapes[:, [0, 2]]), None)
+    assert len(again.modes) == 2 and again.notes == ()
 
 
 def test_a_spurious_heavily_damped_neighbour_is_left_out_and_said(light_diagram):
@@ -268,6 +270,7 @@ def test_a_spurious_heavily_damped_neighbour_is_left_out_and_said(light_diagram)
     1-storey model's storey mode) is not needed by the FRF once the mode's own pole is
     refitted: left out, as a split of that peak (its half-power band covers the mode)."""
     from armaxmodal.modes.completeness import modes_the_record_needs
+    from armaxmodal.modes.working import WorkingSelection
 
     s, diagram = light_diagram
     m = s.modes()
@@ -281,9 +284,10 @@ def test_a_spurious_heavily_damped_neighbour_is_left_out_and_said(light_diagram)
         }
     )
     shapes = np.column_stack([m.modal_constants[:, 0], 0.1 * m.modal_constants[:, 0], m.modal_constants[:, 1]])
-    kept, _, notes, _ = modes_the_record_needs(diagram.recording, modes, shapes, None)
-    assert kept.freq_hz.tolist() == [m.freq_hz[0], m.freq_hz[1]]
-    assert [n.code for n in notes] == ["split_merged"] and notes[0].value == pytest.approx(1.15 * m.freq_hz[0])
+    kept = modes_the_record_needs(diagram.recording, WorkingSelection(modes, shapes), None)
+    assert kept.modes.freq_hz.tolist() == [m.freq_hz[0], m.freq_hz[1]]
+    (note,) = kept.notes
+    assert note.code == "split_merged" and note.value == pytest.approx(1.15 * m.freq_hz[0])
 
 
 def _none_if_nan(v):

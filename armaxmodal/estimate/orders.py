@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import partial
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -25,7 +26,7 @@ from armaxmodal.estimate.result import ArmaxFit
 from armaxmodal.exceptions import OrderError
 from armaxmodal.recording import Recording
 
-__all__ = ["choose_orders", "OrderChoice", "default_nb", "default_nc"]
+__all__ = ["choose_orders", "OrderChoice", "Orders", "default_nb", "default_nc"]
 
 
 def default_nb(na: int, nk: int) -> int:
@@ -36,6 +37,16 @@ def default_nb(na: int, nk: int) -> int:
 def default_nc(na: int) -> int:
     """``nc = na``."""
     return na
+
+
+class Orders(NamedTuple):
+    """An ARMAX model's orders (Eq. 3.9): ``na`` poles, ``nb`` input and ``nc`` noise
+    coefficients, input delay ``nk`` samples. A tuple, so ``(na, nb, nc, nk)`` still unpacks."""
+
+    na: int
+    nb: int
+    nc: int
+    nk: int
 
 
 @dataclass(frozen=True)

@@ -5,12 +5,15 @@ peak no selected mode explains.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, order_criteria, representative_pole
 from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_band, selection_job
+from armaxmodal.modes.working import WorkingSelection
 from armaxmodal.notes import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.stats import Z95
@@ -34,24 +37,25 @@ EDGE_FRACTION = 0.95
 DUPLICATE_FREQ = 0.01
 
 
-def modes_the_record_needs(recording: Recording, modes: pd.DataFrame, shapes: np.ndarray, band):
+def modes_the_record_needs(recording: Recording, work: WorkingSelection, band) -> WorkingSelection:
     """Selection by the data: drop, one at a time and least supported first, every mode the
     modal-model check does not need (:func:`armaxmodal.modes.support.mode_support`: leaving it
     out, a neighbour inside its half-power band refitted in its place, raises no output's
     misfit by :data:`~armaxmodal.modes.support.MODEL_ERROR_RISE` significantly). A dropped half
     of a split peak is a ``split_merged`` note, any other a ``mode_not_needed`` note.
-    Returns ``(modes, shapes, notes, check)`` with the check of the modes kept."""
+    Returns the selection of the modes kept, with their check."""
     from armaxmodal.modes.support import MODEL_ERROR_RISE, mode_support
 
-    notes: list[QualityWarning] = []
     while True:
+        modes = work.modes
         check = check_modes(recording, modes.freq_hz, modes.damping, band)
+        work = replace(work, check=check)
         if len(modes) < 2 or not np.isfinite(check.error).any():
-            return modes, shapes, notes, check
+            return work
         support = [mode_support(recording, modes.freq_hz, modes.damping, m, check, band) for m in range(len(modes))]
         weak = [m for m in range(len(modes)) if not support[m].needed]
         if not weak:
-            return modes, shapes, notes, check
+            return work
         # the least supported across orders goes first (of a split, the half the diagram
         # shows less), then the least needed
         rank = modes.sort_values(["support", "count", "energy"]).index.tolist()
@@ -63,40 +67,36 @@ def modes_the_record_needs(recording: Recording, modes: pd.DataFrame, shapes: np
         )
         if s.refitted_neighbour is not None:
             f_n = modes.at[s.refitted_neighbour, "freq_hz"]
-            notes.append(QualityWarning(
+            note = QualityWarning(
                 "split_merged", (),
                 f"modes at {f_n:.3f} and {f_m:.3f} Hz overlap within their half-power bands and the measured FRF does "
                 f"not need both: {evidence} once {f_n:.3f} Hz may take the whole peak; one peak split by the model, "
                 f"{f_n:.3f} Hz is reported", float(f_m),
-            ))  # fmt: skip
+            )  # fmt: skip
         else:
-            notes.append(QualityWarning(
+            note = QualityWarning(
                 "mode_not_needed", (),
                 f"a stable pole at {f_m:.3f} Hz (damping {x_m:.3f}) is left out: the measured FRF does not need it, "
                 f"{evidence}: a spurious pole of the model (noise, a nonlinearity, leakage), not a mode of the record",
                 float(f_m),
-            ))  # fmt: skip
-        keep = [i for i in range(len(modes)) if i != m]
-        modes, shapes = modes.iloc[keep].reset_index(drop=True), shapes[:, keep]
+            )  # fmt: skip
+        work = work.kept(i for i in range(len(modes)) if i != m).noted(note)
 
 
-def refit_with_added(diagram, modes, shapes, band, limits, refinement):
+def refit_with_added(diagram, work: WorkingSelection, band, limits) -> WorkingSelection:
     """The frequency-domain refit again, of every mode once the check has added some: a mode
     missing from a refit biases its neighbours (a five-segment chain's 13.5 Hz mode came out
     at 12.5 Hz while the 24.8 Hz one was missing, and its refit was refused as too far; now
-    13.3 Hz for the exact 13.54). ``(modes, shapes, refinement, check, notes)``."""
-
-    refit = selection_job(diagram.recording, [], modes, ("refit", refit_band(diagram.recording, band)))
-    notes = []
+    13.3 Hz for the exact 13.54). A refit that cannot be made leaves the modes, said."""
+    refit = selection_job(diagram.recording, [], work.modes, ("refit", refit_band(diagram.recording, band)))
     if isinstance(refit, RefitFailure):
-        notes = refit.notes("the modes with those the check added")
+        work = work.noted(*refit.notes("the modes with those the check added"))
     else:  # the first refit's start lacked these modes: its refusals may not stand
-        modes, shapes, refinement = refined_modes(diagram, modes, shapes, refit, *limits, relaxed=True)
-    check = check_modes(diagram.recording, modes.freq_hz, modes.damping, band)
-    return modes, shapes, refinement, check, notes
+        work = refined_modes(diagram, work, refit, *limits, relaxed=True)
+    return replace(work, check=check_modes(diagram.recording, work.modes.freq_hz, work.modes.damping, band))
 
 
-def modes_the_check_adds(diagram, modes: pd.DataFrame, shapes: np.ndarray, band, nas, check, clustering):
+def modes_the_check_adds(diagram, work: WorkingSelection, band, nas, clustering) -> WorkingSelection:
     """Stable clusters the support rule left out enter when the modal-model check needs them
     (as :func:`modes_the_record_needs` judges, but with the nearest mode refitted in its place,
     not only an overlapping one: one at a time, the largest first): the
@@ -106,10 +106,11 @@ def modes_the_check_adds(diagram, modes: pd.DataFrame, shapes: np.ndarray, band,
     poles of at least three orders away from the selected modes (heavily damped modes make
     no clear peak, and their poles scatter over the orders; these need a damping the record
     resolves, as a peak's cluster does not). A peak left unexplained is listed at the end as
-    before. Returns ``(modes, shapes, check)``."""
+    before. Returns the selection with those added, by frequency, and its check."""
     from armaxmodal.modes.support import mode_support
 
     bic = order_criteria(diagram)
+    modes, shapes, check = work.modes, work.shapes, work.check
     for sub, at_peak in _left_out_clusters(diagram, modes, band, nas, clustering):
         # the cluster's centre is tried: its lowest-BIC pole may sit at its edge
         centre = float(sub.freq_hz.median()), float(sub.damping.median())
@@ -131,8 +132,7 @@ def modes_the_check_adds(diagram, modes: pd.DataFrame, shapes: np.ndarray, band,
         modes = pd.concat([modes, pd.DataFrame([row])], ignore_index=True)
         shapes = np.column_stack([shapes, rep.vector])
         check = check_modes(diagram.recording, modes.freq_hz, modes.damping, band)
-    order = modes.sort_values("freq_hz").index.tolist()
-    return modes.loc[order].reset_index(drop=True), shapes[:, order], check
+    return work.with_modes(modes, shapes, check=check).kept(modes.sort_values("freq_hz").index)
 
 
 def _left_out_clusters(diagram, modes: pd.DataFrame, band, nas, clustering) -> list[tuple[pd.DataFrame, bool]]:

@@ -16,6 +16,7 @@ from armaxmodal.modes.modal_model import DAMPING_BOUNDS, DftLines, fit_modal_mod
 from armaxmodal.modes.mode_count import DECISIVE_BIC, FINAL_NFEV, ModeCount, count_modes, matched_poles
 from armaxmodal.modes.spread import split_segments
 from armaxmodal.modes.support import CANDIDATE_MIN_ORDERS, stable_in_diagram
+from armaxmodal.modes.working import WorkingSelection
 from armaxmodal.notes import QualityWarning
 from armaxmodal.stats import MAX_DAMPING, Z95
 
@@ -65,14 +66,15 @@ def _on_whole_record(count: ModeCount, rec, band_hz, hold: str) -> ModeCount:
     return replace(count, model=fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, FINAL_NFEV))
 
 
-def counted_modes(diagram, modes: pd.DataFrame, band_hz, hold: str, nas, clustering, band=None):
+def counted_modes(diagram, work: WorkingSelection, band_hz, hold: str, nas, clustering, band=None) -> WorkingSelection:
     """Count the modes from the selection's and return them as the selection reports modes.
 
     Parameters
     ----------
     diagram : StabilisationDiagram
-    modes : DataFrame
-        The selection so far (one row per mode, as :func:`armaxmodal.select_modes` builds).
+    work : WorkingSelection
+        The selection so far (its modes the start, one row per mode as
+        :func:`armaxmodal.select_modes` builds them).
     band_hz : (float, float)
         The band the model is fitted in (Hz).
     hold : {"bandlimited", "zoh"}
@@ -86,14 +88,11 @@ def counted_modes(diagram, modes: pd.DataFrame, band_hz, hold: str, nas, cluster
 
     Returns
     -------
-    modes : DataFrame
-    shapes : (n_sensors, n_modes) complex ndarray, or None
-        None when the model keeps no mode in the band: ``modes`` is then the selection's, and
-        the note says so (``count_undecided``).
-    count : ModeCount
-    notes : list of QualityWarning
+    WorkingSelection
+        The counted modes with the count and its notes. When the model keeps no mode in the band,
+        the modes stay the selection's, and a ``count_undecided`` note says so.
     """
-    rec = diagram.recording
+    rec, modes = diagram.recording, work.modes
     # the search runs on the record's first COUNT_MAX_SAMPLES; the chosen model is then fitted
     # to the whole record, so a long ride costs one fit more, not a search more
     part = rec if rec.n_samples <= COUNT_MAX_SAMPLES else split_segments(rec, rec.n_samples // COUNT_MAX_SAMPLES)[0]
@@ -108,9 +107,9 @@ def counted_modes(diagram, modes: pd.DataFrame, band_hz, hold: str, nas, cluster
         count = _on_whole_record(count, rec, band_hz, hold)
     keep = reported(count.model, data.band_hz)
     if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
-        return modes, None, count, [_no_mode_kept(count, modes, data.band_hz)]
-    rows = [_row(modes, count, i, hold) for i in np.flatnonzero(keep)]
-    return pd.DataFrame(rows), count.model.shapes[:, keep], count, _notes(count, keep, data.band_hz)
+        return work.noted(_no_mode_kept(count, modes, data.band_hz), count=count)
+    rows = pd.DataFrame([_row(modes, count, i, hold) for i in np.flatnonzero(keep)])
+    return work.with_modes(rows, count.model.shapes[:, keep], count=count).noted(*_notes(count, keep, data.band_hz))
 
 
 def _no_mode_kept(count: ModeCount, modes: pd.DataFrame, band_hz) -> QualityWarning:

@@ -17,7 +17,7 @@ import pandas as pd
 
 from armaxmodal._threads import one_blas_thread
 from armaxmodal.estimate.fit import fit_resumable
-from armaxmodal.estimate.orders import default_nb, default_nc, information_criterion, output_mean_squares
+from armaxmodal.estimate.orders import Orders, default_nb, default_nc, information_criterion, output_mean_squares
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.poles import SHARED, Tolerances, pole_rows, rejection_reasons, stability_classes
@@ -74,7 +74,7 @@ class StabilisationDiagram:
         damped_freq_hz, freq_sd, damping_sd, energy (residue energy), cls (stability class),
         rejected (reason, empty when kept), pole (complex), vector (complex shape over
         sensors for shared poles; the residue for a sensor's own pole).
-    orders : list of (na, nb, nc, nk)
+    orders : list of Orders
     tolerances : Tolerances
     recording : Recording
         The record the sweep fitted (after :func:`armaxmodal.prepare.preparation.prepare`).
@@ -95,7 +95,7 @@ class StabilisationDiagram:
         """Data-quality findings of the preparation and of the sweep itself."""
         found = list(self.preparation.warnings) if self.preparation is not None else []
         found += list(self.notes)
-        found += _nk_edge_warning(self.orders[0][3], self.recording)
+        found += _nk_edge_warning(self.orders[0].nk, self.recording)
         return found + disturbance_lines(self.poles, self.tolerances.min_energy, self.recording, SHARED)
 
     def to_frame(self) -> pd.DataFrame:
@@ -247,9 +247,9 @@ def stabilisation_diagram(
             with tqdm(total=first, desc="input delay choice", unit="fit", disable=not progress) as bar:
                 nk, known = _choose_nk(recording, NK_SEARCH, DELAY_CHOICE_ORDERS, n_jobs, tol, bar=bar)
         sources = [SHARED] + (list(recording.sensors) if per_sensor else [])
-        order_list = [(na, default_nb(na, nk), default_nc(na), nk) for na in orders]
+        order_list = [Orders(na, default_nb(na, nk), default_nc(na), nk) for na in orders]
         # single sensors cannot support high orders (their bounds are wide): stop them earlier
-        jobs = [(s, o) for o in order_list for s in sources if s == SHARED or o[0] <= per_sensor_max_order]
+        jobs = [(s, o) for o in order_list for s in sources if s == SHARED or o.na <= per_sensor_max_order]
         # the delay choice's fits of these orders continue from where they stopped, exactly
         # as if fitted here from the start (unless this sweep's cap is below theirs)
         if max_iter < DELAY_CHOICE_ITERATIONS:
@@ -270,7 +270,7 @@ def stabilisation_diagram(
             fit, fit_rows = done[(source, o)]
             if fit is None:
                 continue
-            kept[(source, o[0])] = fit
+            kept[(source, o.na)] = fit
             rows += fit_rows
         if not rows:
             raise OrderError("no order in the sweep could be fitted; use lower orders or a longer record.")

@@ -59,7 +59,7 @@ def plot_stabilisation(diagram, selection=None, ax=None):
     ax.set_ylabel("model order na")
     ax.set_title(
         f"Stabilisation: tolerances f {100 * tol.freq:g} %, ξ {100 * tol.damping:g} %, "
-        f"shape 1-MAC {tol.shape:g}; nk = {diagram.orders[0][3]}",
+        f"shape 1-MAC {tol.shape:g}; nk = {diagram.orders[0].nk}",
         fontsize=10,
         pad=28,
     )
@@ -75,7 +75,7 @@ def plot_stabilisation(diagram, selection=None, ax=None):
         ax.axvspan(lo, hi, color=_LOW_COHERENCE, alpha=0.5, zorder=0, lw=0)
     if selection is not None:
         _draw_check(ax, ax_f, f, selection)
-        top = max(o[0] for o in diagram.orders)
+        top = max(o.na for o in diagram.orders)
         for m in selection.modes.itertuples(index=False):
             ax.axvline(m.freq_hz, color="k", lw=0.8, ls=":")
             ax_d.axvline(m.freq_hz, color="k", lw=0.8, ls=":")

@@ -5,7 +5,7 @@ together over the worker threads, and the refit's values applied within their li
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial
 
 import numpy as np
@@ -20,6 +20,7 @@ from armaxmodal.modes.spread import (
     segment_poles,
     split_segments,
 )
+from armaxmodal.modes.working import WorkingSelection
 from armaxmodal.notes import QualityWarning
 from armaxmodal.prepare.frf import excited_band
 from armaxmodal.recording import Recording
@@ -77,19 +78,22 @@ class RefitFailure:
         ]
 
 
-def refined_modes(diagram, modes, shapes, refinement, cluster_freq, cluster_damping, merge_mac, relaxed=False):
+def refined_modes(
+    diagram, work: WorkingSelection, refinement, cluster_freq, cluster_damping, merge_mac, relaxed=False
+) -> WorkingSelection:
     """The frequency-domain refit (:func:`armaxmodal.modes.refine.refine_modes`, or a
-    :class:`RefitFailure` when it could not be made), reported for a band-limited record;
-    ``(modes, shapes, refinement)``.
+    :class:`RefitFailure` when it could not be made, which leaves the selection without one)
+    reported for a band-limited record, and kept as the selection's ``refinement``.
     ``relaxed``: the refit may move a mode by :func:`_refit_reach`, not ``cluster_freq``."""
     if refinement is None or isinstance(refinement, RefitFailure):
-        return modes, shapes, None
+        return replace(work, refinement=None)
+    work = replace(work, refinement=refinement)
     if refinement.hold == "bandlimited":
-        modes, shapes = _apply_refinement(modes, shapes, refinement, cluster_freq, cluster_damping, relaxed)
+        modes, shapes = _apply_refinement(work.modes, work.shapes, refinement, cluster_freq, cluster_damping, relaxed)
         # two modes the refit brought together are one peak
         keep = merge_duplicates(modes, list(shapes.T), merge_mac, diagram.recording.duration)
-        modes, shapes = modes.loc[keep].reset_index(drop=True), shapes[:, keep]
-    return modes, shapes, refinement
+        work = work.with_modes(modes, shapes).kept(keep)
+    return work
 
 
 def _refit_reach(freq_hz: np.ndarray, i: int, max_freq_change: float) -> float:

@@ -9,7 +9,7 @@ modes. :class:`ModeSelection` is the result and its JSON contract.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
@@ -30,6 +30,7 @@ from armaxmodal.modes.spread import (
     apply_segment_spread,
     segment_spread,
 )
+from armaxmodal.modes.working import WorkingSelection
 from armaxmodal.notes import UNCERTAIN_CODES, QualityWarning
 from armaxmodal.prepare.preparation import oversampling_note, record_header
 from armaxmodal.stats import Z95
@@ -144,8 +145,8 @@ class ModeSelection:
         prep = self.diagram.preparation
         return {
             **record_header(rec, prep, self.warnings),
-            "nk": self.diagram.orders[0][3],
-            "orders_na": [o[0] for o in self.diagram.orders],
+            "nk": self.diagram.orders[0].nk,
+            "orders_na": [o.na for o in self.diagram.orders],
             "tolerances": {"freq": t.freq, "damping": t.damping, "shape": t.shape, "max_damping": t.max_damping},
             "quality": self.quality,
             "reconstruction_error": _finite_or_none(self.reconstruction_error),
@@ -212,7 +213,7 @@ def select_modes(
     with one_blas_thread(), tqdm(desc="mode selection", unit="fit", disable=not progress) as bar:
         if band is None and diagram.preparation is not None:
             band = diagram.preparation.band
-        nas = sorted({o[0] for o in diagram.orders})
+        nas = sorted({o.na for o in diagram.orders})
         modes, vectors = clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs, bar)
         if not modes.empty:
             keep = merge_duplicates(modes, vectors, merge_mac, diagram.recording.duration)
@@ -224,59 +225,73 @@ def select_modes(
         if n_modes is not None:
             order = order[:n_modes]
         order = modes.loc[order].sort_values("freq_hz").index
-        modes = modes.loc[order].reset_index(drop=True)
-        shapes = np.column_stack([vectors[i] for i in order])
-        modes["estimator"] = "armax"
-        # the segment refits are ARMAX fits: their spread is judged against the ARMAX intervals
-        modes["freq_sd_armax"] = (modes.freq_ci95_hi - modes.freq_ci95_lo) / (2 * Z95)
-        modes["damping_sd_armax"] = (modes.damping_ci95_hi - modes.damping_ci95_lo) / (2 * Z95)
-        refinement, refit_notes = None, []
-        orders = {o[0]: o for o in diagram.orders}
-        fitted = refit_and_segment_fits(diagram, modes, band, refine, segments, orders, n_jobs, bar)
+        work = WorkingSelection(modes.loc[order].reset_index(drop=True), np.column_stack([vectors[i] for i in order]))
+        limits, clustering = (cluster_freq, cluster_damping, merge_mac), (cluster_freq, cluster_damping)
+        orders = {o.na: o for o in diagram.orders}
+        work = replace(work, modes=_armax_intervals(work.modes))
+        fitted = refit_and_segment_fits(diagram, work.modes, band, refine, segments, orders, n_jobs, bar)
+        refit_notes = []
         if refine:
-            refit, limits = fitted.pop("refit"), (cluster_freq, cluster_damping, merge_mac)
-            modes, shapes, refinement = refined_modes(diagram, modes, shapes, refit, *limits)
+            refit = fitted.pop("refit")
+            work = refined_modes(diagram, work, refit, *limits)
             refit_notes = refit.notes() if isinstance(refit, RefitFailure) else []
         if n_modes is None:
-            modes, shapes, notes, check = modes_the_record_needs(diagram.recording, modes, shapes, band)
-            clustering, n_before = (cluster_freq, cluster_damping), len(modes)
-            modes, shapes, check = modes_the_check_adds(diagram, modes, shapes, band, nas, check, clustering)
-            if len(modes) > n_before:  # a mode the added ones make redundant goes (a merge of two)
-                modes, shapes, more, check = modes_the_record_needs(diagram.recording, modes, shapes, band)
-                notes += more
-            if refine and len(modes) > n_before:  # the refit saw fewer modes than are reported
-                limits = (cluster_freq, cluster_damping, merge_mac)
-                again = refit_with_added(diagram, modes, shapes, band, limits, refinement)
-                modes, shapes, refinement, check, more = again
-                refit_notes += more
+            work = _by_the_check(diagram, work, band, nas, clustering, limits, refine)
+            if work.refinement is not None and len(work.modes):
+                # the last word on the number of modes: nested tests of the modal model with every pole free
+                hold, band_hz = work.refinement.hold, work.refinement.band_hz
+                work = counted_modes(diagram, work, band_hz, hold, nas, clustering, band)
+                work = work.noted(*_not_separated(work.modes))
+                bar.update(work.count.trials)
+                work = replace(work, check=check_modes(diagram.recording, work.modes.freq_hz, work.modes.damping, band))
         else:  # the user fixed the number of modes: the check judges them, it does not choose
-            notes, check = [], check_modes(diagram.recording, modes.freq_hz, modes.damping, band)
-        count = None
-        if n_modes is None and refinement is not None and len(modes):
-            # the last word on the number of modes: nested tests of the modal model with every pole free
-            counted, counted_shapes, count, more = counted_modes(
-                diagram, modes, refinement.band_hz, refinement.hold, nas, (cluster_freq, cluster_damping), band
-            )
-            if counted_shapes is not None:
-                modes, shapes = counted, counted_shapes
-            notes += more + _not_separated(modes)
-            bar.update(count.trials)
-            check = check_modes(diagram.recording, modes.freq_hz, modes.damping, band)
+            work = replace(work, check=check_modes(diagram.recording, work.modes.freq_hz, work.modes.damping, band))
         if segments >= 2:
-            orders_of = lambda i: orders[int(modes.at[i, "na"])]  # noqa: E731
-            spread = segment_spread(diagram.recording, modes, orders_of, segments, n_jobs, fitted)
+            modes = work.modes
+            spread = segment_spread(diagram.recording, modes, lambda i: orders[int(modes.at[i, "na"])], segments,
+                                    n_jobs, fitted)  # fmt: skip
             modes, spread_notes = apply_segment_spread(modes, spread, segments)
-            notes += spread_notes
-        notes += refit_notes
-        per_sensor, weighted = per_sensor_table(diagram, modes, shapes, cluster_freq)
-        from armaxmodal.modes.frf_check import unexplained_peaks
+            work = replace(work, modes=modes).noted(*spread_notes)
+        return _finished(diagram, work.noted(*refit_notes), band, cluster_freq, len(nas))
 
-        notes += unexplained_peaks(diagram.recording, modes.freq_hz.to_numpy(), modes.damping.to_numpy(), band)
-        notes += oversampling_note(modes.freq_hz.to_numpy(), diagram.recording.fs)
-        notes += _unresolved_damping_notes(modes, len(nas))
-        notes += check.warnings()
-        return ModeSelection(modes, shapes, per_sensor, weighted, diagram, refinement, tuple(notes), check, count)
 
+def _armax_intervals(modes: pd.DataFrame) -> pd.DataFrame:
+    """The ARMAX fit's standard deviations beside its intervals: the segment refits are ARMAX
+    fits, and their spread is judged against these even where another estimator is reported."""
+    modes = modes.assign(estimator="armax")
+    modes["freq_sd_armax"] = (modes.freq_ci95_hi - modes.freq_ci95_lo) / (2 * Z95)
+    modes["damping_sd_armax"] = (modes.damping_ci95_hi - modes.damping_ci95_lo) / (2 * Z95)
+    return modes
+
+
+def _by_the_check(diagram, work: WorkingSelection, band, nas, clustering, limits, refine: bool) -> WorkingSelection:
+    """The modal-model check drops the modes the record does not need and adds left-out clusters
+    it needs; after an addition, a mode the added ones make redundant goes (a merge of two), and
+    the refit is made again of all of them."""
+    recording, n_before = diagram.recording, len(work.modes)
+    work = modes_the_check_adds(diagram, modes_the_record_needs(recording, work, band), band, nas, clustering)
+    if len(work.modes) > n_before:
+        work = modes_the_record_needs(recording, work, band)
+    if refine and len(work.modes) > n_before:  # the refit saw fewer modes than are reported
+        work = refit_with_added(diagram, work, band, limits)
+    return work
+
+
+def _finished(diagram, work: WorkingSelection, band, cluster_freq: float, n_orders: int) -> ModeSelection:
+    """The selection with its per-sensor tables and the notes read off the final modes."""
+    from armaxmodal.modes.frf_check import unexplained_peaks
+
+    modes, shapes = work.modes, work.shapes
+    per_sensor, weighted = per_sensor_table(diagram, modes, shapes, cluster_freq)
+    freq, damping = modes.freq_hz.to_numpy(), modes.damping.to_numpy()
+    work = work.noted(
+        *unexplained_peaks(diagram.recording, freq, damping, band),
+        *oversampling_note(freq, diagram.recording.fs),
+        *_unresolved_damping_notes(modes, n_orders),
+        *work.check.warnings(),
+    )
+    return ModeSelection(modes, shapes, per_sensor, weighted, diagram, work.refinement, work.notes, work.check,
+                         work.count)  # fmt: skip
 
 #: the columns of an empty selection (what the command line and the JSON read of a mode)
 _MODE_COLUMNS = ("freq_hz", "damping", "damped_freq_hz", "freq_ci95_lo", "freq_ci95_hi", "damping_ci95_lo",
