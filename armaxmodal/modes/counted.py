@@ -12,35 +12,24 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
-from armaxmodal.modes.modal_model import DAMPING_BOUNDS, DftLines, fit_modal_model
-from armaxmodal.modes.mode_count import DECISIVE_BIC, FINAL_NFEV, ModeCount, count_modes, matched_poles
+from armaxmodal.modes.modal_model import DftLines, fit_modal_model
+from armaxmodal.modes.mode_count import DECISIVE_BIC, FINAL_NFEV, ModeCount, count_modes, matched_poles, reported
 from armaxmodal.modes.spread import split_segments
 from armaxmodal.modes.support import CANDIDATE_MIN_ORDERS, stable_in_diagram
 from armaxmodal.modes.working import WorkingSelection
 from armaxmodal.notes import QualityWarning
 from armaxmodal.stats import MAX_DAMPING, Z95
 
-__all__ = ["counted_modes", "reported"]
+__all__ = ["counted_modes"]
 
 #: a counted mode within this relative frequency of a selected one keeps that row's cluster
 #: facts (orders, support, spread); the clustering's own reach
 SAME_ROW_FREQ = 0.05
-#: a pole damped this little sits at the fit's floor (:data:`~armaxmodal.modes.modal_model.DAMPING_BOUNDS`):
-#: a line, a periodic disturbance or a frequency that moves, not a mode (the supine ride's 0.3 m/s^2
-#: hum at 12.5 Hz came out at 12.500 Hz, damping 1e-4; the bodies' modes are damped 0.3 % and more)
-LINE_DAMPING = 2 * DAMPING_BOUNDS[0]
 #: the nested tests run on at most this many samples of a record (18 min at 60 Hz, 9 at 120 Hz:
 #: every body's modes are counted on less); a longer record's chosen model is fitted whole
 COUNT_MAX_SAMPLES = 65_536
 #: left-out clusters of the diagram tried as additions: the largest few (each costs a fit)
 MAX_CANDIDATES = 3
-
-
-def reported(model, band_hz) -> np.ndarray:
-    """Which of a model's poles are modes of the band (bool per pole): not beyond it, not damped
-    beyond :data:`~armaxmodal.stats.MAX_DAMPING`, and not a line (damping at the fit's floor)."""
-    f, x = model.freq_hz, model.damping
-    return (f >= band_hz[0]) & (f <= band_hz[1]) & (x <= MAX_DAMPING) & (x > LINE_DAMPING)
 
 
 def _candidates(diagram, modes: pd.DataFrame, band, nas, cluster_freq, cluster_damping) -> list[tuple[float, float]]:
@@ -189,6 +178,12 @@ def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
             "count_undecided", (),
             f"the record does not rule out one mode more (near {f:.3f} Hz): adding it changes the criterion by "
             f"{-count.best_addition:+.1f}, less than {DECISIVE_BIC:g} either way", f,
+        ))  # fmt: skip
+    for start, went in count.carried_away:
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
+            "damping unresolved, or no three orders of the diagram hold a pole there); left out", went,
         ))  # fmt: skip
     for f in count.unconfirmed_hz:
         notes.append(QualityWarning(

@@ -35,10 +35,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from armaxmodal._threads import single_blas_thread
-from armaxmodal.modes.modal_model import DftLines, ModalModel, fit_modal_model
+from armaxmodal.modes.modal_model import DAMPING_BOUNDS, DftLines, ModalModel, fit_modal_model
 from armaxmodal.stats import MAX_DAMPING, Z95
 
-__all__ = ["DECISIVE_BIC", "ModeCount", "Step", "count_modes", "effective_fraction", "matched_poles"]
+__all__ = ["DECISIVE_BIC", "ModeCount", "Step", "count_modes", "effective_fraction", "matched_poles", "reported"]
 
 #: a change of the criterion this large is "very strong" evidence (Kass & Raftery 1995): a
 #: mode's removal, or a candidate's addition, that moves it less leaves the count undecided
@@ -59,6 +59,17 @@ HALVES_SD = 3.0
 FINAL_NFEV = 200
 #: a candidate addition within this relative frequency of a mode is that mode
 SAME_MODE_FREQ = 0.03
+#: a pole damped this little sits at the fit's floor (:data:`~armaxmodal.modes.modal_model.DAMPING_BOUNDS`):
+#: a line, a periodic disturbance or a frequency that moves, not a mode (the supine ride's 0.3 m/s^2
+#: hum at 12.5 Hz came out at 12.500 Hz, damping 1e-4; the bodies' modes are damped 0.3 % and more)
+LINE_DAMPING = 2 * DAMPING_BOUNDS[0]
+
+
+def reported(model, band_hz) -> np.ndarray:
+    """Which of a model's poles are modes of the band (bool per pole): not beyond it, not damped
+    beyond :data:`~armaxmodal.stats.MAX_DAMPING`, and not a line (damping at the fit's floor)."""
+    f, x = model.freq_hz, model.damping
+    return (f >= band_hz[0]) & (f <= band_hz[1]) & (x <= MAX_DAMPING) & (x > LINE_DAMPING)
 
 
 @dataclass(frozen=True)
@@ -102,6 +113,9 @@ class ModeCount:
         each converged, with its criterion's difference from the chosen model's (under
         :data:`DECISIVE_BIC`). The reported intervals cover their modes
         (:func:`armaxmodal.modes.counted.counted_modes`).
+    carried_away : tuple of (float, float)
+        Starting modes the first free fit carried to where no mode is founded, and which were
+        left out: (start Hz, where it went Hz). See :func:`_without_unfounded`.
     """
 
     model: ModalModel
@@ -114,6 +128,7 @@ class ModeCount:
     trials: int = field(default=0)
     unconfirmed_hz: tuple[float, ...] = ()
     alternatives: tuple[tuple[float, ModalModel], ...] = ()
+    carried_away: tuple[tuple[float, float], ...] = ()
 
 
 def effective_fraction(residual: np.ndarray, max_lag: int = MAX_CORRELATION_LAG) -> float:
@@ -264,6 +279,31 @@ def _margins(search: _Search, here: float, current: ModalModel, removed, best_re
     return rise, gain, new_hz
 
 
+def _without_unfounded(data: DftLines, start_hz, model: ModalModel, hold: str, max_nfev: int, supported):
+    """The first free fit without the starting poles it carried beyond :data:`SAME_MODE_FREQ` of
+    their start to where no mode is founded: a pole reported there is a new pole, and must be a
+    mode as an addition must (its damping resolved and, where ``supported`` says what is, stable
+    across the diagram's orders). A bridge's heavily damped 5.83 Hz start went to 4.40 Hz with
+    damping 0.007, where no order holds a pole. Returns ``(model, ((start Hz, Hz), ...))``."""
+    start_hz = np.atleast_1d(np.asarray(start_hz, float))
+    shown = reported(model, data.band_hz)
+    unfounded = []
+    for i, j in matched_poles(start_hz, model.freq_hz):
+        f, x = model.freq_hz[i], model.damping[i]
+        if not shown[i] or abs(np.log(f / start_hz[j])) <= SAME_MODE_FREQ:
+            continue
+        founded = x - Z95 * model.damping_sd[i] > 0 and (supported is None or supported(f, x))
+        if not founded:
+            unfounded.append((i, (float(start_hz[j]), float(f))))
+    if not unfounded:
+        return model, ()
+    keep = np.setdiff1d(np.arange(model.n_modes), [i for i, _ in unfounded])
+    if keep.size == 0:
+        return model, ()  # nothing else to stand on: the search decides
+    return (fit_modal_model(data, model.freq_hz[keep], model.damping[keep], hold, max_nfev),
+            tuple(moved for _, moved in unfounded))  # fmt: skip
+
+
 def _equally_good(search: _Search, chosen: ModalModel, rise: np.ndarray, addition: ModalModel | None):
     """The models with one mode fewer (each mode whose removal the criterion barely resists) or
     one more (the best addition, when it barely loses), converged on the chosen model's weights
@@ -363,6 +403,7 @@ def count_modes(
     # concentrated over those levels; the weights only steer the fits)
     data = data.noise_weighted(start_model)
     start_model = fit_modal_model(data, start_model.freq_hz, start_model.damping, hold, max_nfev)
+    start_model, carried_away = _without_unfounded(data, freq_hz, start_model, hold, max_nfev, supported)
     fraction = effective_fraction(start_model.residual)
     search = _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev)
     # a starting mode the free fit carried away (a weak mode's pole to beyond the band) is tried
@@ -401,4 +442,4 @@ def count_modes(
     close = best_addition[2] if best_addition is not None and gain > -DECISIVE_BIC else None
     alternatives = _equally_good(search, current, rise, close)
     return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
-                     tuple(unconfirmed), alternatives)  # fmt: skip
+                     tuple(unconfirmed), alternatives, carried_away)  # fmt: skip
