@@ -187,12 +187,30 @@ def test_csv_output_selection(tmp_path):
         ("", {}, "empty"),
         ("time,base,a\n0,1,2\n1,1,3\n2,1,1\n", {}, "constant"),
         ("time,base\n0,1\n1,2\n2,0\n", {}, "no outputs"),
+        # a channel exported twice under one name: once read as 'a' and 'a.1' in silence
+        ("time,base,a,a\n0,1,2,2\n1,2,3,3\n2,0,1,1\n", {}, "'a' .columns 3, 4."),
+        ("time,base,a,b,a,b\n0,1,2,2,2,2\n1,2,3,3,3,3\n", {}, "'a' .columns 3, 5.; 'b' .columns 4, 6."),
+        # a second 'CSV UTF-8' export appended to the first: its byte-order mark inside the file
+        ("time,base,a\n0,1,2\n1,2,3\n\ufefftime,base,a\n2,0,1\n", {}, "line 4 holds a byte-order mark"),
     ],
 )
 def test_bad_csv_gets_a_clear_error(tmp_path, text, kwargs, message):
     p = _write(tmp_path, "bad.csv", text)
     with pytest.raises(DataError, match=message):
         am.read_recording(p, **kwargs)
+
+
+@pytest.mark.parametrize("gz", [False, True])
+def test_a_spreadsheets_byte_order_mark_before_comment_lines_is_read_through(tmp_path, rec, gz):
+    """'CSV UTF-8' from a spreadsheet starts with a byte-order mark, which hid the first '#': the
+    comment line was refused as a metadata line that needs a '#' it already has."""
+    plain = am.write_recording_csv(rec, tmp_path / "plain.csv").read_bytes()
+    assert plain.startswith(b"#")
+    p = tmp_path / ("bom.csv.gz" if gz else "bom.csv")
+    p.write_bytes(gzip.compress(b"\xef\xbb\xbf" + plain) if gz else b"\xef\xbb\xbf" + plain)
+    back = am.read_recording(p)
+    assert back.subject == "S3" and back.mass_kg == pytest.approx(76.96) and back.sensors == rec.sensors
+    np.testing.assert_allclose(back.response, rec.response, rtol=1e-8)
 
 
 @pytest.mark.parametrize("lost", [1, 2, 3])

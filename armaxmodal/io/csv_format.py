@@ -32,9 +32,10 @@ def _check_csv_layout(path: Path) -> None:
             head = gzip.decompress(head) if len(head) < (1 << 16) else gzip.open(path).read(1 << 16)
         except (EOFError, OSError, zlib.error) as exc:
             raise DataError(f"{path.name}: a damaged or truncated gzip file ({exc}); copy or export it again.") from exc
-    lines = [
-        ln for ln in head.decode("utf-8", errors="replace").splitlines()[:-1] if ln.strip() and not ln.startswith("#")
-    ]
+    # a byte-order mark at the start ("CSV UTF-8" in a spreadsheet) is read through, as pandas does
+    text = head.decode("utf-8-sig", errors="replace").splitlines()[:-1]
+    _check_byte_order_marks(path, text)
+    lines = [ln for ln in text if ln.strip() and not ln.startswith("#")]
     if not lines:
         return
     _check_separator(path, lines[:200])
@@ -48,6 +49,41 @@ def _check_csv_layout(path: Path) -> None:
             f"{path.name}: {leading} line(s) before the header have fewer fields than the data (first: "
             f"{lines[0][:40]!r}): metadata lines. Put '#' before each (they are then read as comments) or "
             "delete them. Xsens DOT exports are read as they are when you pass one file per sensor."
+        )
+    _check_duplicate_columns(path, lines[0])
+
+
+def _check_byte_order_marks(path: Path, lines: list[str]) -> None:
+    """Refuse a byte-order mark inside the file (at its start it is read through): one sits where
+    a second exported file was appended to the first, and pandas would read it into a cell."""
+    for i, line in enumerate(lines):
+        if "\ufeff" in line:
+            raise _byte_order_mark_error(path, f"line {i + 1}")
+
+
+def _byte_order_mark_error(path: Path, where: str) -> DataError:
+    return DataError(
+        f"{path.name}: {where} holds a byte-order mark (the invisible mark a spreadsheet writes at the start of a "
+        "'CSV UTF-8' file): two exported files joined into one? Keep one header and delete the mark, or analyse "
+        "the parts apart."
+    )
+
+
+def _check_duplicate_columns(path: Path, header: str) -> None:
+    """Refuse two columns of one name, naming them: pandas would rename the second ``name.1``
+    in silence, and a channel renamed in silence is a wrong channel in the results."""
+    import csv
+
+    names = [name.strip() for name in next(csv.reader([header]))]
+    seen: dict[str, list[int]] = {}
+    for k, name in enumerate(names):
+        seen.setdefault(name, []).append(k + 1)
+    twice = {name: cols for name, cols in seen.items() if len(cols) > 1}
+    if twice:
+        listed = "; ".join(f"'{name}' (columns {', '.join(map(str, cols))})" for name, cols in twice.items())
+        raise DataError(
+            f"{path.name}: the header names a column more than once: {listed}. A channel exported twice, or two "
+            "sensors given one name: rename them apart, or delete the copy."
         )
 
 
@@ -81,10 +117,12 @@ def read_csv_file(path: Path):
         # every cell a number, the common case, is parsed in C; anything else (text, empty or
         # missing cells) is read again as text below, to say which cell is wrong (the same
         # doubles either way: checked on the fixtures and a 20,000-row record)
-        frame = pd.read_csv(path, comment="#", skipinitialspace=True, keep_default_na=False)
+        # pandas reads through a byte-order mark at the start itself
+        options = {"comment": "#", "skipinitialspace": True, "keep_default_na": False}
+        frame = pd.read_csv(path, **options)
         numeric = all(dtype.kind in "iuf" for dtype in frame.dtypes)
         if not numeric:
-            frame = pd.read_csv(path, comment="#", skipinitialspace=True, dtype=str, keep_default_na=False)
+            frame = pd.read_csv(path, dtype=str, **options)
     except pd.errors.EmptyDataError as exc:
         raise DataError(f"{path.name}: the file is empty; expected a header row and data.") from exc
     except (pd.errors.ParserError, UnicodeDecodeError, OSError, EOFError) as exc:
@@ -145,6 +183,8 @@ def _text_channels(frame: pd.DataFrame, path: Path) -> dict[str, np.ndarray]:
                     f"{path.name}: column '{col}', data row {row + 1} is empty (a missing "
                     "sample); fill or trim it before analysis."
                 )
+            if "\ufeff" in frame[col].iloc[row]:
+                raise _byte_order_mark_error(path, f"column '{col}', data row {row + 1}")
             raise DataError(
                 f"{path.name}: column '{col}', data row {row + 1}: {frame[col].iloc[row]!r} is "
                 "not a number; fix or remove that cell."
@@ -160,7 +200,7 @@ def _csv_comments(path: Path) -> dict:
     opener = gzip.open if path.suffix.lower() == ".gz" else open
     info: dict = {}
     try:
-        with opener(path, "rt", encoding="utf-8") as fh:
+        with opener(path, "rt", encoding="utf-8-sig") as fh:
             for line in fh:
                 if not line.startswith("#"):
                     break
