@@ -301,8 +301,8 @@ def test_a_decided_count_has_no_equally_good_model(monkeypatch, supine):
     "stable_there, resolved, dropped", [(False, True, True), (True, False, True), (True, True, False)]
 )
 def test_a_start_mode_the_free_fit_carries_away_must_be_founded(monkeypatch, supine, stable_there, resolved, dropped):
-    """The first free fit moves the 13 Hz start to 11 Hz: a new pole, which stays only when its
-    damping is resolved and the diagram holds a pole there (as an addition must)."""
+    """The search's converged model holds the 13 Hz start at 11 Hz: a new pole, which stays only
+    when its damping is resolved and the diagram holds a pole there (as an addition must)."""
     import armaxmodal.modes.mode_count as mode_count
 
     data, _ = supine
@@ -311,7 +311,8 @@ def test_a_start_mode_the_free_fit_carries_away_must_be_founded(monkeypatch, sup
         moved.damping_sd = np.array([0.003, 0.003, 0.2])  # 11 Hz: interval reaches below zero
     refits = []
     monkeypatch.setattr(mode_count, "fit_modal_model", lambda d, f, x, hold, n: refits.append(list(f)) or _model(f, x))
-    model, carried = mode_count._without_unfounded(data, [5.0, 9.0, 13.0], moved, "zoh", 40,
+    search = mode_count._Search(data, "zoh", 1.0, 40)
+    model, carried = mode_count._without_unfounded(search, [5.0, 9.0, 13.0], moved,
                                                    lambda f, x: stable_there or abs(f - 11.0) > 0.5)  # fmt: skip
     if dropped:
         assert carried == ((13.0, 11.0),) and refits == [[5.0, 9.0]] and model.n_modes == 2
@@ -319,4 +320,4 @@ def test_a_start_mode_the_free_fit_carries_away_must_be_founded(monkeypatch, sup
         assert carried == () and model is moved and refits == []
     # a pole that stayed near its start is not judged, however unsupported
     near = _model([5.0, 9.0, 12.8], [0.3, 0.3, 0.3])
-    assert mode_count._without_unfounded(data, [5.0, 9.0, 13.0], near, "zoh", 40, lambda f, x: False)[1] == ()
+    assert mode_count._without_unfounded(search, [5.0, 9.0, 13.0], near, lambda f, x: False)[1] == ()

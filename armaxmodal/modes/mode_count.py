@@ -114,8 +114,8 @@ class ModeCount:
         :data:`DECISIVE_BIC`). The reported intervals cover their modes
         (:func:`armaxmodal.modes.counted.counted_modes`).
     carried_away : tuple of (float, float)
-        Starting modes the first free fit carried to where no mode is founded, and which were
-        left out: (start Hz, where it went Hz). See :func:`_without_unfounded`.
+        Starting modes the search carried to where no mode is founded, and which were left out
+        of the chosen model: (start Hz, where it went Hz). See :func:`_without_unfounded`.
     """
 
     model: ModalModel
@@ -279,14 +279,17 @@ def _margins(search: _Search, here: float, current: ModalModel, removed, best_re
     return rise, gain, new_hz
 
 
-def _without_unfounded(data: DftLines, start_hz, model: ModalModel, hold: str, max_nfev: int, supported):
-    """The first free fit without the starting poles it carried beyond :data:`SAME_MODE_FREQ` of
-    their start to where no mode is founded: a pole reported there is a new pole, and must be a
-    mode as an addition must (its damping resolved and, where ``supported`` says what is, stable
-    across the diagram's orders). A bridge's heavily damped 5.83 Hz start went to 4.40 Hz with
-    damping 0.007, where no order holds a pole. Returns ``(model, ((start Hz, Hz), ...))``."""
+def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported):
+    """The chosen model without the starting poles the search carried beyond :data:`SAME_MODE_FREQ`
+    of every start to where no mode is founded, refitted to convergence: a pole reported there
+    is a new pole, and must be a mode as an addition must (its damping resolved and, where
+    ``supported`` says what is, stable across the diagram's orders). Judged on the converged model
+    only: on the way, a moved pole may stand in for a mode not yet added (a body's 15.78 Hz start
+    stood at 19.99 Hz until the mode above the band was added, then came back). A bridge's heavily
+    damped 5.83 Hz start ended at 4.40 Hz with damping 0.007, where no order holds a pole.
+    Returns ``(model, ((start Hz, Hz), ...))``."""
     start_hz = np.atleast_1d(np.asarray(start_hz, float))
-    shown = reported(model, data.band_hz)
+    shown = reported(model, search.data.band_hz)
     unfounded = []
     for i, j in matched_poles(start_hz, model.freq_hz):
         f, x = model.freq_hz[i], model.damping[i]
@@ -295,12 +298,10 @@ def _without_unfounded(data: DftLines, start_hz, model: ModalModel, hold: str, m
         founded = x - Z95 * model.damping_sd[i] > 0 and (supported is None or supported(f, x))
         if not founded:
             unfounded.append((i, (float(start_hz[j]), float(f))))
-    if not unfounded:
-        return model, ()
     keep = np.setdiff1d(np.arange(model.n_modes), [i for i, _ in unfounded])
-    if keep.size == 0:
-        return model, ()  # nothing else to stand on: the search decides
-    return (fit_modal_model(data, model.freq_hz[keep], model.damping[keep], hold, max_nfev),
+    if not unfounded or keep.size == 0:  # nothing else to stand on: the search's model stays
+        return model, ()
+    return (search.fit(model.freq_hz[keep], model.damping[keep], FINAL_NFEV),
             tuple(moved for _, moved in unfounded))  # fmt: skip
 
 
@@ -403,7 +404,6 @@ def count_modes(
     # concentrated over those levels; the weights only steer the fits)
     data = data.noise_weighted(start_model)
     start_model = fit_modal_model(data, start_model.freq_hz, start_model.damping, hold, max_nfev)
-    start_model, carried_away = _without_unfounded(data, freq_hz, start_model, hold, max_nfev, supported)
     fraction = effective_fraction(start_model.residual)
     search = _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev)
     # a starting mode the free fit carried away (a weak mode's pole to beyond the band) is tried
@@ -412,20 +412,24 @@ def count_modes(
             if np.min(np.abs(np.log(start_model.freq_hz / f))) > SAME_MODE_FREQ]  # fmt: skip
     current, steps, candidates, unconfirmed = start_model, [], list(candidates) + lost, []
 
-    def admissible(model: ModalModel | None) -> bool:
-        return search.admissible(model, current, supported)
-
-    while True:
+    def neighbours():
+        """The current model's criterion, its removals, and the best removal and addition (an
+        addition the halves do not confirm is noted and dropped)."""
         here = search.bic(current)
         removed = search.removals(current)
-        peak = residual_peak(current, data)
+        peak = residual_peak(current, search.data)
         added = search.additions(current, candidates + [peak], peak[0])
-        best_removal, best_addition = search.best(removed), search.best(added, admissible)
+        best_removal = search.best(removed)
+        best_addition = search.best(added, lambda model: search.admissible(model, current, supported))
         if best_addition is not None and search.bic(best_addition[2]) < here and len(halves) == 2:
             new = _new_poles(current.freq_hz, best_addition[2].freq_hz)
             if not search.in_both_halves(best_addition[2], new, halves):
                 unconfirmed.append(best_addition[1])
                 best_addition = None
+        return here, removed, best_removal, best_addition
+
+    while True:
+        here, removed, best_removal, best_addition = neighbours()
         better = [t for t in (best_removal, best_addition) if t is not None and search.bic(t[2]) < here]
         if not better or len(steps) == MAX_STEPS:
             break
@@ -439,6 +443,10 @@ def count_modes(
     final = search.fit(current.freq_hz, current.damping, FINAL_NFEV)
     if search.bic(final) < here:
         rise, gain, current = rise + here - search.bic(final), gain - (here - search.bic(final)), final
+    current, carried_away = _without_unfounded(search, freq_hz, current, supported)
+    if carried_away:  # the model lost a pole: its neighbours are judged again, from where it stands
+        here, removed, best_removal, best_addition = neighbours()
+        rise, gain, new_hz = _margins(search, here, current, removed, best_removal, best_addition)
     close = best_addition[2] if best_addition is not None and gain > -DECISIVE_BIC else None
     alternatives = _equally_good(search, current, rise, close)
     return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
