@@ -183,7 +183,7 @@ def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
         notes.append(QualityWarning(
             "mode_count", (),
             f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
-            "damping unresolved, or no three orders of the diagram hold a pole there); left out", went,
+            "damping unresolved, or not the same in both halves of the record); left out", went,
         ))  # fmt: skip
     for f in count.unconfirmed_hz:
         notes.append(QualityWarning(
