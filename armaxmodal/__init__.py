@@ -21,7 +21,7 @@ import importlib
 
 from armaxmodal._version import __version__
 from armaxmodal.estimate import ArmaxFit, choose_orders, fit_armax
-from armaxmodal.exceptions import ArmaxModalError, ConvergenceWarning, DataError, OrderError, StructureError
+from armaxmodal.exceptions import ArmaxModalError, ConvergenceWarning, DataError, OrderError, PickError, StructureError
 from armaxmodal.io import read_recording, read_xsens, write_recording_csv, write_recording_uff
 from armaxmodal.modes import (
     Identification,
@@ -77,6 +77,7 @@ __all__ = [
     "Recording",
     "StabilisationDiagram",
     "Structure",
+    "PickError",
     "StructureError",
     "__version__",
     "add_noise",

@@ -11,6 +11,7 @@ __all__ = [
     "DataError",
     "OrderError",
     "StructureError",
+    "PickError",
     "ConvergenceWarning",
 ]
 
@@ -29,6 +30,11 @@ class OrderError(ArmaxModalError, ValueError):
 
 class StructureError(ArmaxModalError, ValueError):
     """Mass, damping or stiffness matrices are not physical, or not of the asked topology."""
+
+
+class PickError(ArmaxModalError, ValueError):
+    """A mode picked by hand is not one the stabilisation diagram offers (outside the band, no
+    stable cluster near it, two picks on one cluster)."""
 
 
 class ConvergenceWarning(UserWarning):

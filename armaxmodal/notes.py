@@ -42,6 +42,7 @@ WARNING_CODES = (
     "mode_count",
     "count_undecided",
     "modes_not_separated",
+    "pick_not_supported",
 )
 
 #: the codes that make a passing selection ``uncertain``: the nested tests do not decide the
@@ -52,6 +53,7 @@ WARNING_CODES = (
 UNCERTAIN_CODES = (
     "count_undecided",
     "modes_not_separated",
+    "pick_not_supported",
     "drift",
     "periodic_disturbance",
     "stuck_samples",

@@ -15,7 +15,7 @@ from armaxmodal.cli.common import (
     print_warnings,
     write_outputs,
 )
-from armaxmodal.exceptions import OrderError
+from armaxmodal.exceptions import OrderError, PickError
 from armaxmodal.io.write import write_json
 
 
@@ -29,6 +29,10 @@ def add_parser(sub, parents) -> None:
         "--orders", default=None, help="range of na, LO:HI (even steps); default 2:30, capped to suit the record"
     )
     p.add_argument("--modes", type=POSITIVE_INT, default=None, help="number of modes to keep (default: automatic)")
+    p.add_argument(
+        "--pick", default=None, help="modes picked by hand, F1,F2,... in Hz: each takes the nearest stable column "
+        "of the diagram (within 5 %%); not with --modes"
+    )  # fmt: skip
     p.add_argument("--band", default=None, help="frequency band LO:HI in Hz")
     p.add_argument("--plot", default=None, help="stabilisation plot (.png, .svg or .pdf)")
     p.add_argument("--json", default=None, help="selected modes as JSON")
@@ -50,20 +54,24 @@ def add_parser(sub, parents) -> None:
 
 def run(args) -> int:
     from armaxmodal.modes.diagram import stabilisation_diagram
+    from armaxmodal.modes.picks import check_picks
     from armaxmodal.modes.selection import select_modes
     from armaxmodal.prepare.preparation import check_band
 
     plot_format = output_format(args.plot) if args.plot else None
     orders = None if args.orders is None else order_range(args.orders)
     band = check_band(parse_pair(args.band, "--band")) if args.band else None
+    picks = _picks(args.pick, args.modes)
     rec = load_recording(args)
     check_band(band, rec.fs)
+    if picks is not None:  # refused before the sweep, not after it
+        check_picks(picks, band, rec.fs)
     if not args.quiet:
         outputs = ", ".join(rec.sensors)
         print(f"{args.data}: input {rec.input_name}; outputs {outputs}; {rec.n_samples} samples at {rec.fs:g} Hz")
     diagram = stabilisation_diagram(rec, orders, band=band, detrend=args.detrend, progress=not args.quiet)
     try:
-        selection = select_modes(diagram, args.modes, band, progress=not args.quiet)
+        selection = select_modes(diagram, args.modes, band, progress=not args.quiet, picks=picks)
     except OrderError:
         # no mode: the diagram and the pole table still show the user why
         print_warnings(diagram.warnings)
@@ -84,6 +92,7 @@ def run(args) -> int:
                     "damping_ci95_lo",
                     "damping_ci95_hi",
                     "count",
+                    *(["picked_hz"] if "picked_hz" in selection.modes else []),
                 ]
             ].to_string(float_format=lambda v: f"{v:.4f}")
         )
@@ -97,6 +106,20 @@ def run(args) -> int:
     write_outputs(outputs)
     print(verdict(selection.check, len(selection.modes), selection.uncertain_because))
     return 0
+
+
+def _picks(text: str | None, n_modes: int | None) -> list[float] | None:
+    """``--pick F1,F2,...`` as frequencies (Hz); refused with ``--modes`` or when not numbers."""
+    if text is None:
+        return None
+    if n_modes is not None:
+        raise PickError("--pick and --modes do not mix: pick the modes, or give their number, not both.")
+    try:
+        return [float(v) for v in text.split(",") if v.strip()]
+    except ValueError as exc:
+        raise PickError(
+            f"--pick: expected frequencies in Hz separated by commas, such as 5.8,8.3,13.5; got {text!r}."
+        ) from exc
 
 
 def print_check(check) -> None:

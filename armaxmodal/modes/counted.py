@@ -8,10 +8,13 @@ or lines at the damping floor -- stay in the model and are not reported.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
+from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.modal_model import DftLines, fit_modal_model
 from armaxmodal.modes.mode_count import DECISIVE_BIC, FINAL_NFEV, ModeCount, count_modes, matched_poles, reported
 from armaxmodal.modes.spread import split_segments
@@ -55,7 +58,9 @@ def _on_whole_record(count: ModeCount, rec, band_hz, hold: str) -> ModeCount:
     return replace(count, model=fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, FINAL_NFEV))
 
 
-def counted_modes(diagram, work: WorkingSelection, band_hz, hold: str, nas, clustering, band=None) -> WorkingSelection:
+def counted_modes(
+    diagram, work: WorkingSelection, band_hz, hold: str, nas, clustering, band=None, *, picked: bool = False
+) -> WorkingSelection:
     """Count the modes from the selection's and return them as the selection reports modes.
 
     Parameters
@@ -74,6 +79,11 @@ def counted_modes(diagram, work: WorkingSelection, band_hz, hold: str, nas, clus
         The clustering's relative frequency and damping reach.
     band : (float, float), optional
         The user's band, for the left-out clusters.
+    picked : bool
+        Modes were picked by hand (the rows with a finite ``picked_hz``): the model of every row
+        and of the poles the selection's own model kept unreported (``work.count``) is fitted as it
+        stands and its margins measured, and the picked modes are reported (``pick_not_supported``
+        says which picks the record does not need); the rest stay in the model.
 
     Returns
     -------
@@ -89,16 +99,70 @@ def counted_modes(diagram, work: WorkingSelection, band_hz, hold: str, nas, clus
     candidates = _candidates(diagram, modes, band, nas, *clustering)
     halves = tuple(DftLines.from_recording(half, band_hz) for half in split_segments(part, 2))
     supported = stable_in_diagram(diagram, band, *clustering)
-    count = count_modes(
-        data, modes.freq_hz, modes.damping, candidates, hold=hold, halves=halves, supported=supported
-    )
+    start_f, start_x = modes.freq_hz.to_numpy(), modes.damping.to_numpy()
+    if picked and work.count is not None:  # the poles the selection's model kept unreported stay in it
+        model = work.count.model
+        hidden = ~reported(model, band_hz)
+        start_f, start_x = np.r_[start_f, model.freq_hz[hidden]], np.r_[start_x, model.damping[hidden]]
+    count = count_modes(data, start_f, start_x, candidates, hold=hold, halves=halves, supported=supported,
+                        search=not picked)  # fmt: skip
     if part is not rec:
         count = _on_whole_record(count, rec, band_hz, hold)
     keep = reported(count.model, data.band_hz)
+    if picked:
+        return _picked_result(work, count, keep, hold, rec, band)
     if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
         return work.noted(_no_mode_kept(count, modes, data.band_hz), count=count)
     rows = pd.DataFrame([_row(modes, count, i, hold) for i in np.flatnonzero(keep)])
     return work.with_modes(rows, count.model.shapes[:, keep], count=count).noted(*_notes(count, keep, data.band_hz))
+
+
+def _picked_result(work: WorkingSelection, count: ModeCount, keep: np.ndarray, hold: str, recording=None,
+                   band=None) -> WorkingSelection:  # fmt: skip
+    """The picked rows (finite ``picked_hz``) reported: from the modal model where it keeps the pick
+    as a mode of the band, else as the selection had it (the diagram's or the refit's values) with a
+    ``pick_not_supported`` note that says where the model took it. The rows not picked stay in the
+    model, said in a note; the check (with ``recording``) judges every mode of the model in the band."""
+    m, rows, shapes = count.model, [], []
+    picked = np.isfinite(work.modes.picked_hz.to_numpy())
+    pairs = dict((j, i) for i, j in matched_poles(work.modes.freq_hz.to_numpy(), m.freq_hz))  # row -> pole
+    picked_poles = np.zeros(m.n_modes, dtype=bool)
+    for j, i in pairs.items():
+        picked_poles[i] = keep[i] and picked[j]
+    notes = _pick_notes(count, picked_poles)
+    for j in np.flatnonzero(picked):
+        i = pairs[j]
+        if keep[i]:
+            rows.append({**_row(work.modes, count, i, hold), "picked_hz": work.modes.picked_hz.iloc[j]})
+            shapes.append(m.shapes[:, i])
+            continue
+        row = work.modes.iloc[j].to_dict()
+        rows.append({**row, "count_undecided": True, "structure_widened": False})
+        shapes.append(work.shapes[:, j])
+        notes.append(QualityWarning(
+            "pick_not_supported", (),
+            f"the maximum-likelihood modal model takes the mode picked at {row['freq_hz']:.3f} Hz to "
+            f"{m.freq_hz[i]:.3f} Hz (damping {m.damping[i]:.3g}): beyond the band, damped beyond {MAX_DAMPING:g} or "
+            "a line. The record does not support a mode there; it is reported from the diagram's fit, unconfirmed",
+            float(row["freq_hz"]),
+        ))  # fmt: skip
+    others = [pairs[j] for j in np.flatnonzero(~picked) if keep[pairs[j]]]
+    if others:
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"{len(others)} mode(s) of the record were not picked and are not reported: "
+            + ", ".join(f"{m.freq_hz[i]:.3f} Hz (damping {m.damping[i]:.3g})" for i in others)
+            + "; they stay in the modal model, so that the picked modes' values are not biased by their absence",
+            float(len(others)),
+        ))  # fmt: skip
+    order = np.argsort([r["freq_hz"] for r in rows])
+    work = work.with_modes(pd.DataFrame([rows[k] for k in order]), np.column_stack([shapes[k] for k in order]),
+                           count=count)  # fmt: skip
+    if recording is not None:  # the check of the model the picks come from: the picks and the others
+        f = np.r_[work.modes.freq_hz.to_numpy(), m.freq_hz[others]]
+        x = np.r_[work.modes.damping.to_numpy(), m.damping[others]]
+        work = replace(work, check=check_modes(recording, f, x, band))
+    return work.noted(*notes)
 
 
 def _no_mode_kept(count: ModeCount, modes: pd.DataFrame, band_hz) -> QualityWarning:
@@ -152,6 +216,32 @@ def _structure_hull(count: ModeCount, i: int):
                 widened |= bool(lo < ci[0] or hi > ci[1])
                 ci[:] = [min(ci[0], lo), max(ci[1], hi)]
     return tuple(freq), tuple(damping), widened
+
+
+def _pick_notes(count: ModeCount, keep: np.ndarray) -> list[QualityWarning]:
+    """What the record says of modes picked by hand: a ``pick_not_supported`` note for each pick
+    whose removal (the rest refitted free) raises the criterion by less than :data:`DECISIVE_BIC`
+    (``keep``: the picked poles, by pole), and a ``mode_count`` note when one mode more than the
+    model holds lowers it by more."""
+    notes = []
+    for i in np.flatnonzero(keep):
+        rise = float(count.removal_rise[i])
+        if rise < DECISIVE_BIC:
+            f = float(count.model.freq_hz[i])
+            notes.append(QualityWarning(
+                "pick_not_supported", (),
+                f"the record does not support the mode picked at {f:.3f} Hz: without it (the other modes refitted "
+                f"free) the information criterion changes by {rise:+.1f}, less than the {DECISIVE_BIC:g} a needed "
+                "mode raises it; treat it as tentative, or pick another column of the diagram", f,
+            ))  # fmt: skip
+    if count.best_addition > DECISIVE_BIC and np.isfinite(count.best_addition_hz):
+        f = count.best_addition_hz
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"the record holds one mode more than the modal model behind the picks, near {f:.3f} Hz: adding it lowers "
+            f"the information criterion by {count.best_addition:.1f}", f,
+        ))  # fmt: skip
+    return notes
 
 
 def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:

@@ -18,6 +18,7 @@ _STYLE = {
     "f+d+v": ("*", "#d62728", "stable f, ξ, shape"),
 }
 _LOW_COHERENCE = "#fff3b0"  # shading of the bands where some sensor's coherence is low
+_PICKED = "tab:purple"  # the line of a mode picked by hand (an automatic mode's is black, dotted)
 _MISFIT = "#e53935"  # shading of the bands the modal model does not explain
 
 
@@ -76,9 +77,13 @@ def plot_stabilisation(diagram, selection=None, ax=None):
     if selection is not None:
         _draw_check(ax, ax_f, f, selection)
         top = max(o.na for o in diagram.orders)
+        labelled = False  # the legend names the picked modes' line once
         for m in selection.modes.itertuples(index=False):
-            ax.axvline(m.freq_hz, color="k", lw=0.8, ls=":")
-            ax_d.axvline(m.freq_hz, color="k", lw=0.8, ls=":")
+            by_hand = np.isfinite(getattr(m, "picked_hz", np.nan))
+            style = {"color": _PICKED, "lw": 1.2, "ls": "--"} if by_hand else {"color": "k", "lw": 0.8, "ls": ":"}
+            ax.axvline(m.freq_hz, **style, label="mode picked by hand" if by_hand and not labelled else None)
+            ax_d.axvline(m.freq_hz, **style)
+            labelled |= by_hand
         ax.set_ylim(0, top * 1.05)
     lo, hi = _frequency_span(diagram)
     ax.set_xlim(lo, hi)

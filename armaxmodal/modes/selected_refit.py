@@ -84,15 +84,16 @@ def refined_modes(
     """The frequency-domain refit (:func:`armaxmodal.modes.refine.refine_modes`, or a
     :class:`RefitFailure` when it could not be made, which leaves the selection without one)
     reported for a band-limited record, and kept as the selection's ``refinement``.
-    ``relaxed``: the refit may move a mode by :func:`_refit_reach`, not ``cluster_freq``."""
+    ``relaxed``: the refit may move a mode by :func:`_refit_reach`, not ``cluster_freq``.
+    ``merge_mac`` None: two modes the refit brings together stay two (modes picked by hand)."""
     if refinement is None or isinstance(refinement, RefitFailure):
         return replace(work, refinement=None)
     work = replace(work, refinement=refinement)
     if refinement.hold == "bandlimited":
         modes, shapes = _apply_refinement(work.modes, work.shapes, refinement, cluster_freq, cluster_damping, relaxed)
-        # two modes the refit brought together are one peak
-        keep = merge_duplicates(modes, list(shapes.T), merge_mac, diagram.recording.duration)
-        work = work.with_modes(modes, shapes).kept(keep)
+        work = work.with_modes(modes, shapes)
+        if merge_mac is not None:  # two modes the refit brought together are one peak
+            work = work.kept(merge_duplicates(modes, list(shapes.T), merge_mac, diagram.recording.duration))
     return work
 
 

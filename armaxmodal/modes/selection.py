@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal._threads import one_blas_thread
+from armaxmodal.exceptions import PickError
 from armaxmodal.modal import mode_record
 from armaxmodal.modes.clusters import clustered_modes, merge_duplicates, why_no_mode
 from armaxmodal.modes.completeness import modes_the_check_adds, modes_the_record_needs, refit_with_added
@@ -23,6 +24,7 @@ from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.modal_check import ModalCheck, check_modes
 from armaxmodal.modes.mode_count import ModeCount
 from armaxmodal.modes.per_sensor import per_sensor_table
+from armaxmodal.modes.picks import PICK_REACH, check_picks, picked_modes
 from armaxmodal.modes.refine import ModalRefinement
 from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_and_segment_fits
 from armaxmodal.modes.spread import (
@@ -73,6 +75,13 @@ class ModeSelection:
     notes: tuple[QualityWarning, ...] = ()
     check: ModalCheck | None = None
     count: ModeCount | None = None
+
+    @property
+    def picks(self) -> list[float] | None:
+        """The frequencies (Hz) the modes were picked at by hand, or None for an automatic pick."""
+        if "picked_hz" not in self.modes:
+            return None
+        return sorted(float(f) for f in self.modes.picked_hz if np.isfinite(f))
 
     @property
     def reconstruction_error(self) -> float:
@@ -133,6 +142,7 @@ class ModeSelection:
                     "damping_sd": _finite_or_none(row.damping_segment_sd),
                 }
                 record["model_error_dominates"] = bool(row.model_error_dominates)
+            record["picked"] = bool(np.isfinite(getattr(row, "picked_hz", np.nan)))
             if "structure_widened" in self.modes:  # the modal model's count (modes/counted.py)
                 record["count_undecided"] = bool(row.count_undecided)
                 record["interval_covers_other_counts"] = bool(row.structure_widened)
@@ -153,6 +163,7 @@ class ModeSelection:
             "modal_check": None if self.check is None else self.check.to_dict(),
             "intersample_hold": None if self.refinement is None else self.refinement.hold,
             "estimator": sorted(set(self.modes.estimator)),
+            "picks": self.picks,
             "modes": modes,
             "per_sensor": per_sensor,
         }
@@ -171,6 +182,7 @@ def select_modes(
     segments: int = N_SEGMENTS,
     n_jobs: int | None = None,
     progress: bool = False,
+    picks=None,
 ) -> ModeSelection:
     """Pick the physical modes from the shared-pole poles of a diagram.
 
@@ -203,6 +215,12 @@ def select_modes(
     n_jobs : int, optional
         Worker threads for the finishing and segment fits (default: all cores; 1 inside a
         worker that has one core already, e.g. a study's).
+    picks : sequence of float, optional
+        Frequencies (Hz) picked by hand: each takes the nearest cluster of the diagram holding
+        poles of at least 3 orders within :data:`~armaxmodal.modes.picks.PICK_REACH` (a
+        :class:`~armaxmodal.exceptions.PickError` says when none does). The picks are refitted,
+        checked and judged as automatic modes are, but none is dropped or added: a pick the
+        record does not need is said to be (``pick_not_supported``). Not with ``n_modes``.
     progress : bool
         Show a count of the fits the selection runs (finishing fits, the refit and the
         segment refits: on a long record they take as long as the sweep). A count, not a
@@ -214,19 +232,19 @@ def select_modes(
         if band is None and diagram.preparation is not None:
             band = diagram.preparation.band
         nas = sorted({o.na for o in diagram.orders})
-        modes, vectors = clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs, bar)
-        if not modes.empty:
-            keep = merge_duplicates(modes, vectors, merge_mac, diagram.recording.duration)
-            modes, vectors = modes.loc[keep].reset_index(drop=True), [vectors[i] for i in keep]
+        clustering = (cluster_freq, cluster_damping)
+        if picks is not None:  # each takes its cluster now: a pick the diagram does not offer stops here
+            if n_modes is not None:
+                raise PickError("picks and n_modes do not mix: pick the modes, or give their number, not both.")
+            picked = picked_modes(diagram, check_picks(picks, band, diagram.recording.fs), band, nas, clustering)
+        modes, vectors = _automatic(diagram, band, nas, min_support, clustering, merge_mac, n_modes, n_jobs, bar)
+        if modes.empty and picks is not None:  # no automatic mode: the picks stand alone
+            modes, vectors = picked
         if modes.empty:  # a result, not a stop: the diagram, its poles and why each cluster failed
             why = why_no_mode(diagram, band, nas, min_support, cluster_freq, cluster_damping)
             return _no_mode_selection(diagram, why)
-        order = modes.sort_values(["support", "count", "energy"], ascending=False).index
-        if n_modes is not None:
-            order = order[:n_modes]
-        order = modes.loc[order].sort_values("freq_hz").index
-        work = WorkingSelection(modes.loc[order].reset_index(drop=True), np.column_stack([vectors[i] for i in order]))
-        limits, clustering = (cluster_freq, cluster_damping, merge_mac), (cluster_freq, cluster_damping)
+        work = WorkingSelection(modes, np.column_stack(vectors))
+        limits = (cluster_freq, cluster_damping, merge_mac)
         orders = {o.na: o for o in diagram.orders}
         work = replace(work, modes=_armax_intervals(work.modes))
         fitted = refit_and_segment_fits(diagram, work.modes, band, refine, segments, orders, n_jobs, bar)
@@ -241,10 +259,11 @@ def select_modes(
                 # the last word on the number of modes: nested tests of the modal model with every pole free
                 hold, band_hz = work.refinement.hold, work.refinement.band_hz
                 work = counted_modes(diagram, work, band_hz, hold, nas, clustering, band)
-                work = work.noted(*_not_separated(work.modes))
                 bar.update(work.count.trials)
-                work = replace(work, check=check_modes(diagram.recording, work.modes.freq_hz, work.modes.damping, band))
-        else:  # the user fixed the number of modes: the check judges them, it does not choose
+            if picks is not None:
+                work = _with_picks(diagram, work, picked, nas, clustering, band)
+            work = work.noted(*_not_separated(work.modes))
+        if picks is None or work.check is None:
             work = replace(work, check=check_modes(diagram.recording, work.modes.freq_hz, work.modes.damping, band))
         if segments >= 2:
             modes = work.modes
@@ -253,6 +272,48 @@ def select_modes(
             modes, spread_notes = apply_segment_spread(modes, spread, segments)
             work = replace(work, modes=modes).noted(*spread_notes)
         return _finished(diagram, work.noted(*refit_notes), band, cluster_freq, len(nas))
+
+
+def _with_picks(diagram, work: WorkingSelection, picked, nas, clustering, band) -> WorkingSelection:
+    """The picks as the modes reported. A pick is the automatic mode within
+    :data:`~armaxmodal.modes.picks.PICK_REACH` of it or of its cluster; a pick no automatic mode
+    answers is added from its cluster. The modal model is then fitted with every mode and pole
+    of the automatic one kept as it stands, so that the modes not picked do not bias the picked
+    ones (:func:`~armaxmodal.modes.counted.counted_modes` with ``picks``)."""
+    rows, vectors = picked
+    modes = work.modes.assign(picked_hz=np.nan)
+    forced = []
+    for k, row in rows.iterrows():
+        near = [np.min(np.abs(np.log(modes.freq_hz.to_numpy() / f))) for f in (row.picked_hz, row.freq_hz)]
+        at = [int(np.argmin(np.abs(np.log(modes.freq_hz.to_numpy() / f)))) for f in (row.picked_hz, row.freq_hz)]
+        best = int(np.argmin(near))
+        if near[best] <= PICK_REACH and not np.isfinite(modes.at[at[best], "picked_hz"]):
+            modes.at[at[best], "picked_hz"] = row.picked_hz
+        else:
+            forced.append(k)
+    extra = _armax_intervals(rows.loc[forced])
+    modes = pd.concat([modes, extra], ignore_index=True)
+    shapes = np.column_stack([work.shapes, *[vectors[k] for k in forced]]) if forced else work.shapes
+    work = work.with_modes(modes, shapes)
+    if work.refinement is None:  # no modal model to fit them with: the picks as the diagram has them
+        return work.kept(np.flatnonzero(np.isfinite(modes.picked_hz.to_numpy())))
+    hold, band_hz = work.refinement.hold, work.refinement.band_hz
+    return counted_modes(diagram, work, band_hz, hold, nas, clustering, band, picked=True)
+
+
+def _automatic(diagram, band, nas, min_support, clustering, merge_mac, n_modes, n_jobs, bar):
+    """The supported clusters, split modes merged, the ``n_modes`` best supported when given:
+    ``(modes by frequency, shape vectors)``."""
+    modes, vectors = clustered_modes(diagram, band, nas, min_support, *clustering, n_jobs, bar)
+    if modes.empty:
+        return modes, vectors
+    keep = merge_duplicates(modes, vectors, merge_mac, diagram.recording.duration)
+    modes, vectors = modes.loc[keep].reset_index(drop=True), [vectors[i] for i in keep]
+    order = modes.sort_values(["support", "count", "energy"], ascending=False).index
+    if n_modes is not None:
+        order = order[:n_modes]
+    order = modes.loc[order].sort_values("freq_hz").index
+    return modes.loc[order].reset_index(drop=True), [vectors[i] for i in order]
 
 
 def _armax_intervals(modes: pd.DataFrame) -> pd.DataFrame:
@@ -284,14 +345,20 @@ def _finished(diagram, work: WorkingSelection, band, cluster_freq: float, n_orde
     modes, shapes = work.modes, work.shapes
     per_sensor, weighted = per_sensor_table(diagram, modes, shapes, cluster_freq)
     freq, damping = modes.freq_hz.to_numpy(), modes.damping.to_numpy()
+    # a peak a mode of the model explains is explained, picked or not (the check's poles are the model's)
+    explaining = (freq, damping)
+    if "picked_hz" in modes:
+        poles = work.check.poles
+        explaining = (np.abs(poles) / (2 * np.pi), -poles.real / np.abs(poles))
     work = work.noted(
-        *unexplained_peaks(diagram.recording, freq, damping, band),
+        *unexplained_peaks(diagram.recording, *explaining, band),
         *oversampling_note(freq, diagram.recording.fs),
         *_unresolved_damping_notes(modes, n_orders),
         *work.check.warnings(),
     )
     return ModeSelection(modes, shapes, per_sensor, weighted, diagram, work.refinement, work.notes, work.check,
                          work.count)  # fmt: skip
+
 
 #: the columns of an empty selection (what the command line and the JSON read of a mode)
 _MODE_COLUMNS = ("freq_hz", "damping", "damped_freq_hz", "freq_ci95_lo", "freq_ci95_hi", "damping_ci95_lo",

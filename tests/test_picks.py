@@ -1,0 +1,105 @@
+"""Modes picked by hand (``select_modes(picks=...)``, ``stabilise --pick``): against the exact modes
+of the bundled supine ride, and every way a pick can be wrong refused with its reason."""
+
+import json
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import armaxmodal as am
+from armaxmodal.cli.main import main
+from armaxmodal.modes.counted import _picked_result
+from armaxmodal.modes.picks import PICK_REACH, check_picks
+from armaxmodal.modes.working import WorkingSelection
+
+
+@pytest.fixture(scope="module")
+def ride(fixtures_dir):
+    """The bundled supine ride (exact modes 5.83, 8.31, 13.50, 16.25 Hz) and its diagram."""
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    return am.supine_human().modes(), am.stabilisation_diagram(rec, range(2, 21, 2), per_sensor=False)
+
+
+def test_three_picks_are_the_three_exact_modes_and_the_fourth_is_said_to_be_there(ride):
+    exact, diagram = ride
+    sel = am.select_modes(diagram, picks=[13.6, 5.9, 8.2], segments=0)
+    assert sel.picks == [5.9, 8.2, 13.6] and sel.modes.picked_hz.tolist() == [5.9, 8.2, 13.6]
+    np.testing.assert_allclose(sel.modes.freq_hz, exact.freq_hz[:3], rtol=0.02)
+    np.testing.assert_allclose(sel.modes.damping, exact.damping[:3], rtol=0.15)
+    assert sel.count is not None and sel.count.steps == ()  # the number of modes is the user's
+    # each pick is needed; the mode not picked stays in the model (without it, 13.50 Hz came out at
+    # 15.77, standing for both) and is named
+    assert not [w for w in sel.warnings if w.code == "pick_not_supported"]
+    (other,) = [w for w in sel.warnings if w.code == "mode_count" and "not picked" in w.message]
+    assert other.value == 1 and "16.2" in other.message
+    assert sel.check.passed and len(sel.check.residues[0]) == 4  # the check judges the model: 4 modes
+    record = sel.to_dict()
+    assert record["picks"] == [5.9, 8.2, 13.6] and all(m["picked"] for m in record["modes"])
+    assert am.select_modes(diagram, segments=0).to_dict()["picks"] is None
+
+
+@pytest.mark.parametrize(
+    "picks, kwargs, message",
+    [
+        ([11.0], {}, r"pick 11 Hz: no stable cluster of the diagram within 5 % \(the nearest is at"),
+        ([5.8, 30.0], {}, r"picks \[30.0\] Hz lie at or above the Nyquist frequency .30 Hz"),
+        ([5.8, 5.9], {}, r"within 5 % of each other"),
+        ([5.8, -1.0], {}, r"positive number"),
+        ([], {}, r"no frequency given"),
+        ([5.8], {"n_modes": 2}, r"do not mix"),
+    ],
+)
+def test_a_pick_the_diagram_does_not_offer_is_refused_with_the_reason(ride, picks, kwargs, message):
+    with pytest.raises(am.PickError, match=message):
+        am.select_modes(ride[1], picks=picks, segments=0, **kwargs)
+
+
+def test_picks_are_checked_against_the_band_and_nyquist():
+    assert check_picks([8.0, 5.0], (1.0, 20.0), 60.0).tolist() == [5.0, 8.0]
+    with pytest.raises(am.PickError, match="Nyquist frequency .30 Hz"):
+        check_picks([31.0], None, 60.0)
+    with pytest.raises(am.PickError, match="the band 1-20 Hz"):
+        check_picks([0.5], (1.0, 20.0), 60.0)
+    assert check_picks([10.0, 10.0 * (1 + PICK_REACH) * 1.001], None, 60.0).size == 2  # just apart
+
+
+def test_a_pick_the_modal_model_takes_out_of_the_band_is_reported_and_said():
+    """Three modes in the model, two picked: the model keeps the 5 Hz pick and takes the 9 Hz pick
+    to 20 Hz, so that pick is reported as the selection had it, tentative, with the reason; the
+    12 Hz mode not picked stays in the model, unreported, and is named."""
+    modes = pd.DataFrame({"freq_hz": [5.0, 9.0, 12.0], "damping": [0.1, 0.05, 0.05], "count": [6, 4, 5],
+                          "picked_hz": [5.1, 9.0, np.nan]})  # fmt: skip
+    work = WorkingSelection(modes, np.array([[1.0, 2.0, 5.0]], dtype=complex))
+    model = SimpleNamespace(
+        freq_hz=np.array([5.1, 20.0, 12.1]), damping=np.array([0.1, 1e-4, 0.05]), freq_sd=np.full(3, 0.01),
+        damping_sd=np.array([0.001, 0.0, 0.001]), shapes=np.array([[3.0, 4.0, 6.0]], dtype=complex), n_modes=3,
+    )  # fmt: skip
+    count = SimpleNamespace(model=model, removal_rise=np.array([80.0, -3.0, 60.0]), alternatives=(),
+                            best_addition=-50.0, best_addition_hz=np.nan)  # fmt: skip
+    out = _picked_result(work, count, np.array([True, False, True]), "bandlimited")
+    assert out.modes.freq_hz.tolist() == [5.1, 9.0] and out.shapes.tolist() == [[3.0, 2.0]]
+    assert out.modes.count_undecided.tolist() == [False, True] and out.modes.picked_hz.tolist() == [5.1, 9.0]
+    (said,) = [n for n in out.notes if n.code == "pick_not_supported"]
+    assert "9.000 Hz to 20.000 Hz" in said.message
+    (other,) = [n for n in out.notes if n.code == "mode_count"]
+    assert other.value == 1 and "12.100 Hz" in other.message
+
+
+def test_stabilise_pick_from_the_command_line(fixtures_dir, tmp_path, capsys):
+    data = str(fixtures_dir / "supine_random.csv")
+    out = tmp_path / "modes.json"
+    assert main(["--quiet", "stabilise", data, "--orders", "2:20", "--pick", "5.9,8.2", "--json", str(out)]) == 0
+    capsys.readouterr()  # the run's own warnings
+    record = json.loads(out.read_text())
+    assert record["picks"] == [5.9, 8.2] and [round(m["freq_hz"], 1) for m in record["modes"]] == [5.8, 8.3]
+    for argv, message in (
+        (["--pick", "5.9", "--modes", "2"], "--pick and --modes do not mix"),
+        (["--pick", "5.9,eight"], "--pick: expected frequencies in Hz"),
+        (["--pick", "45"], "at or above the Nyquist frequency"),
+        (["--pick", "25", "--band", "2:20"], "outside the band 2-20 Hz"),
+    ):
+        assert main(["--quiet", "stabilise", data, *argv]) == 2
+        err = capsys.readouterr().err
+        assert message in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
