@@ -76,6 +76,11 @@ def test_the_nested_tests_undo_planted_over_and_under_modelling(supine, plant):
     # split of the neighbour whose place it had taken)
     wanted = {"split": ("remove",), "invented": ("remove",), "taken_out": ("add", "split")}[plant]
     assert count.steps and count.steps[0].action in wanted
+    first = count.steps[0]  # a removal has no new pole; an addition's settled at an exact mode
+    if first.action == "remove":
+        assert np.isnan(first.settled_hz)
+    else:
+        assert np.min(np.abs(truth.freq_hz / first.settled_hz - 1)) < FREQ_TOL, first
     # a clear record decides: every mode is needed by far more than the decisive margin, and no
     # further mode comes near it
     assert np.all(count.removal_rise > 10 * DECISIVE_BIC)

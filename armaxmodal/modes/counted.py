@@ -248,10 +248,12 @@ def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
     notes = []
     words = {"remove": "left out", "add": "added", "split": "split in two"}
     for step in count.steps:
+        moved = np.isfinite(step.settled_hz) and abs(np.log(step.settled_hz / step.freq_hz)) > SAME_ROW_FREQ
+        where = f" (its new pole settled at {step.settled_hz:.3f} Hz)" if moved else ""
         notes.append(QualityWarning(
             "mode_count", (),
             f"the maximum-likelihood modal model with every pole free: the mode at {step.freq_hz:.3f} Hz "
-            f"{words[step.action]}, the information criterion (BIC) falls by {step.bic_fall:.1f}",
+            f"{words[step.action]}{where}, the information criterion (BIC) falls by {step.bic_fall:.1f}",
             float(step.freq_hz),
         ))  # fmt: skip
     rise = float(count.removal_rise.min()) if count.removal_rise.size else np.inf

@@ -75,11 +75,13 @@ def reported(model, band_hz) -> np.ndarray:
 @dataclass(frozen=True)
 class Step:
     """One accepted step of the search: ``action`` ("remove", "add" or "split"), the mode's
-    frequency (Hz) and the criterion's fall (positive)."""
+    frequency (Hz; an addition's start), the criterion's fall (positive), and where an addition's
+    new pole settled (Hz; NaN for a removal)."""
 
     action: str
     freq_hz: float
     bic_fall: float
+    settled_hz: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -446,7 +448,9 @@ def count_modes(
         if not better or len(steps) == (MAX_STEPS if searching else 0):
             break
         step = min(better, key=lambda t: search.bic(t[2]))
-        steps.append(Step(step[0], step[1], here - search.bic(step[2])))
+        new = _new_poles(current.freq_hz, step[2].freq_hz)
+        settled = float(step[2].freq_hz[new[0]]) if new else float("nan")
+        steps.append(Step(step[0], step[1], here - search.bic(step[2]), settled))
         current = step[2]
     rise, gain, new_hz = _margins(search, here, current, removed, best_removal, best_addition)
     # the reported model is the likelihood's maximum, not where the search's cap left it (a body's
