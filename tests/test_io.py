@@ -242,6 +242,13 @@ def test_a_dropped_row_is_bridged_and_named(tmp_path, fixtures_dir, lost):
     assert am.read_recording(path, outputs=["chest"]).meta["read_warnings"][0].channels == ("base", "chest")
 
 
+@pytest.mark.parametrize("given, message", [(["a.csv", "b.csv"], "reads one file; got 2.*read_xsens"),
+                                            (42, "expected a file path, got int")])
+def test_not_a_path_gets_a_typed_error(given, message):
+    with pytest.raises(DataError, match=message):
+        am.read_recording(given)
+
+
 def test_missing_file():
     with pytest.raises(FileNotFoundError):
         am.read_recording("/nonexistent/file.csv")

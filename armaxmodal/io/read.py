@@ -56,6 +56,13 @@ def read_recording(
     -------
     Recording
     """
+    if isinstance(path, (list, tuple)):
+        raise DataError(
+            f"read_recording reads one file; got {len(path)}. For one export per sensor (Xsens DOT, a shake table's "
+            "IMUs) use read_xsens(paths, input=...), as the command line does when given several files."
+        )
+    if not isinstance(path, (str, os.PathLike)):
+        raise DataError(f"read_recording: expected a file path, got {type(path).__name__}.")
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no such recording: {path}")
