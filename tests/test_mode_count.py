@@ -342,3 +342,28 @@ def test_with_the_halves_a_moved_pole_is_judged_by_them_not_by_the_diagram(monke
     model, carried = mode_count._without_unfounded(search, [5.0, 9.0, 13.0], moved, lambda f, x: False, ("a", "b"))
     assert asked == [[2]]  # only the moved pole is put to the halves
     assert (carried == ()) is same_in_halves and model.n_modes == (3 if same_in_halves else 2)
+
+
+@pytest.mark.parametrize(
+    "rise, halves_agree, confirmed", [(500.0, True, True), (5.0, True, False), (500.0, False, False)]
+)
+def test_the_modal_model_confirms_a_mode_where_the_h1_is_not_coherent(monkeypatch, bundled_diagram, rise, halves_agree,
+                                                                      confirmed):  # fmt: skip
+    """A mode the FRF check cannot test (no coherent H1 line near it) is confirmed when the
+    likelihood needs it decisively and the record's halves agree on it; else it stays unconfirmed."""
+    from dataclasses import replace
+
+    import armaxmodal.modes.counted as counted
+    from armaxmodal.modes.working import WorkingSelection
+
+    sel = am.select_modes(bundled_diagram, segments=0)
+    f0 = float(sel.modes.freq_hz[0])
+    count = replace(sel.count, removal_rise=np.full(sel.count.model.n_modes, rise))
+    check = replace(sel.check, unconfirmed_hz=(f0,))
+    assert not check.passed
+    monkeypatch.setattr(counted, "agree_in_halves", lambda d, m, h, hold: np.full(m.n_modes, halves_agree))
+    work = counted.confirmed_where_incoherent(
+        bundled_diagram, WorkingSelection(sel.modes, sel.shapes, sel.refinement, check, count)
+    )
+    assert work.check.passed is confirmed and (work.check.unconfirmed_hz == ()) is confirmed
+    assert [n.value for n in work.notes] == ([f0] if confirmed else [])

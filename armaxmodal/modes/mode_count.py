@@ -38,7 +38,8 @@ from armaxmodal._threads import single_blas_thread
 from armaxmodal.modes.modal_model import DAMPING_BOUNDS, DftLines, ModalModel, fit_modal_model
 from armaxmodal.stats import MAX_DAMPING, Z95
 
-__all__ = ["DECISIVE_BIC", "ModeCount", "Step", "count_modes", "effective_fraction", "matched_poles", "reported"]
+__all__ = ["DECISIVE_BIC", "ModeCount", "Step", "agree_in_halves", "count_modes", "effective_fraction", "matched_poles",
+           "reported"]  # fmt: skip
 
 #: a change of the criterion this large is "very strong" evidence (Kass & Raftery 1995): a
 #: mode's removal, or a candidate's addition, that moves it less leaves the count undecided
@@ -225,16 +226,9 @@ class _Search:
         :data:`HALVES_SD` standard deviations of the difference: a mode of the structure is the
         same mode in both halves, while a pole that soaks up a change during the record or a
         nonlinearity (a drifting frequency, a doublet beside a real mode) lands elsewhere."""
-        a, b = (fit_modal_model(h.weighted(self.data.weights), trial.freq_hz, trial.damping, self.hold,
-                                self.max_nfev) for h in halves)  # fmt: skip
         self.trials += 2
-        for i in new:
-            j, k = _nearest(a.freq_hz, trial.freq_hz[i]), _nearest(b.freq_hz, trial.freq_hz[i])
-            for one, two, sd_one, sd_two in ((a.freq_hz, b.freq_hz, a.freq_sd, b.freq_sd),
-                                             (a.damping, b.damping, a.damping_sd, b.damping_sd)):  # fmt: skip
-                if abs(one[j] - two[k]) > HALVES_SD * np.hypot(sd_one[j], sd_two[k]):
-                    return False
-        return True
+        agree = agree_in_halves(self.data, trial, halves, self.hold, self.max_nfev)
+        return all(agree[i] for i in new)
 
     def removals(self, current: ModalModel) -> list[tuple[str, float, ModalModel | None]]:
         out = []
@@ -329,6 +323,26 @@ def _equally_good(search: _Search, chosen: ModalModel, rise: np.ndarray, additio
         if model is not None and abs(search.bic(model) - here) < DECISIVE_BIC:
             out.append((float(search.bic(model) - here), model))
     return tuple(out)
+
+
+def agree_in_halves(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: int = 40) -> np.ndarray:
+    """Per pole of ``model``: the record's two halves (``halves``, lines weighted as ``data``),
+    each fitted from ``model``'s poles, give the same frequency and damping within
+    :data:`HALVES_SD` standard deviations of the difference (each half's pole the one nearest
+    the model's). Two fits.
+
+    Returns
+    -------
+    (n_modes,) bool ndarray
+    """
+    a, b = (fit_modal_model(h.weighted(data.weights), model.freq_hz, model.damping, hold, max_nfev) for h in halves)
+    agree = np.ones(model.n_modes, dtype=bool)
+    for i, f in enumerate(model.freq_hz):
+        j, k = _nearest(a.freq_hz, f), _nearest(b.freq_hz, f)
+        for one, two, sd_one, sd_two in ((a.freq_hz, b.freq_hz, a.freq_sd, b.freq_sd),
+                                         (a.damping, b.damping, a.damping_sd, b.damping_sd)):  # fmt: skip
+            agree[i] &= bool(abs(one[j] - two[k]) <= HALVES_SD * np.hypot(sd_one[j], sd_two[k]))
+    return agree
 
 
 def _nearest(freq_hz: np.ndarray, f: float) -> int:

@@ -19,7 +19,7 @@ from armaxmodal.exceptions import PickError
 from armaxmodal.modal import mode_record
 from armaxmodal.modes.clusters import clustered_modes, merge_duplicates, why_no_mode
 from armaxmodal.modes.completeness import modes_the_check_adds, modes_the_record_needs, refit_with_added
-from armaxmodal.modes.counted import counted_modes
+from armaxmodal.modes.counted import confirmed_where_incoherent, counted_modes
 from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.modal_check import ModalCheck, check_modes
 from armaxmodal.modes.mode_count import ModeCount
@@ -265,6 +265,7 @@ def select_modes(
             work = work.noted(*_not_separated(work.modes))
         if picks is None or work.check is None:
             work = replace(work, check=check_modes(diagram.recording, work.modes.freq_hz, work.modes.damping, band))
+        work = confirmed_where_incoherent(diagram, work)
         if segments >= 2:
             modes = work.modes
             spread = segment_spread(diagram.recording, modes, lambda i: orders[int(modes.at[i, "na"])], segments,
