@@ -18,6 +18,7 @@ __all__ = [
     "thesis_frequency_damping",
     "pole_uncertainty",
     "mode_record",
+    "normalised_shape",
 ]
 
 
@@ -110,14 +111,31 @@ def pole_uncertainty(a, mu, cov_a, fs: float) -> tuple[np.ndarray, np.ndarray]:
     return np.sqrt(np.maximum(var_f, 0)), np.sqrt(np.maximum(var_xi, 0))
 
 
-def mode_record(row, shape: np.ndarray, sensors, supplemented=None) -> dict:
-    """One mode of the JSON contract: frequency, damping, 95 % intervals and the shape
-    (normalised to a unit largest component on the positive real axis) per sensor."""
+def normalised_shape(shape: np.ndarray) -> np.ndarray:
+    """A mode shape scaled so that its largest component is 1 (on the positive real axis).
+
+    Parameters
+    ----------
+    shape : (n_sensors,) complex array_like
+
+    Returns
+    -------
+    (n_sensors,) complex ndarray
+        Unchanged when every component is zero.
+    """
+    shape = np.asarray(shape, dtype=complex).copy()
     i_big = int(np.argmax(np.abs(shape)))
     big = shape[i_big]
     if abs(big) > 0:
         shape = shape / big
         shape[i_big] = 1.0  # complex z / z can round to 0.9999999999999999 or a phase of 1e-15 deg
+    return shape
+
+
+def mode_record(row, shape: np.ndarray, sensors, supplemented=None) -> dict:
+    """One mode of the JSON contract: frequency, damping, 95 % intervals and the shape
+    (normalised to a unit largest component on the positive real axis) per sensor."""
+    shape = normalised_shape(shape)
     flags = np.zeros(len(sensors), dtype=bool) if supplemented is None else supplemented
     return {
         "freq_hz": float(row.freq_hz),

@@ -143,10 +143,10 @@ def write_outputs(outputs) -> None:
             sys.modules["matplotlib.pyplot"].close("all")
 
 
-def output_format(path: str) -> str:
+def output_format(path: str, option: str = "--plot") -> str:
     ext = path.rsplit(".", 1)[-1].lower()
     if ext not in ("png", "svg", "pdf"):
-        raise DataError(f"--plot: expected a .png, .svg or .pdf file name, got {path!r}.")
+        raise DataError(f"{option}: expected a .png, .svg or .pdf file name, got {path!r}.")
     return ext
 
 

@@ -37,6 +37,7 @@ def add_parser(sub, parents) -> None:
     p.add_argument("--plot", default=None, help="stabilisation plot (.png, .svg or .pdf)")
     p.add_argument("--json", default=None, help="selected modes as JSON")
     p.add_argument("--csv", default=None, help="every pole of the sweep as CSV")
+    p.add_argument("--shapes-plot", default=None, help="the selected modes' shapes over the sensors (.png, .svg, .pdf)")
     p.add_argument(
         "--detrend",
         choices=["mean", "linear", "none"],
@@ -59,6 +60,7 @@ def run(args) -> int:
     from armaxmodal.prepare.preparation import check_band
 
     plot_format = output_format(args.plot) if args.plot else None
+    shapes_format = output_format(args.shapes_plot, "--shapes-plot") if args.shapes_plot else None
     orders = None if args.orders is None else order_range(args.orders)
     band = check_band(parse_pair(args.band, "--band")) if args.band else None
     picks = _picks(args.pick, args.modes)
@@ -100,6 +102,11 @@ def run(args) -> int:
             print_check(selection.check)
     print_warnings(selection.warnings)
     outputs = _diagram_outputs(args, diagram, selection, plot_format)
+    if args.shapes_plot:
+        from armaxmodal.modes.shape_plot import plot_shapes
+
+        shapes_fig = plot_shapes(selection)
+        outputs.append((args.shapes_plot, lambda tmp: shapes_fig.savefig(tmp, dpi=150, format=shapes_format)))
     if args.json:
         report = selection.to_dict(args.shapes.replace("-", "_"))
         outputs.append((args.json, lambda tmp: write_json(report, tmp)))
