@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from armaxmodal.cli.common import POSITIVE, output_format, write_outputs
@@ -15,7 +17,7 @@ from armaxmodal.systems import datasets
 def add_parser(sub, parents) -> None:
     """Register the ``invert`` command."""
     p = sub.add_parser("invert", parents=parents, help="physical chain model (M, C, K) from identified modes")
-    p.add_argument("modes", help="modes JSON written by 'stabilise --json'")
+    p.add_argument("modes", help="modes JSON written by 'stabilise --json', or UFF 55 ('stabilise --uff', .uff/.unv)")
     p.add_argument("--recording", default=None, help="the recording, for the measured transmissibility")
     p.add_argument("--input", default="base")
     p.add_argument("--fs", type=POSITIVE, default=None)
@@ -68,9 +70,16 @@ def run(args) -> int:
 
 
 def _read_modes(path: str) -> dict:
-    """A ``stabilise --json`` file, refused with advice when it holds no modes."""
+    """A ``stabilise --json`` file, or the UFF 55 modes of a ``.uff``/``.unv`` file, refused with
+    advice when it holds no modes."""
     import json
 
+    if path.lower().endswith((".uff", ".unv")):
+        from armaxmodal.io.uff_modes import read_modes_uff
+
+        if not os.path.isfile(path):
+            raise DataError(f"{path}: no such file.")
+        return read_modes_uff(path)
     try:
         data = json.loads(open(path, encoding="utf-8").read())
     except (OSError, json.JSONDecodeError, UnicodeDecodeError) as exc:

@@ -37,6 +37,7 @@ def add_parser(sub, parents) -> None:
     p.add_argument("--plot", default=None, help="stabilisation plot (.png, .svg or .pdf)")
     p.add_argument("--json", default=None, help="selected modes as JSON")
     p.add_argument("--csv", default=None, help="every pole of the sweep as CSV")
+    p.add_argument("--uff", default=None, help="the modes as UFF 55 and the measured and modal-model FRFs as UFF 58")
     p.add_argument("--shapes-plot", default=None, help="the selected modes' shapes over the sensors (.png, .svg, .pdf)")
     p.add_argument(
         "--detrend",
@@ -107,12 +108,33 @@ def run(args) -> int:
 
         shapes_fig = plot_shapes(selection)
         outputs.append((args.shapes_plot, lambda tmp: shapes_fig.savefig(tmp, dpi=150, format=shapes_format)))
+    if args.uff:
+        outputs.append((args.uff, _uff_writer(selection)))
     if args.json:
         report = selection.to_dict(args.shapes.replace("-", "_"))
         outputs.append((args.json, lambda tmp: write_json(report, tmp)))
     write_outputs(outputs)
     print(verdict(selection.check, len(selection.modes), selection.uncertain_because))
     return 0
+
+
+def _uff_writer(selection):
+    """``write(tmp)`` of the modes (UFF 55) and, per sensor, the measured H1 and the modal model's
+    FRF on the check's lines inside its band (UFF 58)."""
+    from armaxmodal.io.uff_modes import write_modes_uff
+    from armaxmodal.prepare.frf import excited_band, measured_frf
+
+    rec, check, modes = selection.diagram.recording, selection.check, selection.modes
+    frfs = []
+    if check is not None:
+        f, h, _ = measured_frf(rec, check.nperseg)
+        lo, hi = selection.refinement.band_hz if selection.refinement is not None else excited_band(rec)
+        keep = (f >= lo) & (f <= hi)
+        model = check.frf(f[keep])
+        for k in range(len(rec.sensors)):
+            frfs += [("measured H1", k, f[keep], h[keep, k]), ("modal model", k, f[keep], model[:, k])]
+    shapes, sensors = selection.shapes, list(rec.sensors)
+    return lambda tmp: write_modes_uff(tmp, modes.freq_hz, modes.damping, shapes, sensors, frfs)
 
 
 def _picks(text: str | None, n_modes: int | None) -> list[float] | None:

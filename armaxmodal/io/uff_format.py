@@ -14,29 +14,7 @@ from armaxmodal.exceptions import DataError
 
 # -- UFF ------------------------------------------------------------------------------
 def read_uff_file(path: Path):
-    import pyuff
-
-    try:
-        sets = pyuff.UFF(str(path)).read_sets()
-    except (
-        ValueError,
-        IndexError,
-        KeyError,
-        TypeError,
-        UnicodeDecodeError,
-        struct.error,
-        OSError,
-        EOFError,
-        AttributeError,
-    ) as exc:
-        raise DataError(f"{path.name}: not a readable UFF file ({exc}).") from exc
-    except Exception as exc:  # pyuff raises a bare Exception for a data set it cannot parse
-        raise DataError(
-            f"{path.name}: not a readable UFF file: a data set could not be parsed ({exc}). Check that it is a "
-            "complete UFF export (type 58 time histories, each closed by a '-1' line), or export to CSV."
-        ) from exc
-    _check_uff_complete(path)
-    sets = [sets] if isinstance(sets, dict) else list(sets)
+    sets = read_sets(path)
     series = [s for s in sets if s.get("type") == 58]
     if not series:
         raise DataError(f"{path.name}: no type-58 (function at node) data sets in this UFF file.")
@@ -61,6 +39,33 @@ def read_uff_file(path: Path):
         raise DataError(f"{path.name}: channels have different sample steps {sorted(steps)}.")
     file_fs = 1.0 / steps.pop() if steps else None
     return channels, file_fs, {}
+
+
+def read_sets(path: Path) -> list[dict]:
+    """Every data set of a UFF file (pyuff), a damaged or truncated file refused with the reason."""
+    import pyuff
+
+    try:
+        sets = pyuff.UFF(str(path)).read_sets()
+    except (
+        ValueError,
+        IndexError,
+        KeyError,
+        TypeError,
+        UnicodeDecodeError,
+        struct.error,
+        OSError,
+        EOFError,
+        AttributeError,
+    ) as exc:
+        raise DataError(f"{path.name}: not a readable UFF file ({exc}).") from exc
+    except Exception as exc:  # pyuff raises a bare Exception for a data set it cannot parse
+        raise DataError(
+            f"{path.name}: not a readable UFF file: a data set could not be parsed ({exc}). Check that it is a "
+            "complete UFF export (each data set closed by a '-1' line), or export to CSV."
+        ) from exc
+    _check_uff_complete(path)
+    return [sets] if isinstance(sets, dict) else list(sets)
 
 
 def _check_uff_complete(path: Path) -> None:
