@@ -538,6 +538,48 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/mode_count.py",
+        "founded = x - Z95 * model.damping_sd[i] > 0 and search.in_both_halves(model, [i], halves)",
+        "founded = x - Z95 * model.damping_sd[i] > 0",
+        "a carried-away pole not put to the halves (count)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > SAME_MODE_FREQ]",
+        "if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > 1.0]",
+        "no start pole ever counted as carried away (count)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "and count.removal_rise[i] >= DECISIVE_BIC and agree[i]:",
+        "and agree[i]:",
+        "a mode the likelihood does not need confirmed where the H1 is incoherent (count)",
+    ),
+    (
+        "armaxmodal/modes/picks.py",
+        "if abs(centres[k] / f - 1) > PICK_REACH:",
+        "if abs(centres[k] / f - 1) > 10 * PICK_REACH:",
+        "a pick takes a cluster far from it (pick)",
+    ),
+    (
+        "armaxmodal/modes/picks.py",
+        "close = np.flatnonzero(np.diff(values) / values[:-1] <= PICK_REACH)",
+        "close = np.flatnonzero(np.diff(values) / values[:-1] < 0)",
+        "two picks on one cluster allowed (pick)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "if rise < DECISIVE_BIC:\n            f = float(count.model.freq_hz[i])",
+        "if rise < -DECISIVE_BIC:\n            f = float(count.model.freq_hz[i])",
+        "an unsupported pick not said (pick)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "start_f, start_x = np.r_[start_f, model.freq_hz[hidden]], np.r_[start_x, model.damping[hidden]]",
+        "start_f, start_x = start_f, start_x",
+        "the automatic model's hidden poles dropped from the picks' model (pick)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
         "return 1.0 / (1.0 + 2.0 * total)",
         "return 1.0 / (1.0 + total)",
         "Bartlett's factor 2 dropped (count)",
@@ -550,8 +592,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/mode_count.py",
-        "if abs(one[j] - two[k]) > HALVES_SD * np.hypot(sd_one[j], sd_two[k]):",
-        "if abs(one[j] - two[k]) > 1e9 * HALVES_SD * np.hypot(sd_one[j], sd_two[k]):",
+        "agree[i] &= bool(abs(one[j] - two[k]) <= HALVES_SD * np.hypot(sd_one[j], sd_two[k]))",
+        "agree[i] &= bool(abs(one[j] - two[k]) <= 1e9 * HALVES_SD * np.hypot(sd_one[j], sd_two[k]))",
         "the halves' agreement ignored (count)",
     ),
     (
@@ -562,12 +604,12 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/counted.py",
-        "if rise < DECISIVE_BIC:",
-        "if rise < -DECISIVE_BIC:",
+        "    if rise < DECISIVE_BIC:\n        notes.append(",
+        "    if rise < -DECISIVE_BIC:\n        notes.append(",
         "an undecided removal not said (count)",
     ),
     (
-        "armaxmodal/modes/counted.py",
+        "armaxmodal/modes/mode_count.py",
         "return (f >= band_hz[0]) & (f <= band_hz[1]) & (x <= MAX_DAMPING)",
         "return (f >= band_hz[0]) & (x <= MAX_DAMPING)",
         "poles above the band reported (count)",

@@ -103,3 +103,39 @@ def test_stabilise_pick_from_the_command_line(fixtures_dir, tmp_path, capsys):
         assert main(["--quiet", "stabilise", data, *argv]) == 2
         err = capsys.readouterr().err
         assert message in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_pick_the_record_does_not_need_is_said():
+    """Two kept picks: without the first the criterion rises by 4 only (under 10), without the second by 80."""
+    from armaxmodal.modes.counted import _pick_notes
+
+    model = SimpleNamespace(freq_hz=np.array([5.0, 9.0]), damping=np.array([0.1, 0.05]))
+    count = SimpleNamespace(model=model, removal_rise=np.array([4.0, 80.0]), best_addition=-30.0, best_addition_hz=7.0)
+    (note,) = _pick_notes(count, np.array([True, True]))
+    assert note.code == "pick_not_supported" and note.value == 5.0 and "+4.0" in note.message
+    assert _pick_notes(count, np.array([False, True])) == []  # only the picked poles are judged
+
+
+def test_the_picks_model_keeps_the_poles_the_automatic_model_hides(monkeypatch, ride):
+    """A pole the automatic model holds beyond the band (it stands for the modes above it) stays in
+    the model the picks are fitted with: leaving it out biases the top picks."""
+    from dataclasses import replace
+
+    import armaxmodal.modes.counted as counted
+
+    _, diagram = ride
+    sel = am.select_modes(diagram, segments=0)
+    beyond = SimpleNamespace(freq_hz=np.r_[sel.count.model.freq_hz, 40.0], damping=np.r_[sel.count.model.damping, 0.1])
+    modes = sel.modes.assign(picked_hz=[5.9, 8.2, np.nan, np.nan])
+    work = WorkingSelection(modes, sel.shapes, sel.refinement, sel.check, replace(sel.count, model=beyond))
+    seen = []
+
+    def stop(data, freq_hz, damping, *args, search=True, **kwargs):
+        seen.append((list(freq_hz), search))
+        raise KeyboardInterrupt  # what was asked is all this test needs
+
+    monkeypatch.setattr(counted, "count_modes", stop)
+    with pytest.raises(KeyboardInterrupt):
+        counted.counted_modes(diagram, work, sel.refinement.band_hz, "bandlimited", [2, 4], (0.05, 0.5), picked=True)
+    (starts, search), = seen
+    assert starts[-1] == 40.0 and len(starts) == 5 and search is False
