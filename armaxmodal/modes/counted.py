@@ -67,7 +67,8 @@ def _on_whole_record(count: ModeCount, rec, band_hz, hold: str) -> ModeCount:
 
 
 def counted_modes(
-    diagram, work: WorkingSelection, band_hz, hold: str, nas, clustering, band=None, *, picked: bool = False
+    diagram, work: WorkingSelection, band_hz, hold: str, nas, clustering, band=None, *, picked: bool = False,
+    n_jobs: int | None = None,
 ) -> WorkingSelection:
     """Count the modes from the selection's and return them as the selection reports modes.
 
@@ -92,6 +93,8 @@ def counted_modes(
         and of the poles the selection's own model kept unreported (``work.count``) is fitted as it
         stands and its margins measured, and the picked modes are reported (``pick_not_supported``
         says which picks the record does not need); the rest stay in the model.
+    n_jobs : int, optional
+        Worker threads for the count's screening fits (default: all cores).
 
     Returns
     -------
@@ -113,7 +116,7 @@ def counted_modes(
         hidden = ~reported(model, band_hz)
         start_f, start_x = np.r_[start_f, model.freq_hz[hidden]], np.r_[start_x, model.damping[hidden]]
     count = count_modes(data, start_f, start_x, candidates, hold=hold, halves=halves, supported=supported,
-                        search=not picked)  # fmt: skip
+                        search=not picked, n_jobs=n_jobs)  # fmt: skip
     if part is not rec:
         count = _on_whole_record(count, rec, band_hz, hold)
     keep = reported(count.model, data.band_hz)

@@ -171,9 +171,23 @@ class _Search:
     """The fits of one search: every candidate from the current model's poles, screened with a
     few steps (:data:`SCREEN_NFEV`) and the best of each kind taken to convergence."""
 
-    def __init__(self, data: DftLines, hold: str, n_effective: float, max_nfev: int):
-        self.data, self.hold, self.n_eff, self.max_nfev = data, hold, n_effective, max_nfev
+    def __init__(self, data: DftLines, hold: str, n_effective: float, max_nfev: int, n_jobs: int | None = 1):
+        self.data, self.hold, self.n_eff, self.max_nfev, self.n_jobs = data, hold, n_effective, max_nfev, n_jobs
         self.trials = 0
+
+    def screened(self, starts: list[tuple[np.ndarray, np.ndarray]]) -> list[ModalModel | None]:
+        """Each start ``(freq_hz, damping)`` fitted for :data:`SCREEN_NFEV` steps, over the worker
+        threads: the fits are independent, and numpy releases the interpreter in their large
+        array work (the count's screening is most of its time on a long record)."""
+        from armaxmodal.estimate.pool import parallel_map
+
+        self.trials += sum(len(f) > 0 for f, _ in starts)
+
+        def one(start):
+            f, x = start
+            return fit_modal_model(self.data, f, x, self.hold, SCREEN_NFEV) if len(f) else None
+
+        return parallel_map(one, starts, self.n_jobs, min_items=2)
 
     def fit(self, freq_hz, damping, max_nfev: int | None = None) -> ModalModel | None:
         if len(freq_hz) == 0:
@@ -181,22 +195,30 @@ class _Search:
         self.trials += 1
         return fit_modal_model(self.data, freq_hz, damping, self.hold, max_nfev or self.max_nfev)
 
-    def finish(self, trial: tuple[str, float, ModalModel | None]) -> tuple[str, float, ModalModel | None]:
-        """The screened trial iterated to convergence from where it stands."""
-        action, f, model = trial
-        return (action, f, model) if model is None else (action, f, self.fit(model.freq_hz, model.damping))
-
     def bic(self, model: ModalModel | None) -> float:
         return np.inf if model is None else model.bic(self.n_eff)
 
-    def best(self, trials: list, admissible=None) -> tuple[str, float, ModalModel | None] | None:
-        """The trial of lowest criterion once the best screened one has converged; with
-        ``admissible`` (a test of a model), the best that passes it before and after."""
-        trials = [t for t in trials if admissible is None or admissible(t[2])]
-        if not trials:
-            return None
-        done = self.finish(min(trials, key=lambda t: self.bic(t[2])))
-        return done if admissible is None or admissible(done[2]) else None
+    def best_of_each(self, removed: list, added: list, admissible) -> list:
+        """``[best removal, best addition]``: of each kind the trial of lowest criterion, iterated to
+        convergence from where its screening left it; an addition must pass ``admissible`` (a test
+        of a model) before and after. The two converge at once, over the worker threads. None
+        where a kind has no trial (or no admissible one)."""
+        from armaxmodal.estimate.pool import parallel_map
+
+        chosen = []
+        for trials, test in ((removed, None), (added, admissible)):
+            trials = [t for t in trials if test is None or test(t[2])]
+            chosen.append(min(trials, key=lambda t: self.bic(t[2])) if trials else None)
+        todo = [t for t in chosen if t is not None and t[2] is not None]
+        self.trials += len(todo)
+        fits = parallel_map(lambda t: fit_modal_model(self.data, t[2].freq_hz, t[2].damping, self.hold, self.max_nfev),
+                            todo, self.n_jobs, min_items=2)  # fmt: skip
+        converged = {id(t): (t[0], t[1], fit) for t, fit in zip(todo, fits, strict=True)}
+        out = []
+        for trial, test in zip(chosen, (None, admissible), strict=True):
+            done = None if trial is None else converged.get(id(trial), trial)
+            out.append(done if done is None or test is None or test(done[2]) else None)
+        return out
 
     def resolved(self, model: ModalModel | None) -> bool:
         """Every pole of ``model`` in the band is a mode with a damping the record resolves
@@ -231,30 +253,27 @@ class _Search:
         return all(agree[i] for i in new)
 
     def removals(self, current: ModalModel) -> list[tuple[str, float, ModalModel | None]]:
-        out = []
-        for m in range(current.n_modes):
-            keep = np.arange(current.n_modes) != m
-            fit = self.fit(current.freq_hz[keep], current.damping[keep], SCREEN_NFEV)
-            out.append(("remove", float(current.freq_hz[m]), fit))
-        return out
+        keep = [np.arange(current.n_modes) != m for m in range(current.n_modes)]
+        fits = self.screened([(current.freq_hz[k], current.damping[k]) for k in keep])
+        return [("remove", float(f), fit) for f, fit in zip(current.freq_hz, fits, strict=True)]
 
     def additions(self, current: ModalModel, candidates, peak_hz: float) -> list[tuple[str, float, ModalModel]]:
         """Each candidate added, and the mode nearest the residual's peak (``peak_hz``) split:
         a mode that hides two leaves its largest residual inside its own band. (Splitting every
         mode cost twice the fits and found nothing more on the bodies' battery.)"""
-        out = []
+        trials = []
         for f, x in candidates:
             if current.n_modes and np.min(np.abs(current.freq_hz / f - 1)) <= SAME_MODE_FREQ:
                 continue
-            fit = self.fit(np.r_[current.freq_hz, f], np.r_[current.damping, x], SCREEN_NFEV)
-            out.append(("add", float(f), fit))
+            trials.append(("add", float(f), np.r_[current.freq_hz, f], np.r_[current.damping, x]))
         for m in [_nearest(current.freq_hz, peak_hz)] if current.n_modes else []:
             f, x = current.freq_hz[m], current.damping[m]
             half = max(x, 0.01) / 2  # the two halves a half-power bandwidth apart
             pair_f = np.r_[np.delete(current.freq_hz, m), f * (1 - half), f * (1 + half)]
             pair_x = np.r_[np.delete(current.damping, m), x / 2, x / 2]
-            out.append(("split", float(f), self.fit(pair_f, pair_x, SCREEN_NFEV)))
-        return out
+            trials.append(("split", float(f), pair_f, pair_x))
+        fits = self.screened([(f, x) for _, _, f, x in trials])
+        return [(action, f, fit) for (action, f, _, _), fit in zip(trials, fits, strict=True)]
 
 
 def _margins(search: _Search, here: float, current: ModalModel, removed, best_removal, best_addition):
@@ -397,6 +416,7 @@ def count_modes(
     halves: tuple[DftLines, ...] = (),
     supported: Callable[[float, float], bool] | None = None,
     search: bool = True,
+    n_jobs: int | None = None,
 ) -> ModeCount:
     """Choose the number of modes by nested tests of free refits (see the module notes).
 
@@ -422,6 +442,8 @@ def count_modes(
     search : bool
         False: the starting set is the model (modes picked by hand); it is fitted and its margins
         measured (each mode's removal, the best addition), but no step is taken and no mode left out.
+    n_jobs : int, optional
+        Worker threads for the screening fits (default: all cores).
 
     Returns
     -------
@@ -433,7 +455,7 @@ def count_modes(
     data = data.noise_weighted(start_model)
     start_model = fit_modal_model(data, start_model.freq_hz, start_model.damping, hold, max_nfev)
     fraction = effective_fraction(start_model.residual)
-    searching, search = search, _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev)
+    searching, search = search, _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev, n_jobs)
     # a starting mode the free fit carried away (a weak mode's pole to beyond the band) is tried
     # again as an addition
     lost = [(f, x) for f, x in zip(np.atleast_1d(freq_hz), np.atleast_1d(damping), strict=True)
@@ -447,8 +469,9 @@ def count_modes(
         removed = search.removals(current)
         peak = residual_peak(current, search.data)
         added = search.additions(current, candidates + [peak], peak[0])
-        best_removal = search.best(removed)
-        best_addition = search.best(added, lambda model: search.admissible(model, current, supported))
+        best_removal, best_addition = search.best_of_each(
+            removed, added, lambda model: search.admissible(model, current, supported)
+        )
         if best_addition is not None and search.bic(best_addition[2]) < here and len(halves) == 2:
             new = _new_poles(current.freq_hz, best_addition[2].freq_hz)
             if not search.in_both_halves(best_addition[2], new, halves):

@@ -258,10 +258,10 @@ def select_modes(
             if work.refinement is not None and len(work.modes):
                 # the last word on the number of modes: nested tests of the modal model with every pole free
                 hold, band_hz = work.refinement.hold, work.refinement.band_hz
-                work = counted_modes(diagram, work, band_hz, hold, nas, clustering, band)
+                work = counted_modes(diagram, work, band_hz, hold, nas, clustering, band, n_jobs=n_jobs)
                 bar.update(work.count.trials)
             if picks is not None:
-                work = _with_picks(diagram, work, picked, nas, clustering, band)
+                work = _with_picks(diagram, work, picked, nas, clustering, band, n_jobs)
             work = work.noted(*_not_separated(work.modes))
         if picks is None or work.check is None:
             work = replace(work, check=check_modes(diagram.recording, work.modes.freq_hz, work.modes.damping, band))
@@ -275,7 +275,7 @@ def select_modes(
         return _finished(diagram, work.noted(*refit_notes), band, cluster_freq, len(nas))
 
 
-def _with_picks(diagram, work: WorkingSelection, picked, nas, clustering, band) -> WorkingSelection:
+def _with_picks(diagram, work: WorkingSelection, picked, nas, clustering, band, n_jobs=None) -> WorkingSelection:
     """The picks as the modes reported. A pick is the automatic mode within
     :data:`~armaxmodal.modes.picks.PICK_REACH` of it or of its cluster; a pick no automatic mode
     answers is added from its cluster. The modal model is then fitted with every mode and pole
@@ -299,7 +299,7 @@ def _with_picks(diagram, work: WorkingSelection, picked, nas, clustering, band) 
     if work.refinement is None:  # no modal model to fit them with: the picks as the diagram has them
         return work.kept(np.flatnonzero(np.isfinite(modes.picked_hz.to_numpy())))
     hold, band_hz = work.refinement.hold, work.refinement.band_hz
-    return counted_modes(diagram, work, band_hz, hold, nas, clustering, band, picked=True)
+    return counted_modes(diagram, work, band_hz, hold, nas, clustering, band, picked=True, n_jobs=n_jobs)
 
 
 def _automatic(diagram, band, nas, min_support, clustering, merge_mac, n_modes, n_jobs, bar):
