@@ -34,3 +34,19 @@ def light_ride():
     s = am.Structure.from_chain([10.0, 5.0], [8000.0, 0.0], [8.0, 0.0], [12000.0], [5.0], ("m1", "m2"))
     u = am.random_vibration(50.0, 240.0, (0.5, 24.0), seed=3)
     return s, am.simulate_recording(s, u, 50.0, noise=0.02, seed=4, hold="bandlimited")
+
+
+def open_in_headless_chromium(page: Path, profile: Path):
+    """``(dom, console errors)`` of an HTML file opened in headless Chromium (Debian package
+    'chromium'), or a skip where it is not installed: the reports are looked at as a reader would."""
+    import shutil
+    import subprocess
+
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    if chromium is None:
+        pytest.skip("Chromium not installed (Debian package 'chromium'); the static checks ran")
+    flags = ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking",
+             "--disable-component-update", "--disable-sync", f"--user-data-dir={profile}", "--enable-logging=stderr",
+             "--v=0", "--virtual-time-budget=5000", "--dump-dom"]  # fmt: skip
+    run = subprocess.run([chromium, *flags, page.as_uri()], capture_output=True, text=True, timeout=120)
+    return run.stdout, [line for line in run.stderr.splitlines() if "CONSOLE" in line and "rror" in line]

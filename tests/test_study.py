@@ -4,7 +4,6 @@ serial one, resume from the cache, bad rows reported while the rest go on, the H
 import hashlib
 import json
 import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +14,7 @@ from armaxmodal.cli import main
 from armaxmodal.exceptions import DataError
 from armaxmodal.study import StudySettings, make_study, match_modes, run_study, write_study
 from armaxmodal.study.run import CACHE_FOLDER
+from tests.conftest import open_in_headless_chromium
 
 SETTINGS = StudySettings(lump=("legs", "feet"))
 
@@ -202,9 +202,6 @@ def test_mode_matching_numbers_modes_across_recordings():
     assert labels[2].tolist() == [1, 2, 3]  # 9.9 Hz is within 25 % of 8.1 Hz
 
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-
-
 def test_report_is_self_contained_and_renders_in_a_headless_browser(finished, tmp_path):
     study, _, _ = finished
     write_study(study, tmp_path)
@@ -212,31 +209,8 @@ def test_report_is_self_contained_and_renders_in_a_headless_browser(finished, tm
     assert "http://" not in html and "https://" not in html  # nothing fetched
     n_img = html.count("<img alt='stabilisation")
     assert n_img == 10 and html.count("src='data:image/png;base64,") == n_img + 2  # + two shape figures
-    if CHROMIUM is None:
-        pytest.skip("Chromium not installed (Debian package 'chromium'); the static checks above ran")
-    run = subprocess.run(
-        [
-            CHROMIUM,
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            f"--user-data-dir={tmp_path / 'profile'}",
-            "--enable-logging=stderr",
-            "--v=0",
-            "--virtual-time-budget=5000",
-            "--dump-dom",
-            (tmp_path / "report.html").as_uri(),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert 'data-figures="12/12"' in run.stdout
-    console_errors = [line for line in run.stderr.splitlines() if "CONSOLE" in line and "rror" in line]
+    dom, console_errors = open_in_headless_chromium(tmp_path / "report.html", tmp_path / "profile")
+    assert 'data-figures="12/12"' in dom
     assert not console_errors
 
 

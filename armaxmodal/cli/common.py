@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -141,6 +142,15 @@ def write_outputs(outputs) -> None:
         # cost every run without --plot 0.7 s
         if "matplotlib.pyplot" in sys.modules:
             sys.modules["matplotlib.pyplot"].close("all")
+
+
+def check_report_path(path: str) -> None:
+    """``--report FILE``: an .html name in a folder that exists, refused before any work."""
+    target = Path(path)
+    if target.suffix.lower() not in (".html", ".htm"):
+        raise DataError(f"--report: expected an .html file name, got {path!r}.")
+    if not target.parent.is_dir():
+        raise DataError(f"--report {path}: the folder {str(target.parent)!r} does not exist; create it first.")
 
 
 def output_format(path: str, option: str = "--plot") -> str:

@@ -5,9 +5,10 @@ from __future__ import annotations
 import numpy as np
 
 from armaxmodal.cli.common import DETREND_HELP, add_data_args, load_recording, parse_pair, print_warnings
-from armaxmodal.cli.stabilise import print_check, verdict
+from armaxmodal.cli.stabilise import print_check
 from armaxmodal.exceptions import OrderError
 from armaxmodal.io.write import write_all, write_json
+from armaxmodal.modes.selection import verdict
 
 
 def add_parser(sub, parents) -> None:

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from armaxmodal.cli.common import (
     DETREND_HELP,
     POSITIVE_INT,
     add_data_args,
+    check_report_path,
     load_recording,
     order_range,
     output_format,
@@ -37,6 +40,7 @@ def add_parser(sub, parents) -> None:
     p.add_argument("--plot", default=None, help="stabilisation plot (.png, .svg or .pdf)")
     p.add_argument("--json", default=None, help="selected modes as JSON")
     p.add_argument("--csv", default=None, help="every pole of the sweep as CSV")
+    p.add_argument("--report", default=None, help="one self-contained HTML page of the run (.html)")
     p.add_argument("--uff", default=None, help="the modes as UFF 55 and the measured and modal-model FRFs as UFF 58")
     p.add_argument("--shapes-plot", default=None, help="the selected modes' shapes over the sensors (.png, .svg, .pdf)")
     p.add_argument(
@@ -65,6 +69,8 @@ def run(args) -> int:
     orders = None if args.orders is None else order_range(args.orders)
     band = check_band(parse_pair(args.band, "--band")) if args.band else None
     picks = _picks(args.pick, args.modes)
+    if args.report:
+        check_report_path(args.report)
     rec = load_recording(args)
     check_band(band, rec.fs)
     if picks is not None:  # refused before the sweep, not after it
@@ -110,11 +116,17 @@ def run(args) -> int:
         outputs.append((args.shapes_plot, lambda tmp: shapes_fig.savefig(tmp, dpi=150, format=shapes_format)))
     if args.uff:
         outputs.append((args.uff, _uff_writer(selection)))
+    if args.report:
+        from armaxmodal.modes.report import render_selection_report
+
+        settings = {"band (Hz)": args.band, "detrend": args.detrend, "command": "armaxmodal stabilise"}
+        page = render_selection_report(selection, selection.verdict, args.data, settings)
+        outputs.append((args.report, lambda tmp: Path(tmp).write_text(page, encoding="utf-8")))
     if args.json:
         report = selection.to_dict(args.shapes.replace("-", "_"))
         outputs.append((args.json, lambda tmp: write_json(report, tmp)))
     write_outputs(outputs)
-    print(verdict(selection.check, len(selection.modes), selection.uncertain_because))
+    print(selection.verdict)
     return 0
 
 
@@ -168,30 +180,6 @@ def print_check(check) -> None:
             f"model error {100 * check.model_error[k]:.1f} %, delay {1e3 * check.delay_s[k]:+.1f} ms, "
             f"{check.n_lines[k]} lines"
         )
-
-
-def verdict(check, n_modes: int, uncertain_because: list[str] = ()) -> str:
-    """The closing line: whether the modes explain the record, and whether the record decides them
-    (``uncertain_because``: the codes of the warnings that leave it undecided)."""
-    if n_modes == 0:
-        return "quality: POOR -- no stable mode found: the no_modes note says why each cluster was rejected"
-    if check is not None and check.passed and uncertain_because:
-        return (
-            f"quality: UNCERTAIN -- the {n_modes} selected mode(s) explain the measured FRF, but the record does not "
-            f"settle them: {', '.join(uncertain_because)} (see the notes)"
-        )
-    if check is not None and check.passed:
-        return f"quality: good -- the {n_modes} selected mode(s) explain the measured FRF of every checked output"
-    if check is not None and check.unconfirmed_hz and not check.failing:
-        where = ", ".join(f"{f:.2f}" for f in check.unconfirmed_hz)
-        return f"quality: POOR -- the record does not confirm the mode(s) at {where} Hz (no coherent H1 there)"
-    if check is None or not check.failing:
-        return "quality: POOR -- no output has coherent lines to check the modes against: treat them as unconfirmed"
-    worst = float(np.nanmax(check.model_error))
-    return (
-        f"quality: POOR -- the selected modes do not explain the measured FRF of {', '.join(check.failing)} "
-        f"(model error up to {100 * worst:.0f} %): treat them as unconfirmed (see the warning)"
-    )
 
 
 def _diagram_outputs(args, diagram, selection, plot_format) -> list:

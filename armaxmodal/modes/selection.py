@@ -37,7 +37,7 @@ from armaxmodal.notes import UNCERTAIN_CODES, QualityWarning
 from armaxmodal.prepare.preparation import oversampling_note, record_header
 from armaxmodal.stats import Z95
 
-__all__ = ["select_modes", "ModeSelection"]
+__all__ = ["select_modes", "ModeSelection", "verdict"]
 
 
 # -- automatic selection -----------------------------------------------------------------------
@@ -100,6 +100,20 @@ class ModeSelection:
         if self.check is None or not self.check.passed:
             return "poor"
         return "uncertain" if self.uncertain_because else "good"
+
+    @property
+    def verdict(self) -> str:
+        """The closing line of ``stabilise``: the quality and why (:func:`verdict`)."""
+        return verdict(self.check, len(self.modes), self.uncertain_because)
+
+    def _repr_html_(self) -> str:
+        """A notebook's view: the verdict and the modes with their intervals."""
+        import html
+
+        from armaxmodal.modes.report import modes_table
+
+        table = modes_table(self).to_html(index=False, float_format=lambda v: f"{v:.4g}", border=0)
+        return f"<p><b>{html.escape(self.verdict)}</b></p>{table}"
 
     @property
     def uncertain_because(self) -> list[str]:
@@ -359,6 +373,30 @@ def _finished(diagram, work: WorkingSelection, band, cluster_freq: float, n_orde
     )
     return ModeSelection(modes, shapes, per_sensor, weighted, diagram, work.refinement, work.notes, work.check,
                          work.count)  # fmt: skip
+
+
+def verdict(check, n_modes: int, uncertain_because: list[str] = ()) -> str:
+    """The closing line: whether the modes explain the record, and whether the record decides them
+    (``uncertain_because``: the codes of the warnings that leave it undecided)."""
+    if n_modes == 0:
+        return "quality: POOR -- no stable mode found: the no_modes note says why each cluster was rejected"
+    if check is not None and check.passed and uncertain_because:
+        return (
+            f"quality: UNCERTAIN -- the {n_modes} selected mode(s) explain the measured FRF, but the record does not "
+            f"settle them: {', '.join(uncertain_because)} (see the notes)"
+        )
+    if check is not None and check.passed:
+        return f"quality: good -- the {n_modes} selected mode(s) explain the measured FRF of every checked output"
+    if check is not None and check.unconfirmed_hz and not check.failing:
+        where = ", ".join(f"{f:.2f}" for f in check.unconfirmed_hz)
+        return f"quality: POOR -- the record does not confirm the mode(s) at {where} Hz (no coherent H1 there)"
+    if check is None or not check.failing:
+        return "quality: POOR -- no output has coherent lines to check the modes against: treat them as unconfirmed"
+    worst = float(np.nanmax(check.model_error))
+    return (
+        f"quality: POOR -- the selected modes do not explain the measured FRF of {', '.join(check.failing)} "
+        f"(model error up to {100 * worst:.0f} %): treat them as unconfirmed (see the warning)"
+    )
 
 
 #: the columns of an empty selection (what the command line and the JSON read of a mode)

@@ -1,47 +1,16 @@
-"""The study as one self-contained HTML page: settings, tables, figures embedded as data
-URIs, failures with reasons. No network: no script, font or style is fetched."""
+"""The study as one self-contained HTML page (:mod:`armaxmodal.io.html_page`, the one-record
+reports' look): settings, tables, figures embedded as data URIs, failures with reasons."""
 
 from __future__ import annotations
 
-import base64
 import html
-import io
 
 import numpy as np
 import pandas as pd
 
+from armaxmodal.io.html_page import figure_uri, page, table
+
 __all__ = ["render_report"]
-
-STYLE = """
-body{font-family:system-ui,sans-serif;margin:2em auto;max-width:1200px;color:#222}
-table{border-collapse:collapse;margin:0.5em 0 1.5em;font-size:0.9em}
-th,td{border:1px solid #ccc;padding:3px 8px;text-align:right}th{background:#f0f0f0}
-td.gap{color:#b00;text-align:center}.thumbs{display:flex;flex-wrap:wrap;gap:10px}
-figure{margin:0;text-align:center;font-size:0.8em}.thumbs img{width:260px;cursor:zoom-in;border:1px solid #ddd}
-#full{display:none;position:fixed;inset:0;background:rgba(0,0,0,.8);align-items:center;justify-content:center}
-#full.on{display:flex}#full img{max-width:95vw;max-height:95vh;background:#fff}
-.fail{color:#900}.note{color:#555}img{max-width:100%}.wide{overflow-x:auto}
-"""
-SCRIPT = """
-document.querySelectorAll('.thumbs img').forEach(function(img){img.addEventListener('click',function(){
-var f=document.getElementById('full');f.querySelector('img').src=img.src;f.classList.add('on');});});
-document.getElementById('full').addEventListener('click',function(){this.classList.remove('on');});
-window.addEventListener('load',function(){var imgs=[].slice.call(document.querySelectorAll('img[src]'));
-var ok=imgs.filter(function(i){return i.complete&&i.naturalWidth>0;}).length;
-document.documentElement.dataset.figures=ok+'/'+imgs.length;});
-"""
-
-
-def _png(fig) -> str:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90)
-    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
-
-
-def _table(frame: pd.DataFrame, digits: int = 4) -> str:
-    html_table = frame.to_html(index=False, na_rep="X", float_format=lambda v: f"{v:.{digits}g}", border=0)
-    return f"<div class=wide>{html_table}</div>"
-
 
 def _table_3_3(study) -> str:
     """Per ride: each subject's modes, then the Average and SD rows (Table 3.3 form)."""
@@ -57,7 +26,7 @@ def _table_3_3(study) -> str:
         if len(avg) == wide.shape[1]:
             wide.loc["Average"] = avg
             wide.loc["SD"] = sd
-        parts.append(f"<h3>ride: {html.escape(str(ride))}</h3>" + _table(wide.reset_index()))
+        parts.append(f"<h3>ride: {html.escape(str(ride))}</h3>" + table(wide.reset_index()))
     return "".join(parts)
 
 
@@ -69,7 +38,7 @@ def _table_3_2(study) -> str:
         index=["ride", "subject", "file", "sensor"], columns="mode", values="freq_hz", aggfunc="first", dropna=False
     )
     wide.columns = [f"f{m} (Hz)" for m in wide.columns]
-    return _table(wide.reset_index(), 4)
+    return table(wide.reset_index(), 4)
 
 
 def _models(study) -> str:
@@ -89,9 +58,9 @@ def _models(study) -> str:
         ]
         parts.append(
             f"<h3>ride: {ride} ({m['mass_kg']:.1f} kg)</h3>"
-            + _table(pd.DataFrame(rows), 5)
+            + table(pd.DataFrame(rows), 5)
             + "<p>its modes</p>"
-            + _table(pd.DataFrame(m["model_modes"]))
+            + table(pd.DataFrame(m["model_modes"]))
         )
         parts += [f"<p class=note>{html.escape(f)}</p>" for f in m.get("flags", [])]
     return "".join(parts)
@@ -130,21 +99,21 @@ def render_report(study, shape_figures: dict, lump_rows: pd.DataFrame | None = N
         if r.get("figure_png")
     )
     shapes = "".join(
-        f"<h3>ride: {esc(str(ride))}</h3><img alt='mode shapes {esc(str(ride))}' src='{_png(fig)}'>"
+        f"<h3>ride: {esc(str(ride))}</h3><img alt='mode shapes {esc(str(ride))}' src='{figure_uri(fig)}'>"
         for ride, fig in shape_figures.items()
     )
     lump = (
         ""
         if lump_rows is None or lump_rows.empty
-        else "<h2>Can the segments be lumped? (Chapter 5)</h2>" + _table(lump_rows)
+        else "<h2>Can the segments be lumped? (Chapter 5)</h2>" + table(lump_rows)
     )
     body = f"""
 <h1>armaxmodal study</h1>
 <p>{len(study.recordings)} recordings analysed, {study.reused} of them reused from an earlier run;
 {len(study.failures)} left out.</p>
-<h2>Settings</h2>{_table(settings)}
+<h2>Settings</h2>{table(settings)}
 {"<h2>Notes</h2><ul>" + notes + "</ul>" if notes else ""}
-<h2>Across subjects (Table 3.3 form: mean and sample SD)</h2>{_table(study.tables.summary)}
+<h2>Across subjects (Table 3.3 form: mean and sample SD)</h2>{table(study.tables.summary)}
 <h2>Per subject</h2>{_table_3_3(study)}
 <h2>Mode shapes (Fig. 3.7 form)</h2>{shapes}
 {_models(study)}
@@ -156,7 +125,4 @@ def render_report(study, shape_figures: dict, lump_rows: pd.DataFrame | None = N
 {_table_3_2(study)}</details>
 <div id=full><img alt='enlarged figure'></div>
 """
-    return (
-        f"<!DOCTYPE html><html lang=en><head><meta charset=utf-8><title>armaxmodal study</title>"
-        f"<style>{STYLE}</style></head><body>{body}<script>{SCRIPT}</script></body></html>\n"
-    )
+    return page("armaxmodal study", body)
