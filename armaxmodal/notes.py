@@ -17,6 +17,7 @@ WARNING_CODES = (
     "narrowband_input",
     "clipping",
     "dropped_packet",
+    "gap_filled",
     "offset_removed",
     "offset_step",
     "drift",

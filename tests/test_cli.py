@@ -167,3 +167,21 @@ def test_the_command_keeps_one_malloc_arena_for_its_worker_threads():
         for mode in ("one", "default")
     }  # fmt: skip
     assert heaps["one"] == 1 and heaps["default"] > 1, heaps
+
+
+def test_a_ride_with_a_filled_gap_gives_the_modes_of_the_whole_ride(fixtures_dir, tmp_path):
+    """A 40 ms dropped packet (two empty cells of the head at 60 Hz), filled on request: every
+    mode within the intervals of the ride without the gap."""
+    from tests.test_io import _ride_with_gap
+
+    gapped = _ride_with_gap(fixtures_dir, tmp_path, range(3000, 3002))
+    runs = {}
+    cases = (("whole", fixtures_dir / "supine_random.csv", []), ("filled", gapped, ["--fill-gaps", "0.04"]))
+    for name, data, extra in cases:
+        out = tmp_path / f"{name}.json"
+        assert main(["--quiet", "stabilise", str(data), "--orders", "2:20", "--json", str(out), *extra]) == 0
+        runs[name] = json.loads(out.read_text())
+    assert "gap_filled" in [w["code"] for w in runs["filled"]["warnings"]]
+    for whole, filled in zip(runs["whole"]["modes"], runs["filled"]["modes"], strict=True):
+        assert whole["freq_ci95"][0] <= filled["freq_hz"] <= whole["freq_ci95"][1]
+        assert whole["damping_ci95"][0] <= filled["damping"] <= whole["damping_ci95"][1]

@@ -381,3 +381,54 @@ def test_an_all_numeric_csv_reads_the_same_doubles_as_the_cell_by_cell_path(fixt
         assert fast.keys() == slow.keys()
         for name in fast:
             np.testing.assert_array_equal(fast[name], slow[name])
+
+
+def _ride_with_gap(fixtures_dir, tmp_path, rows, name="gap.csv", column=2):
+    """The bundled ride with the cells of ``column`` (head) emptied on the data rows ``rows``."""
+    lines = (fixtures_dir / "supine_random.csv").read_text().splitlines()
+    header = next(i for i, line in enumerate(lines) if line.startswith("time,"))
+    out = lines[: header + 1]
+    for i, line in enumerate(lines[header + 1 :]):
+        cells = line.split(",")
+        if i in rows:
+            cells[column] = ""
+        out.append(",".join(cells))
+    path = tmp_path / name
+    path.write_text("\n".join(out) + "\n")
+    return path
+
+
+def test_a_gap_is_refused_unless_asked_to_fill_and_then_filled_and_named(fixtures_dir, tmp_path):
+    path = _ride_with_gap(fixtures_dir, tmp_path, range(3000, 3002))  # 2 samples, 33 ms at 60 Hz
+    with pytest.raises(DataError, match=r"data row 3001 is empty .*--fill-gaps SECONDS"):
+        am.read_recording(path)
+    whole = am.read_recording(fixtures_dir / "supine_random.csv")
+    filled = am.read_recording(path, fill_gaps=0.04)
+    (note,) = filled.meta["read_warnings"]
+    assert note.code == "gap_filled" and note.channels == ("head",) and "data rows 3001-3002" in note.message
+    head = list(whole.sensors).index("head")
+    expected = np.interp([3000, 3001], [2999, 3002], whole.response[[2999, 3002], head])
+    np.testing.assert_allclose(filled.response[3000:3002, head], expected)
+    untouched = np.ones(whole.n_samples, bool)
+    untouched[3000:3002] = False
+    np.testing.assert_array_equal(filled.response[untouched], whole.response[untouched])
+
+
+@pytest.mark.parametrize("rows, limit, message", [
+    (range(3000, 3003), 0.04, r"data rows 3001-3003: 3 missing samples, more than the 2 samples --fill-gaps allows"),
+    (range(0, 2), 0.1, r"data rows 1-2: missing at the start"),
+])  # fmt: skip
+def test_a_gap_longer_than_asked_or_at_an_end_is_refused_with_its_rows(fixtures_dir, tmp_path, rows, limit, message):
+    with pytest.raises(DataError, match=message):
+        am.read_recording(_ride_with_gap(fixtures_dir, tmp_path, rows), fill_gaps=limit)
+
+
+def test_fill_gaps_bridges_more_dropped_rows_than_the_default(tmp_path):
+    text = "time,base,a\n" + "".join(f"{t},{np.sin(t)},{np.cos(t)}\n" for t in [*range(0, 5), *range(10, 40)])
+    path = _write(tmp_path, "dropped.csv", text)
+    with pytest.raises(DataError, match="5 samples missing"):
+        am.read_recording(path)
+    rec = am.read_recording(path, fill_gaps=5.0)
+    assert rec.n_samples == 40 and [w.code for w in rec.meta["read_warnings"]] == ["dropped_packet"]
+    with pytest.raises(DataError, match="fill_gaps: expected the longest gap"):
+        am.read_recording(path, fill_gaps=-1.0)

@@ -89,6 +89,10 @@ def add_data_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--fs", type=POSITIVE, default=None, help="sampling rate in Hz if the file has no time column")
     p.add_argument("--outputs", default=None, help="comma-separated output columns to use (default: all)")
     p.add_argument("--axis", default="Acc_X", help="Xsens exports: the column to use; default Acc_X")
+    p.add_argument(
+        "--fill-gaps", type=POSITIVE, default=None, metavar="SECONDS",
+        help="fill gaps (missing cells, dropped rows) of up to SECONDS by interpolation, each named in a warning",
+    )  # fmt: skip
 
 
 def load_recording(args):
@@ -96,11 +100,14 @@ def load_recording(args):
     if len(args.data) > 1:
         from armaxmodal.io.xsens import read_xsens
 
+        if getattr(args, "fill_gaps", None) is not None:
+            raise DataError("--fill-gaps fills the gaps of one file; per-sensor exports bridge up to 3 dropped packets "
+                            "each and refuse longer gaps (cut the record there).")  # fmt: skip
         rec = read_xsens(args.data, input=args.input, axis=args.axis)
         args.data = " + ".join(args.data)
         return rec if outputs is None else rec.select(outputs)
     args.data = args.data[0]
-    rec = read_recording(args.data, input=args.input, fs=args.fs, outputs=outputs)
+    rec = read_recording(args.data, input=args.input, fs=args.fs, outputs=outputs, fill_gaps=args.fill_gaps)
     skipped = rec.meta.get("axis_columns", ())
     if skipped and not getattr(args, "quiet", False):
         named = ", ".join(f"'{c}'" for c in skipped)

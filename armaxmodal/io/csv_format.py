@@ -110,7 +110,7 @@ def _check_separator(path: Path, lines: list[str]) -> None:
 _MISSING = ("", "na", "n/a", "nan", "null", "none", "-")
 
 
-def read_csv_file(path: Path):
+def read_csv_file(path: Path, fill_gaps_s: float | None = None):
     _check_csv_layout(path)
     info = _csv_comments(path)
     try:
@@ -137,7 +137,7 @@ def read_csv_file(path: Path):
     if numeric:
         channels = {col: frame[col].to_numpy(dtype=float) for col in frame.columns}
     else:
-        channels = _text_channels(frame, path)
+        channels = _text_channels(frame, path, missing_ok=fill_gaps_s is not None)
     file_fs = None
     time_col = next((c for c in channels if time_scale(c) is not None), None)
     if time_col is not None:
@@ -145,7 +145,7 @@ def read_csv_file(path: Path):
         if not np.all(np.isfinite(t)):
             raise DataError(f"{path.name}: the time column contains NaN or empty cells.")
         scale = TO_SECONDS.get(units.get(time_col, "").strip("()[] ").lower()) or time_scale(time_col)
-        t, channels, info["read_warnings"] = bridge_dropped_rows(t * scale, channels, path)
+        t, channels, info["read_warnings"] = bridge_dropped_rows(t * scale, channels, path, fill_gaps_s)
         file_fs = fs_from_time(t, path)
     return channels, file_fs, info
 
@@ -162,10 +162,11 @@ def _units_row(frame: pd.DataFrame) -> dict[str, str]:
     return dict(zip(frame.columns, first, strict=True)) if second.notna().all() else {}
 
 
-def _text_channels(frame: pd.DataFrame, path: Path) -> dict[str, np.ndarray]:
+def _text_channels(frame: pd.DataFrame, path: Path, missing_ok: bool = False) -> dict[str, np.ndarray]:
     """Channels of a CSV read as text: numbers parsed, text columns skipped, an all-missing
     column kept as NaN (refused by name if used), any other missing or non-numeric cell an
-    error that names it."""
+    error that names it; with ``missing_ok`` (``--fill-gaps``) a missing cell is NaN, for the
+    gap filler to fill or refuse."""
     channels: dict[str, np.ndarray] = {}
     for col in frame.columns:
         text = frame[col].str.strip()
@@ -176,12 +177,15 @@ def _text_channels(frame: pd.DataFrame, path: Path) -> dict[str, np.ndarray]:
             continue
         if bad.all():
             continue  # a text column (labels, comments): not a channel
+        if missing_ok:
+            bad &= ~text.str.lower().isin(_MISSING).to_numpy()
         if bad.any():
             row = int(np.argmax(bad))
             if text.iloc[row] == "":
                 raise DataError(
                     f"{path.name}: column '{col}', data row {row + 1} is empty (a missing "
-                    "sample); fill or trim it before analysis."
+                    "sample); fill or trim it, or give --fill-gaps SECONDS (read_recording(fill_gaps=...)) to "
+                    "interpolate gaps up to that length."
                 )
             if "\ufeff" in frame[col].iloc[row]:
                 raise _byte_order_mark_error(path, f"column '{col}', data row {row + 1}")

@@ -15,7 +15,7 @@ import numpy as np
 from armaxmodal.exceptions import DataError
 from armaxmodal.io.csv_format import read_csv_file
 from armaxmodal.io.mat_format import read_mat_file
-from armaxmodal.io.time_axis import SLOWEST_FS, TIME_JITTER, is_axis, is_number
+from armaxmodal.io.time_axis import SLOWEST_FS, TIME_JITTER, fill_missing_samples, is_axis, is_number
 from armaxmodal.io.uff_format import read_uff_file
 from armaxmodal.recording import Recording
 
@@ -29,6 +29,7 @@ def read_recording(
     format: str | None = None,
     subject: str | None = None,
     mass_kg: float | None = None,
+    fill_gaps: float | None = None,
 ) -> Recording:
     """Read a recording: one input column, the other numeric columns as outputs.
 
@@ -51,6 +52,10 @@ def read_recording(
     subject, mass_kg : optional
         Who was measured and the total mass in kg; CSV files may also carry them as
         ``# subject: ...`` and ``# mass_kg: ...`` lines before the header.
+    fill_gaps : float, optional
+        Fill gaps of up to this many seconds (missing cells, rows a logger dropped) by linear
+        interpolation, each a warning with its rows (``gap_filled``, ``dropped_packet``). Without
+        it a missing sample is refused, and at most 3 dropped rows are bridged.
 
     Returns
     -------
@@ -66,11 +71,13 @@ def read_recording(
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no such recording: {path}")
+    if fill_gaps is not None and not (np.isfinite(fill_gaps) and fill_gaps > 0):
+        raise DataError(f"fill_gaps: expected the longest gap to fill in seconds (> 0), got {fill_gaps!r}.")
     kind = format or _guess_format(path)
     readers: dict[str, Callable] = {"csv": read_csv_file, "mat": read_mat_file, "uff": read_uff_file}
     if kind not in readers:
         raise DataError(f"unknown format {kind!r} for {path.name}; use csv, mat or uff.")
-    channels, file_fs, info = readers[kind](path)
+    channels, file_fs, info = readers[kind](path, fill_gaps) if kind == "csv" else readers[kind](path)
     if not channels:
         raise DataError(f"{path.name}: no numeric channels found.")
     if kind == "csv" and input not in channels and all(is_number(c) for c in channels):
@@ -104,10 +111,15 @@ def read_recording(
             "Name the input column with input=... (CLI: --input)."
         )
     names = _output_names(channels, input, outputs, axes, odd, path)
+    if fill_gaps is not None:
+        used = {c: channels[c] for c in (input, *names)}
+        filled, notes = fill_missing_samples(used, int(fill_gaps * fs + 1e-9), path.name)
+        channels.update(filled)
+        info["read_warnings"] = list(info.get("read_warnings", ())) + notes
     meta = {"source": str(path), "format": kind, "axis_columns": tuple(c for c in axes if c not in names)}
     if "units" in info:  # a CSV's row of units under the header
         meta["units"] = info["units"]
-    if info.get("read_warnings"):  # rows a logger dropped, bridged
+    if info.get("read_warnings"):  # rows a logger dropped, bridged; gaps filled
         kept = (input, *names)
         notes = info["read_warnings"]
         meta["read_warnings"] = [replace(w, channels=tuple(c for c in w.channels if c in kept)) for w in notes]

@@ -83,18 +83,20 @@ def whole_step_gaps(t: np.ndarray, step: float, max_gap: int, unit: str, source:
     return gaps
 
 
-def bridge_dropped_rows(t: np.ndarray, channels: dict, path: Path) -> tuple[np.ndarray, dict, list]:
+def bridge_dropped_rows(t: np.ndarray, channels: dict, path: Path, fill_gaps_s: float | None = None):
     """Rows missing from a uniform time column (:func:`whole_step_gaps`, at most
-    ``MAX_BRIDGED_SAMPLES`` at once) filled by linear interpolation in every channel, each
-    gap a ``dropped_packet`` warning. Other uneven steps are left to :func:`fs_from_time`,
-    which refuses them."""
+    ``MAX_BRIDGED_SAMPLES`` at once, or as many as ``fill_gaps_s`` seconds hold when the user
+    asks) filled by linear interpolation in every channel, each gap a ``dropped_packet`` warning.
+    Other uneven steps are left to :func:`fs_from_time`, which refuses them. Returns
+    ``(t, channels, warnings)``."""
     from armaxmodal.notes import QualityWarning
 
     steps = np.diff(t)
     dt = float(np.median(steps)) if steps.size else 0.0
     if not dt > 0 or np.any(steps <= 0):  # rows out of order or repeated: refused as they are
         return t, channels, []
-    gaps = whole_step_gaps(t, dt, MAX_BRIDGED_SAMPLES, "samples", path.name)
+    limit = MAX_BRIDGED_SAMPLES if fill_gaps_s is None else max(MAX_BRIDGED_SAMPLES, int(fill_gaps_s / dt + 1e-9))
+    gaps = whole_step_gaps(t, dt, limit, "samples", path.name)
     if not gaps:
         return t, channels, []
     notes = [
@@ -145,3 +147,53 @@ def fs_from_time(t: np.ndarray, path: Path) -> float:
     # The mean step over the whole record is far less sensitive to printed rounding; ten
     # significant digits is more than any printed time column carries.
     return float(f"{(t.size - 1) / float(t[-1] - t[0]):.10g}")
+
+
+def fill_missing_samples(channels: dict, max_samples: int, source: str) -> tuple[dict, list]:
+    """Runs of missing samples (NaN cells, a dropped packet a logger wrote as empty) of at most
+    ``max_samples`` filled by linear interpolation between the samples either side, each run a
+    ``gap_filled`` warning with its rows. Asked for by the user (``--fill-gaps``): without it a
+    missing sample is refused. A longer run, or one at the start or end of the record (nothing to
+    interpolate from), is refused with its rows.
+
+    Parameters
+    ----------
+    channels : dict of str to (n,) ndarray
+    max_samples : int
+        The longest run filled.
+    source : str
+        The file, for the messages.
+
+    Returns
+    -------
+    channels : dict
+        Copies with the runs filled (unchanged channels are the same arrays).
+    warnings : list of QualityWarning
+    """
+    from armaxmodal.notes import QualityWarning
+
+    out, notes = dict(channels), []
+    for name, x in channels.items():
+        missing = ~np.isfinite(x)
+        if not missing.any():
+            continue
+        edges = np.flatnonzero(np.diff(np.r_[0, missing.astype(int), 0]))
+        runs = list(zip(edges[::2], edges[1::2], strict=True))  # [start, stop) of each run
+        for start, stop in runs:
+            where = f"{source}: channel '{name}', data rows {start + 1}-{stop}"
+            if stop - start > max_samples:
+                raise DataError(
+                    f"{where}: {stop - start} missing samples, more than the {max_samples} samples --fill-gaps allows; "
+                    "cut the record there and analyse the parts apart, or allow a longer gap."
+                )
+            if start == 0 or stop == x.size:
+                raise DataError(f"{where}: missing at the {'start' if start == 0 else 'end'} of the record, with "
+                                "nothing to interpolate from on one side; trim those rows.")  # fmt: skip
+        idx = np.arange(x.size)
+        out[name] = np.where(missing, np.interp(idx, idx[~missing], x[~missing]), x)
+        notes += [
+            QualityWarning("gap_filled", (name,), f"channel '{name}', data rows {start + 1}-{stop}: {stop - start} "
+                           "missing sample(s) filled by linear interpolation (--fill-gaps)", float(stop - start))
+            for start, stop in runs
+        ]  # fmt: skip
+    return out, notes
