@@ -35,7 +35,7 @@ def plot_shapes(selection, fig=None):
     modes, sensors = selection.modes, list(selection.diagram.recording.sensors)
     n = max(len(modes), 1)
     if fig is None:
-        fig = plt.figure(figsize=(1.2 + 2.3 * n, 4.8), layout="constrained")
+        fig = plt.figure(figsize=(max(1.2 + 2.3 * n, 5.5), 4.8), layout="constrained")
     fig.clear()
     axes = fig.subplots(2, n, sharex=True, sharey="row", squeeze=False, height_ratios=(2, 1))
     x = np.arange(len(sensors))
@@ -60,6 +60,5 @@ def plot_shapes(selection, fig=None):
     handles, labels = axes[0, 0].get_legend_handles_labels()
     if handles:
         fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize=8, frameon=False)
-    fig.suptitle("Mode shapes over the sensors (modal constants, Eq. 3.24, each scaled to its largest component)",
-                 fontsize=10)  # fmt: skip
+    fig.suptitle("Mode shapes (modal constants, Eq. 3.24; largest = 1)", fontsize=10)
     return fig
