@@ -20,6 +20,7 @@ from armaxmodal.diagnosis.inject import inject
 from armaxmodal.diagnosis.model import fractional_shift
 from armaxmodal.diagnosis.spectral import harmonic_f_test
 from armaxmodal.exceptions import DataError
+from tests.conftest import open_in_headless_chromium
 
 ORDERS = (10, 16, 10, -5)  # the supine fixture's orders chosen by BIC (README)
 
@@ -57,6 +58,12 @@ def test_periodic_disturbance_is_named_measured_and_removed(clean):
         truth = 0.1 * np.sqrt(2) * np.std(clean.response[:, clean.sensors.index(name)])
         assert p["per_channel"][name]["amp"] == pytest.approx(truth, rel=0.03)
     assert p["sim_error_after"] < 0.6 * p["sim_error_before"]
+
+
+def test_a_notebook_shows_the_diagnosis_verdict_and_effects(clean):
+    d = _run(inject(clean, "periodic_disturbance", ["head"], freq_hz=11.7, amp=0.1))
+    shown = d._repr_html_()
+    assert d.to_dict()["verdict"] in shown and "periodic_disturbance" in shown and "multitaper_F" in shown
 
 
 def test_a_line_where_the_random_input_reads_a_chance_p_of_1e_3_is_still_named(clean):
@@ -159,8 +166,8 @@ def test_cli_writes_strict_json_with_the_contract(tmp_path, clean):
 
     data = tmp_path / "ride.csv"
     write_recording_csv(inject(clean, "offset_drift", ["chest"], offset=0.3, drift_per_s=0.004), data)
-    out, fig = tmp_path / "d.json", tmp_path / "d.png"
-    assert main(["diagnose", str(data), "--json", str(out), "--plot", str(fig), "--quiet"]) == 0
+    out, fig, page = tmp_path / "d.json", tmp_path / "d.png", tmp_path / "d.html"
+    assert main(["diagnose", str(data), "--json", str(out), "--plot", str(fig), "--report", str(page), "--quiet"]) == 0
     js = json.loads(out.read_text(), parse_constant=lambda c: pytest.fail(f"bare {c} in JSON"))
     assert {"baseline", "effects", "final"} <= js.keys()
     assert {"fit_val_pct", "one_step_fit_pct", "resid_rms", "whiteness_p"} <= js["baseline"].keys()
@@ -170,6 +177,13 @@ def test_cli_writes_strict_json_with_the_contract(tmp_path, clean):
     assert {"statistic", "p"} <= first["evidence"].keys()
     assert first["error_after"] <= first["error_before"]
     assert fig.stat().st_size > 10_000
+    # the one-page report: the effect with its errors before and after, the figures, nothing fetched
+    html = page.read_text()
+    assert "https://" not in html and html.count("src='data:image/png;base64,") == 1
+    assert "offset_drift" in html and f"{first['error_before']:.4g}" in html and f"{first['error_after']:.4g}" in html
+    assert js["verdict"] in html
+    dom, console_errors = open_in_headless_chromium(page, tmp_path / "profile")
+    assert 'data-figures="1/1"' in dom and not console_errors
 
 
 @pytest.fixture(scope="module")

@@ -2,15 +2,19 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from armaxmodal.cli.common import (
     NONNEG_INT,
     add_data_args,
+    check_report_path,
     load_recording,
     output_format,
     parse_pair,
     print_warnings,
     write_outputs,
 )
+from armaxmodal.diagnosis.report import short_parameters
 from armaxmodal.io.write import write_json
 
 
@@ -24,6 +28,7 @@ def add_parser(sub, parents) -> None:
     p.add_argument("--max-rounds", type=NONNEG_INT, default=3, help="effects added at most; default 3")
     p.add_argument("--json", default=None, help="write the diagnosis as JSON")
     p.add_argument("--plot", default=None, help="figure page (.png/.svg/.pdf)")
+    p.add_argument("--report", default=None, help="one self-contained HTML page of the diagnosis (.html)")
     p.set_defaults(func=run)
 
 
@@ -33,6 +38,8 @@ def run(args) -> int:
 
     plot_format = output_format(args.plot) if args.plot else None
     band = check_band(parse_pair(args.band, "--band")) if args.band else None
+    if args.report:
+        check_report_path(args.report)
     rec = load_recording(args)
     result = diagnose(rec, band=band, max_rounds=args.max_rounds, progress=not args.quiet)
     print_warnings(result.warnings)
@@ -46,6 +53,11 @@ def run(args) -> int:
         outputs.append((args.plot, lambda tmp: fig.savefig(tmp, dpi=120, format=plot_format)))
     if args.json:
         outputs.append((args.json, lambda tmp: write_json(report, tmp)))
+    if args.report:
+        from armaxmodal.diagnosis.report import render_diagnosis_report
+
+        page = render_diagnosis_report(result, args.data)
+        outputs.append((args.report, lambda tmp: Path(tmp).write_text(page, encoding="utf-8")))
     write_outputs(outputs)
     return 0
 
@@ -71,7 +83,7 @@ def _diagnosis_text(name: str, report: dict) -> str:
         lines.append(
             f"effect {e['effect']} on {', '.join(e['channels'])}: "
             f"{e['evidence']['statistic']} p = {e['evidence']['p']:.2g}; "
-            f"held-out one-step RMS {e['error_before']:.4g} -> {e['error_after']:.4g}; {_short(params)}"
+            f"held-out one-step RMS {e['error_before']:.4g} -> {e['error_after']:.4g}; {short_parameters(params)}"
         )
         if e.get("note"):
             lines.append(f"  note: {e['note']}")
@@ -86,14 +98,3 @@ def _diagnosis_text(name: str, report: dict) -> str:
 def _or_unresolved(value) -> str:
     """A noise floor, or why there is none (the record cannot resolve its lightest mode)."""
     return "unresolved" if value is None else f"{value:.4g}"
-
-
-def _short(params: dict) -> str:
-    def fmt(v):
-        if isinstance(v, float):
-            return f"{v:.4g}"
-        if isinstance(v, list):
-            return "[" + ", ".join(fmt(x) for x in v) + "]"
-        return str(v)
-
-    return ", ".join(f"{k} {fmt(v)}" for k, v in params.items())

@@ -162,6 +162,16 @@ class Diagnosis:
         """The physical modes of a stage's model (identify's rejection rules)."""
         return stage_modes(stage, self.recording)
 
+    def _repr_html_(self) -> str:
+        """A notebook's view: the verdict and each effect with its evidence and error before and after."""
+        import html
+
+        from armaxmodal.diagnosis.report import effects_table
+
+        report = self.to_dict()
+        table = effects_table(report).to_html(index=False, float_format=lambda v: f"{v:.4g}", border=0)
+        return f"<p><b>verdict: {html.escape(report['verdict'])}</b></p>{table}"
+
     def to_dict(self) -> dict:
         na, nb, nc, nk = self.baseline.model.spec.orders
 
