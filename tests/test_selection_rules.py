@@ -451,3 +451,23 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     assert calls == [(0.05, 0.5), (2, 0.8, rec.duration)]
     assert out.modes.freq_hz.tolist() == [9.0] and out.modes.index.tolist() == [0]
     assert out.shapes.tolist() == [[0.0], [1.0]]
+
+
+def test_filled_samples_widen_every_interval_by_the_information_they_lack():
+    """720 of 7,200 samples filled: the intervals widen by sqrt(7200 / 6480) about each value."""
+    from types import SimpleNamespace
+
+    from armaxmodal.modes.selection import _discount_filled_samples
+
+    filled = am.QualityWarning("gap_filled", ("head",), "x", 700.0)
+    bridged = am.QualityWarning("dropped_packet", ("head",), "y", 20.0)
+    rec = SimpleNamespace(duration=120.0, fs=20.0, meta={"read_warnings": [filled, bridged]})
+    modes = pd.DataFrame({"freq_hz": [5.0], "freq_ci95_lo": [4.9], "freq_ci95_hi": [5.2], "damping": [0.1],
+                          "damping_ci95_lo": [0.09], "damping_ci95_hi": [0.1]})  # fmt: skip
+    out, (note,) = _discount_filled_samples(modes, rec, SimpleNamespace(original_fs=60.0))  # resampled 60 -> 20 Hz
+    k = np.sqrt(7200 / 6480)
+    assert note.value == pytest.approx(k)
+    np.testing.assert_allclose(out[["freq_ci95_lo", "freq_ci95_hi"]].to_numpy(), [[5 - 0.1 * k, 5 + 0.2 * k]])
+    np.testing.assert_allclose(out[["damping_ci95_lo", "damping_ci95_hi"]].to_numpy(), [[0.1 - 0.01 * k, 0.1]])
+    rec.meta = {}
+    assert _discount_filled_samples(modes, rec, None) == (modes, [])

@@ -331,6 +331,31 @@ def _automatic(diagram, band, nas, min_support, clustering, merge_mac, n_modes, 
     return modes.loc[order].reset_index(drop=True), [vectors[i] for i in order]
 
 
+def _discount_filled_samples(modes: pd.DataFrame, recording, preparation) -> tuple[pd.DataFrame, list[QualityWarning]]:
+    """The intervals widened for samples the reader filled in (``gap_filled``, ``dropped_packet``):
+    an interpolated sample carries no information, so a record of ``N`` samples with ``k`` filled
+    holds ``N - k`` observations, and a standard deviation the fit computed from ``N`` is too
+    small by ``sqrt(N / (N - k))``. Counted in the record's own samples, before any resampling."""
+    filled = sum(w.value or 0.0 for w in recording.meta.get("read_warnings", ())
+                 if w.code in ("gap_filled", "dropped_packet"))  # fmt: skip
+    if not filled or modes.empty:
+        return modes, []
+    # gap_filled counts one channel's samples; a filled sample of any channel is lost to the fit
+    n = recording.duration * (recording.fs if preparation is None else preparation.original_fs)
+    factor = float(np.sqrt(n / max(n - filled, 1.0)))
+    modes = modes.copy()
+    for value, lo, hi in (("freq_hz", "freq_ci95_lo", "freq_ci95_hi"), ("damping", "damping_ci95_lo",
+                                                                         "damping_ci95_hi")):  # fmt: skip
+        modes[lo] = modes[value] - factor * (modes[value] - modes[lo])
+        modes[hi] = modes[value] + factor * (modes[hi] - modes[value])
+    note = QualityWarning(
+        "gap_filled", (),
+        f"{filled:g} filled sample(s) carry no information: every interval is widened by {factor:.6f} "
+        f"(sqrt(N / (N - filled)), N = {n:.0f})", factor,
+    )  # fmt: skip
+    return modes, [note]
+
+
 def _armax_intervals(modes: pd.DataFrame) -> pd.DataFrame:
     """The ARMAX fit's standard deviations beside its intervals: the segment refits are ARMAX
     fits, and their spread is judged against these even where another estimator is reported."""
@@ -357,7 +382,9 @@ def _finished(diagram, work: WorkingSelection, band, cluster_freq: float, n_orde
     """The selection with its per-sensor tables and the notes read off the final modes."""
     from armaxmodal.modes.frf_check import unexplained_peaks
 
-    modes, shapes = work.modes, work.shapes
+    modes, widened = _discount_filled_samples(work.modes, diagram.recording, diagram.preparation)
+    work = replace(work, modes=modes).noted(*widened)
+    shapes = work.shapes
     per_sensor, weighted = per_sensor_table(diagram, modes, shapes, cluster_freq)
     freq, damping = modes.freq_hz.to_numpy(), modes.damping.to_numpy()
     # a peak a mode of the model explains is explained, picked or not (the check's poles are the model's)
