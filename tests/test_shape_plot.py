@@ -44,3 +44,27 @@ def test_stabilise_writes_the_shapes_figure(fixtures_dir, tmp_path, capsys):
     capsys.readouterr()
     assert main(["--quiet", "stabilise", data, "--shapes-plot", str(tmp_path / "s.jpg")]) == 2
     assert "--shapes-plot: expected a .png, .svg or .pdf" in capsys.readouterr().err
+
+
+def test_with_positions_the_top_row_draws_the_deflected_chain(selection):
+    positions = {"head": 1.7, "chest": 1.3, "pelvis": 0.9, "legs": 0.4}
+    fig = plot_shapes(selection, positions=positions)
+    for k, ax in enumerate(fig.axes[: len(selection.modes)]):
+        rest, deflected = ax.lines[:2]
+        phi = normalised_shape(selection.shapes[:, k])
+        order = np.argsort([positions[s] for s in selection.diagram.recording.sensors])
+        np.testing.assert_allclose(deflected.get_ydata(), [0.4, 0.9, 1.3, 1.7])
+        np.testing.assert_allclose(deflected.get_xdata(), phi.real[order])
+        assert np.all(rest.get_xdata() == 0)
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--positions", "head=1"], "give --shapes-plot FILE as well"),
+    (["--shapes-plot", "s.png", "--positions", "head=1,chest=2,pelvis=3"], "missing ['legs']"),
+    (["--shapes-plot", "s.png", "--positions", "head=1,chest=2,pelvis=3,legs=4,feet=5"], "not a sensor ['feet']"),
+    (["--shapes-plot", "s.png", "--positions", "head:1"], "expected NAME=VALUE pairs"),
+])  # fmt: skip
+def test_bad_positions_are_refused_before_the_sweep(fixtures_dir, tmp_path, capsys, argv, message):
+    assert main(["--quiet", "stabilise", str(fixtures_dir / "supine_random.csv"), *argv]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1

@@ -18,7 +18,7 @@ from armaxmodal.cli.common import (
     print_warnings,
     write_outputs,
 )
-from armaxmodal.exceptions import OrderError, PickError
+from armaxmodal.exceptions import DataError, OrderError, PickError
 from armaxmodal.io.write import write_json
 
 
@@ -43,6 +43,10 @@ def add_parser(sub, parents) -> None:
     p.add_argument("--report", default=None, help="one self-contained HTML page of the run (.html)")
     p.add_argument("--uff", default=None, help="the modes as UFF 55 and the measured and modal-model FRFs as UFF 58")
     p.add_argument("--shapes-plot", default=None, help="the selected modes' shapes over the sensors (.png, .svg, .pdf)")
+    p.add_argument(
+        "--positions", default=None, help="each sensor's place along the chain, NAME=VALUE,... (a height, a storey): "
+        "the shapes figure then draws the deflected chain"
+    )  # fmt: skip
     p.add_argument(
         "--detrend",
         choices=["mean", "linear", "none"],
@@ -69,12 +73,17 @@ def run(args) -> int:
     orders = None if args.orders is None else order_range(args.orders)
     band = check_band(parse_pair(args.band, "--band")) if args.band else None
     picks = _picks(args.pick, args.modes)
+    positions = _positions(args.positions, args.shapes_plot)
     if args.report:
         check_report_path(args.report)
     rec = load_recording(args)
     check_band(band, rec.fs)
     if picks is not None:  # refused before the sweep, not after it
         check_picks(picks, band, rec.fs)
+    if positions is not None:
+        from armaxmodal.modes.shape_plot import check_positions
+
+        check_positions(positions, list(rec.sensors))
     if not args.quiet:
         outputs = ", ".join(rec.sensors)
         print(f"{args.data}: input {rec.input_name}; outputs {outputs}; {rec.n_samples} samples at {rec.fs:g} Hz")
@@ -112,7 +121,7 @@ def run(args) -> int:
     if args.shapes_plot:
         from armaxmodal.modes.shape_plot import plot_shapes
 
-        shapes_fig = plot_shapes(selection)
+        shapes_fig = plot_shapes(selection, positions=positions)
         outputs.append((args.shapes_plot, lambda tmp: shapes_fig.savefig(tmp, dpi=150, format=shapes_format)))
     if args.uff:
         outputs.append((args.uff, _uff_writer(selection)))
@@ -147,6 +156,19 @@ def _uff_writer(selection):
             frfs += [("measured H1", k, f[keep], h[keep, k]), ("modal model", k, f[keep], model[:, k])]
     shapes, sensors = selection.shapes, list(rec.sensors)
     return lambda tmp: write_modes_uff(tmp, modes.freq_hz, modes.damping, shapes, sensors, frfs)
+
+
+def _positions(text: str | None, shapes_plot: str | None) -> dict | None:
+    """``--positions head=1.7,chest=1.3,...`` as ``{sensor: position}``; only with --shapes-plot."""
+    if text is None:
+        return None
+    if shapes_plot is None:
+        raise DataError("--positions places the sensors in the shapes figure: give --shapes-plot FILE as well.")
+    try:
+        pairs = [item.split("=") for item in text.split(",") if item.strip()]
+        return {name.strip(): float(value) for name, value in pairs}
+    except ValueError as exc:
+        raise DataError(f"--positions: expected NAME=VALUE pairs such as head=1.7,chest=1.3; got {text!r}.") from exc
 
 
 def _picks(text: str | None, n_modes: int | None) -> list[float] | None:
