@@ -493,6 +493,44 @@ MUTANTS = [
         "results put back in the order they ran (pool)",
     ),
     # the maximum-likelihood modal model and the count of modes (issue: the seed's own bodies); run with
+    # issue 39's desk: gaps filled on request, modes out as UFF 55 (run with --match "(desk)"
+    # --tests tests/test_io.py tests/test_uff_modes.py tests/test_selection_rules.py)
+    (
+        "armaxmodal/io/time_axis.py",
+        "            if stop - start > max_samples:",
+        "            if stop - start > 10 * max_samples:",
+        "a gap longer than asked filled (desk)",
+    ),
+    (
+        "armaxmodal/io/time_axis.py",
+        "            if start == 0 or stop == x.size:",
+        "            if False:",
+        "a gap at an end extrapolated (desk)",
+    ),
+    (
+        "armaxmodal/io/time_axis.py",
+        "        out[name] = np.where(missing, np.interp(idx, idx[~missing], x[~missing]), x)",
+        "        out[name] = np.where(missing, 0.0, x)",
+        "a gap filled with zeros (desk)",
+    ),
+    (
+        "armaxmodal/io/uff_modes.py",
+        "            \"freq_hz\": wn / (2 * np.pi), \"damping\": -lam.real / wn if wn > 0 else float(\"nan\"),",
+        "            \"freq_hz\": lam.imag / (2 * np.pi), \"damping\": -lam.real / wn if wn > 0 else float(\"nan\"),",
+        "the damped frequency read as the natural one (desk)",
+    ),
+    (
+        "armaxmodal/io/uff_modes.py",
+        "    return [named.get(str(k), f\"node {k}\").strip() for k in nodes]",
+        "    return [f\"node {k}\" for k in nodes]",
+        "sensor names lost (desk)",
+    ),
+    (
+        "armaxmodal/modes/selection.py",
+        "    factor = float(np.sqrt(n / max(n - filled, 1.0)))",
+        "    factor = float(n / max(n - filled, 1.0))",
+        "the widening squared (desk)",
+    ),
     # --match "(count)" --tests tests/test_mode_count.py
     (
         "armaxmodal/modes/modal_model.py",
