@@ -88,8 +88,18 @@ def test_supplement_fills_a_removed_component_from_the_transmissibility(light_se
 
 
 def test_json_per_sensor_shapes_flag_supplemented(light_selection):
+    """The JSON flags exactly the component Eq. (3.34) filled (sensor c's own model made to miss
+    mode 2), and no other; the shared shapes are never flagged. (This test once never saw the
+    flag set.)"""
     _, selection = light_selection
     data = selection.to_dict("per_sensor")
     assert all(not c["supplemented"] for m in data["modes"] for c in m["shape"].values())
+    table = selection.per_sensor.copy()
+    table.loc[(table["sensor"] == "c") & (table["mode"] == 2), "own_modal_constant"] = np.nan + 0j
+    damaged = dataclasses.replace(selection, per_sensor=table)
+    flagged = [(m, s) for m, mode in enumerate(damaged.to_dict("per_sensor")["modes"], start=1)
+               for s, c in mode["shape"].items() if c["supplemented"]]  # fmt: skip
+    assert flagged == [(2, "c")]
+    assert not any(c["supplemented"] for m in damaged.to_dict()["modes"] for c in m["shape"].values())
     with pytest.raises(ValueError, match="shapes"):
         selection.to_dict("other")
