@@ -4,7 +4,7 @@ Each mutant is a one-line change a tired developer could make; the script applie
 working tree, runs the test files that cover that code, restores the file, and reports
 whether a test failed (killed) or not (survived).
 
-    python scripts/mutation_check.py [--tests tests/test_guards.py tests/test_fit.py ...]
+    python scripts/mutation_check.py [--tests tests/estimate/test_guards.py tests/estimate/test_fit.py ...]
 """
 
 from __future__ import annotations
@@ -19,9 +19,9 @@ ROOT = Path(__file__).resolve().parents[1]
 # (file, original text, mutated text, what it models)
 MUTANTS = [
     # the modal-model check and the selection by it (issue 26); run with
-    # --match "(check)" --tests tests/test_modal_check.py tests/test_frf_check.py
-    #   tests/test_stabilisation.py::test_a_split_the_frf_does_not_need_is_merged_and_said
-    #   tests/test_stabilisation.py::test_a_spurious_heavily_damped_neighbour_is_left_out_and_said
+    # --match "(check)" --tests tests/modes/test_modal_check.py tests/modes/test_frf_check.py
+    #   tests/modes/test_stabilisation.py::test_a_split_the_frf_does_not_need_is_merged_and_said
+    #   tests/modes/test_stabilisation.py::test_a_spurious_heavily_damped_neighbour_is_left_out_and_said
     (
         "armaxmodal/modes/modal_check.py",
         "model = np.sqrt(np.clip(error**2 - rand**2, 0.0, None))",
@@ -271,7 +271,7 @@ MUTANTS = [
         "abs(local) >= 0 * spread",
         "wander as a shift (step)",
     ),
-    # channels filled in from a lower rate (run with --tests tests/test_held.py)
+    # channels filled in from a lower rate (run with --tests tests/prepare/test_held.py)
     (
         "armaxmodal/prepare/held.py",
         "k = min(k for k, (stat, _)",
@@ -308,7 +308,7 @@ MUTANTS = [
         "top = np.inf",
         "band ignored (held)",
     ),
-    # the delay's interval (run with --tests tests/test_prepare.py)
+    # the delay's interval (run with --tests tests/prepare/test_prepare.py)
     (
         "armaxmodal/prepare/quality.py",
         "            if jackknife > sd:",
@@ -322,7 +322,7 @@ MUTANTS = [
         "normal quantile (delay)",
     ),
     # delays in the diagnosis loop and the loop's rules (issue 27); run with
-    # --match "(loop delay)" --tests tests/test_diagnose_delays.py tests/test_bad_input.py
+    # --match "(loop delay)" --tests tests/diagnosis/test_diagnose_delays.py tests/cli/test_bad_input.py
     (
         "armaxmodal/diagnosis/loop.py",
         "earlier = -d if finding.channels == (s.input_name,) else d",
@@ -402,9 +402,9 @@ MUTANTS = [
         "bad = peak > MAX_AMPLITUDE",
         "tiny amplitudes pass (loop delay)",
     ),
-    # issue 28's shared numbers and fallbacks (run with --match "(layout)" --tests tests/test_frf.py
-    # tests/test_prepare.py tests/test_inverse.py tests/test_lumping.py
-    # tests/test_stabilisation.py::test_a_refit_that_cannot_be_made_is_said_not_taken_for_refine_false)
+    # issue 28's shared numbers and fallbacks (run with --match "(layout)" --tests tests/prepare/test_frf.py
+    # tests/prepare/test_prepare.py tests/inverse/test_inverse.py tests/lumping/test_lumping.py
+    # tests/modes/test_stabilisation.py::test_a_refit_that_cannot_be_made_is_said_not_taken_for_refine_false)
     (
         "armaxmodal/stats.py",
         "2 ** int(np.ceil(np.log2(fs * seconds)))",
@@ -459,8 +459,8 @@ MUTANTS = [
         "max_fraction=2)",
         "lumping averages too few segments (layout)",
     ),
-    # issue 29's per-sensor start (run with --match "(warm)" --tests tests/test_fit.py
-    # tests/test_sweep_in_process.py)
+    # issue 29's per-sensor start (run with --match "(warm)" --tests tests/estimate/test_fit.py
+    # tests/estimate/test_sweep_in_process.py)
     (
         "armaxmodal/estimate/fit.py",
         "models = [start.models[start.sensors.index(s)] for s in sensors]",
@@ -473,7 +473,7 @@ MUTANTS = [
         "todo = single",
         "per-sensor fits start from scratch (warm)",
     ),
-    # the worker threads (run with --match "(pool)" --tests tests/test_pool.py)
+    # the worker threads (run with --match "(pool)" --tests tests/estimate/test_pool.py)
     (
         "armaxmodal/estimate/pool.py",
         "key=lambda i: -cost(items[i])",
@@ -494,7 +494,7 @@ MUTANTS = [
     ),
     # the maximum-likelihood modal model and the count of modes (issue: the seed's own bodies); run with
     # issue 39's desk: gaps filled on request, modes out as UFF 55 (run with --match "(desk)"
-    # --tests tests/test_io.py tests/test_uff_modes.py tests/test_selection_rules.py)
+    # --tests tests/io/test_io.py tests/io/test_uff_modes.py tests/modes/test_selection_rules.py)
     (
         "armaxmodal/io/time_axis.py",
         "            if stop - start > max_samples:",
@@ -531,7 +531,7 @@ MUTANTS = [
         "    factor = float(n / max(n - filled, 1.0))",
         "the widening squared (desk)",
     ),
-    # --match "(count)" --tests tests/test_mode_count.py
+    # --match "(count)" --tests tests/modes/test_mode_count.py
     (
         "armaxmodal/modes/modal_model.py",
         "return self.neg2_loglik * n_eff / n_total + self.n_params * np.log(n_eff)",
@@ -666,11 +666,11 @@ MUTANTS = [
     ),
 ]
 DEFAULT_TESTS = [
-    "tests/test_guards.py",
-    "tests/test_fit.py",
-    "tests/test_refine.py",
-    "tests/test_stabilisation.py",
-    "tests/test_armax.py",
+    "tests/estimate/test_guards.py",
+    "tests/estimate/test_fit.py",
+    "tests/modes/test_refine.py",
+    "tests/modes/test_stabilisation.py",
+    "tests/estimate/test_armax.py",
 ]
 
 

@@ -149,8 +149,7 @@ def test_sdp_inner_solve_matches_the_cvxpy_statement_on_noisy_modes(pattern):
     """The hand-built conic form against the same problem stated in cvxpy, on noisy
     eigenvectors where the bounds and sign constraints are active."""
     from armaxmodal.inverse import inner_solve_sdp
-
-    from .naive import sdp_inner_cvxpy
+    from tests.naive import sdp_inner_cvxpy
 
     s = am.chapter2_system()
     m = s.modes()

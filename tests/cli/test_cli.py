@@ -172,7 +172,7 @@ def test_the_command_keeps_one_malloc_arena_for_its_worker_threads():
 def test_a_ride_with_a_filled_gap_gives_the_modes_of_the_whole_ride(fixtures_dir, tmp_path):
     """A 40 ms dropped packet (two empty cells of the head at 60 Hz), filled on request: every
     mode within the intervals of the ride without the gap."""
-    from tests.test_io import _ride_with_gap
+    from tests.io.test_io import _ride_with_gap
 
     gapped = _ride_with_gap(fixtures_dir, tmp_path, range(3000, 3002))
     runs = {}

@@ -13,8 +13,7 @@ from armaxmodal.estimate.fit import covariance_at, fit_armax
 from armaxmodal.estimate.orders import choose_orders
 from armaxmodal.exceptions import ConvergenceWarning, DataError, OrderError
 from armaxmodal.systems.simulation import exact_armax
-
-from . import naive
+from tests import naive
 
 KERNEL_RTOL = 1e-10
 # Finite differences with h = 1e-7 on a loss of order 10 are good to about 1e-6.
@@ -42,7 +41,7 @@ def _truth(name):
 
 
 def fixture_path(name):
-    from .conftest import FIXTURES
+    from tests.conftest import FIXTURES
 
     return FIXTURES / f"{name}.csv"
 

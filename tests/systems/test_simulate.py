@@ -5,8 +5,7 @@ import scipy.signal
 import armaxmodal as am
 from armaxmodal._kernels import hold_recursion
 from armaxmodal.exceptions import DataError
-
-from . import naive
+from tests import naive
 
 # Kernel and reference do the same float operations in a different order.
 KERNEL_RTOL = 1e-10

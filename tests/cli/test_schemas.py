@@ -10,7 +10,7 @@ from referencing import Registry, Resource
 
 from armaxmodal.cli import main
 
-SCHEMAS = Path(__file__).resolve().parents[1] / "schemas"
+SCHEMAS = Path(__file__).resolve().parents[2] / "schemas"
 
 
 def _validator(name: str) -> Draft202012Validator:
