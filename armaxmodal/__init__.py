@@ -54,7 +54,7 @@ _LATER = {
     "Diagnosis": ("armaxmodal.diagnosis", "Diagnosis"),
     "run_study": ("armaxmodal.study", "run_study"),
     "write_study": ("armaxmodal.study", "write_study"),
-    "check_lumping": ("armaxmodal.lumping", "lump_check"),
+    "lump_check": ("armaxmodal.lumping", "lump_check"),
     "model_update": ("armaxmodal.inverse", "model_update"),
     "evphc": ("armaxmodal.inverse", "evphc"),
     "pia": ("armaxmodal.inverse", "pia"),

@@ -15,7 +15,9 @@ def add_parser(sub, parents) -> None:
     """Register the ``identify`` command."""
     p = sub.add_parser("identify", parents=parents, help="fit a shared-pole ARMAX model and print the modes")
     add_data_args(p)
-    p.add_argument("--orders", default="auto", help="'auto' (BIC) or na,nb,nc,nk; default auto")
+    p.add_argument(
+        "--model", default="auto", help="the model's orders, na,nb,nc,nk, or 'auto' (chosen by BIC); default auto"
+    )
     p.add_argument("--band", default=None, help="frequency band LO:HI in Hz")
     p.add_argument("--detrend", choices=["mean", "linear", "none"], default="mean", help=DETREND_HELP)
     p.add_argument("--json", default=None, help="write modes as JSON")
@@ -28,13 +30,13 @@ def run(args) -> int:
 
     rec = load_recording(args)
     orders = None
-    if args.orders != "auto":
+    if args.model != "auto":
         try:
-            orders = tuple(int(v) for v in args.orders.split(","))
+            orders = tuple(int(v) for v in args.model.split(","))
         except ValueError as exc:
-            raise OrderError(f"--orders: expected 'auto' or na,nb,nc,nk, got {args.orders!r}.") from exc
+            raise OrderError(f"--model: expected 'auto' or na,nb,nc,nk, got {args.model!r}.") from exc
         if len(orders) != 4:
-            raise OrderError(f"--orders: expected four integers na,nb,nc,nk, got {args.orders!r}.")
+            raise OrderError(f"--model: expected four integers na,nb,nc,nk, got {args.model!r}.")
     band = parse_pair(args.band, "--band") if args.band else None
     result = identify(rec, orders, band=band, progress=not args.quiet, detrend=args.detrend)
     print_warnings(result.warnings)

@@ -1,11 +1,17 @@
 """Command-line interface: a thin layer over the public API, one module per command.
 
+armaxmodal stabilise DATA [--orders LO:HI] [--band LO:HI] [--modes N | --pick F1,F2] [--plot OUT] [--json OUT]
+                          [--csv OUT] [--uff OUT] [--shapes-plot OUT] [--positions S=P,...] [--report OUT.html]
+armaxmodal invert MODES.json|MODES.uff [--recording DATA] [--method ...] [--total-mass KG] [--json OUT]
+armaxmodal identify DATA [--model auto|na,nb,nc,nk] [--band LO:HI] [--json OUT] [--csv OUT]
+armaxmodal diagnose DATA [--input COL] [--fs HZ] [--json OUT] [--plot OUT] [--report OUT.html]
 armaxmodal info DATA [--input COL] [--fs HZ]
 armaxmodal modes --system supine|chapter2 [--json OUT]
 armaxmodal simulate --system supine --excitation random|sweep --out DATA.csv
-armaxmodal diagnose DATA [--input COL] [--fs HZ] [--json OUT] [--plot OUT]
 armaxmodal study MANIFEST_OR_FOLDER --out DIR [--report FILE] [--jobs N] [--scheduler ADDRESS]
 armaxmodal lump DATA A B [--json OUT] [--plot OUT]
+
+Every command that reads a recording takes --input COL, --fs HZ, --outputs A,B and --fill-gaps SECONDS.
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ from armaxmodal.lumping.plot import plot_lump
 chain = am.supine_with_feet()
 ride = am.random_vibration(fs=60.0, duration=120.0, band=(0.5, 28.0), seed=5)
 separate = am.simulate_recording(chain, ride, 60.0, noise=0.03, seed=6)
-apart = am.check_lumping(separate, "legs", "feet")
+apart = am.lump_check(separate, "legs", "feet")
 print(apart.verdict, "-", apart.message)
 
 # %%
@@ -24,7 +24,7 @@ print(apart.verdict, "-", apart.message)
 legs = separate.response[:, 3:4]
 feet = am.add_noise(legs, 0.03, np.random.default_rng(7))
 together = am.Recording(60.0, separate.base, np.column_stack([separate.response[:, :4], feet]), separate.sensors)
-joined = am.check_lumping(together, "legs", "feet")
+joined = am.lump_check(together, "legs", "feet")
 print(joined.verdict, "-", joined.message)
 
 # %%

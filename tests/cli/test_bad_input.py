@@ -20,9 +20,9 @@ CASES = [
     (["stabilise", "{data}", "--band", "40:10"], "lower edge first"),
     (["stabilise", "{data}", "--band", "10:40"], "Nyquist"),
     (["stabilise", "{data}", "--fs", "nan"], "finite number > 0"),
-    (["identify", "{data}", "--orders", "10,16,10"], "four integers"),
-    (["identify", "{data}", "--orders", "10,16,10,-8000"], "no modal model has a delay that long"),
-    (["identify", "{data}", "--orders", "150,151,150,0"], "Lower the orders"),
+    (["identify", "{data}", "--model", "10,16,10"], "four integers"),
+    (["identify", "{data}", "--model", "10,16,10,-8000"], "no modal model has a delay that long"),
+    (["identify", "{data}", "--model", "150,151,150,0"], "Lower the orders"),
     (["identify", "{data}", "--band", "40:50"], "Nyquist"),
     (["simulate", "--duration", "0", "--out", "{tmp}/s.csv"], "finite number > 0"),
     (["simulate", "--duration", "-5", "--out", "{tmp}/s.csv"], "finite number > 0"),
@@ -70,7 +70,7 @@ def test_a_sensor_name_with_an_apostrophe_works(tmp_path, fixtures_dir):
     text = (fixtures_dir / "supine_random.csv").read_text().replace("head", "subject's head", 1)
     data = tmp_path / "ride.csv"
     data.write_text(text)
-    assert main(["identify", str(data), "--orders", "6,7,6,0", "--json", str(tmp_path / "m.json"), "--quiet"]) == 0
+    assert main(["identify", str(data), "--model", "6,7,6,0", "--json", str(tmp_path / "m.json"), "--quiet"]) == 0
 
 
 API_CASES = [

@@ -67,7 +67,7 @@ def test_identify_fixed_orders_writes_the_json_contract(fixtures_dir, tmp_path, 
         [
             "identify",
             str(fixtures_dir / "supine_random_zoh.csv"),
-            "--orders",
+            "--model",
             "8,9,8,0",
             "--json",
             str(out),
@@ -90,7 +90,7 @@ def test_identify_fixed_orders_writes_the_json_contract(fixtures_dir, tmp_path, 
 
 
 def test_identify_rejects_bad_orders(fixtures_dir, capsys):
-    assert main(["identify", str(fixtures_dir / "supine_random_zoh.csv"), "--orders", "8,9"]) == 2
+    assert main(["identify", str(fixtures_dir / "supine_random_zoh.csv"), "--model", "8,9"]) == 2
     assert "na,nb,nc,nk" in capsys.readouterr().err
 
 

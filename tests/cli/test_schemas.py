@@ -31,7 +31,7 @@ def _strict(path: Path) -> dict:
     ("command", "extra"),
     [
         ("stabilise", ["--orders", "2:16"]),
-        ("identify", ["--orders", "10,16,10,-5"]),
+        ("identify", ["--model", "10,16,10,-5"]),
         ("diagnose", ["--max-rounds", "1"]),
     ],
 )
