@@ -310,13 +310,13 @@ MUTANTS = [
     ),
     # the delay's interval (run with --tests tests/prepare/test_prepare.py)
     (
-        "armaxmodal/prepare/quality.py",
+        "armaxmodal/prepare/delay.py",
         "            if jackknife > sd:",
         "            if False:",
         "jackknife unused (delay)",
     ),
     (
-        "armaxmodal/prepare/quality.py",
+        "armaxmodal/prepare/delay.py",
         "return float(stdtrit(max(self.dof, 1), probability))",
         "return float(stdtrit(1000, probability))",
         "normal quantile (delay)",
@@ -430,7 +430,7 @@ MUTANTS = [
         "failed refit not said (layout)",
     ),
     (
-        "armaxmodal/prepare/quality.py",
+        "armaxmodal/prepare/delay.py",
         "    if untested:\n",
         "    if False:\n",
         "untested delay check not said (layout)",

@@ -17,7 +17,7 @@ from scipy.special import stdtrit
 
 from armaxmodal.diagnosis.finding import Finding
 from armaxmodal.diagnosis.model import FittedModel, usable
-from armaxmodal.prepare.quality import MIN_DELAY_SAMPLES, DelayEstimate, estimate_delays, jackknife_sd
+from armaxmodal.prepare.delay import MIN_DELAY_SAMPLES, DelayEstimate, estimate_delays, jackknife_sd
 from armaxmodal.recording import Recording
 
 __all__ = ["delay_findings", "lead_findings", "cross_correlation", "late_start", "SPREAD_ALPHA"]
@@ -41,7 +41,7 @@ LEAD_GUARD = 6
 
 def delay_findings(fitted: FittedModel, n_tests: int) -> list[Finding]:
     """A sensor or the input out of time, from the quasi-static transmissibility phase
-    (:func:`armaxmodal.prepare.quality.estimate_delays`): its slope is the time offset whatever ``nk``
+    (:func:`armaxmodal.prepare.delay.estimate_delays`): its slope is the time offset whatever ``nk``
     the model needed, and a held input's half sample stays under the reporting floor.
 
     Every output late (or early) alike is one finding on the input (:func:`_common_delay`);

@@ -1,14 +1,14 @@
 """Every data-quality check run before a fit, in one call (the checks themselves live in
-:mod:`armaxmodal.prepare.quality`, :mod:`~armaxmodal.prepare.held` and
+:mod:`armaxmodal.prepare.quality`, :mod:`~armaxmodal.prepare.delay`, :mod:`~armaxmodal.prepare.held` and
 :mod:`~armaxmodal.prepare.units`)."""
 
 from __future__ import annotations
 
 from armaxmodal.notes import QualityWarning
+from armaxmodal.prepare.delay import delay_and_inversion
 from armaxmodal.prepare.held import held_samples
 from armaxmodal.prepare.quality import (
     clipped_channels,
-    delay_and_inversion,
     duplicate_channels,
     incoherent_outputs,
     narrowband_input,

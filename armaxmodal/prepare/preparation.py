@@ -30,7 +30,7 @@ from armaxmodal._validate import check_outputs_carry_signal
 from armaxmodal.exceptions import DataError
 from armaxmodal.notes import QualityWarning
 from armaxmodal.prepare.checks import check_quality
-from armaxmodal.prepare.quality import estimate_delays
+from armaxmodal.prepare.delay import estimate_delays
 from armaxmodal.recording import Recording
 
 __all__ = ["prepare", "Preparation", "check_band", "decimate", "level_shifts", "oversampling_note", "DETRENDS"]

@@ -10,7 +10,7 @@ in mg, two of the four modes were merged away with no warning), and the shapes a
 inverse problem's residues come out wrong by that factor.
 
 The check needs a quasi-static band (the lowest coherent lines, where at least half of the
-other outputs read ``|T|`` within :data:`~armaxmodal.prepare.quality.QUASI_STATIC_MAGNITUDE` of 1);
+other outputs read ``|T|`` within :data:`~armaxmodal.prepare.delay.QUASI_STATIC_MAGNITUDE` of 1);
 without one (a force input, a ride starting above the first mode) it says nothing. When the
 ratio matches a unit conversion within :data:`UNIT_MATCH`, :func:`armaxmodal.prepare.preparation.prepare`
 converts the channel by that exact factor (by the measured ratio where two conversions are
@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from armaxmodal.notes import QualityWarning, not_run
-from armaxmodal.prepare.quality import QUASI_STATIC_MAGNITUDE, transmissibility_spectra
+from armaxmodal.prepare.delay import QUASI_STATIC_MAGNITUDE, transmissibility_spectra
 from armaxmodal.recording import Recording
 from armaxmodal.stats import QUASI_STATIC_COHERENCE
 

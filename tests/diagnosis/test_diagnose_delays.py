@@ -20,7 +20,7 @@ from armaxmodal.diagnosis.delays import _common_delay, delay_findings
 from armaxmodal.diagnosis.evidence import EFFECT_TESTS, run_tests
 from armaxmodal.diagnosis.inject import inject
 from armaxmodal.diagnosis.model import ModelSpec, Signals, fit_model, fractional_shift, usable
-from armaxmodal.prepare.quality import DelayEstimate, estimate_delays
+from armaxmodal.prepare.delay import DelayEstimate, estimate_delays
 
 ORDERS = (10, 16, 10, -5)  # the supine fixture's orders chosen by BIC
 
