@@ -1,5 +1,7 @@
 """A headless look at the built documentation: every page opens in Chromium, shows its title,
-and every figure it shows exists; no example printed a traceback. Run by .ci/run after the build.
+and every figure it shows exists; no example printed a traceback or an object's repr, and no
+Markdown table row was left as raw text (a blank line inside a table ends it). Run by .ci/run
+after the build.
 
 Run:  python scripts/check_docs_pages.py [docs/_build/html]
 """
@@ -36,6 +38,20 @@ def rendered(browser: str, page: Path) -> str:
     return out.stdout
 
 
+#: an object's default repr in printed output (a gallery cell ending in a call that returns one)
+OBJECT_REPR = re.compile(r"&lt;[\w.]+ object at 0x[0-9a-f]+&gt;")
+#: a paragraph that is a Markdown table row: the table ended early at a blank line
+RAW_TABLE_ROW = re.compile(r"<p>\s*\|(?:(?!</p>).)*\|\s*</p>", re.S)
+
+
+def shown_as_text(dom: str) -> list[str]:
+    """What a reader sees as debris: object reprs, and table rows left as raw text."""
+    found = [f"prints an object's repr: {r}" for r in sorted(set(OBJECT_REPR.findall(dom)))]
+    for row in RAW_TABLE_ROW.findall(dom):
+        found.append("a table row shown as raw text: " + " ".join(re.sub(r"<[^>]+>", "", row).split())[:80])
+    return found
+
+
 def problems(site: Path, browser: str) -> list[str]:
     found = []
     examples = sorted(p.relative_to(site).as_posix() for p in (site / "auto_examples").glob("plot_*.html"))
@@ -56,6 +72,7 @@ def problems(site: Path, browser: str) -> list[str]:
                 found.append(f"{name}: image {src} not found")
         if "Traceback (most recent call last)" in dom:
             found.append(f"{name}: shows a traceback")
+        found += [f"{name}: {problem}" for problem in shown_as_text(dom)]
         figure = "sphx-glr-single-img" in dom or "sphx-glr-multi-img" in dom
         if name.startswith("auto_examples/plot_") and not figure:
             found.append(f"{name}: no figure")

@@ -43,4 +43,4 @@ x = np.arange(len(labels))
 for i, (name, v) in enumerate(values.items()):
     ax.bar(x + (i - 1) * 0.27, v / 1000, 0.27, label=name, yerr=errors / 1000 if name == "model updating" else None)
 ax.set(xticks=x, xticklabels=labels, ylabel="stiffness (kN/m)")
-ax.legend(fontsize=8)
+_ = ax.legend(fontsize=8)  # a bare call prints its repr in the gallery
