@@ -24,6 +24,7 @@ PAGES = {
     "validation.html": "Validation",
     "performance.html": "Performance",
     "api.html": "API reference",
+    "changelog.html": "Changelog",
 }
 
 
