@@ -19,7 +19,7 @@ from armaxmodal.exceptions import PickError
 from armaxmodal.modal import mode_record
 from armaxmodal.modes.clusters import clustered_modes, merge_duplicates, why_no_mode
 from armaxmodal.modes.completeness import modes_the_check_adds, modes_the_record_needs, refit_with_added
-from armaxmodal.modes.counted import confirmed_where_incoherent, counted_modes
+from armaxmodal.modes.counted import SEPARATION_SD, confirmed_where_incoherent, counted_modes, not_separated
 from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.modal_check import ModalCheck, check_modes
 from armaxmodal.modes.mode_count import ModeCount
@@ -278,7 +278,10 @@ def select_modes(
                 work = _with_picks(diagram, work, picked, nas, clustering, band, n_jobs)
             work = work.noted(*_not_separated(work.modes))
         if picks is None or work.check is None:
-            work = replace(work, check=check_modes(diagram.recording, work.modes.freq_hz, work.modes.damping, band))
+            f, x = work.modes.freq_hz, work.modes.damping
+            if work.check_poles:  # two poles reported as one: the check fits the model's poles
+                f, x = zip(*work.check_poles, strict=True)
+            work = replace(work, check=check_modes(diagram.recording, np.array(f), np.array(x), band))
         work = confirmed_where_incoherent(diagram, work)
         if segments >= 2:
             modes = work.modes
@@ -389,7 +392,7 @@ def _finished(diagram, work: WorkingSelection, band, cluster_freq: float, n_orde
     freq, damping = modes.freq_hz.to_numpy(), modes.damping.to_numpy()
     # a peak a mode of the model explains is explained, picked or not (the check's poles are the model's)
     explaining = (freq, damping)
-    if "picked_hz" in modes:
+    if "picked_hz" in modes or work.check_poles is not None:
         poles = work.check.poles
         explaining = (np.abs(poles) / (2 * np.pi), -poles.real / np.abs(poles))
     work = work.noted(
@@ -443,27 +446,16 @@ def _no_mode_selection(diagram: StabilisationDiagram, why: str) -> ModeSelection
     return ModeSelection(empty, shapes, per_sensor, pd.DataFrame(columns=["mode"]), diagram, None, (note,), None)
 
 
-#: two modes closer than this many standard deviations of their difference are not separated
-#: by the record (a difference 3 SD from zero is the usual resolution rule; the issue's bound)
-SEPARATION_SD = 3.0
-
-
 def _not_separated(modes: pd.DataFrame) -> list[QualityWarning]:
     """A ``modes_not_separated`` note for each pair of neighbouring modes whose frequencies
-    differ by less than :data:`SEPARATION_SD` standard deviations of the difference."""
-    notes = []
+    differ by less than :data:`~armaxmodal.modes.counted.SEPARATION_SD` standard deviations of
+    the difference and that the count did not report as one (picks, or modes the count left)."""
     f = modes.freq_hz.to_numpy()
-    sd = (modes.freq_ci95_hi.to_numpy() - modes.freq_ci95_lo.to_numpy()) / (2 * Z95)
-    for i in range(len(f) - 1):
-        gap, sd_gap = f[i + 1] - f[i], float(np.hypot(sd[i], sd[i + 1]))
-        if gap < SEPARATION_SD * sd_gap:
-            notes.append(QualityWarning(
-                "modes_not_separated", (),
-                f"modes at {f[i]:.3f} and {f[i + 1]:.3f} Hz are {gap / sd_gap:.1f} standard deviations of their "
-                f"difference apart (under {SEPARATION_SD:g}): the record does not separate them; they may be one mode",
-                float(f[i]),
-            ))  # fmt: skip
-    return notes
+    return [QualityWarning(
+        "modes_not_separated", (),
+        f"modes at {f[i]:.3f} and {f[j]:.3f} Hz are {gap:.1f} standard deviations of their difference apart (under "
+        f"{SEPARATION_SD:g}): the record does not separate them; they may be one mode", float(f[i]),
+    ) for i, j, gap in not_separated(modes)]  # fmt: skip
 
 
 def _unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[QualityWarning]:

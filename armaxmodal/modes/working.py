@@ -37,6 +37,9 @@ class WorkingSelection:
         The maximum-likelihood count, once run.
     notes : tuple of QualityWarning
         What the stages said, in order.
+    check_poles : tuple of (float, float) or None
+        The poles the check fits, ``(Hz, ratio)``, where they are not the rows': the model's two
+        poles of a pair the record does not separate, which one row reports. None: the rows'.
     """
 
     modes: pd.DataFrame
@@ -45,6 +48,7 @@ class WorkingSelection:
     check: ModalCheck | None = None
     count: ModeCount | None = None
     notes: tuple[QualityWarning, ...] = ()
+    check_poles: tuple[tuple[float, float], ...] | None = None
 
     def __post_init__(self):
         if self.shapes.shape[1] != len(self.modes):

@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 import armaxmodal as am
-from armaxmodal.modes.counted import _notes, _structure_hull
+from armaxmodal.modes.counted import _notes, _one_where_not_separated, _structure_hull, not_separated
 from armaxmodal.modes.modal_model import DftLines, fit_modal_model
 from armaxmodal.modes.mode_count import DECISIVE_BIC, ModeCount, count_modes, effective_fraction, reported
 from armaxmodal.modes.selection import ModeSelection, _not_separated
@@ -20,12 +20,17 @@ FREQ_TOL, DAMPING_TOL = 0.02, 0.10
 
 
 @pytest.fixture(scope="module")
-def supine():
+def supine_ride():
+    """The thesis's supine chain (Table 4.3) on a 120 s random ride at 60 Hz, 3 % sensor noise."""
+    u = am.random_vibration(60.0, 120.0, (0.5, 28.0), seed=21)
+    return am.simulate_recording(am.supine_human(), u, 60.0, noise=0.03, seed=22)
+
+
+@pytest.fixture(scope="module")
+def supine(supine_ride):
     """The thesis's supine chain (Table 4.3: heavily damped, overlapping modes) on a 120 s
     random ride at 60 Hz with 3 % sensor noise, its lines weighted, and its exact modes."""
-    s = am.supine_human()
-    u = am.random_vibration(60.0, 120.0, (0.5, 28.0), seed=21)
-    rec = am.simulate_recording(s, u, 60.0, noise=0.03, seed=22)
+    s, rec = am.supine_human(), supine_ride
     data = DftLines.from_recording(rec, (0.5, 27.0))
     truth = s.modes()
     start = fit_modal_model(data, truth.freq_hz, truth.damping, "zoh", max_nfev=1)
@@ -158,6 +163,46 @@ def _modes(f, sd):
 def test_modes_closer_than_three_deviations_are_not_separated():
     assert [n.value for n in _not_separated(_modes([10.0, 10.5, 20.0], [0.2, 0.2, 0.2]))] == [10.0]
     assert _not_separated(_modes([10.0, 10.5], [0.05, 0.05])) == []  # 7 SD apart
+    # taken left to right without overlap: a run of three gives the first pair only
+    assert not_separated(_modes([10.0, 10.1, 10.2, 30.0], [0.2, 0.2, 0.2, 0.2])) == [(0, 1, pytest.approx(0.354, 1e-2))]
+
+
+def _rows_of(model):
+    """A model's poles as selection rows with its own 95 % intervals."""
+    f, x, sf, sx = model.freq_hz, model.damping, model.freq_sd, model.damping_sd
+    return pd.DataFrame({"freq_hz": f, "damping": x, "damped_freq_hz": f * np.sqrt(1 - x**2),
+                         "freq_ci95_lo": f - Z95 * sf, "freq_ci95_hi": f + Z95 * sf, "damping_ci95_lo": x - Z95 * sx,
+                         "damping_ci95_hi": x + Z95 * sx, "structure_widened": False})  # fmt: skip
+
+
+@pytest.mark.parametrize("inseparable", [True, False])
+def test_two_poles_the_record_does_not_separate_are_reported_as_one(supine, supine_ride, inseparable):
+    """The chest mode given a second pole 1 % away. With intervals planted 0.3 Hz wide on either side
+    (the F-16's highest level left a pair 0.2 SD apart), the two are reported as one mode: the exact
+    one, refitted with one pole there, with intervals that cover both poles and a note. With
+    intervals 0.01 Hz wide they are separated and reported as they are."""
+    data, truth = supine
+    f, x = np.r_[truth.freq_hz, truth.freq_hz[1] * 1.01], np.r_[truth.damping, truth.damping[1]]
+    model = fit_modal_model(data, f, x, "zoh", max_nfev=1)  # a pair at the chest mode, as started
+    keep = np.ones(model.n_modes, dtype=bool)
+    rows, reach = _rows_of(model), 0.3 if inseparable else 0.01
+    rows.loc[[1, 2], "freq_ci95_lo"] = rows.freq_hz[[1, 2]] - reach
+    rows.loc[[1, 2], "freq_ci95_hi"] = rows.freq_hz[[1, 2]] + reach
+    count = SimpleNamespace(model=model)
+    out, shapes, notes = _one_where_not_separated(rows, model.shapes, count, keep, supine_ride, data.band_hz, "zoh")
+    assert [n.code for n in notes] == (["modes_not_separated"] if inseparable else [])
+    if not inseparable:
+        pd.testing.assert_frame_equal(out, rows)
+        return
+    assert len(out) == truth.freq_hz.size and shapes.shape == (4, truth.freq_hz.size)
+    assert np.all(np.abs(out.freq_hz / truth.freq_hz - 1) < FREQ_TOL)
+    assert np.all(np.abs(out.damping / truth.damping - 1) < DAMPING_TOL)
+    pair = rows.iloc[1:3]  # the merged row covers both poles of the pair and says it was widened
+    assert out.freq_ci95_lo[1] <= pair.freq_ci95_lo.min() and out.freq_ci95_hi[1] >= pair.freq_ci95_hi.max()
+    assert out.damping_ci95_lo[1] <= pair.damping_ci95_lo.min() and out.damping_ci95_hi[1] >= pair.damping_ci95_hi.max()
+    assert out.structure_widened[1] and not out.structure_widened[[0, 2, 3]].any()
+    a, b = shapes[:, 1], truth.modal_constants[:, 1]  # the shape is the merged model's: the chest mode's
+    assert abs(np.vdot(a, b)) ** 2 / (np.vdot(a, a).real * np.vdot(b, b).real) > 0.99
 
 
 @pytest.mark.parametrize(
