@@ -19,7 +19,13 @@ from armaxmodal.exceptions import PickError
 from armaxmodal.modal import mode_record
 from armaxmodal.modes.clusters import clustered_modes, merge_duplicates, why_no_mode
 from armaxmodal.modes.completeness import modes_the_check_adds, modes_the_record_needs, refit_with_added
-from armaxmodal.modes.counted import SEPARATION_SD, confirmed_where_incoherent, counted_modes, not_separated
+from armaxmodal.modes.counted import (
+    SEPARATION_SD,
+    confirmed_where_incoherent,
+    counted_modes,
+    dropped_where_peaks_remain,
+    not_separated,
+)
 from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.modal_check import ModalCheck, check_modes
 from armaxmodal.modes.mode_count import ModeCount
@@ -395,8 +401,10 @@ def _finished(diagram, work: WorkingSelection, band, cluster_freq: float, n_orde
     if "picked_hz" in modes or work.check_poles is not None:
         poles = work.check.poles
         explaining = (np.abs(poles) / (2 * np.pi), -poles.real / np.abs(poles))
+    peaks = unexplained_peaks(diagram.recording, *explaining, band)
     work = work.noted(
-        *unexplained_peaks(diagram.recording, *explaining, band),
+        *peaks,
+        *dropped_where_peaks_remain(work.count, peaks),
         *oversampling_note(freq, diagram.recording.fs),
         *_unresolved_damping_notes(modes, n_orders),
         *work.check.warnings(),

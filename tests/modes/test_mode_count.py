@@ -8,7 +8,13 @@ import pandas as pd
 import pytest
 
 import armaxmodal as am
-from armaxmodal.modes.counted import _notes, _one_where_not_separated, _structure_hull, not_separated
+from armaxmodal.modes.counted import (
+    _notes,
+    _one_where_not_separated,
+    _structure_hull,
+    dropped_where_peaks_remain,
+    not_separated,
+)
 from armaxmodal.modes.modal_model import DftLines, fit_modal_model
 from armaxmodal.modes.mode_count import DECISIVE_BIC, ModeCount, count_modes, effective_fraction, reported
 from armaxmodal.modes.selection import ModeSelection, _not_separated
@@ -412,3 +418,25 @@ def test_the_modal_model_confirms_a_mode_where_the_h1_is_not_coherent(monkeypatc
     )
     assert work.check.passed is confirmed and (work.check.unconfirmed_hz == ()) is confirmed
     assert [n.value for n in work.notes] == ([f0] if confirmed else [])
+
+
+@pytest.mark.parametrize(
+    "peaks_hz, near",
+    [
+        ((4.38, 5.77, 7.90), [4.38, 5.77]),  # Inglewood: peaks left where the start was and where it went
+        ((5.50, 7.90), []),  # beyond 5 % of both
+        ((), []),
+    ],
+)
+def test_a_start_mode_left_out_where_a_coherent_peak_remains_leaves_the_count_undecided(peaks_hz, near):
+    from armaxmodal.notes import UNCERTAIN_CODES, QualityWarning
+
+    peaks = [QualityWarning("unexplained_peak", ("deck",), "a peak", f) for f in peaks_hz]
+    count = SimpleNamespace(carried_away=((5.826, 4.401),))
+    notes = dropped_where_peaks_remain(count, peaks)
+    assert [n.code for n in notes] == (["count_undecided"] if near else [])
+    if near:
+        assert notes[0].value == 5.826 and all(f"{f:.2f}" in notes[0].message for f in near)
+        assert notes[0].code in UNCERTAIN_CODES
+    assert dropped_where_peaks_remain(None, peaks) == []
+    assert dropped_where_peaks_remain(SimpleNamespace(carried_away=()), peaks) == []
