@@ -154,17 +154,23 @@ def not_separated(modes: pd.DataFrame) -> list[tuple[int, int, float]]:
 
 def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: ModeCount, keep: np.ndarray, rec,
                              band_hz, hold: str):  # fmt: skip
-    """Two counted modes the record does not separate (:func:`not_separated`) reported as one: the
+    """Two counted modes the record does not separate (:func:`not_separated`, on the model's own
+    intervals) reported as one: the
     model with one pole there (either of the two taken out, the rest refitted free; the lower
     criterion), whose mode's intervals are widened to cover both. The likelihood may need two poles
     for one resonance whose frequency moves during the record (a nonlinearity: the F-16 at its
     highest level had two poles at 6.356 and 6.395 Hz, 0.2 SD apart), but their values are not
     two modes. Returns ``(rows, shapes, notes)``; a ``modes_not_separated`` note per merge."""
-    pairs = not_separated(rows)
+    poles, m = np.flatnonzero(keep), count.model
+    # judged on the model's own intervals: a hull widened by the equally good counts says the
+    # count is undecided, not that two modes of this model coincide (two bodies' modes 7-8 %
+    # apart, each within 2 bounds, overlapped only in their hulls)
+    own = pd.DataFrame({"freq_hz": m.freq_hz[poles], "freq_ci95_lo": m.freq_hz[poles] - Z95 * m.freq_sd[poles],
+                        "freq_ci95_hi": m.freq_hz[poles] + Z95 * m.freq_sd[poles]})  # fmt: skip
+    pairs = not_separated(own)
     if not pairs:
         return rows, shapes, []
     data = DftLines.from_recording(rec, band_hz).noise_weighted(count.model)
-    poles, m = np.flatnonzero(keep), count.model
     rows, shapes, notes, gone = rows.copy(), shapes.copy(), [], []
     for a, b, gap in pairs:
         fits = [fit_modal_model(data, np.delete(m.freq_hz, k), np.delete(m.damping, k), hold, FINAL_NFEV)

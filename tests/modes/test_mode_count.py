@@ -181,23 +181,30 @@ def _rows_of(model):
                          "damping_ci95_hi": x + Z95 * sx, "structure_widened": False})  # fmt: skip
 
 
-@pytest.mark.parametrize("inseparable", [True, False])
-def test_two_poles_the_record_does_not_separate_are_reported_as_one(supine, supine_ride, inseparable):
-    """The chest mode given a second pole 1 % away. With intervals planted 0.3 Hz wide on either side
-    (the F-16's highest level left a pair 0.2 SD apart), the two are reported as one mode: the exact
-    one, refitted with one pole there, with intervals that cover both poles and a note. With
-    intervals 0.01 Hz wide they are separated and reported as they are."""
+@pytest.mark.parametrize("planted", ["own", "hull_only", "none"])
+def test_two_poles_the_record_does_not_separate_are_reported_as_one(supine, supine_ride, planted):
+    """The chest mode given a second pole 1 % away. With the model's own standard deviations of
+    the pair planted at 0.15 Hz (the F-16's highest level left a pair 0.2 SD apart), the two are
+    reported as one mode: the exact one, refitted with one pole there, with intervals that cover
+    both poles and a note. Planted at 0.005 Hz they are separated and reported as they are, also
+    when only the rows' intervals (a hull over equally good counts) overlap."""
+    from dataclasses import replace
+
     data, truth = supine
     f, x = np.r_[truth.freq_hz, truth.freq_hz[1] * 1.01], np.r_[truth.damping, truth.damping[1]]
-    model = fit_modal_model(data, f, x, "zoh", max_nfev=1)  # a pair at the chest mode, as started
+    started = fit_modal_model(data, f, x, "zoh", max_nfev=1)  # a pair at the chest mode, as started
+    sd = started.freq_sd.copy()
+    sd[[1, 2]] = 0.15 if planted == "own" else 0.005
+    model = replace(started, freq_sd=sd)
+    rows = _rows_of(model)
+    if planted == "hull_only":
+        rows.loc[[1, 2], "freq_ci95_lo"] -= 0.3
+        rows.loc[[1, 2], "freq_ci95_hi"] += 0.3
     keep = np.ones(model.n_modes, dtype=bool)
-    rows, reach = _rows_of(model), 0.3 if inseparable else 0.01
-    rows.loc[[1, 2], "freq_ci95_lo"] = rows.freq_hz[[1, 2]] - reach
-    rows.loc[[1, 2], "freq_ci95_hi"] = rows.freq_hz[[1, 2]] + reach
     count = SimpleNamespace(model=model)
     out, shapes, notes = _one_where_not_separated(rows, model.shapes, count, keep, supine_ride, data.band_hz, "zoh")
-    assert [n.code for n in notes] == (["modes_not_separated"] if inseparable else [])
-    if not inseparable:
+    assert [n.code for n in notes] == (["modes_not_separated"] if planted == "own" else [])
+    if planted != "own":
         pd.testing.assert_frame_equal(out, rows)
         return
     assert len(out) == truth.freq_hz.size and shapes.shape == (4, truth.freq_hz.size)
