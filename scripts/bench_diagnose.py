@@ -17,12 +17,13 @@ import time
 from pathlib import Path
 
 import armaxmodal as am
-from armaxmodal.diagnosis import delays as dl
 from armaxmodal.diagnosis import diagnose
-from armaxmodal.diagnosis import evidence as ev
+from armaxmodal.diagnosis.acceptance import try_fix
+from armaxmodal.diagnosis.effects import REGISTRY, Evidence, entry_of
 from armaxmodal.diagnosis.inject import inject
-from armaxmodal.diagnosis.loop import _baseline_orders, _signals, _try_fix
-from armaxmodal.diagnosis.model import ModelSpec, fit_model, held_out, usable
+from armaxmodal.diagnosis.loop import _baseline_orders, _signals
+from armaxmodal.diagnosis.model import ModelSpec, counted, fit_model, held_out
+from armaxmodal.diagnosis.result import Stage
 from armaxmodal.estimate.fit import load_kernels
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -54,30 +55,16 @@ def stages(rec: am.Recording) -> None:
     clock.lap("baseline fit")
     held = held_out(spec, signals, model)
     clock.lap("held-out folds (two refits)")
-    k, eps = len(signals.sensors), model.one_step_errors()
-    n_tests, mask = len(ev.EFFECT_TESTS) * k, usable(signals.n, spec)
-    table = {"whiteness_p": [], "trend_p": [], "line_p": []}  # as run_tests starts it
-    found = dl.delay_findings(model, n_tests)
-    clock.lap("test: delay (quasi-static phase slope)")
-    found += dl.lead_findings(model, n_tests, set())
-    clock.lap("test: lead (residual-input cross-correlation)")
-    found += ev.mode_findings(model, n_tests, table)
-    clock.lap("test: unmodelled mode (FRF misfit)")
-    found += ev._trend_findings(model, eps, mask, n_tests, table)
-    clock.lap("test: offset and drift (score test)")
-    found += ev._line_findings(model, mask, n_tests, table)
-    clock.lap("test: periodic disturbance (multitaper)")
-    found += ev._whiteness_findings(model, eps, mask, n_tests, table)
-    clock.lap("test: coloured noise (Breusch-Godfrey)")
-    found += ev._time_findings(model, mask, n_tests, table)
-    clock.lap("test: time variation (6 windowed refits)")
-    found += ev._nonlinear_findings(model, eps, mask, n_tests, table)
-    clock.lap("test: stiffness nonlinearity (score tests)")
-    significant = sorted((f for f in found if f.p < 0.01), key=lambda f: f.p)
+    tests = [e.test for e in REGISTRY]
+    tests = [t for i, t in enumerate(tests) if t not in tests[:i]]
+    ev = Evidence(model, model.one_step_errors(), counted(model), len(tests) * len(signals.sensors))
+    for test in tests:  # each of the registry's tests once, as run_tests runs them
+        ev.found += test(ev)
+        names = ", ".join(e.name for e in REGISTRY if e.test is test)
+        clock.lap(f"test: {names}")
+    significant = sorted((f for f in ev.found if f.p < 0.01), key=lambda f: f.p)
     if significant:
-        from armaxmodal.diagnosis.loop import Stage
-
-        _try_fix(Stage(model, held), significant[0], 0.01)
+        try_fix(Stage(model, held), significant[0], 0.01, entry_of(significant[0].effect))
         clock.lap(f"one fix with its held-out folds: {significant[0].effect}")
 
 

@@ -324,39 +324,39 @@ MUTANTS = [
     # delays in the diagnosis loop and the loop's rules (issue 27); run with
     # --match "(loop delay)" --tests tests/diagnosis/test_diagnose_delays.py tests/cli/test_bad_input.py
     (
-        "armaxmodal/diagnosis/loop.py",
+        "armaxmodal/diagnosis/acceptance.py",
         "earlier = -d if finding.channels == (s.input_name,) else d",
         "earlier = d",
         "an input's move taken as an output's (loop delay)",
     ),
     (
-        "armaxmodal/diagnosis/loop.py",
+        "armaxmodal/diagnosis/acceptance.py",
         "centre = nk0 - int(round(earlier))",
         "centre = nk0 + int(round(earlier))",
         "nk moved the wrong way (loop delay)",
     ),
     (
-        "armaxmodal/diagnosis/loop.py",
+        "armaxmodal/diagnosis/acceptance.py",
         "nb = nb0 - (min(nk, 0) - min(nk0, 0))",
         "nb = nb0",
         "nb not re-chosen with nk (loop delay)",
     ),
     (
-        "armaxmodal/diagnosis/loop.py",
+        "armaxmodal/diagnosis/acceptance.py",
         "if after > before * (1 + NO_WORSE) and 1 - p < alpha:",
         "if after > before * (1 + NO_WORSE):",
         "any rise refuses a delay (loop delay)",
     ),
     (
-        "armaxmodal/diagnosis/loop.py",
-        "if p >= alpha or dbic >= 0:",
-        "if p >= alpha and dbic >= 0:",
+        "armaxmodal/diagnosis/acceptance.py",
+        "if j.p >= j.alpha or j.delta_bic >= 0:",
+        "if j.p >= j.alpha and j.delta_bic >= 0:",
         "either criterion keeps a fix (loop delay)",
     ),
     (
-        "armaxmodal/diagnosis/evidence.py",
-        "n_tests = len(EFFECT_TESTS) * k_count",
-        "n_tests = k_count",
+        "armaxmodal/diagnosis/effects.py",
+        "ev = Evidence(fitted, fitted.one_step_errors(), counted(fitted), len(tests) * len(fitted.signals.sensors))",
+        "ev = Evidence(fitted, fitted.one_step_errors(), counted(fitted), len(fitted.signals.sensors))",
         "family size without the tests (loop delay)",
     ),
     (
@@ -659,10 +659,67 @@ MUTANTS = [
         "the verdict never uncertain (count)",
     ),
     (
-        "armaxmodal/modes/selection.py",
-        "if gap < SEPARATION_SD * sd_gap:",
-        "if gap < sd_gap:",
+        "armaxmodal/modes/counted.py",
+        "if gap < SEPARATION_SD:",
+        "if gap < 1.0:",
         "separation at one deviation (count)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "pairs = not_separated(own)",
+        "pairs = not_separated(rows)",
+        "pairs judged on the widened hull (count)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "rows.loc[a, \"structure_widened\"] = True",
+        "pass",
+        "a merged row not marked widened (count)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "if near:",
+        "if False:",
+        "a left-out start with a peak there stays decided (count)",
+    ),
+    # the diagnosis registry and the joint-force test (issue 38); run with --match "(registry)"
+    # --tests tests/diagnosis/test_diagnose_delays.py tests/diagnosis/test_diagnose.py -k (as pytest
+    # takes it): "friction or cubic or registry or clipping or joint_ride"
+    (
+        "armaxmodal/diagnosis/effects.py",
+        "if entry.test not in out:",
+        "if True:",
+        "a test two effects share run twice (registry)",
+    ),
+    (
+        "armaxmodal/diagnosis/effects.py",
+        "return entry_of(\"coloured_noise\").tier",
+        "return entry_of(finding.effect).tier",
+        "a lead by cross-correlation in the delay's tier (registry)",
+    ),
+    (
+        "armaxmodal/diagnosis/acceptance.py",
+        "kept, text = entry.keep(judgement)",
+        "kept, text = significant_drop(judgement)",
+        "every effect kept on the general rule (registry)",
+    ),
+    (
+        "armaxmodal/diagnosis/joint_forces.py",
+        "\"dry_friction\": (\"damping_nonlinearity\", \"velocity\", np.sign),",
+        "\"dry_friction\": (\"damping_nonlinearity\", \"deflection\", np.sign),",
+        "friction on a deflection (registry)",
+    ),
+    (
+        "armaxmodal/diagnosis/joint_forces.py",
+        "gain[f >= f_lo] = 1.0 / (2j * np.pi * f[f >= f_lo]) ** integrations",
+        "gain[f >= f_lo] = 1.0 / (2j * np.pi * f[f >= f_lo]) ** 2",
+        "velocities integrated twice (registry)",
+    ),
+    (
+        "armaxmodal/diagnosis/inject.py",
+        "f_nl = size * np.tanh((v[i] - (v[j] if j >= 0 else 0.0)) / scale)",
+        "f_nl = size * np.tanh((v[i] + (v[j] if j >= 0 else 0.0)) / scale)",
+        "friction on the sum of velocities (registry)",
     ),
 ]
 DEFAULT_TESTS = [
@@ -674,8 +731,9 @@ DEFAULT_TESTS = [
 ]
 
 
-def run(tests: list[str]) -> bool:
+def run(tests: list[str], select: str = "") -> bool:
     cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", *tests]
+    cmd += ["-k", select] if select else []
     return subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True).returncode == 0
 
 
@@ -683,6 +741,7 @@ def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--tests", nargs="+", default=DEFAULT_TESTS)
     parser.add_argument("--match", default="", help="only the mutants whose description contains this")
+    parser.add_argument("-k", dest="select", default="", help="only the tests pytest's -k selects")
     args = parser.parse_args()
     killed = 0
     mutants = [m for m in MUTANTS if args.match in m[3]]
@@ -695,7 +754,7 @@ def main() -> None:
         start = time.perf_counter()
         try:
             file.write_text(text.replace(old, new))
-            passed = run(args.tests)
+            passed = run(args.tests, args.select)
         finally:
             file.write_text(text)
         killed += not passed

@@ -89,8 +89,6 @@ def _diagnosis_text(name: str, report: dict) -> str:
             lines.append(f"  note: {e['note']}")
     for u in report["unconfirmed"]:
         lines.append(f"unconfirmed {u['effect']} on {', '.join(u['channels'])}: {u['reason']}")
-    if report["not_tested"]:
-        lines.append("not tested by this version: " + ", ".join(report["not_tested"]))
     lines.append("verdict: " + report["verdict"])
     return "\n".join(lines)
 

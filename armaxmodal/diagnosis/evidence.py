@@ -4,7 +4,8 @@ In-sample least-squares residuals are orthogonal to the model's own regressors, 
 regression of the residual on a candidate would understate it; the in-sample tests here are
 score (LM) tests in their F form: the residual regressed on the model's gradient columns and
 the candidate together (Breusch-Godfrey for whiteness, the same for trend terms). Whether a
-fix is kept is decided on held-out data elsewhere (:mod:`.loop`).
+fix is kept is decided on held-out data elsewhere (:mod:`.acceptance`); which tests a
+round runs, and in what order, is the registry's (:mod:`.effects`).
 
 Every p-value is corrected for the number of sensors times tests (Bonferroni), so the
 chance of naming any effect on a clean recording stays near ``alpha``.
@@ -17,7 +18,6 @@ from scipy import stats
 from scipy.signal import lfilter
 
 from armaxmodal.diagnosis.clipping import rail_pileup
-from armaxmodal.diagnosis.delays import delay_findings, late_start, lead_findings
 from armaxmodal.diagnosis.faults import (
     FAULT_ALPHA,
     FOLLOWS_ALPHA,
@@ -30,31 +30,18 @@ from armaxmodal.diagnosis.faults import (
     stuck_runs,
 )
 from armaxmodal.diagnosis.finding import Finding
-from armaxmodal.diagnosis.missing_mode import mode_findings
-from armaxmodal.diagnosis.model import LINE_MERGE_HZ, UNDAMPED, FittedModel, counted, usable
+from armaxmodal.diagnosis.model import LINE_MERGE_HZ, UNDAMPED, FittedModel, usable
 from armaxmodal.diagnosis.model import lagged as _lag
 from armaxmodal.diagnosis.spectral import harmonic_f_test
 from armaxmodal.prepare.quality import input_coherence
-from armaxmodal.recording import Recording
 from armaxmodal.stats import MAX_DAMPING, SECOND_INPUT_COHERENCE
 
-__all__ = ["Finding", "run_tests", "whiteness_p", "EFFECT_TESTS"]
+__all__ = ["clipping_findings", "fault_findings", "gradient_columns", "line_findings", "lm_f_test",
+           "merge_per_sensor", "projected_f", "second_input_findings", "time_findings", "trend_findings",
+           "whiteness_findings", "whiteness_p"]  # fmt: skip
 
 #: Lags of the residual in the Breusch-Godfrey whiteness test.
 WHITENESS_LAGS = 10
-#: The tests each round runs, in the order linear/structural effects come first.
-EFFECT_TESTS = (
-    "clipping",
-    "sensor_fault",
-    "input_delay",
-    "unmodelled_mode",
-    "offset_drift",
-    "periodic_disturbance",
-    "coloured_noise",
-    "time_varying",
-    "stiffness_nonlinearity",
-    "second_input",
-)
 #: Windows of the windowed re-identification (time variation).
 N_WINDOWS = 6
 #: A line in the residual is the input's (model error), not a disturbance, when the input
@@ -90,7 +77,7 @@ def lm_f_test(eps: np.ndarray, psi: np.ndarray, z: np.ndarray) -> tuple[float, f
     return f, float(stats.f.sf(f, q, dof))
 
 
-def _projected_f(e: np.ndarray, z: np.ndarray, p: int) -> tuple[float, float]:
+def projected_f(e: np.ndarray, z: np.ndarray, p: int) -> tuple[float, float]:
     """:func:`lm_f_test` with the regressors already projected out of ``e`` and ``z``."""
     coef = np.linalg.lstsq(z, e, rcond=None)[0]
     rss_r, rss_u = float(e @ e), float(np.sum((e - z @ coef) ** 2))
@@ -99,31 +86,7 @@ def _projected_f(e: np.ndarray, z: np.ndarray, p: int) -> tuple[float, float]:
     return f, float(stats.f.sf(f, q, dof))
 
 
-def run_tests(fitted: FittedModel, alpha: float = 0.01) -> tuple[list[Finding], dict]:
-    """Every effect test on ``fitted``; returns the significant findings (corrected p below
-    ``alpha``), strongest first within each tier, and the per-sensor statistics for the report."""
-    k_count = len(fitted.signals.sensors)
-    n_tests = len(EFFECT_TESTS) * k_count
-    eps = fitted.one_step_errors()
-    mask = counted(fitted)
-    table = {"whiteness_p": [], "trend_p": [], "line_p": []}
-    delays = delay_findings(fitted, n_tests)
-    found = _clipping_findings(fitted, n_tests)
-    found += _fault_findings(fitted, eps, mask, n_tests, late_start(fitted, delays))
-    found += delays
-    found += lead_findings(fitted, n_tests, {c for f in found for c in f.channels})
-    found += mode_findings(fitted, n_tests, table)
-    found += _trend_findings(fitted, eps, mask, n_tests, table)
-    found += _line_findings(fitted, mask, n_tests, table)
-    found += _whiteness_findings(fitted, eps, mask, n_tests, table)
-    found += _time_findings(fitted, mask, n_tests, table)
-    found += _nonlinear_findings(fitted, eps, mask, n_tests, table)
-    found += _second_input_findings(fitted, eps, mask, n_tests, table)
-    significant = [f for f in found if f.p < alpha]
-    return _merge_per_sensor(significant, ("offset_drift", "coloured_noise", "unmodelled_mode")), table
-
-
-def _merge_per_sensor(findings: list[Finding], effects) -> list[Finding]:
+def merge_per_sensor(findings: list[Finding], effects) -> list[Finding]:
     """One finding per effect whose fix acts on every sensor (a trend, a richer C), listing
     each sensor where it is significant, strongest first."""
     out = [f for f in findings if f.effect not in effects]
@@ -138,7 +101,7 @@ def _merge_per_sensor(findings: list[Finding], effects) -> list[Finding]:
     return out
 
 
-def _clipping_findings(fitted: FittedModel, n_tests: int) -> list[Finding]:
+def clipping_findings(fitted: FittedModel, n_tests: int) -> list[Finding]:
     """A channel piled up at a rail beyond its own amplitude distribution (:mod:`.clipping`),
     tested on the recorded values; p corrected for both rails and for sensors x tests."""
     s = fitted.raw
@@ -160,7 +123,7 @@ def _clipping_findings(fitted: FittedModel, n_tests: int) -> list[Finding]:
     return out
 
 
-def _fault_findings(
+def fault_findings(
     fitted: FittedModel, eps: np.ndarray, mask: np.ndarray, n_tests: int, delayed: dict[str, int]
 ) -> list[Finding]:
     """Per output, a stuck run or glitches (:mod:`.faults`); p corrected for sensors x tests.
@@ -206,7 +169,7 @@ def _fault_findings(
     return out
 
 
-def _trend_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
+def trend_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
     """Offset and drift: score test of ``[1, t, t^2]`` (the terms the model does not yet have)
     filtered by ``A / C`` like the model's own disturbance regressors."""
     spec, s = fitted.spec, fitted.signals
@@ -230,7 +193,7 @@ def _trend_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
     return out
 
 
-def _line_findings(fitted, mask, n_tests, table) -> list[Finding]:
+def line_findings(fitted, mask, n_tests, table) -> list[Finding]:
     """Spectral lines not coherent with the input (the input has no line there): Thomson's
     multitaper harmonic F-test on the simulation residual and on the output itself. A model
     of high enough order absorbs a line as an undamped pole pair; at such a pole's frequency
@@ -304,7 +267,7 @@ def _merge_lines(findings: list[Finding]) -> list[Finding]:
     return merged
 
 
-def _whiteness_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
+def whiteness_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
     """Breusch-Godfrey: residual on the gradient columns and its own lags 1..L."""
     s = fitted.signals
     out = []
@@ -323,81 +286,8 @@ def whiteness_p(fitted: FittedModel) -> list[float]:
     """Breusch-Godfrey p-value per sensor (corrected for the sensors only)."""
     table: dict = {"whiteness_p": []}
     eps = fitted.one_step_errors()
-    _whiteness_findings(fitted, eps, usable(fitted.signals.n, fitted.spec), 1, table)
+    whiteness_findings(fitted, eps, usable(fitted.signals.n, fitted.spec), 1, table)
     return table["whiteness_p"]
-
-
-TERM_KINDS = {"cubic": lambda d: d**3, "quadratic": lambda d: d**2, "abs_times": lambda d: np.abs(d) * d}
-
-
-def deflections(fitted: FittedModel) -> dict[tuple[str, str], np.ndarray]:
-    """Deflections of the model's simulated response: each sensor relative to the base and
-    each pair of sensors, (n,) each, keyed by (sensor, other or input). Displacements come
-    from the simulated relative accelerations integrated twice in the frequency domain,
-    from half the lowest mode (and the input's excited band) up."""
-    from armaxmodal.prepare.frf import excited_band
-
-    s = fitted.signals
-    rel = fitted.simulated() - s.u[:, None]
-    # below the first mode the relative motion is quasi-static and a double integral only
-    # amplifies the model's low-frequency error: integrate from half the lowest mode up
-    _, f_modes, xi, _ = fitted.fit.models[0].modal_parameters()
-    physical = f_modes[(xi > 0) & (xi < MAX_DAMPING)]
-    f_first = float(physical.min()) if physical.size else 0.0
-    f_lo = max(excited_band(Recording(s.fs, s.u, s.y, s.sensors, s.input_name))[0], 0.5 * f_first, 3 * s.fs / s.n)
-    f = np.fft.rfftfreq(s.n, 1 / s.fs)
-    spec = np.fft.rfft(rel, axis=0)
-    gain = np.where(f >= f_lo, -1.0 / np.maximum((2 * np.pi * f) ** 2, 1e-300), 0.0)
-    disp = np.fft.irfft(spec * gain[:, None], s.n, axis=0)
-    out = {(name, s.input_name): disp[:, k] for k, name in enumerate(s.sensors)}
-    for k in range(len(s.sensors)):
-        for j in range(k + 1, len(s.sensors)):
-            out[(s.sensors[k], s.sensors[j])] = disp[:, k] - disp[:, j]
-    return out
-
-
-def _nonlinear_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
-    """Score test of candidate restoring forces built from the simulated response (cubic,
-    quadratic, |d| d of every deflection), entering through the structure's dynamics as a
-    second input ``B_nl / A``: the one-step error's gradient in ``B_nl`` is the term filtered
-    by 1/C (lags 0..TERM_LAGS-1 tested). The candidate with the largest summed F over
-    sensors is tested; p corrected for candidates x sensors x tests."""
-    from armaxmodal.diagnosis.model import TERM_LAGS
-
-    s = fitted.signals
-    defl = deflections(fitted)
-    candidates = [(kind, pair) for pair in defl for kind in TERM_KINDS]
-    # the score test against each candidate shares the gradient columns: project them out once
-    bases, resid = [], []
-    dist = fitted.disturbance()
-    for k, m in enumerate(fitted.fit.models):
-        q, _ = np.linalg.qr(gradient_columns(m, s.y[:, k] - dist[:, k], s.inputs(fitted.spec), eps[:, k])[mask])
-        bases.append(q)
-        resid.append(eps[mask, k] - q @ (q.T @ eps[mask, k]))
-    best, best_sum, best_ps = None, -np.inf, None
-    for kind, pair in candidates:
-        term = TERM_KINDS[kind](defl[pair])
-        term = term / max(float(np.std(term)), 1e-300)
-        fs_, ps = [], []
-        for k, m in enumerate(fitted.fit.models):
-            z = lfilter([1.0], m.c, term)
-            cols = np.column_stack([_lag(z, j) for j in range(TERM_LAGS)])[mask]
-            f, p = _projected_f(resid[k], cols - bases[k] @ (bases[k].T @ cols), bases[k].shape[1])
-            fs_.append(f)
-            ps.append(p)
-        if sum(fs_) > best_sum:
-            best, best_sum, best_ps = (kind, pair, term), sum(fs_), ps
-    if best is None:
-        return []
-    kind, pair, term = best
-    scale = len(candidates) * n_tests
-    ps = [min(1.0, p * scale) for p in best_ps]
-    table["nonlinear_p"] = ps
-    channels = tuple(name for name, p in zip(s.sensors, ps, strict=True) if p < 0.01)
-    if not channels:
-        return []
-    params = {"term": kind, "between": list(pair)}
-    return [Finding("stiffness_nonlinearity", channels, "score_F", best_sum, min(ps), params, payload=term)]
 
 
 def _window_modes(fitted: FittedModel, mask: np.ndarray):
@@ -428,7 +318,7 @@ def _window_modes(fitted: FittedModel, mask: np.ndarray):
     return ref, freq, sd, rms, edges
 
 
-def _time_findings(fitted, mask, n_tests, table) -> list[Finding]:
+def time_findings(fitted, mask, n_tests, table) -> list[Finding]:
     """Time variation: modes re-identified on consecutive windows; for each mode and each
     window boundary a Chow-type z of the means after against before (the windows' own
     standard deviations), corrected for modes x boundaries x tests. A shift that follows
@@ -476,7 +366,7 @@ def _time_findings(fitted, mask, n_tests, table) -> list[Finding]:
     return [Finding("time_varying", tuple(s.sensors), "chow_z", z, p, params, payload=int(edges[b]))]
 
 
-def _second_input_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
+def second_input_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
     """A recorded channel that is an input, not a response: the base explains little of it
     (coherence below ``SECOND_INPUT_COHERENCE``, :func:`~armaxmodal.prepare.quality.input_coherence`)
     and, entering the other channels through the dynamics as a second input ``B_2 / A``, it

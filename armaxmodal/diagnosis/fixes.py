@@ -1,4 +1,5 @@
-"""Each effect's fix: the model spec with that effect added, and what the fit says about it."""
+"""Each effect's fix -- the model spec with that effect added (``add_*``) -- and what the refit
+says about it (``*_parameters``). The registry (:mod:`.effects`) pairs them with their effect."""
 
 from __future__ import annotations
 
@@ -11,43 +12,69 @@ from armaxmodal.diagnosis.finding import Finding
 from armaxmodal.diagnosis.model import FittedModel, ModelSpec, response_free_of, usable
 from armaxmodal.stats import MAX_DAMPING, Z95
 
-__all__ = ["add_effect", "effect_parameters"]
+__all__ = [
+    "add_clipped", "add_delay", "add_fault", "add_joint_force", "add_line", "add_mode", "add_noise_model",
+    "add_second_input", "add_trend", "finding_parameters", "joint_force_parameters", "line_parameters",
+    "mode_parameters", "noise_model_parameters", "refine_line", "second_input_parameters", "time_change_parameters",
+    "trend_parameters",
+]  # fmt: skip
 
 #: C coefficients a richer noise model adds.
 EXTRA_NC_STEP = 6
 
 
-def add_effect(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
-    """``spec`` with the effect of ``finding`` added (see :mod:`armaxmodal.diagnosis.model`)."""
-    if finding.effect == "input_delay":
-        shifts = dict(spec.shifts)
-        name = finding.channels[0]
-        lead = finding.parameters["delay_samples"]
-        # an input late by d is moved earlier by d; a sensor late by d likewise
-        shifts[name] = shifts.get(name, 0.0) + lead
-        return replace(spec, shifts=tuple(sorted(shifts.items())))
-    if finding.effect == "offset_drift":
-        return replace(spec, trend_degree=min(2, max(1, spec.trend_degree + 1)))
-    if finding.effect == "periodic_disturbance":
-        f0 = refine_line(fitted, finding.parameters["freq_hz"], finding.channels)
-        return replace(spec, lines_hz=spec.lines_hz + (f0,))
-    if finding.effect == "coloured_noise":
-        return replace(spec, extra_nc=spec.extra_nc + EXTRA_NC_STEP)
-    if finding.effect == "unmodelled_mode":  # one more pole pair; nb and nc follow na's rules
-        na, nb, nc, nk = spec.orders
-        return replace(spec, orders=(na + 2, nb + 2, nc + 2, nk))
-    if finding.effect == "clipping":
-        return replace(spec, clipped=tuple(sorted(set(spec.clipped) | set(finding.channels))))
-    if finding.effect == "sensor_fault":
-        return replace(spec, faults=spec.faults + ((finding.channels[0], tuple(finding.payload)),))
-    if finding.effect == "second_input":
-        name = finding.channels[0]
-        return replace(spec, terms=spec.terms + (name,), inputs_from=spec.inputs_from + (name,))
-    if finding.effect == "stiffness_nonlinearity":
-        name = f"{finding.parameters['term']}:{'-'.join(finding.parameters['between'])}#{len(spec.terms) + 1}"
-        fitted.signals.extra[name] = finding.payload
-        return replace(spec, terms=spec.terms + (name,))
-    raise ValueError(f"no fix for effect {finding.effect!r}")
+def add_delay(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
+    """The channel moved: an input late by d is moved earlier by d; a sensor late by d likewise."""
+    shifts = dict(spec.shifts)
+    name = finding.channels[0]
+    shifts[name] = shifts.get(name, 0.0) + finding.parameters["delay_samples"]
+    return replace(spec, shifts=tuple(sorted(shifts.items())))
+
+
+def add_trend(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
+    """One more polynomial degree of the output's trend (at most a quadratic)."""
+    return replace(spec, trend_degree=min(2, max(1, spec.trend_degree + 1)))
+
+
+def add_line(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
+    """A sine at the line's frequency, refined (:func:`refine_line`)."""
+    f0 = refine_line(fitted, finding.parameters["freq_hz"], finding.channels)
+    return replace(spec, lines_hz=spec.lines_hz + (f0,))
+
+
+def add_noise_model(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
+    """A richer noise model: :data:`EXTRA_NC_STEP` more C coefficients."""
+    return replace(spec, extra_nc=spec.extra_nc + EXTRA_NC_STEP)
+
+
+def add_mode(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
+    """One more pole pair; nb and nc follow na's rules."""
+    na, nb, nc, nk = spec.orders
+    return replace(spec, orders=(na + 2, nb + 2, nc + 2, nk))
+
+
+def add_clipped(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
+    """The clipped channels' samples at the rail filled from the model."""
+    return replace(spec, clipped=tuple(sorted(set(spec.clipped) | set(finding.channels))))
+
+
+def add_fault(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
+    """The spoiled samples (the finding's payload) filled from the model."""
+    return replace(spec, faults=spec.faults + ((finding.channels[0], tuple(finding.payload)),))
+
+
+def add_second_input(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
+    """The channel taken from the outputs and made an input."""
+    name = finding.channels[0]
+    return replace(spec, terms=spec.terms + (name,), inputs_from=spec.inputs_from + (name,))
+
+
+def add_joint_force(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
+    """The joint force (the finding's payload, built from the model's simulated response) as an
+    extra input."""
+    name = f"{finding.parameters['term']}:{'-'.join(finding.parameters['between'])}#{len(spec.terms) + 1}"
+    fitted.signals.extra[name] = finding.payload
+    return replace(spec, terms=spec.terms + (name,))
 
 
 def refine_line(fitted: FittedModel, freq_hz: float, channels) -> float:
@@ -74,66 +101,90 @@ def refine_line(fitted: FittedModel, freq_hz: float, channels) -> float:
     return float(res.x)
 
 
-def effect_parameters(finding: Finding, fitted) -> dict:
-    """The effect's parameters in the refitted model, with 95 % intervals where the fit gives them."""
-    if finding.effect == "time_varying":
-        return {**finding.parameters, "modes_each_side": _modes_each_side(fitted)}
-    spec, s = fitted.spec, fitted.signals
-    if finding.effect == "offset_drift":
-        dur = s.n / s.fs
-        out = {}
-        for name in finding.channels:
-            k = s.sensors.index(name)
-            th, cov = fitted.theta[:, k], fitted.theta_cov[k]
-            sd = np.sqrt(np.clip(np.diag(cov), 0, None))
-            # tau runs -1..1 over the record: the offset is the value mid-record, drift per s
-            out[name] = {
-                "offset": float(th[0]),
-                "offset_ci95": [float(th[0] - Z95 * sd[0]), float(th[0] + Z95 * sd[0])],
-                "drift_per_s": float(th[1] * 2 / dur),
-                "drift_ci95_per_s": [float((th[1] - Z95 * sd[1]) * 2 / dur), float((th[1] + Z95 * sd[1]) * 2 / dur)],
-            }
-        return {"trend_degree": spec.trend_degree, "per_channel": out}
-    if finding.effect == "periodic_disturbance":
-        i0 = spec.trend_degree + 1 + 2 * (len(spec.lines_hz) - 1)
-        amps = {}
-        for name in finding.channels:
-            k = s.sensors.index(name)
-            a, b = fitted.theta[i0 : i0 + 2, k]
-            cov = fitted.theta_cov[k][i0 : i0 + 2, i0 : i0 + 2]
-            amp = float(np.hypot(a, b))
-            grad = np.array([a, b]) / max(amp, 1e-300)
-            sd = float(np.sqrt(max(grad @ cov @ grad, 0.0)))
-            amps[name] = {"amp": amp, "amp_ci95": [amp - Z95 * sd, amp + Z95 * sd]}
-        first = amps[finding.channels[0]]
-        return {"freq_hz": spec.lines_hz[-1], "amp": first["amp"], "amp_ci95": first["amp_ci95"], "per_channel": amps}
-    if finding.effect == "stiffness_nonlinearity":
-        # the term's share of each channel: RMS of its simulated contribution over the output's
-        u = np.zeros((s.n, 1 + len(spec.terms)))
-        u[:, -1] = s.extra[spec.terms[-1]]
-        share = {
-            name: float(np.std(fitted.fit.models[k].simulate(u)) / np.std(s.y[:, k]))
-            for k, name in enumerate(s.sensors)
-            if name in finding.channels
-        }
-        return {**finding.parameters, "rms_share_of_output": share}
-    if finding.effect == "second_input":
-        # each explained channel's share of the response to the new input
-        u = np.zeros((s.n, 1 + len(spec.terms)))
-        u[:, 1 + spec.terms.index(finding.channels[0])] = s.extra[finding.channels[0]]
-        share = {
-            name: float(np.std(fitted.fit.models[k].simulate(u)) / np.std(s.y[:, k]))
-            for k, name in enumerate(s.sensors)
-            if name in finding.parameters["explains"]
-        }
-        return {**finding.parameters, "rms_share_of_output": share}
-    if finding.effect == "unmodelled_mode":
-        from armaxmodal.diagnosis.missing_mode import added_modes
-
-        return {**finding.parameters, "na": spec.orders[0], "added_modes": added_modes(finding.payload, fitted)}
-    if finding.effect == "coloured_noise":
-        return {"nc": spec.orders[2] + spec.extra_nc, "nc_before": spec.orders[2] + spec.extra_nc - EXTRA_NC_STEP}
+def finding_parameters(finding: Finding, fitted) -> dict:
+    """The finding's own parameters: an effect whose fit adds nothing to them."""
     return dict(finding.parameters)
+
+
+def time_change_parameters(finding: Finding, fitted) -> dict:
+    """The change's time and each mode before and after it."""
+    return {**finding.parameters, "modes_each_side": _modes_each_side(fitted)}
+
+
+def trend_parameters(finding: Finding, fitted) -> dict:
+    """Each channel's offset (mid-record) and drift per second, with 95 % intervals."""
+    spec, s = fitted.spec, fitted.signals
+    dur = s.n / s.fs
+    out = {}
+    for name in finding.channels:
+        k = s.sensors.index(name)
+        th, cov = fitted.theta[:, k], fitted.theta_cov[k]
+        sd = np.sqrt(np.clip(np.diag(cov), 0, None))
+        # tau runs -1..1 over the record: the offset is the value mid-record, drift per s
+        out[name] = {
+            "offset": float(th[0]),
+            "offset_ci95": [float(th[0] - Z95 * sd[0]), float(th[0] + Z95 * sd[0])],
+            "drift_per_s": float(th[1] * 2 / dur),
+            "drift_ci95_per_s": [float((th[1] - Z95 * sd[1]) * 2 / dur), float((th[1] + Z95 * sd[1]) * 2 / dur)],
+        }
+    return {"trend_degree": spec.trend_degree, "per_channel": out}
+
+
+def line_parameters(finding: Finding, fitted) -> dict:
+    """The line's frequency and each channel's amplitude, with 95 % intervals."""
+    spec, s = fitted.spec, fitted.signals
+    i0 = spec.trend_degree + 1 + 2 * (len(spec.lines_hz) - 1)
+    amps = {}
+    for name in finding.channels:
+        k = s.sensors.index(name)
+        a, b = fitted.theta[i0 : i0 + 2, k]
+        cov = fitted.theta_cov[k][i0 : i0 + 2, i0 : i0 + 2]
+        amp = float(np.hypot(a, b))
+        grad = np.array([a, b]) / max(amp, 1e-300)
+        sd = float(np.sqrt(max(grad @ cov @ grad, 0.0)))
+        amps[name] = {"amp": amp, "amp_ci95": [amp - Z95 * sd, amp + Z95 * sd]}
+    first = amps[finding.channels[0]]
+    return {"freq_hz": spec.lines_hz[-1], "amp": first["amp"], "amp_ci95": first["amp_ci95"], "per_channel": amps}
+
+
+def joint_force_parameters(finding: Finding, fitted) -> dict:
+    """The term, its joint, and its share of each channel: the RMS of its simulated contribution
+    over the output's."""
+    spec, s = fitted.spec, fitted.signals
+    u = np.zeros((s.n, 1 + len(spec.terms)))
+    u[:, -1] = s.extra[spec.terms[-1]]
+    share = {
+        name: float(np.std(fitted.fit.models[k].simulate(u)) / np.std(s.y[:, k]))
+        for k, name in enumerate(s.sensors)
+        if name in finding.channels
+    }
+    return {**finding.parameters, "rms_share_of_output": share}
+
+
+def second_input_parameters(finding: Finding, fitted) -> dict:
+    """Each explained channel's share of the response to the new input."""
+    spec, s = fitted.spec, fitted.signals
+    u = np.zeros((s.n, 1 + len(spec.terms)))
+    u[:, 1 + spec.terms.index(finding.channels[0])] = s.extra[finding.channels[0]]
+    share = {
+        name: float(np.std(fitted.fit.models[k].simulate(u)) / np.std(s.y[:, k]))
+        for k, name in enumerate(s.sensors)
+        if name in finding.parameters["explains"]
+    }
+    return {**finding.parameters, "rms_share_of_output": share}
+
+
+def mode_parameters(finding: Finding, fitted) -> dict:
+    """The order reached and the modes the added pole pair gave."""
+    from armaxmodal.diagnosis.missing_mode import added_modes
+
+    return {**finding.parameters, "na": fitted.spec.orders[0], "added_modes": added_modes(finding.payload, fitted)}
+
+
+def noise_model_parameters(finding: Finding, fitted) -> dict:
+    """The noise model's order before and after."""
+    spec = fitted.spec
+    return {"nc": spec.orders[2] + spec.extra_nc, "nc_before": spec.orders[2] + spec.extra_nc - EXTRA_NC_STEP}
 
 
 def _modes_each_side(piecewise) -> list[dict]:

@@ -151,61 +151,93 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, stru
     return replace(recording, base=base, response=y, meta=meta)
 
 
-def cubic_spring_ride(
+#: the joint forces :func:`nonlinear_joint_ride` adds, and the effect each is the truth for
+JOINT_FORCES = {"cubic": "stiffness_nonlinearity", "friction": "damping_nonlinearity"}
+#: dry friction's sign is smoothed over this fraction of the joint's RMS relative velocity
+#: (``tanh(v / v0)``): a discontinuous force would need an event-locating integrator, and at 1 %
+#: the force differs from Coulomb's only in the 1 % of time the joint sticks
+FRICTION_SMOOTHING = 0.01
+
+
+def cubic_spring_ride(structure, base: np.ndarray, fs: float, between: tuple[int, int], ratio: float, *,
+                      noise: float = 0.05, seed: int = 0, oversample: int = 16) -> Recording:  # fmt: skip
+    """A ride of ``structure`` with a cubic spring between DOFs ``between``: the truth for
+    ``stiffness_nonlinearity`` (:func:`nonlinear_joint_ride` with ``force="cubic"``)."""
+    return nonlinear_joint_ride(structure, base, fs, between, ratio, force="cubic", noise=noise, seed=seed,
+                                oversample=oversample)  # fmt: skip
+
+
+def nonlinear_joint_ride(
     structure,
     base: np.ndarray,
     fs: float,
     between: tuple[int, int],
     ratio: float,
     *,
+    force: str = "cubic",
     noise: float = 0.05,
     seed: int = 0,
     oversample: int = 16,
 ) -> Recording:
-    """A ride of ``structure`` with a cubic spring added between DOFs ``between = (i, j)``
-    (``j = -1``: to the base), the truth for ``stiffness_nonlinearity``.
+    """A ride of ``structure`` with a nonlinear force added in the joint between DOFs
+    ``between = (i, j)`` (``j = -1``: to the base).
 
-    The spring force is ``k3 s^3`` on the deflection ``s = z_i - z_j``, with ``k3`` set so
-    that at the linear ride's RMS deflection it is ``ratio`` times the linear force
-    ``|K_ij| s`` there. Integrated by classical Runge-Kutta on a grid ``oversample`` times
-    finer than ``fs`` with the band-limited input interpolated exactly (FFT); relative
-    coordinates ``M z'' + C z' + K z + f_nl(z) = -M 1 a``; outputs are absolute accelerations
-    with white noise of ``noise`` times their RMS. ``meta["injected"]`` holds ``k3``.
+    ``force="cubic"`` is a cubic spring ``k3 s^3`` on the deflection ``s = z_i - z_j`` (the truth
+    for ``stiffness_nonlinearity``), set so that at the linear ride's RMS deflection it is
+    ``ratio`` times the linear spring's force ``|K_ij| s`` there. ``force="friction"`` is dry
+    (Coulomb) friction ``F tanh(v / v0)`` on the joint's relative velocity ``v`` (the truth for
+    ``damping_nonlinearity``), ``F`` set to ``ratio`` times the linear damper's force
+    ``|C_ij| v`` at the linear ride's RMS relative velocity, ``v0`` :data:`FRICTION_SMOOTHING`
+    of it. Integrated by classical Runge-Kutta on a grid ``oversample`` times finer than ``fs``
+    with the band-limited input interpolated exactly (FFT); relative coordinates
+    ``M z'' + C z' + K z + f_nl = -M 1 a``; outputs are absolute accelerations with white noise
+    of ``noise`` times their RMS. ``meta["injected"]`` holds the force's size (``k3`` or ``F``).
     """
     from scipy.signal import resample
 
     from armaxmodal.systems.simulation import add_noise, simulate
 
+    if force not in JOINT_FORCES:
+        raise ValueError(f"force must be one of {sorted(JOINT_FORCES)}, not {force!r}")
     i, j = between
     m_inv = 1.0 / np.diag(structure.M)
-    lin = simulate(structure, base, fs, hold="bandlimited", quantity="displacement", frame="relative")
-    s_lin = lin[:, i] - (lin[:, j] if j >= 0 else 0.0)
-    k_lin = abs(structure.K[i, j]) if j >= 0 else abs(structure.K[i].sum())
-    k3 = ratio * k_lin / float(np.mean(s_lin**2))
+    quantity = "displacement" if force == "cubic" else "velocity"
+    lin = simulate(structure, base, fs, hold="bandlimited", quantity=quantity, frame="relative")
+    rel = lin[:, i] - (lin[:, j] if j >= 0 else 0.0)
+    rms = float(np.sqrt(np.mean(rel**2)))
+    if force == "cubic":
+        k_lin = abs(structure.K[i, j]) if j >= 0 else abs(structure.K[i].sum())
+        size, scale, kind = ratio * k_lin / rms**2, 1.0, 0
+    else:
+        c_lin = abs(structure.C[i, j]) if j >= 0 else abs(structure.C[i].sum())
+        size, scale, kind = ratio * c_lin * rms, FRICTION_SMOOTHING * rms, 1
     r = int(oversample)
     fine = resample(base, base.size * 2 * r)  # values at every half step
     c, k = np.ascontiguousarray(structure.C, float), np.ascontiguousarray(structure.K, float)
-    acc = _rk4_cubic(m_inv, c, k, np.ascontiguousarray(fine), 1.0 / (fs * r), i, j, float(k3))
+    acc = _rk4_joint(m_inv, c, k, np.ascontiguousarray(fine), 1.0 / (fs * r), i, j, float(size), kind, scale)
     absolute = acc[::r][: base.size] + base[:, None]
-    rng = np.random.default_rng(seed)
-    y = add_noise(absolute, noise, rng)
-    meta = {"injected": {"effect": "stiffness_nonlinearity", "between": [i, j], "k3": k3, "ratio": ratio}}
+    y = add_noise(absolute, noise, np.random.default_rng(seed))
+    sized = {"k3": size} if force == "cubic" else {"friction_force": size}
+    meta = {"injected": {"effect": JOINT_FORCES[force], "force": force, "between": [i, j], **sized, "ratio": ratio}}
     names = structure.names or tuple(f"dof{k + 1}" for k in range(y.shape[1]))
     return Recording(fs, base.copy(), y, names, meta=meta)
 
 
 @numba.njit(cache=True)
-def _accel(m_inv, c, k, z, v, a_base, i, j, k3):
+def _accel(m_inv, c, k, z, v, a_base, i, j, size, kind, scale):
     f = c @ v + k @ z
-    s = z[i] - (z[j] if j >= 0 else 0.0)
-    f[i] += k3 * s**3
+    if kind == 0:  # a cubic spring on the deflection
+        f_nl = size * (z[i] - (z[j] if j >= 0 else 0.0)) ** 3
+    else:  # dry friction on the relative velocity, its sign smoothed
+        f_nl = size * np.tanh((v[i] - (v[j] if j >= 0 else 0.0)) / scale)
+    f[i] += f_nl
     if j >= 0:
-        f[j] -= k3 * s**3
+        f[j] -= f_nl
     return -m_inv * f - a_base
 
 
 @numba.njit(cache=True)
-def _rk4_cubic(m_inv, c, k, fine, h, i, j, k3):
+def _rk4_joint(m_inv, c, k, fine, h, i, j, size, kind, scale):
     """Relative accelerations at every step of ``h`` (input sampled at half steps); numba
     because the loop is 10^5 small steps."""
     n_dof = m_inv.size
@@ -214,14 +246,14 @@ def _rk4_cubic(m_inv, c, k, fine, h, i, j, k3):
     out = np.empty((steps, n_dof))
     for t in range(steps):
         a0, a_half, a1 = fine[2 * t], fine[2 * t + 1], fine[(2 * t + 2) % fine.size]
-        k1v = _accel(m_inv, c, k, z, v, a0, i, j, k3)
+        k1v = _accel(m_inv, c, k, z, v, a0, i, j, size, kind, scale)
         out[t] = k1v
         k1z = v
-        k2v = _accel(m_inv, c, k, z + 0.5 * h * k1z, v + 0.5 * h * k1v, a_half, i, j, k3)
+        k2v = _accel(m_inv, c, k, z + 0.5 * h * k1z, v + 0.5 * h * k1v, a_half, i, j, size, kind, scale)
         k2z = v + 0.5 * h * k1v
-        k3v = _accel(m_inv, c, k, z + 0.5 * h * k2z, v + 0.5 * h * k2v, a_half, i, j, k3)
+        k3v = _accel(m_inv, c, k, z + 0.5 * h * k2z, v + 0.5 * h * k2v, a_half, i, j, size, kind, scale)
         k3z = v + 0.5 * h * k2v
-        k4v = _accel(m_inv, c, k, z + h * k3z, v + h * k3v, a1, i, j, k3)
+        k4v = _accel(m_inv, c, k, z + h * k3z, v + h * k3v, a1, i, j, size, kind, scale)
         k4z = v + h * k3v
         z = z + h / 6 * (k1z + 2 * k2z + 2 * k3z + k4z)
         v = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)

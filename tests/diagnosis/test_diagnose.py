@@ -200,13 +200,17 @@ def nonlinear_rides():
     return {r: cubic_spring_ride(am.supine_human(), u, 60.0, (1, 2), r, seed=2) for r in (0.0, 0.3)}
 
 
-def test_cubic_spring_ride_reduces_to_the_exact_linear_simulation():
-    from armaxmodal.diagnosis.inject import cubic_spring_ride
+@pytest.mark.parametrize("force", ["cubic", "friction"])
+def test_a_joint_ride_without_its_force_is_the_exact_linear_simulation(force):
+    from armaxmodal.diagnosis.inject import nonlinear_joint_ride
 
     u = am.random_vibration(60.0, 20.0, band=(0.5, 28.0), seed=5)
-    rk4 = cubic_spring_ride(am.supine_human(), u, 60.0, (1, 2), 0.0, noise=0.0)
+    rk4 = nonlinear_joint_ride(am.supine_human(), u, 60.0, (1, 2), 0.0, force=force, noise=0.0)
     exact = am.simulate(am.supine_human(), u, 60.0, hold="bandlimited")
     assert np.max(np.abs(rk4.response - exact)) < 1e-4 * np.std(exact)
+    # with its force, the ride differs: the force is applied (a sign slip would cancel it)
+    forced = nonlinear_joint_ride(am.supine_human(), u, 60.0, (1, 2), 1.0, force=force, noise=0.0)
+    assert np.std(forced.response[:, 1] - exact[:, 1]) > 0.005 * np.std(exact[:, 1])
 
 
 def test_a_cubic_spring_is_named_between_the_right_segments(nonlinear_rides):
@@ -217,6 +221,45 @@ def test_a_cubic_spring_is_named_between_the_right_segments(nonlinear_rides):
     assert {"chest", "pelvis"} <= set(effect.finding.channels)
     assert effect.parameters["sim_error_after"] < 0.95 * effect.parameters["sim_error_before"]
     assert effect.error_after < effect.error_before
+
+
+@pytest.mark.parametrize("seed", [1, 3])
+def test_dry_friction_in_a_joint_is_a_damping_nonlinearity_placed_at_that_joint(seed):
+    """Dry friction between chest and pelvis (its force twice the linear damper's at the RMS
+    relative velocity) was named ``stiffness_nonlinearity`` and its fix refused; now the
+    joint-force test names a damping nonlinearity, dry friction, at that joint, and the fix is
+    kept (held-out simulation error falls)."""
+    from armaxmodal.diagnosis.inject import nonlinear_joint_ride
+
+    u = am.random_vibration(60.0, 120.0, band=(0.5, 28.0), seed=seed)
+    rec = nonlinear_joint_ride(am.supine_human(), u, 60.0, (1, 2), 2.0, force="friction", seed=seed + 1)
+    effect = _first(diagnose(rec, max_rounds=1))
+    assert effect.finding.effect == "damping_nonlinearity"
+    assert effect.parameters["term"] == "dry_friction" and effect.parameters["between"] == ["chest", "pelvis"]
+    assert {"chest", "pelvis"} <= set(effect.finding.channels)
+    assert effect.parameters["sim_error_after"] < effect.parameters["sim_error_before"]
+
+
+def test_an_effect_is_one_registry_entry(clean, monkeypatch):
+    """A made-up effect -- the line test's findings under another name, with the line's fix --
+    added as one registry entry in place of ``periodic_disturbance``: the loop tests it, fixes it,
+    keeps it and reports it, with no other change."""
+    from dataclasses import replace
+
+    from armaxmodal.diagnosis import effects
+
+    lines = effects.entry_of("periodic_disturbance")
+
+    def made_up(ev):
+        return [replace(f, effect="made_up_hum") for f in lines.test(ev)]
+
+    entry = replace(lines, name="made_up_hum", test=made_up)
+    registry = tuple(entry if e.name == "periodic_disturbance" else e for e in effects.REGISTRY)
+    monkeypatch.setattr(effects, "REGISTRY", registry)
+    rec = inject(clean, "periodic_disturbance", ["head"], freq_hz=11.7, amp=0.1)
+    report = _run(rec, max_rounds=1).to_dict()
+    (effect,) = report["effects"]
+    assert effect["effect"] == "made_up_hum" and effect["parameters"]["freq_hz"] == pytest.approx(11.7, abs=0.01)
 
 
 def test_the_linear_twin_has_no_nonlinearity(nonlinear_rides):
@@ -394,7 +437,7 @@ def test_clipping_near_its_threshold_and_on_the_input(clean):
     """Three samples at a rail are what a continuous signal may show (p = 0.08 before the
     correction): not named; twelve are (p = 1e-9): named. A clipped input is named but not
     'fixed': no fill restores the base motion the structure felt."""
-    from armaxmodal.diagnosis.evidence import run_tests
+    from armaxmodal.diagnosis.effects import run_tests
 
     def clipping(rec):
         return [f for f in run_tests(_baseline_model(rec))[0] if f.effect == "clipping"]
@@ -574,12 +617,12 @@ def test_the_noise_floor_is_the_sensor_noise_and_none_where_the_record_cannot_re
     """The supine ride's floor is its 5 % sensor noise; a 0.3 %-damped two-mode ride of 60 s
     smears its peaks at every segment the record allows (its 'floor' lies above the linear
     baseline's own held-out error): no floor rather than a wrong one."""
-    from armaxmodal.diagnosis.loop import _noise_floor
     from armaxmodal.diagnosis.model import Signals
+    from armaxmodal.diagnosis.noise_floor import noise_floor
 
     def floor(rec):
         s = Signals(rec.base, rec.response, rec.fs, rec.sensors, rec.input_name)
-        return _noise_floor(s, np.ones(s.n, bool))
+        return noise_floor(s, np.ones(s.n, bool))
 
     u = am.random_vibration(60.0, 120.0, band=(0.5, 28.0), seed=8)
     exact = am.simulate(am.supine_human(), u, 60.0, hold="bandlimited")

@@ -15,11 +15,13 @@ import pytest
 from scipy import stats
 
 import armaxmodal as am
-from armaxmodal.diagnosis import diagnose, loop
+from armaxmodal.diagnosis import acceptance, diagnose
 from armaxmodal.diagnosis.delays import _common_delay, delay_findings
-from armaxmodal.diagnosis.evidence import EFFECT_TESTS, run_tests
+from armaxmodal.diagnosis.effects import REGISTRY, entry_of, run_tests
+from armaxmodal.diagnosis.finding import Finding
 from armaxmodal.diagnosis.inject import inject
-from armaxmodal.diagnosis.model import ModelSpec, Signals, fit_model, fractional_shift, usable
+from armaxmodal.diagnosis.model import ModelSpec, Signals, fit_model, fractional_shift, held_out, usable
+from armaxmodal.diagnosis.result import Stage
 from armaxmodal.prepare.delay import DelayEstimate, estimate_delays
 
 ORDERS = (10, 16, 10, -5)  # the supine fixture's orders chosen by BIC
@@ -63,7 +65,8 @@ def test_outputs_that_lag_alike_are_one_input_delay_confirmed_with_nk_chosen_aga
 
 def test_a_late_input_is_one_input_delay_of_the_other_sign(clean):
     """The input 3 samples late: every output leads alike, the input is named late by 3."""
-    (f,) = delay_findings(_model(inject(clean, "input_delay", ["base"], samples=3.0)), len(EFFECT_TESTS) * 4)
+    n_tests = len({e.test for e in REGISTRY}) * 4
+    (f,) = delay_findings(_model(inject(clean, "input_delay", ["base"], samples=3.0)), n_tests)
     assert f.channels == ("base",) and f.parameters["delay_samples"] == pytest.approx(3.0, abs=0.1)
     assert f.parameters["outputs_lag_ci95_ms"][0] < -50.0 < f.parameters["outputs_lag_ci95_ms"][1]
 
@@ -139,17 +142,17 @@ def test_a_fix_is_kept_only_when_the_held_out_test_and_bic_both_say_so(clean, mo
     with the held-out test made to disagree is refused, and so is a useless richer noise model
     with the held-out test made to agree (BIC disagrees)."""
     rec = _planted_line(clean)
-    stage = loop.Stage(_model(rec), loop.held_out(ModelSpec(ORDERS), _signals(rec)))
+    stage = Stage(_model(rec), held_out(ModelSpec(ORDERS), _signals(rec)))
     findings, _ = run_tests(stage.model)
     line = next(f for f in findings if f.effect == "periodic_disturbance")
-    kept, reason = loop._try_fix(stage, line, 0.01)
+    kept, reason = acceptance.try_fix(stage, line, 0.01, entry_of(line.effect))
     assert kept is not None and kept[0].delta_bic < 0 and kept[0].dm_p < 0.01, reason
-    monkeypatch.setattr(loop, "_held_out_p", lambda *a, **k: 0.5)
-    assert loop._try_fix(stage, line, 0.01)[0] is None
-    monkeypatch.setattr(loop, "_held_out_p", lambda *a, **k: 1e-9)
-    plain = loop.Stage(_model(clean), loop.held_out(ModelSpec(ORDERS), _signals(clean)))
-    noise = loop.Finding("coloured_noise", ("head",), "breusch_godfrey_F", 10.0, 1e-9)
-    refused, reason = loop._try_fix(plain, noise, 0.01)
+    monkeypatch.setattr(acceptance, "_held_out_p", lambda *a, **k: 0.5)
+    assert acceptance.try_fix(stage, line, 0.01, entry_of(line.effect))[0] is None
+    monkeypatch.setattr(acceptance, "_held_out_p", lambda *a, **k: 1e-9)
+    plain = Stage(_model(clean), held_out(ModelSpec(ORDERS), _signals(clean)))
+    noise = Finding("coloured_noise", ("head",), "breusch_godfrey_F", 10.0, 1e-9)
+    refused, reason = acceptance.try_fix(plain, noise, 0.01, entry_of("coloured_noise"))
     assert refused is None and "change in BIC +" in reason
 
 
@@ -165,7 +168,7 @@ def test_each_p_value_is_corrected_for_sensors_times_tests(clean):
     raw = 2 * stats.t.sf(abs(e.delay_s) / e.delay_sd_s, e.dof)
     found, _ = run_tests(_model(late))
     (f,) = [f for f in found if f.effect == "input_delay"]
-    assert f.p == pytest.approx(min(1.0, raw * len(EFFECT_TESTS) * len(clean.sensors)), rel=1e-9)
+    assert f.p == pytest.approx(min(1.0, raw * len({e.test for e in REGISTRY}) * len(clean.sensors)), rel=1e-9)
 
 
 def test_clean_rides_raise_no_alarm_at_the_corrected_level():
@@ -268,7 +271,7 @@ def test_the_delay_keep_rule_at_its_boundaries():
     """Kept unless the moved model is both worse by over 1 % and significantly so; the note
     says which of fell / no worse / not significantly worse, and the common lag."""
     params = {"nk_before": -2, "nk_after": -5}
-    judge = loop._judge_delay
+    judge = acceptance._judge_delay
     assert judge(params, 1.0, 0.9, 0.001, 0.01)[0].endswith(
         "the held-out error fell (1 -> 0.9); the phase slope names and times the delay"
     )
@@ -305,19 +308,19 @@ def test_the_moved_model_tries_nk_around_the_move_with_nb_keeping_the_causal_tap
         tried.append((spec.orders, start))
         return Stub(spec, start)
 
-    monkeypatch.setattr(loop, "fit_model", record)
+    monkeypatch.setattr(acceptance, "fit_model", record)
     # a baseline at nk = 1 (a zero-order hold), nb = 1; the output 2 samples late is moved earlier
     spec = replace(base.spec, orders=(10, 1, 10, 1), shifts=(("legs", 2.0),))
     start = replace(base, spec=replace(spec, shifts=()))
-    late = loop.Finding("input_delay", ("legs",), "phase_slope_z", 9.0, 1e-9, {"delay_samples": 2.0})
-    best = loop._moved_and_reordered(start, spec, late)
+    late = Finding("input_delay", ("legs",), "phase_slope_z", 9.0, 1e-9, {"delay_samples": 2.0})
+    best = acceptance._moved_and_reordered(start, spec, late)
     assert [orders for orders, _ in tried] == [(10, 3, 10, -2), (10, 2, 10, -1), (10, 1, 10, 0), (10, 1, 10, 1)]
     assert [s is start for _, s in tried] == [False, False, False, True]
     assert best.spec.orders == (10, 2, 10, -1)
     # the input late by 2: the outputs move the other way, nk around 3
     tried.clear()
-    early = loop.Finding("input_delay", ("base",), "phase_slope_z", 9.0, 1e-9, {"delay_samples": 2.0})
-    loop._moved_and_reordered(start, replace(spec, shifts=(("base", 2.0),)), early)
+    early = Finding("input_delay", ("base",), "phase_slope_z", 9.0, 1e-9, {"delay_samples": 2.0})
+    acceptance._moved_and_reordered(start, replace(spec, shifts=(("base", 2.0),)), early)
     assert [orders[3] for orders, _ in tried] == [1, 2, 3, 4]
 
 
@@ -368,9 +371,9 @@ def test_late_start_counts_the_samples_each_delay_explains(clean):
     assert late_start(model, []) == {}
     moved = replace(model, spec=replace(model.spec, shifts=(("legs", 2.5),)))
     assert late_start(moved, []) == {"legs": 4}
-    on_input = loop.Finding("input_delay", ("base",), "phase_slope_z", 9.0, 1e-9, {"delay_samples": -0.5})
+    on_input = Finding("input_delay", ("base",), "phase_slope_z", 9.0, 1e-9, {"delay_samples": -0.5})
     assert late_start(moved, [on_input]) == {"head": 2, "chest": 2, "pelvis": 2, "legs": 4}
-    input_late = loop.Finding("input_delay", ("base",), "phase_slope_z", 9.0, 1e-9, {"delay_samples": 3.0})
+    input_late = Finding("input_delay", ("base",), "phase_slope_z", 9.0, 1e-9, {"delay_samples": 3.0})
     assert late_start(model, [input_late]) == {}
 
 

@@ -1,0 +1,167 @@
+"""What the diagnosis found: the stages (a fitted model with its held-out errors), the effects
+kept, and the report (:class:`Diagnosis`, whose ``to_dict`` is the JSON of ``armaxmodal diagnose``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from armaxmodal.diagnosis.evidence import whiteness_p
+from armaxmodal.diagnosis.finding import Finding
+from armaxmodal.diagnosis.model import LINE_MERGE_HZ, UNDAMPED, FittedModel, HeldOut, model_bic
+from armaxmodal.recording import Recording
+
+__all__ = ["Diagnosis", "Effect", "Stage", "stage_modes"]
+
+
+@dataclass(frozen=True)
+class Stage:
+    """A fitted model with its held-out errors."""
+
+    model: FittedModel
+    held: HeldOut
+
+    def bic(self, kind: str = "one_step", channels=None) -> float:
+        """:func:`~.model.model_bic` of the stage's model."""
+        return model_bic(self.model, kind, channels)
+
+    def summary(self, noise_floor: dict) -> dict:
+        s = self.model.signals
+        y = s.y
+        e1 = self.held.one_step[self.held.mask]
+        yy = y[self.held.mask] - y[self.held.mask].mean(axis=0)
+        return {
+            "fit_val_pct": self.held.fit_percent(y).tolist(),
+            "one_step_fit_pct": (100 * (1 - np.linalg.norm(e1, axis=0) / np.linalg.norm(yy, axis=0))).tolist(),
+            "resid_rms": self.held.rms().tolist(),
+            "sim_resid_rms": np.sqrt(np.mean(self.held.simulation[self.held.mask] ** 2, axis=0)).tolist(),
+            "noise_floor_rms": [noise_floor.get(name) for name in s.sensors],
+            "whiteness_p": whiteness_p(self.model),
+        }
+
+
+@dataclass(frozen=True)
+class Effect:
+    """An accepted effect: the finding, its fitted parameters and the errors around the fix."""
+
+    finding: Finding
+    parameters: dict
+    error_before: float
+    error_after: float
+    dm_p: float
+    delta_bic: float
+    note: str = ""
+
+    def to_dict(self) -> dict:
+        out = {
+            "effect": self.finding.effect,
+            "channels": list(self.finding.channels),
+            "evidence": self.finding.evidence(),
+            "parameters": self.parameters,
+            "error_before": self.error_before,
+            "error_after": self.error_after,
+            "held_out_p": self.dm_p,
+            "delta_bic": self.delta_bic,
+        }
+        if self.note:
+            out["note"] = self.note
+        return out
+
+
+@dataclass(frozen=True)
+class Diagnosis:
+    """What :func:`diagnose` found. ``to_dict`` is the JSON contract of ``armaxmodal diagnose``."""
+
+    baseline: Stage
+    final: Stage
+    effects: tuple[Effect, ...]
+    unconfirmed: tuple[dict, ...]
+    #: ``{output: RMS}``, ``None`` where the record cannot resolve it (:func:`~.noise_floor.noise_floor`).
+    noise_floor: dict
+    recording: Recording
+    original_fs: float
+    warnings: tuple = ()
+    tests: dict = field(default_factory=dict)
+
+    @property
+    def sensors(self) -> tuple[str, ...]:
+        return self.baseline.model.signals.sensors
+
+    def modes(self, stage: Stage) -> pd.DataFrame:
+        """The physical modes of a stage's model (identify's rejection rules)."""
+        return stage_modes(stage, self.recording)
+
+    def _repr_html_(self) -> str:
+        """A notebook's view: the verdict and each effect with its evidence and error before and after."""
+        import html
+
+        from armaxmodal.diagnosis.report import effects_table
+
+        report = self.to_dict()
+        table = effects_table(report).to_html(index=False, float_format=lambda v: f"{v:.4g}", border=0)
+        return f"<p><b>verdict: {html.escape(report['verdict'])}</b></p>{table}"
+
+    def to_dict(self) -> dict:
+        na, nb, nc, nk = self.baseline.model.spec.orders
+
+        def modes(stage):
+            return [{k: float(v) for k, v in row.items()} for row in self.modes(stage).to_dict("records")]
+
+        final = _per_output(self.final.summary(self.noise_floor), self.final.model.signals.sensors, self.sensors)
+        final.update(modes_before=modes(self.baseline), modes_after=modes(self.final))
+        return {
+            "verdict": _verdict(self, final["whiteness_p"]),
+            "fs": self.original_fs,
+            "analysis_fs": self.recording.fs,
+            "input": self.recording.input_name,
+            "outputs": list(self.sensors),
+            "orders": {"na": na, "nb": nb, "nc": nc, "nk": nk, "shared_poles": True},
+            "validation": "two blocked folds: each half predicted by the model fitted on the other half",
+            "baseline": self.baseline.summary(self.noise_floor),
+            "effects": [e.to_dict() for e in self.effects],
+            "unconfirmed": list(self.unconfirmed),
+            "final": final,
+            "tests": self.tests,
+            "warnings": [w.to_dict() for w in self.warnings],
+        }
+
+
+def stage_modes(stage: Stage, recording: Recording) -> pd.DataFrame:
+    """The physical modes of a stage's model (identify's rejection rules), without a pole
+    pair that duplicates a modelled line."""
+    from armaxmodal.modes.poles import POLE_COLUMNS, SHARED, Tolerances, pole_rows, rejection_reasons
+
+    poles = pd.DataFrame(pole_rows(stage.model.fit, SHARED), columns=POLE_COLUMNS)
+    poles = poles[np.array(rejection_reasons(poles, Tolerances(), recording)) == ""]
+    for f in stage.model.spec.lines_hz:
+        poles = poles[~((abs(poles.freq_hz - f) < LINE_MERGE_HZ) & (poles.damping < UNDAMPED))]
+    return poles.sort_values("freq_hz")[["freq_hz", "damping", "freq_ci95_lo", "freq_ci95_hi"]]
+
+
+def _per_output(summary: dict, sensors, outputs) -> dict:
+    """``summary``'s per-sensor lists over ``outputs`` (the recording's), ``None`` where an
+    output became an input (a second input); ``inputs_added`` names those."""
+    out = {}
+    for key, values in summary.items():
+        by_name = dict(zip(sensors, values, strict=True))
+        out[key] = [by_name.get(name) for name in outputs]
+    out["inputs_added"] = [name for name in outputs if name not in sensors]
+    return out
+
+
+def _verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float = 0.01) -> str:
+    """One sentence a person can act on, unsure where the data leave doubt."""
+    coloured = [s for s, p in zip(diagnosis.sensors, whiteness, strict=True) if p is not None and p < alpha]
+    if coloured:
+        return (
+            f"unsure: the residual of {', '.join(coloured)} is still not white after the fixes; an effect the "
+            "fixes do not capture (a non-smooth nonlinearity such as friction or a clearance, a time change, a "
+            "missing mode) may remain. Look at the figure."
+        )
+    if diagnosis.unconfirmed:
+        return "unsure: some tests fired but their fixes did not lower the held-out error (see 'unconfirmed')."
+    if diagnosis.effects:
+        return "the effects listed explain the residual: it is white after the fixes."
+    return "no effect: the residual is consistent with the model."
