@@ -25,6 +25,7 @@ from armaxmodal.modes.mode_count import (
     matched_poles,
     reported,
 )
+from armaxmodal.modes.poles import mac
 from armaxmodal.modes.spread import split_segments
 from armaxmodal.modes.support import CANDIDATE_MIN_ORDERS, stable_in_diagram
 from armaxmodal.modes.working import WorkingSelection
@@ -45,6 +46,9 @@ MAX_CANDIDATES = 3
 #: two modes closer than this many standard deviations of their difference are not separated
 #: by the record (a difference 3 SD from zero is the usual resolution rule)
 SEPARATION_SD = 3.0
+#: two modes whose shapes agree this well (MAC) are not told apart by their shapes either (the
+#: selection's own ``merge_mac`` default)
+SAME_SHAPE_MAC = 0.8
 
 
 def _candidates(diagram, modes: pd.DataFrame, band, nas, cluster_freq, cluster_damping) -> list[tuple[float, float]]:
@@ -154,20 +158,22 @@ def not_separated(modes: pd.DataFrame) -> list[tuple[int, int, float]]:
 
 def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: ModeCount, keep: np.ndarray, rec,
                              band_hz, hold: str):  # fmt: skip
-    """Two counted modes the record does not separate (:func:`not_separated`, on the model's own
-    intervals) reported as one: the
+    """Two counted modes the record does not separate -- neither by frequency (:func:`not_separated`,
+    on the model's own intervals) nor by shape (MAC at least :data:`SAME_SHAPE_MAC`) -- reported as
+    one: the
     model with one pole there (either of the two taken out, the rest refitted free; the lower
     criterion), whose mode's intervals are widened to cover both. The likelihood may need two poles
     for one resonance whose frequency moves during the record (a nonlinearity: the F-16 at its
     highest level had two poles at 6.356 and 6.395 Hz, 0.2 SD apart), but their values are not
     two modes. Returns ``(rows, shapes, notes)``; a ``modes_not_separated`` note per merge."""
     poles, m = np.flatnonzero(keep), count.model
-    # judged on the model's own intervals: a hull widened by the equally good counts says the
-    # count is undecided, not that two modes of this model coincide (two bodies' modes 7-8 %
-    # apart, each within 2 bounds, overlapped only in their hulls)
+    # judged on the model's own intervals and shapes: two bodies' heavily damped modes 7-8 % apart
+    # were 1.8 and 2.3 SD apart, and their shapes told them apart (MAC 0.70 and 0.05); the F-16's
+    # pair at its highest level, 0.2 SD apart, has one shape as far as three sensors can tell
     own = pd.DataFrame({"freq_hz": m.freq_hz[poles], "freq_ci95_lo": m.freq_hz[poles] - Z95 * m.freq_sd[poles],
                         "freq_ci95_hi": m.freq_hz[poles] + Z95 * m.freq_sd[poles]})  # fmt: skip
-    pairs = not_separated(own)
+    pairs = [(a, b, gap) for a, b, gap in not_separated(own) if mac(m.shapes[:, poles[a]], m.shapes[:, poles[b]])
+             >= SAME_SHAPE_MAC]  # fmt: skip
     if not pairs:
         return rows, shapes, []
     data = DftLines.from_recording(rec, band_hz).noise_weighted(count.model)
@@ -192,10 +198,11 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
         notes.append(QualityWarning(
             "modes_not_separated", (),
             f"the modal model needs two poles at {both.freq_hz.iloc[0]:.3f} and {both.freq_hz.iloc[1]:.3f} Hz, but "
-            f"they are {gap:.1f} standard deviations of their difference apart (under {SEPARATION_SD:g}): the record "
-            f"does not separate them. Reported as one mode at {f:.3f} Hz (damping {x:.3g}, the model with one pole "
-            "there), its intervals covering both: one resonance whose frequency moves during the record (a "
-            "nonlinearity, a change) or two modes this record cannot resolve", f,
+            f"they are {gap:.1f} standard deviations of their difference apart (under {SEPARATION_SD:g}) and their "
+            f"shapes agree (MAC at least {SAME_SHAPE_MAC:g}): the record does not separate them. Reported as one mode "
+            f"at {f:.3f} Hz (damping {x:.3g}, the model with one pole there), its intervals covering both: one "
+            "resonance whose frequency moves during the record (a nonlinearity, a change) or two modes this record "
+            "cannot resolve", f,
         ))  # fmt: skip
     kept = [i for i in range(len(rows)) if i not in gone]
     return rows.iloc[kept].reset_index(drop=True), shapes[:, kept], notes

@@ -181,21 +181,24 @@ def _rows_of(model):
                          "damping_ci95_hi": x + Z95 * sx, "structure_widened": False})  # fmt: skip
 
 
-@pytest.mark.parametrize("planted", ["own", "hull_only", "none"])
+@pytest.mark.parametrize("planted", ["own", "own_other_shape", "hull_only", "none"])
 def test_two_poles_the_record_does_not_separate_are_reported_as_one(supine, supine_ride, planted):
     """The chest mode given a second pole 1 % away. With the model's own standard deviations of
-    the pair planted at 0.15 Hz (the F-16's highest level left a pair 0.2 SD apart), the two are
-    reported as one mode: the exact one, refitted with one pole there, with intervals that cover
-    both poles and a note. Planted at 0.005 Hz they are separated and reported as they are, also
-    when only the rows' intervals (a hull over equally good counts) overlap."""
+    the pair planted at 0.15 Hz and one shape for both (the F-16's highest level left a pair 0.2 SD
+    apart whose shapes three sensors cannot tell apart), the two are reported as one mode: the
+    exact one, refitted with one pole there, with intervals that cover both poles and a note.
+    Shapes that differ (the head mode's for the second) separate them; so do standard deviations of
+    0.005 Hz, also when only the rows' intervals (a hull over equally good counts) overlap."""
     from dataclasses import replace
 
     data, truth = supine
     f, x = np.r_[truth.freq_hz, truth.freq_hz[1] * 1.01], np.r_[truth.damping, truth.damping[1]]
     started = fit_modal_model(data, f, x, "zoh", max_nfev=1)  # a pair at the chest mode, as started
     sd = started.freq_sd.copy()
-    sd[[1, 2]] = 0.15 if planted == "own" else 0.005
-    model = replace(started, freq_sd=sd)
+    sd[[1, 2]] = 0.15 if planted.startswith("own") else 0.005
+    shapes = started.shapes.copy()
+    shapes[:, 2] = 1.3 * shapes[:, 1] if planted != "own_other_shape" else truth.modal_constants[:, 0]
+    model = replace(started, freq_sd=sd, shapes=shapes)
     rows = _rows_of(model)
     if planted == "hull_only":
         rows.loc[[1, 2], "freq_ci95_lo"] -= 0.3
