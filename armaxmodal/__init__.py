@@ -31,7 +31,7 @@ from armaxmodal.modes import (
     select_modes,
     stabilisation_diagram,
 )
-from armaxmodal.notes import QualityWarning
+from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.systems import (
     ChainComponents,

@@ -15,6 +15,32 @@ sys.path.insert(0, str(ROOT))
 os.environ.setdefault("MPLBACKEND", "Agg")  # the gallery draws without a display
 
 from armaxmodal import __version__  # noqa: E402
+from armaxmodal.quality_warnings import CODES  # noqa: E402
+
+
+def _warning_page() -> str:
+    """The warning codes' page, written from their own definitions
+    (:data:`armaxmodal.quality_warnings.CODES`) so that it cannot go stale."""
+    lines = [
+        "# Warning codes",
+        "",
+        "Every warning the product raises, as `armaxmodal.quality_warnings.CODES` defines it (this page is",
+        "generated from those definitions when the docs build). A warning travels with its result: the JSON's",
+        "`warnings` list (code, channels, message, value) and a `warning [code]:` line on stderr, even with",
+        "`--quiet`. Codes marked **uncertain** make a selection that passes its check say",
+        '`"quality": "uncertain"`: the record does not settle the modes.',
+        "",
+    ]
+    for c in CODES:
+        flag = " (**uncertain**)" if c.uncertain else ""
+        lines += [f"## `{c.code}`", "", f"*Raised by:* {c.stage}{flag}", "", f"**Measured:** {c.measured}", "",
+                  f"**What is done:** {c.done}", "", f"**What to do:** {c.advice}", ""]
+    return "\n".join(lines)
+
+
+_page = Path(__file__).parent / "user_guide" / "warnings.md"
+if not _page.exists() or _page.read_text() != _warning_page():
+    _page.write_text(_warning_page())
 
 project = "armaxmodal"
 author = "the armaxmodal developers"

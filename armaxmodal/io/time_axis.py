@@ -89,7 +89,7 @@ def bridge_dropped_rows(t: np.ndarray, channels: dict, path: Path, fill_gaps_s: 
     asks) filled by linear interpolation in every channel, each gap a ``dropped_packet`` warning.
     Other uneven steps are left to :func:`fs_from_time`, which refuses them. Returns
     ``(t, channels, warnings)``."""
-    from armaxmodal.notes import QualityWarning
+    from armaxmodal.quality_warnings import QualityWarning
 
     steps = np.diff(t)
     dt = float(np.median(steps)) if steps.size else 0.0
@@ -170,7 +170,7 @@ def fill_missing_samples(channels: dict, max_samples: int, source: str) -> tuple
         Copies with the runs filled (unchanged channels are the same arrays).
     warnings : list of QualityWarning
     """
-    from armaxmodal.notes import QualityWarning
+    from armaxmodal.quality_warnings import QualityWarning
 
     out, notes = dict(channels), []
     for name, x in channels.items():

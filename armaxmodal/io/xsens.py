@@ -20,7 +20,7 @@ import pandas as pd
 
 from armaxmodal.exceptions import DataError
 from armaxmodal.io.time_axis import whole_step_gaps
-from armaxmodal.notes import QualityWarning
+from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
 __all__ = ["read_xsens", "MAX_BRIDGED_PACKETS"]

@@ -14,7 +14,7 @@ from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, 
 from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_band, selection_job
 from armaxmodal.modes.working import WorkingSelection
-from armaxmodal.notes import QualityWarning
+from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.stats import Z95
 
@@ -80,7 +80,7 @@ def modes_the_record_needs(recording: Recording, work: WorkingSelection, band) -
                 f"{evidence}: a spurious pole of the model (noise, a nonlinearity, leakage), not a mode of the record",
                 float(f_m),
             )  # fmt: skip
-        work = work.kept(i for i in range(len(modes)) if i != m).noted(note)
+        work = work.kept(i for i in range(len(modes)) if i != m).warned(note)
 
 
 def refit_with_added(diagram, work: WorkingSelection, band, limits) -> WorkingSelection:
@@ -90,7 +90,7 @@ def refit_with_added(diagram, work: WorkingSelection, band, limits) -> WorkingSe
     13.3 Hz for the exact 13.54). A refit that cannot be made leaves the modes, said."""
     refit = selection_job(diagram.recording, [], work.modes, ("refit", refit_band(diagram.recording, band)))
     if isinstance(refit, RefitFailure):
-        work = work.noted(*refit.notes("the modes with those the check added"))
+        work = work.warned(*refit.notes("the modes with those the check added"))
     else:  # the first refit's start lacked these modes: its refusals may not stand
         work = refined_modes(diagram, work, refit, *limits, relaxed=True)
     return replace(work, check=check_modes(diagram.recording, work.modes.freq_hz, work.modes.damping, band))

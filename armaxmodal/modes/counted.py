@@ -29,7 +29,7 @@ from armaxmodal.modes.poles import mac
 from armaxmodal.modes.spread import split_segments
 from armaxmodal.modes.support import CANDIDATE_MIN_ORDERS, stable_in_diagram
 from armaxmodal.modes.working import WorkingSelection
-from armaxmodal.notes import QualityWarning
+from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.stats import MAX_DAMPING, Z95
 
 __all__ = ["SEPARATION_SD", "confirmed_where_incoherent", "counted_modes", "dropped_where_peaks_remain",
@@ -131,13 +131,13 @@ def counted_modes(
     if picked:
         return _picked_result(work, count, keep, hold, rec, band)
     if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
-        return work.noted(_no_mode_kept(count, modes, data.band_hz), count=count)
+        return work.warned(_no_mode_kept(count, modes, data.band_hz), count=count)
     rows = pd.DataFrame([_row(modes, count, i, hold) for i in np.flatnonzero(keep)])
     rows, shapes, merged = _one_where_not_separated(rows, count.model.shapes[:, keep], count, keep, rec, band_hz, hold)
     # where two poles are reported as one, the check fits the model's poles, not the row's
     poles = tuple(zip(count.model.freq_hz[keep].tolist(), count.model.damping[keep].tolist(), strict=True))
     work = work.with_modes(rows, shapes, count=count, check_poles=poles if merged else None)
-    return work.noted(*_notes(count, keep, data.band_hz), *merged)
+    return work.warned(*_notes(count, keep, data.band_hz), *merged)
 
 
 def not_separated(modes: pd.DataFrame) -> list[tuple[int, int, float]]:
@@ -242,7 +242,7 @@ def confirmed_where_incoherent(diagram, work: WorkingSelection) -> WorkingSelect
     if not confirmed:
         return work
     left = tuple(f for f in check.unconfirmed_hz if f not in confirmed)
-    return replace(work, check=replace(check, unconfirmed_hz=left)).noted(*notes)
+    return replace(work, check=replace(check, unconfirmed_hz=left)).warned(*notes)
 
 
 def dropped_where_peaks_remain(count: ModeCount | None, peaks) -> list[QualityWarning]:
@@ -315,7 +315,7 @@ def _picked_result(work: WorkingSelection, count: ModeCount, keep: np.ndarray, h
         f = np.r_[work.modes.freq_hz.to_numpy(), m.freq_hz[others]]
         x = np.r_[work.modes.damping.to_numpy(), m.damping[others]]
         work = replace(work, check=check_modes(recording, f, x, band))
-    return work.noted(*notes)
+    return work.warned(*notes)
 
 
 def _no_mode_kept(count: ModeCount, modes: pd.DataFrame, band_hz) -> QualityWarning:

@@ -21,9 +21,9 @@ from armaxmodal.estimate.orders import Orders, default_nb, default_nc, informati
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.poles import SHARED, Tolerances, pole_rows, rejection_reasons, stability_classes
-from armaxmodal.notes import QualityWarning
 from armaxmodal.prepare.disturbance import disturbance_lines
 from armaxmodal.prepare.preparation import Preparation, prepare
+from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
 __all__ = ["stabilisation_diagram", "StabilisationDiagram", "choose_nk"]
@@ -88,13 +88,13 @@ class StabilisationDiagram:
     recording: Recording
     fits: dict = field(repr=False, default_factory=dict)
     preparation: Preparation | None = None
-    notes: tuple = ()
+    own_warnings: tuple = ()
 
     @property
     def warnings(self) -> list[QualityWarning]:
         """Data-quality findings of the preparation and of the sweep itself."""
         found = list(self.preparation.warnings) if self.preparation is not None else []
-        found += list(self.notes)
+        found += list(self.own_warnings)
         found += _nk_edge_warning(self.orders[0].nk, self.recording)
         return found + disturbance_lines(self.poles, self.tolerances.min_energy, self.recording, SHARED)
 

@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 
 from armaxmodal.modes.lines import PEAK_RESOLUTION, measured_h1, resolving_nperseg
-from armaxmodal.notes import QualityWarning
 from armaxmodal.prepare.frf import excited_band
+from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.stats import H1_COHERENCE
 

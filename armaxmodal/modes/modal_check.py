@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from armaxmodal.modes.lines import CHECK_RESOLUTION, CoherentLines, coherent_lines, resolving_nperseg
-from armaxmodal.notes import QualityWarning
+from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.stats import H1_COHERENCE
 

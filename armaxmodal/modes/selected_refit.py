@@ -21,8 +21,8 @@ from armaxmodal.modes.spread import (
     split_segments,
 )
 from armaxmodal.modes.working import WorkingSelection
-from armaxmodal.notes import QualityWarning
 from armaxmodal.prepare.frf import excited_band
+from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.stats import Z95
 

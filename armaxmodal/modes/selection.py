@@ -39,8 +39,8 @@ from armaxmodal.modes.spread import (
     segment_spread,
 )
 from armaxmodal.modes.working import WorkingSelection
-from armaxmodal.notes import UNCERTAIN_CODES, QualityWarning
 from armaxmodal.prepare.preparation import oversampling_note, record_header
+from armaxmodal.quality_warnings import UNCERTAIN_CODES, QualityWarning
 from armaxmodal.stats import Z95
 
 __all__ = ["select_modes", "ModeSelection", "verdict"]
@@ -78,7 +78,7 @@ class ModeSelection:
     weighted: pd.DataFrame
     diagram: StabilisationDiagram
     refinement: ModalRefinement | None = None
-    notes: tuple[QualityWarning, ...] = ()
+    own_warnings: tuple[QualityWarning, ...] = ()
     check: ModalCheck | None = None
     count: ModeCount | None = None
 
@@ -100,7 +100,7 @@ class ModeSelection:
     @property
     def quality(self) -> str:
         """``"poor"`` when the modal-model check fails; ``"uncertain"`` when it passes but a
-        warning of :data:`armaxmodal.notes.UNCERTAIN_CODES` stands (the record does not decide
+        warning of :data:`armaxmodal.quality_warnings.UNCERTAIN_CODES` stands (the record does not decide
         the number of modes, two modes are closer than it separates, or the preparation found a
         fault that moves modes); else ``"good"``."""
         if self.check is None or not self.check.passed:
@@ -129,7 +129,7 @@ class ModeSelection:
     @property
     def warnings(self) -> list[QualityWarning]:
         """The diagram's data-quality warnings and the selection's own."""
-        return self.diagram.warnings + list(self.notes)
+        return self.diagram.warnings + list(self.own_warnings)
 
     def to_dict(self, shapes: str = "shared") -> dict:
         """The JSON contract of the ``stabilise`` command.
@@ -282,7 +282,7 @@ def select_modes(
                 bar.update(work.count.trials)
             if picks is not None:
                 work = _with_picks(diagram, work, picked, nas, clustering, band, n_jobs)
-            work = work.noted(*_not_separated(work.modes))
+            work = work.warned(*_not_separated(work.modes))
         if picks is None or work.check is None:
             f, x = work.modes.freq_hz, work.modes.damping
             if work.check_poles:  # two poles reported as one: the check fits the model's poles
@@ -294,8 +294,8 @@ def select_modes(
             spread = segment_spread(diagram.recording, modes, lambda i: orders[int(modes.at[i, "na"])], segments,
                                     n_jobs, fitted)  # fmt: skip
             modes, spread_notes = apply_segment_spread(modes, spread, segments)
-            work = replace(work, modes=modes).noted(*spread_notes)
-        return _finished(diagram, work.noted(*refit_notes), band, cluster_freq, len(nas))
+            work = replace(work, modes=modes).warned(*spread_notes)
+        return _finished(diagram, work.warned(*refit_notes), band, cluster_freq, len(nas))
 
 
 def _with_picks(diagram, work: WorkingSelection, picked, nas, clustering, band, n_jobs=None) -> WorkingSelection:
@@ -392,7 +392,7 @@ def _finished(diagram, work: WorkingSelection, band, cluster_freq: float, n_orde
     from armaxmodal.modes.frf_check import unexplained_peaks
 
     modes, widened = _discount_filled_samples(work.modes, diagram.recording, diagram.preparation)
-    work = replace(work, modes=modes).noted(*widened)
+    work = replace(work, modes=modes).warned(*widened)
     shapes = work.shapes
     per_sensor, weighted = per_sensor_table(diagram, modes, shapes, cluster_freq)
     freq, damping = modes.freq_hz.to_numpy(), modes.damping.to_numpy()
@@ -402,14 +402,14 @@ def _finished(diagram, work: WorkingSelection, band, cluster_freq: float, n_orde
         poles = work.check.poles
         explaining = (np.abs(poles) / (2 * np.pi), -poles.real / np.abs(poles))
     peaks = unexplained_peaks(diagram.recording, *explaining, band)
-    work = work.noted(
+    work = work.warned(
         *peaks,
         *dropped_where_peaks_remain(work.count, peaks),
         *oversampling_note(freq, diagram.recording.fs),
         *_unresolved_damping_notes(modes, n_orders),
         *work.check.warnings(),
     )
-    return ModeSelection(modes, shapes, per_sensor, weighted, diagram, work.refinement, work.notes, work.check,
+    return ModeSelection(modes, shapes, per_sensor, weighted, diagram, work.refinement, work.warnings, work.check,
                          work.count)  # fmt: skip
 
 

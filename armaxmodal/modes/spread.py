@@ -17,7 +17,7 @@ from functools import partial
 import numpy as np
 import pandas as pd
 
-from armaxmodal.notes import QualityWarning
+from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.stats import Z95
 

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
-from armaxmodal.notes import QualityWarning
+from armaxmodal.quality_warnings import QualityWarning
 
 if TYPE_CHECKING:  # types only: the stages that make them import this module
     from armaxmodal.modes.modal_check import ModalCheck
@@ -35,7 +35,7 @@ class WorkingSelection:
         The modal-model check of ``modes``, once run (a stage that changes the modes runs it again).
     count : ModeCount or None
         The maximum-likelihood count, once run.
-    notes : tuple of QualityWarning
+    warnings : tuple of QualityWarning
         What the stages said, in order.
     check_poles : tuple of (float, float) or None
         The poles the check fits, ``(Hz, ratio)``, where they are not the rows': the model's two
@@ -47,7 +47,7 @@ class WorkingSelection:
     refinement: ModalRefinement | None = None
     check: ModalCheck | None = None
     count: ModeCount | None = None
-    notes: tuple[QualityWarning, ...] = ()
+    warnings: tuple[QualityWarning, ...] = ()
     check_poles: tuple[tuple[float, float], ...] | None = None
 
     def __post_init__(self):
@@ -63,6 +63,6 @@ class WorkingSelection:
         """Other modes (and any other attribute by keyword)."""
         return replace(self, modes=modes, shapes=shapes, **changes)
 
-    def noted(self, *notes: QualityWarning, **changes) -> WorkingSelection:
-        """``notes`` appended (and any other attribute by keyword)."""
-        return replace(self, notes=self.notes + tuple(notes), **changes)
+    def warned(self, *warnings: QualityWarning, **changes) -> WorkingSelection:
+        """``warnings`` appended (and any other attribute by keyword)."""
+        return replace(self, warnings=self.warnings + tuple(warnings), **changes)

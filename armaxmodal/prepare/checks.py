@@ -4,7 +4,6 @@
 
 from __future__ import annotations
 
-from armaxmodal.notes import QualityWarning
 from armaxmodal.prepare.delay import delay_and_inversion
 from armaxmodal.prepare.held import held_samples
 from armaxmodal.prepare.quality import (
@@ -15,6 +14,7 @@ from armaxmodal.prepare.quality import (
     stuck_channels,
 )
 from armaxmodal.prepare.units import unit_mismatch
+from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
 __all__ = ["check_quality"]

@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from armaxmodal.notes import QualityWarning, not_run
 from armaxmodal.prepare.frf import coherence, welch_segments, welch_spectra
+from armaxmodal.quality_warnings import QualityWarning, not_run
 from armaxmodal.recording import Recording
 from armaxmodal.stats import QUASI_STATIC_COHERENCE, welch_nperseg
 

@@ -14,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from armaxmodal.notes import QualityWarning
 from armaxmodal.prepare.frf import welch_spectra
+from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
 __all__ = ["UNDAMPED_LINE", "disturbance_lines"]

@@ -21,7 +21,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from armaxmodal.notes import QualityWarning
+from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
 __all__ = ["held_channels", "held_samples", "HeldChannel", "MAX_CYCLE"]

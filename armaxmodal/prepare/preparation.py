@@ -28,9 +28,9 @@ import numpy as np
 
 from armaxmodal._validate import check_outputs_carry_signal
 from armaxmodal.exceptions import DataError
-from armaxmodal.notes import QualityWarning
 from armaxmodal.prepare.checks import check_quality
 from armaxmodal.prepare.delay import estimate_delays
+from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
 __all__ = ["prepare", "Preparation", "check_band", "decimate", "level_shifts", "oversampling_note", "DETRENDS"]

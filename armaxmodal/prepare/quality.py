@@ -33,8 +33,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from armaxmodal.notes import QualityWarning, not_run
 from armaxmodal.prepare.frf import coherence, welch_spectra
+from armaxmodal.quality_warnings import QualityWarning, not_run
 from armaxmodal.recording import Recording
 from armaxmodal.stats import welch_nperseg
 

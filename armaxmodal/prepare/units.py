@@ -21,8 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from armaxmodal.notes import QualityWarning, not_run
 from armaxmodal.prepare.delay import QUASI_STATIC_MAGNITUDE, transmissibility_spectra
+from armaxmodal.quality_warnings import QualityWarning, not_run
 from armaxmodal.recording import Recording
 from armaxmodal.stats import QUASI_STATIC_COHERENCE
 

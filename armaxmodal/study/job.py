@@ -83,7 +83,7 @@ def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[st
         )
         selection = select_modes(diagram, settings.modes, settings.band, n_jobs=1)
         if selection.modes.empty:  # a recording with no mode is a study's failure row, as before
-            raise OrderError(selection.notes[0].message)
+            raise OrderError(selection.own_warnings[0].message)
         report = selection.to_dict("per_sensor")
         figure = _thumbnail(diagram, selection)
         lump = _lump(rec, settings)

@@ -81,7 +81,7 @@ def render_report(study, shape_figures: dict, lump_rows: pd.DataFrame | None = N
     settings = pd.DataFrame([{"setting": k, "value": str(v)} for k, v in study.to_dict()["settings"].items()])
     fails = "".join(f"<li class=fail><b>{esc(f['file'])}</b>: {esc(str(f['reason']))}</li>" for f in study.failures)
     notes = "".join(f"<li class=note>{esc(n)}</li>" for n in study.notes)
-    from armaxmodal.notes import UNCERTAIN_CODES
+    from armaxmodal.quality_warnings import UNCERTAIN_CODES
 
     flagged = {"poor": ("modes_do_not_explain_frf",), "uncertain": UNCERTAIN_CODES}
     poor = "".join(

@@ -324,7 +324,7 @@ def test_the_band_and_the_detrend_reach_the_preparation_and_the_selection(ride):
     assert "trend_removed" in {w.code for w in d.warnings}
     sel = select_modes(d, n_jobs=1)  # the diagram's band: only the first mode, nothing unexplained
     assert sel.modes.freq_hz.to_numpy() == pytest.approx(s.modes().freq_hz[:1], rel=0.005)
-    assert not [n for n in sel.notes if n.code == "unexplained_peak"]
+    assert not [n for n in sel.own_warnings if n.code == "unexplained_peak"]
     # a band the rate need not change for: the selection still keeps to it
     upper = _diagram(rec, band=(6.0, 20.0))
     assert upper.recording.fs == rec.fs

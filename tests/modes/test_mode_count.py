@@ -235,7 +235,7 @@ def test_the_verdict_has_three_values(codes, passed, quality):
     notes = tuple(am.QualityWarning(c, (), "x") for c in codes)
     sel = ModeSelection(
         pd.DataFrame(), np.zeros((1, 0)), pd.DataFrame(), pd.DataFrame(), SimpleNamespace(warnings=[]),
-        notes=notes, check=SimpleNamespace(passed=passed),
+        own_warnings=notes, check=SimpleNamespace(passed=passed),
     )  # fmt: skip
     assert sel.quality == quality
 
@@ -427,7 +427,7 @@ def test_the_modal_model_confirms_a_mode_where_the_h1_is_not_coherent(monkeypatc
         bundled_diagram, WorkingSelection(sel.modes, sel.shapes, sel.refinement, check, count)
     )
     assert work.check.passed is confirmed and (work.check.unconfirmed_hz == ()) is confirmed
-    assert [n.value for n in work.notes] == ([f0] if confirmed else [])
+    assert [n.value for n in work.warnings] == ([f0] if confirmed else [])
 
 
 @pytest.mark.parametrize(
@@ -439,7 +439,7 @@ def test_the_modal_model_confirms_a_mode_where_the_h1_is_not_coherent(monkeypatc
     ],
 )
 def test_a_start_mode_left_out_where_a_coherent_peak_remains_leaves_the_count_undecided(peaks_hz, near):
-    from armaxmodal.notes import UNCERTAIN_CODES, QualityWarning
+    from armaxmodal.quality_warnings import UNCERTAIN_CODES, QualityWarning
 
     peaks = [QualityWarning("unexplained_peak", ("deck",), "a peak", f) for f in peaks_hz]
     count = SimpleNamespace(carried_away=((5.826, 4.401),))

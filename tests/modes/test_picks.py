@@ -81,9 +81,9 @@ def test_a_pick_the_modal_model_takes_out_of_the_band_is_reported_and_said():
     out = _picked_result(work, count, np.array([True, False, True]), "bandlimited")
     assert out.modes.freq_hz.tolist() == [5.1, 9.0] and out.shapes.tolist() == [[3.0, 2.0]]
     assert out.modes.count_undecided.tolist() == [False, True] and out.modes.picked_hz.tolist() == [5.1, 9.0]
-    (said,) = [n for n in out.notes if n.code == "pick_not_supported"]
+    (said,) = [n for n in out.warnings if n.code == "pick_not_supported"]
     assert "9.000 Hz to 20.000 Hz" in said.message
-    (other,) = [n for n in out.notes if n.code == "mode_count"]
+    (other,) = [n for n in out.warnings if n.code == "mode_count"]
     assert other.value == 1 and "12.100 Hz" in other.message
 
 

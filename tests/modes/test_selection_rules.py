@@ -208,7 +208,7 @@ def test_rejection_reasons_each_at_its_threshold():
 def test_order_cap_message_names_the_record_the_cause_and_a_supported_range():
     from types import SimpleNamespace
 
-    from armaxmodal.notes import QualityWarning
+    from armaxmodal.quality_warnings import QualityWarning
 
     # 1,040 samples: (1040 // 20 - 1 - 6 - 3) // 3 = 14
     with pytest.raises(OrderError, match=r"this record \(1040 samples at 60 Hz\) supports at most na = 14 "):

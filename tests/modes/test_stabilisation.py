@@ -255,14 +255,14 @@ def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
     kept = modes_the_record_needs(diagram.recording, WorkingSelection(modes, shapes), None)
     assert kept.modes.freq_hz.tolist() == [m.freq_hz[0], m.freq_hz[1]]  # the better-supported one stays
     np.testing.assert_array_equal(kept.shapes, shapes[:, [0, 2]])
-    (note,) = kept.notes
+    (note,) = kept.warnings
     assert note.code == "split_merged" and note.value == pytest.approx(1.01 * m.freq_hz[0])
     # the check of what is kept (lightly damped: H1 bias)
     assert kept.check.passed and kept.check.model_error.max() < 0.15
     # the true modes alone: nothing to merge
     true = modes.iloc[[0, 2]].reset_index(drop=True)
     again = modes_the_record_needs(diagram.recording, WorkingSelection(true, shapes[:, [0, 2]]), None)
-    assert len(again.modes) == 2 and again.notes == ()
+    assert len(again.modes) == 2 and again.warnings == ()
 
 
 def test_a_spurious_heavily_damped_neighbour_is_left_out_and_said(light_diagram):
@@ -286,7 +286,7 @@ def test_a_spurious_heavily_damped_neighbour_is_left_out_and_said(light_diagram)
     shapes = np.column_stack([m.modal_constants[:, 0], 0.1 * m.modal_constants[:, 0], m.modal_constants[:, 1]])
     kept = modes_the_record_needs(diagram.recording, WorkingSelection(modes, shapes), None)
     assert kept.modes.freq_hz.tolist() == [m.freq_hz[0], m.freq_hz[1]]
-    (note,) = kept.notes
+    (note,) = kept.warnings
     assert note.code == "split_merged" and note.value == pytest.approx(1.15 * m.freq_hz[0])
 
 
