@@ -27,6 +27,7 @@ from armaxmodal.modes.counted import (
     not_separated,
 )
 from armaxmodal.modes.diagram import StabilisationDiagram
+from armaxmodal.modes.header import oversampling_note, record_header
 from armaxmodal.modes.modal_check import ModalCheck, check_modes
 from armaxmodal.modes.mode_count import ModeCount
 from armaxmodal.modes.per_sensor import per_sensor_table
@@ -39,7 +40,6 @@ from armaxmodal.modes.spread import (
     segment_spread,
 )
 from armaxmodal.modes.working import WorkingSelection
-from armaxmodal.prepare.preparation import oversampling_note, record_header
 from armaxmodal.quality_warnings import UNCERTAIN_CODES, QualityWarning
 from armaxmodal.stats import Z95
 

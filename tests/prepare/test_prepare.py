@@ -260,7 +260,7 @@ def test_a_sensor_offset_jumping_mid_record_is_found_removed_and_the_modes_kept(
 
 @pytest.mark.parametrize("where", [0.1, 0.5, 0.9])
 def test_level_shifts_are_located_and_sized_a_drift_is_not_one(clean, where):
-    from armaxmodal.prepare.preparation import level_shifts
+    from armaxmodal.prepare.detrend import level_shifts
 
     x = clean.response[:, 1].copy()
     at = int(where * x.size)
@@ -363,7 +363,7 @@ def test_decimate_equals_scipy_resample_poly_on_the_samples_kept(n, factor):
     on a drifting random walk whose ends differ: the kept samples never see scipy's padding."""
     from scipy.signal import resample_poly
 
-    from armaxmodal.prepare.preparation import RESAMPLE_EDGE, decimate
+    from armaxmodal.prepare.resample import RESAMPLE_EDGE, decimate
 
     rng = np.random.default_rng(n)
     x = rng.standard_normal((n, 3)).cumsum(axis=0) + np.linspace(0.0, 50.0, n)[:, None]
@@ -570,7 +570,7 @@ def test_a_record_sampled_far_above_its_structure_says_so_and_its_advice_finds_t
     structure, so the rate is kept, and the sweep found one of the four modes with nothing
     said. Every mode found lies below 10 % of the Nyquist frequency: 'oversampled' names it
     and the band to use; with that band all four modes are found, within 1.5 %."""
-    from armaxmodal.prepare.preparation import oversampling_note
+    from armaxmodal.modes.header import oversampling_note
 
     system = am.supine_human()
     ride = am.random_vibration(1000.0, 15.0, (0.5, 400.0), seed=1)
