@@ -90,6 +90,21 @@ def diagnose(
     Returns
     -------
     Diagnosis
+
+    Examples
+    --------
+    A hum at 11.7 Hz on the head sensor, which the model of the ride lacks:
+
+    >>> import armaxmodal as am
+    >>> from armaxmodal.diagnosis.inject import inject
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 120.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> hum = inject(ride, "periodic_disturbance", ["head"], freq_hz=11.7, amp=0.1)
+    >>> (effect,) = am.diagnose(hum, max_rounds=1).effects
+    >>> effect.finding.effect, effect.finding.channels, round(effect.parameters["freq_hz"], 1)
+    ('periodic_disturbance', ('head',), 11.7)
+    >>> effect.error_after < effect.error_before
+    True
     """
     if not isinstance(recording, Recording):
         raise DataError(f"recording: expected a Recording, got {type(recording).__name__}.")

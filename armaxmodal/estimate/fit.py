@@ -92,6 +92,18 @@ def fit_armax(
     Returns
     -------
     ArmaxFit
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 120.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> fit = am.fit_armax(ride, 8, 8, 8, 0, shared_poles=True)  # na, nb, nc, nk
+    >>> fit.orders
+    (8, 8, 8, 0)
+    >>> bool(np.all(fit.fit_percent > 90))  # one-step fit of each output, %
+    True
     """
     return fit_resumable(
         data, (na, nb, nc, nk), fs=fs, shared_poles=shared_poles, output_error=output_error, max_iter=max_iter,

@@ -138,6 +138,15 @@ def choose_orders(
     Returns
     -------
     OrderChoice
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 120.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> choice = am.choose_orders(ride, na_values=[6, 8], nk_values=[0, -1])
+    >>> choice.orders[0]  # na of lowest BIC: four modes need eight poles
+    8
     """
     if criterion not in ("bic", "aic"):
         raise ValueError(f"criterion: expected 'bic' or 'aic', got {criterion!r}.")

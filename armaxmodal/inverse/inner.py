@@ -97,6 +97,18 @@ def inner_solve(
     Returns
     -------
     InverseSolution
+
+    Examples
+    --------
+    The supine chain recovered from its exact modes and its total mass:
+
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> body = am.supine_human()
+    >>> modes = body.modes()
+    >>> solution = am.inner_solve(modes.eigenvalues, modes.shapes, total_mass=body.masses.sum())
+    >>> np.round(solution.structure.masses, 2), np.round(body.masses, 2)
+    (array([ 6.23, 21.37, 30.01, 19.95]), array([ 6.23, 21.37, 30.01, 19.95]))
     """
     start = time.perf_counter()
     lam, psi = check_modes(eigenvalues, shapes)

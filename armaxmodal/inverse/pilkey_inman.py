@@ -30,6 +30,18 @@ def pia(eigenvalues, shapes, mass, *, tol: float = 1e-4, max_iter: int = 500, na
         Known masses, kg.
     tol : float
         Relative change of C that ends the iteration.
+
+    Examples
+    --------
+    Stiffness and damping from the exact modes and the masses (Pilkey & Inman):
+
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> body = am.supine_human()
+    >>> modes = body.modes()
+    >>> solution = am.pia(modes.eigenvalues, modes.shapes, body.masses)
+    >>> np.round(np.diag(solution.structure.K) / 1e3, 1), np.round(np.diag(body.K) / 1e3, 1)  # kN/m
+    (array([ 61.7,  76.1, 190.6,  38.2]), array([ 61.7,  76.1, 190.6,  38.2]))
     """
     start = time.perf_counter()
     m = np.diag(mass) if np.ndim(mass) == 2 else np.asarray(mass, dtype=float)

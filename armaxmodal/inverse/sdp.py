@@ -90,6 +90,16 @@ def inner_solve_sdp(
     -------
     InverseSolution
         ``components`` is set when the result is a chain.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> body = am.supine_human()
+    >>> modes = body.modes()
+    >>> solution = am.inner_solve_sdp(modes.eigenvalues, modes.shapes, total_mass=body.masses.sum())
+    >>> np.round(solution.structure.masses, 2)
+    array([ 6.23, 21.37, 30.01, 19.95])
     """
     import clarabel
 

@@ -93,6 +93,19 @@ def model_update(
         As :func:`inner_solve`.
     start : InverseSolution, optional
         Starting model (default: :func:`inner_solve` on the modes).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> body = am.supine_human()
+    >>> modes = body.modes()
+    >>> f = np.linspace(1.0, 25.0, 200)
+    >>> start = am.inner_solve(modes.eigenvalues, modes.shapes, total_mass=body.masses.sum())
+    >>> solution = am.model_update(modes.eigenvalues, modes.shapes, frf=(f, body.transmissibility(f)), start=start,
+    ...                            total_mass=body.masses.sum())
+    >>> np.round(solution.structure.masses, 2)
+    array([ 6.23, 21.37, 30.01, 19.95])
     """
     t_start = time.perf_counter()
     sig = {**DEFAULT_SIGMA, **(sigma or {})}

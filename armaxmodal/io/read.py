@@ -60,6 +60,17 @@ def read_recording(
     Returns
     -------
     Recording
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 20.0, seed=1), 60.0, seed=2)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = am.write_recording_csv(ride, pathlib.Path(folder) / "ride.csv")  # time, base, head, ...
+    ...     back = am.read_recording(path, input="base", outputs=["head", "pelvis"])
+    >>> back.input_name, back.sensors, back.fs
+    ('base', ('head', 'pelvis'), 60.0)
     """
     if isinstance(path, (list, tuple)):
         raise DataError(

@@ -59,7 +59,18 @@ def write_all(outputs) -> list[Path]:
 
 
 def write_recording_csv(recording: Recording, path: str | os.PathLike, float_format: str = "%.9g") -> Path:
-    """Write ``time``, the input and every sensor as CSV, with subject lines if known."""
+    """Write ``time``, the input and every sensor as CSV, with subject lines if known.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 20.0, seed=1), 60.0, seed=2)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = am.write_recording_csv(ride, pathlib.Path(folder) / "ride.csv")
+    ...     am.read_recording(path).sensors
+    ('head', 'chest', 'pelvis', 'legs')
+    """
 
     def write(tmp: str) -> None:
         with open(tmp, "w", encoding="utf-8", newline="") as fh:
@@ -76,7 +87,18 @@ def write_recording_csv(recording: Recording, path: str | os.PathLike, float_for
 
 
 def write_recording_uff(recording: Recording, path: str | os.PathLike) -> Path:
-    """Write every channel (input first) as a type-58 time-response data set."""
+    """Write every channel (input first) as a type-58 time-response data set.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 20.0, seed=1), 60.0, seed=2)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     back = am.read_recording(am.write_recording_uff(ride, pathlib.Path(folder) / "ride.uff"))
+    >>> back.sensors, round(back.fs, 3)  # UFF 58 stores the sampling interval in single precision
+    (('head', 'chest', 'pelvis', 'legs'), 60.0)
+    """
     import pyuff
 
     names = [recording.input_name, *recording.sensors]

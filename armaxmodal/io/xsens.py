@@ -57,6 +57,26 @@ def read_xsens(
     -------
     Recording
         ``meta["read_warnings"]`` holds a ``dropped_packet`` warning per bridged gap.
+
+    Examples
+    --------
+    One export per sensor (the table's and the top floor's), put on the input's time stamps:
+
+    >>> import tempfile, pathlib
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> def export(path, acc_x):  # the columns of an Xsens DOT CSV export, one packet every 8333 us
+    ...     rows = ["PacketCounter,SampleTimeFine,Euler_X,Euler_Y,Euler_Z,Acc_X,Acc_Y,Acc_Z,Gyr_X,Gyr_Y,Gyr_Z"]
+    ...     rows += [f"{i},{i * 8333},0,0,0,{a},0.1,9.8,0,0,0" for i, a in enumerate(acc_x)]
+    ...     pathlib.Path(path).write_text("\\n".join(rows) + "\\n")
+    ...     return path
+    >>> rng = np.random.default_rng(1)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     g = export(pathlib.Path(folder) / "run__g.csv", rng.standard_normal(400))
+    ...     f1 = export(pathlib.Path(folder) / "run__f1.csv", rng.standard_normal(400))
+    ...     rec = am.read_xsens({"g": g, "f1": f1}, input="g")
+    >>> rec.input_name, rec.sensors, round(rec.fs, 2)
+    ('g', ('f1',), 120.0)
     """
     named = _names(files)
     if input not in named:

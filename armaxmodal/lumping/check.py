@@ -131,6 +131,16 @@ def lump_check(
     -------
     LumpCheck
         ``verdict`` is "lump", "separate" or "undetermined" (too few measurable frequencies).
+
+    Examples
+    --------
+    Do the legs and feet of the five-segment body move as one mass?
+
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_with_feet(), am.random_vibration(60.0, 120.0, seed=1), 60.0,
+    ...                              noise=0.03, seed=2)
+    >>> am.lump_check(ride, "legs", "feet", wavelet=False).verdict
+    'separate'
     """
     f, t, coh, measurable = relative_transmissibility(rec, a, b)
     t = np.where(np.isfinite(t), t, 0.0)

@@ -228,6 +228,15 @@ def stabilisation_diagram(
         Worker threads (default: all cores).
     progress : bool
         Show progress bars (the delay choice's fits, then the sweep's).
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 120.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> diagram = am.stabilisation_diagram(ride, range(4, 13, 2))
+    >>> sorted({order.na for order in diagram.orders})
+    [4, 6, 8, 10, 12]
     """
     with one_blas_thread():  # a with block, not a decorator: mutmut skips decorated functions
         limits = tolerances or Tolerances()

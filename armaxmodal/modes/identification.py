@@ -154,6 +154,17 @@ def identify(
     Returns
     -------
     Identification
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 120.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> result = am.identify(ride)  # orders chosen by BIC
+    >>> exact = am.supine_human().modes().freq_hz  # 5.83, 8.31, 13.50, 16.25 Hz
+    >>> bool(np.allclose(result.modes.freq_hz, exact, rtol=0.02))
+    True
     """
     preparation = None
     if not prepared:

@@ -245,6 +245,21 @@ def select_modes(
         Show a count of the fits the selection runs (finishing fits, the refit and the
         segment refits: on a long record they take as long as the sweep). A count, not a
         fraction: how many there are is known only as the selection goes.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 120.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> selection = am.select_modes(am.stabilisation_diagram(ride, range(4, 13, 2)))
+    >>> selection.quality
+    'good'
+    >>> exact = am.supine_human().modes().freq_hz  # 5.83, 8.31, 13.50, 16.25 Hz
+    >>> bool(np.allclose(selection.modes.freq_hz, exact, rtol=0.02))
+    True
+    >>> bool(np.all(selection.modes.freq_ci95_lo < selection.modes.freq_ci95_hi))
+    True
     """
     from tqdm import tqdm
 

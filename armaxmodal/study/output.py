@@ -43,6 +43,19 @@ def write_study(study: Study, out: str | Path, report: str | Path | None = None)
     -------
     list of Path
         The files written.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> import armaxmodal as am
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03,
+    ...                                  seed=1)
+    ...     _ = am.write_recording_csv(ride, pathlib.Path(folder) / "Sub01_ride.csv")
+    ...     study = am.run_study(folder, pathlib.Path(folder) / "out", jobs=1)
+    ...     written = am.write_study(study, pathlib.Path(folder) / "out")
+    >>> sorted(p.name for p in written)[:3]
+    ['modes.csv', 'per_sensor.csv', 'report.html']
     """
     import matplotlib.pyplot as plt
 

@@ -106,6 +106,21 @@ def run_study(
     Returns
     -------
     Study
+
+    Examples
+    --------
+    Two subjects' rides in one folder, analysed and tabled:
+
+    >>> import tempfile, pathlib
+    >>> import armaxmodal as am
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     for k in (1, 2):
+    ...         ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=k), 60.0,
+    ...                                      noise=0.03, seed=k)
+    ...         _ = am.write_recording_csv(ride, pathlib.Path(folder) / f"Sub0{k}_ride.csv")
+    ...     study = am.run_study(folder, pathlib.Path(folder) / "out", jobs=1)
+    >>> sorted(set(study.tables.modes.subject))
+    ['Sub01_ride', 'Sub02_ride']
     """
     settings = settings or StudySettings()
     entries, failures = read_manifest(source)

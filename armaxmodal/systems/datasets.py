@@ -85,7 +85,16 @@ TABLE_4_4 = {
 
 
 def chapter2_system() -> Structure:
-    """The four-DOF base-excited system of Section 2.3.1 (kg, N s/m, N/m)."""
+    """The four-DOF base-excited system of Section 2.3.1 (kg, N s/m, N/m).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> system = am.chapter2_system()
+    >>> system.n_dof, np.round(system.modes().freq_hz, 1).tolist()
+    (4, [5.9, 9.8, 13.3, 19.4])
+    """
     m = np.diag([6.0, 14.0, 22.0, 9.0])
     c = np.array(
         [
@@ -107,7 +116,18 @@ def chapter2_system() -> Structure:
 
 
 def supine_human() -> Structure:
-    """The supine-human chain of Section 4.4 (head, chest, pelvis, legs), symmetric C."""
+    """The supine-human chain of Section 4.4 (head, chest, pelvis, legs), symmetric C.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> body = am.supine_human()
+    >>> body.names
+    ('head', 'chest', 'pelvis', 'legs')
+    >>> np.round(body.modes().freq_hz, 2)  # Table 4.3's natural frequencies, Hz
+    array([ 5.83,  8.31, 13.5 , 16.25])
+    """
     m = np.diag([6.2338, 21.3693, 30.0144, 19.9488])
     c = np.array(
         [
@@ -132,7 +152,18 @@ def supine_with_feet() -> Structure:
     """Table 4.4's supine chain with a light feet segment on the legs (2.5 kg; to the base
     40 kN/m and 250 N s/m, to the legs 20 kN/m and 60 N s/m; not from the thesis, which
     names the feet as an optional fifth sensor): modes 6.89, 8.36, 13.54, 16.25 and
-    24.84 Hz, damping 0.26-0.40, the fifth near the 28 Hz edge of the thesis's rides."""
+    24.84 Hz, damping 0.26-0.40, the fifth near the 28 Hz edge of the thesis's rides.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> body = am.supine_with_feet()
+    >>> body.names
+    ('head', 'chest', 'pelvis', 'legs', 'feet')
+    >>> np.round(body.modes().freq_hz, 1)
+    array([ 6.9,  8.4, 13.5, 16.2, 24.8])
+    """
     return Structure.from_chain(
         [6.2338, 21.3693, 30.0144, 19.9488, 2.5],
         [40707.0, 18152.0, 116596.0, 1059.0, 40000.0],

@@ -106,6 +106,14 @@ def simulate(
     Returns
     -------
     (n_samples, n_dof) ndarray
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> u = am.random_vibration(60.0, 20.0, seed=1)
+    >>> y = am.simulate(am.supine_human(), u, 60.0)  # absolute accelerations of the four masses
+    >>> y.shape
+    (1200, 4)
     """
     if hold not in HOLDS:
         raise ValueError(f"hold: expected one of {HOLDS}, got {hold!r}.")
@@ -198,6 +206,14 @@ def simulate_recording(
     ``noise`` and ``input_noise`` are white Gaussian noise levels relative to each
     channel's RMS (0.05 = 5 %). The noiseless input drives the structure; the recorded
     input carries its own noise, as a platform sensor's would.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> u = am.random_vibration(60.0, 120.0, seed=1)
+    >>> ride = am.simulate_recording(am.supine_human(), u, 60.0, noise=0.03, seed=2)
+    >>> ride.sensors, ride.fs, ride.n_samples
+    (('head', 'chest', 'pelvis', 'legs'), 60.0, 7200)
     """
     u = as_signal_vector(base_acceleration, "base_acceleration")
     y = simulate(structure, u, fs, hold=hold, quantity=quantity, frame=frame, oversample=oversample)
@@ -219,7 +235,17 @@ def simulate_recording(
 
 
 def add_noise(x, level: float, rng: np.random.Generator) -> np.ndarray:
-    """``x`` plus white Gaussian noise of standard deviation ``level`` x RMS per column."""
+    """``x`` plus white Gaussian noise of standard deviation ``level`` x RMS per column.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> y = am.simulate(am.supine_human(), am.random_vibration(60.0, 20.0, seed=1), 60.0)
+    >>> noisy = am.add_noise(y, 0.05, np.random.default_rng(0))
+    >>> round(float(np.std(noisy - y) / np.std(y)), 2)  # 5 % of each channel's RMS
+    0.05
+    """
     x = np.asarray(x, dtype=float)
     if level < 0:
         raise ValueError(f"noise level: expected >= 0, got {level}.")
@@ -258,6 +284,13 @@ def sine_sweep(
     Returns
     -------
     (round(duration * fs),) ndarray, m/s^2
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> u = am.sine_sweep(100.0, 10.0, f_start=1.0, f_stop=20.0)
+    >>> u.shape
+    (1000,)
     """
     fs = check_fs(fs)
     n = int(round(duration * fs))
@@ -284,6 +317,14 @@ def random_vibration(
     Returns
     -------
     (round(duration * fs),) ndarray, m/s^2, scaled to the given RMS.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> u = am.random_vibration(60.0, 20.0, band=(0.5, 28.0), seed=1)
+    >>> u.shape, round(float(np.std(u)), 3)
+    ((1200,), 1.0)
     """
     fs = check_fs(fs)
     lo, hi = band
