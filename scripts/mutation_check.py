@@ -666,9 +666,15 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/counted.py",
-        "pairs = not_separated(own)",
-        "pairs = not_separated(rows)",
+        "in not_separated(own) if mac(",
+        "in not_separated(rows) if mac(",
         "pairs judged on the widened hull (count)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        ">= SAME_SHAPE_MAC]",
+        ">= 0.0]",
+        "pairs merged whatever their shapes (count)",
     ),
     (
         "armaxmodal/modes/counted.py",
