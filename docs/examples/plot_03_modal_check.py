@@ -13,7 +13,7 @@ second left out, and the modes with the second 3 % too high are checked. On a fr
 below about 1 % both wrong sets fail clearly; at 2-3 % a missing mode sits just beyond the
 limit and a 3 % error passes; on a heavily damped chain (the supine human, damping
 0.26-0.35) the broad peaks absorb a missing mode and every set passes. The
-:doc:`validation page <../validation>` gives the check's record on real structures.
+:doc:`validation pages <../validation/real>` gives the check's record on real structures.
 """
 
 import matplotlib.pyplot as plt
