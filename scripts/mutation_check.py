@@ -690,7 +690,8 @@ MUTANTS = [
     ),
     # the diagnosis registry and the joint-force test (issue 38); run with --match "(registry)"
     # --tests tests/diagnosis/test_diagnose_delays.py tests/diagnosis/test_diagnose.py -k (as pytest
-    # takes it): "friction or cubic or registry or clipping or joint_ride"
+    # takes it): "friction or cubic or registry or clipping or joint_ride or kept_only or corrected or waits_for
+    # or own_keep"
     (
         "armaxmodal/diagnosis/effects.py",
         "if entry.test not in out:",

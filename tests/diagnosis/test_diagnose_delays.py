@@ -391,3 +391,26 @@ def test_the_figure_of_a_short_record_is_drawn(tmp_path, clean):
     write_recording_csv(short, data)
     assert main(["diagnose", str(data), "--plot", str(fig), "--json", str(out), "--quiet"]) == 0
     assert fig.stat().st_size > 10_000 and out.exists()
+
+
+def test_a_lead_by_cross_correlation_waits_for_the_disturbances_a_phase_slope_delay_does_not():
+    from armaxmodal.diagnosis.effects import tier_of
+
+    slope = Finding("input_delay", ("legs",), "phase_slope_z", 9.0, 1e-9, {"delay_samples": 2.0})
+    lead = Finding("input_delay", ("legs",), "residual_input_ccf_z", 9.0, 1e-9, {"delay_samples": -14.0})
+    line = Finding("periodic_disturbance", ("head",), "harmonic_F", 9.0, 1e-9, {"freq_hz": 11.7})
+    assert tier_of(slope) == 0 and tier_of(line) == 1 and tier_of(lead) == entry_of("coloured_noise").tier == 2
+    assert sorted([lead, line, slope], key=tier_of) == [slope, line, lead]
+
+
+def test_a_fix_is_judged_by_its_effects_own_keep_rule(clean):
+    """An entry whose refit changes nothing (no significant drop, BIC unchanged): the general rule
+    refuses it, the entry's own rule keeps it, and its note is the effect's."""
+    from dataclasses import replace
+
+    stage = Stage(_model(clean), held_out(ModelSpec(ORDERS), _signals(clean)))
+    finding = Finding("clipping", ("head",), "rail_pileup", 12.0, 1e-9, {"samples": 12})
+    same = replace(entry_of("clipping"), refit=lambda stage, finding, entry: stage, refuse=None)
+    assert acceptance.try_fix(stage, finding, 0.01, replace(same, keep=acceptance.significant_drop))[0] is None
+    kept, _ = acceptance.try_fix(stage, finding, 0.01, replace(same, keep=lambda j: (True, "its own rule")))
+    assert kept is not None and kept[0].note == "its own rule"
