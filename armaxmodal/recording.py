@@ -10,6 +10,7 @@ import pandas as pd
 
 from armaxmodal._validate import as_signal_matrix, as_signal_vector, check_amplitude, check_fs, check_not_constant
 from armaxmodal.exceptions import DataError
+from armaxmodal.welch import welch_spectra
 
 __all__ = ["Recording"]
 
@@ -46,6 +47,8 @@ class Recording:
     subject: str | None = None
     mass_kg: float | None = None
     meta: dict = field(default_factory=dict)
+    #: this record's Welch spectra by segment length (:meth:`welch`): computed once, for every stage
+    _spectra: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         fs = check_fs(self.fs)
@@ -97,6 +100,34 @@ class Recording:
     def channel(self, name: str) -> np.ndarray:
         """One output by name."""
         return self.response[:, self._sensor_index(name)]
+
+    def welch(self, nperseg: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The record's Welch spectra at a segment length, computed at the first call and kept
+        with the record (read-only): every stage that holds this record -- the preparation's
+        checks, the selection, the modal-model check, the figure -- reads the same ones.
+
+        Parameters
+        ----------
+        nperseg : int
+            Segment length, samples (at most the record's).
+
+        Returns
+        -------
+        freq_hz : (nperseg // 2 + 1,) ndarray
+        puu : (n_freq,) ndarray
+            The input's PSD, unit^2/Hz.
+        puy : (n_freq, n_sensors) complex ndarray
+            Cross-spectral densities ``conj(U) Y``.
+        pyy : (n_freq, n_sensors) ndarray
+            The outputs' PSDs.
+        """
+        nperseg = int(nperseg)
+        if nperseg not in self._spectra:
+            spectra = welch_spectra(self.base, self.response, self.fs, nperseg)
+            for array in spectra:
+                array.flags.writeable = False  # shared by every stage that reads them
+            self._spectra[nperseg] = spectra
+        return self._spectra[nperseg]
 
     def select(self, sensors: Sequence[str]) -> Recording:
         """A recording with only the named outputs, in the given order."""

@@ -6,8 +6,9 @@ from __future__ import annotations
 import numpy as np
 
 from armaxmodal.diagnosis.model import FittedModel, usable
-from armaxmodal.prepare.frf import coherence, h1_relative_error, welch_spectra
+from armaxmodal.prepare.frf import h1_relative_error
 from armaxmodal.stats import MISFIT_COHERENCE, welch_nperseg
+from armaxmodal.welch import coherence, welch_spectra
 
 __all__ = ["mode_findings", "added_modes", "MODEL_CLASS_FLOOR"]
 

@@ -12,9 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from armaxmodal.prepare.frf import coherence, excited_band, h1_relative_error, welch_spectra
+from armaxmodal.prepare.frf import excited_band, h1_relative_error
 from armaxmodal.recording import Recording
 from armaxmodal.stats import H1_COHERENCE
+from armaxmodal.welch import coherence
 
 __all__ = ["CHECK_RESOLUTION", "CoherentLines", "PEAK_RESOLUTION", "Resolution", "coherent_lines", "measured_h1",
            "resolving_nperseg"]  # fmt: skip
@@ -73,7 +74,7 @@ def measured_h1(recording: Recording, nperseg: int) -> tuple[np.ndarray, np.ndar
     h1 : (n_lines, n_sensors) complex ndarray
     coherence : (n_lines, n_sensors) ndarray
     """
-    f, puu, puy, pyy = welch_spectra(recording.base, recording.response, recording.fs, nperseg)
+    f, puu, puy, pyy = recording.welch(nperseg)
     return f, puy / puu[:, None], coherence(puu, puy, pyy)
 
 

@@ -17,10 +17,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from armaxmodal.prepare.frf import coherence, welch_segments, welch_spectra
 from armaxmodal.quality_warnings import QualityWarning, not_run
 from armaxmodal.recording import Recording
 from armaxmodal.stats import QUASI_STATIC_COHERENCE, welch_nperseg
+from armaxmodal.welch import coherence, welch_segments
 
 __all__ = [
     "DELAY_ALPHA", "MIN_DELAY_SAMPLES", "QUASI_STATIC_MAGNITUDE", "DelayEstimate", "delay_and_inversion",
@@ -78,7 +78,7 @@ def transmissibility_spectra(recording: Recording):
     nperseg = _quasi_static_nperseg(recording)
     if nperseg < 16:
         return None
-    f, puu, puy, pyy = welch_spectra(recording.base, recording.response, recording.fs, nperseg)
+    f, puu, puy, pyy = recording.welch(nperseg)
     n_segments = max(1, (n - nperseg) // (nperseg // 2) + 1)
     return f, puy / puu[:, None], coherence(puu, puy, pyy), puu >= puu.max() * 1e-3, n_segments
 

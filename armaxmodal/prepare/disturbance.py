@@ -14,7 +14,6 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from armaxmodal.prepare.frf import welch_spectra
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
@@ -104,7 +103,7 @@ def _input_prominence(recording: Recording, freq: float) -> float:
     two bins splits its power) over the median of the 20 lines around them, at a resolution
     of a quarter of the record (a line's PSD grows with the segment; the noise's does not)."""
     nperseg = 2 ** int(np.log2(max(recording.n_samples // 4, 16)))
-    f, puu, _, _ = welch_spectra(recording.base, recording.base[:, None], recording.fs, nperseg)
+    f, puu, _, _ = recording.welch(nperseg)
     i = int(np.argmin(np.abs(f - freq)))
     around = np.r_[puu[max(i - 12, 0) : max(i - 2, 0)], puu[i + 3 : i + 13]]
     peak = float(puu[max(i - 1, 0) : i + 2].max())

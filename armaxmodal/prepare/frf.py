@@ -8,20 +8,16 @@
 
 from __future__ import annotations
 
-import hashlib
-import threading
-from collections import OrderedDict
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from armaxmodal.exceptions import DataError
 from armaxmodal.stats import welch_nperseg
 
 if TYPE_CHECKING:
     from armaxmodal.recording import Recording
 
-__all__ = ["excited_band", "measured_frf", "modal_frf", "welch_segments", "welch_spectra"]
+__all__ = ["excited_band", "measured_frf", "modal_frf"]
 
 
 def default_nperseg(recording) -> int:
@@ -30,118 +26,13 @@ def default_nperseg(recording) -> int:
     return welch_nperseg(recording.n_samples, recording.fs)
 
 
-#: spectra of the last few (signals, rate, segment) sets, kept read-only: one ``stabilise`` run
-#: asked for the input's PSD ten times and for the outputs' 256-sample H1 five times (the
-#: preparation's checks, the band of the refit, the rejection rules, the modal-model check,
-#: the peak check); each is now computed once
-_SPECTRA: OrderedDict = OrderedDict()
-_SPECTRA_KEPT = 8
-_SPECTRA_LOCK = threading.Lock()
-
-
-def welch_spectra(u: np.ndarray, y: np.ndarray, fs: float, nperseg: int):
-    """Welch auto- and cross-spectral densities of an input and several outputs.
-
-    The estimator and scaling of ``scipy.signal.welch`` / ``csd`` with their defaults
-    (periodic Hann window, 50 % overlap, constant detrend per segment, one-sided density,
-    mean over segments; tested equal to them), computed with one FFT per channel and
-    segment and without importing ``scipy.signal``, whose import alone is 0.3 s of the
-    4 s ``stabilise`` command.
-
-    Parameters
-    ----------
-    u : (n,) ndarray
-        Input.
-    y : (n, k) ndarray
-        Outputs.
-    fs : float
-        Sampling rate, Hz.
-    nperseg : int
-        Segment length, samples (at most n).
-
-    Returns
-    -------
-    freq_hz : (nperseg // 2 + 1,) ndarray
-    puu : (n_freq,) ndarray
-        Input PSD, unit^2/Hz.
-    puy : (n_freq, k) complex ndarray
-        Cross-spectral densities ``conj(U) Y``.
-    pyy : (n_freq, k) ndarray
-        Output PSDs.
-    """
-    key = (_digest(u), _digest(y), float(fs), int(nperseg))
-    with _SPECTRA_LOCK:
-        if key in _SPECTRA:
-            _SPECTRA.move_to_end(key)
-            return _SPECTRA[key]
-    f, uf, yf, scale = welch_segments(u, y, fs, nperseg)
-    puu = scale * np.mean(np.abs(uf) ** 2, axis=0)
-    puy = scale[:, None] * np.mean(np.conj(uf)[:, :, None] * yf, axis=0)
-    pyy = scale[:, None] * np.mean(np.abs(yf) ** 2, axis=0)
-    spectra = (f, puu, puy, pyy)
-    for array in spectra:
-        array.flags.writeable = False  # shared by every caller of the same spectra
-    with _SPECTRA_LOCK:
-        _SPECTRA[key] = spectra
-        while len(_SPECTRA) > _SPECTRA_KEPT:
-            _SPECTRA.popitem(last=False)
-    return spectra
-
-
-def _digest(x: np.ndarray) -> tuple:
-    """A signal's identity by content (shape, type and a 128-bit hash of its bytes)."""
-    x = np.ascontiguousarray(x)
-    return x.shape, x.dtype.str, hashlib.blake2b(x.view(np.uint8).data, digest_size=16).digest()
-
-
-def welch_segments(u: np.ndarray, y: np.ndarray, fs: float, nperseg: int):
-    """The windowed segment spectra :func:`welch_spectra` averages, for statistics that need
-    them one by one (a jackknife over segments).
-
-    Returns
-    -------
-    freq_hz : (n_freq,) ndarray
-    uf : (n_segments, n_freq) complex ndarray
-        Input segment DFTs (periodic Hann window, 50 % overlap, each segment's mean removed).
-    yf : (n_segments, n_freq, k) complex ndarray
-        Output segment DFTs.
-    scale : (n_freq,) ndarray
-        Factor turning ``|DFT|^2`` into a one-sided density, unit^2/Hz.
-    """
-    n = u.shape[0]
-    if not 2 <= int(nperseg) <= n:
-        raise DataError(f"nperseg: expected a segment length between 2 and the {n} samples, got {nperseg}.")
-    nperseg = int(nperseg)
-    step = nperseg - nperseg // 2
-    starts = np.arange(0, n - nperseg + 1, step)
-    window = 0.5 - 0.5 * np.cos(2 * np.pi * np.arange(nperseg) / nperseg)
-    idx = starts[:, None] + np.arange(nperseg)[None, :]
-
-    def segments_fft(x):  # (n_segments, n_freq[, k])
-        seg = x[idx]
-        seg = seg - seg.mean(axis=1, keepdims=True)
-        return np.fft.rfft(seg * (window if x.ndim == 1 else window[:, None]), axis=1)
-
-    scale = np.full(nperseg // 2 + 1, 2.0 / (fs * np.sum(window**2)))
-    scale[0] /= 2
-    if nperseg % 2 == 0:
-        scale[-1] /= 2
-    return np.fft.rfftfreq(nperseg, 1.0 / fs), segments_fft(u), segments_fft(y), scale
-
-
-def coherence(puu: np.ndarray, puy: np.ndarray, pyy: np.ndarray) -> np.ndarray:
-    """Magnitude-squared coherence ``|Puy|^2 / (Puu Pyy)`` of :func:`welch_spectra`'s output,
-    (n_freq, K); zero where a spectrum vanishes."""
-    return np.abs(puy) ** 2 / np.maximum(puu[:, None] * pyy, 1e-300)
-
-
 def measured_frf(recording, nperseg: int | None = None):
     """H1 estimate of each output over the input and the coherence.
 
     Returns ``(freq_hz, H (n_freq, n_sensors) complex, coherence (n_freq, n_sensors))``.
     """
     n = default_nperseg(recording) if nperseg is None else nperseg
-    f, puu, puy, pyy = welch_spectra(recording.base, recording.response, recording.fs, n)
+    f, puu, puy, pyy = recording.welch(n)
     return f, puy / puu[:, None], np.abs(puy) ** 2 / (puu[:, None] * pyy)
 
 
@@ -168,6 +59,6 @@ def modal_frf(freq_hz, freqs, dampings, shapes):
 
 def excited_band(recording: Recording, min_db: float = -30.0) -> tuple[float, float]:
     """Lowest and highest frequency (Hz) where the input PSD is within ``min_db`` of its peak."""
-    f, pxx, _, _ = welch_spectra(recording.base, recording.base[:, None], recording.fs, min(recording.n_samples, 1024))
+    f, pxx, _, _ = recording.welch(min(recording.n_samples, 1024))
     live = f[pxx >= pxx.max() * 10 ** (min_db / 10)]
     return float(live.min()), float(live.max())

@@ -33,10 +33,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from armaxmodal.prepare.frf import coherence, welch_spectra
 from armaxmodal.quality_warnings import QualityWarning, not_run
 from armaxmodal.recording import Recording
 from armaxmodal.stats import welch_nperseg
+from armaxmodal.welch import coherence, welch_spectra
 
 __all__ = [
     "CLIP_MIN_SAMPLES", "INCOHERENT", "NEIGHBOUR_LEVELS", "STUCK_EDGE_MIN", "STUCK_MIN_RUN", "clipped_channels",
@@ -159,7 +159,7 @@ def narrowband_input(recording: Recording) -> list[QualityWarning]:
     nperseg = welch_nperseg(n, recording.fs, seconds=20.0, max_fraction=4)
     if nperseg < 16:
         return [not_run("narrowband_input", (recording.input_name,), f"{n} samples, too few for the input's spectrum")]
-    f, puu, _, _ = welch_spectra(recording.base, recording.base[:, None], recording.fs, nperseg)
+    f, puu, _, _ = recording.welch(nperseg)
     peak = float(f[int(np.argmax(puu))])
     live = puu >= 0.1 * puu.max()
     width = float(np.count_nonzero(live) * (f[1] - f[0]))

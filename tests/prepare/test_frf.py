@@ -52,7 +52,7 @@ def test_h1_relative_error_matches_the_scatter_around_the_true_transmissibility(
 def test_welch_spectra_equal_scipy_welch_and_csd(nperseg):
     import scipy.signal
 
-    from armaxmodal.prepare.frf import welch_spectra
+    from armaxmodal.welch import welch_spectra
 
     rng = np.random.default_rng(3)
     u = rng.standard_normal(5000) + 0.3
@@ -87,24 +87,26 @@ def test_segment_longer_than_the_record_is_a_clear_error(fixtures_dir):
         measured_frf(rec, nperseg=rec.n_samples + 1)
 
 
-def test_welch_spectra_are_computed_once_per_signals_and_segment():
-    """The cache keys the spectra by content: the same signals give the very same (read-only)
-    arrays, a one-sample change or another segment length gives new ones, equal to a fresh
-    computation."""
-    from armaxmodal.prepare import frf
+def test_a_recording_computes_its_spectra_once_per_segment_length():
+    """A recording keeps its Welch spectra: the same segment length gives the very same
+    (read-only) arrays, another gives new ones, each equal to a fresh computation; a record
+    made from it (another object) computes its own."""
+    from dataclasses import replace
+
+    from armaxmodal.recording import Recording
+    from armaxmodal.welch import welch_segments, welch_spectra
 
     rng = np.random.default_rng(4)
     u, y = rng.standard_normal(4000), rng.standard_normal((4000, 3))
-    first = frf.welch_spectra(u, y, 50.0, 256)
-    again = frf.welch_spectra(u.copy(), y.copy(), 50.0, 256)
-    assert all(a is b for a, b in zip(first, again, strict=True))
+    rec = Recording(50.0, u, y)
+    first = rec.welch(256)
+    assert all(a is b for a, b in zip(first, rec.welch(256), strict=True))
     assert not any(a.flags.writeable for a in first)
-    changed = y.copy()
-    changed[1000, 2] += 1e-9
-    other = frf.welch_spectra(u, changed, 50.0, 256)
-    assert other[2] is not first[2] and not np.array_equal(other[2], first[2])
-    longer = frf.welch_spectra(u, y, 50.0, 512)
-    assert longer[0].size == 257
-    f, uf, yf, scale = frf.welch_segments(u, y, 50.0, 256)
+    for got, fresh in zip(first, welch_spectra(u, y, 50.0, 256), strict=True):
+        np.testing.assert_array_equal(got, fresh)
+    assert rec.welch(512)[0].size == 257
+    changed = replace(rec, response=y + np.eye(4000, 3)[:, ::-1] * 1e-3)
+    assert changed.welch(256)[2] is not first[2] and not np.array_equal(changed.welch(256)[2], first[2])
+    f, uf, yf, scale = welch_segments(u, y, 50.0, 256)
     np.testing.assert_array_equal(first[1], scale * np.mean(np.abs(uf) ** 2, axis=0))
     np.testing.assert_array_equal(first[2], scale[:, None] * np.mean(np.conj(uf)[:, :, None] * yf, axis=0))
