@@ -38,6 +38,12 @@ def _warning_page() -> str:
     return "\n".join(lines)
 
 
+# the performance page's ratios, from the benchmarks' saved results (benchmarks/report.py)
+sys.path.insert(0, str(ROOT / "benchmarks"))
+import report as _benchmark_report  # noqa: E402
+
+_benchmark_report.write()
+
 _page = Path(__file__).parent / "user_guide" / "warnings.md"
 if not _page.exists() or _page.read_text() != _warning_page():
     _page.write_text(_warning_page())

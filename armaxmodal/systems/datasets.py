@@ -176,7 +176,7 @@ def supine_with_feet() -> Structure:
 
 def five_mass_chain() -> Structure:
     """A five-mass chain (not from the thesis): modes 6.56, 7.66, 9.75, 11.09 and 14.42 Hz
-    at 7-10 % damping, some close. The size benchmark's structure (``scripts/bench_size.py``);
+    at 7-10 % damping, some close. The size benchmark's structure (``benchmarks/bench_size.py``);
     at ``na = 10`` its shared-pole ARMAX model is over-parameterised and its fit crawls."""
     return Structure.from_chain(
         [8.0, 10.0, 30.0, 15.0, 12.0],

@@ -32,7 +32,7 @@ def _assert_json_close(got, want, where=""):
 
 
 def test_fixtures_regenerate(tmp_path, fixtures_dir):
-    script = fixtures_dir.parent / "scripts" / "make_fixtures.py"
+    script = fixtures_dir.parent / "tools" / "make_fixtures.py"
     # run from anywhere, against this checkout's package (not whatever an earlier install left)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(fixtures_dir.parent), os.environ.get("PYTHONPATH", "")]))
     subprocess.run(

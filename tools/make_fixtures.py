@@ -2,7 +2,7 @@
 
 Each fixture is a CSV recording (``time``, ``base``, one column per sensor, subject lines
 on top) and a ``.truth.json`` with the structure, its exact modes and how the data were
-made. Run:  python scripts/make_fixtures.py [--out fixtures]
+made. Run:  python tools/make_fixtures.py [--out fixtures]
 """
 
 from __future__ import annotations

@@ -9,7 +9,7 @@ modes found against the chain's exact ones. With ``--stages`` it also times each
 one run in this process (preparation, delay choice, sweep, selection's finishing fits,
 frequency-domain refit, segment refits).
 
-    python scripts/bench_size.py [--samples 5000,10000,20000,40000] [--stages]
+    python benchmarks/bench_size.py [--samples 5000,10000,20000,40000] [--stages]
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ short: the goal is at most 1), the peak resident memory per sample and sensor of
 run (goal: at most 100 bytes), and what a sample adds: the slope of the peak between the
 two lengths, which leaves out the fixed 0.25 GB of the interpreter and its libraries.
 
-    python scripts/bench_long.py [--short 20000] [--long 432000]
+    python benchmarks/bench_long.py [--short 20000] [--long 432000]
 """
 
 from __future__ import annotations
@@ -19,6 +19,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from results import save  # benchmarks/results.py, beside this script
 
 import armaxmodal as am
 
@@ -71,6 +73,16 @@ def main() -> None:
             f"memory a sample and sensor adds: {slope:.0f} bytes; fixed part {peaks[args.short] / 2**20:.0f} MB; "
             f"ten hours at {FS:g} Hz would peak near {ten_hours / 2**30:.1f} GB"
         )
+        ratio, bytes_long = results[args.long] / results[args.short], peaks[args.long] / (4 * args.long)
+        save("long", [
+            {"what": f"wall time per sample of a {args.long:,} x 4 ride over a {args.short:,} one (defaults, a "
+                     "new process each)", "goal": "<= 1.5 (long records linear)",
+             "measured": f"{ratio:.2f} ({results[args.long] * args.long:.1f} s against "
+                         f"{results[args.short] * args.short:.1f} s)", "met": ratio <= 1.5, "values": [ratio]},
+            {"what": "peak resident memory of that long run per sample and sensor", "goal": "none (100 bytes retired)",
+             "measured": f"{bytes_long:.0f} bytes ({peaks[args.long] / 2**20:.0f} MB; {slope:.0f} bytes a sample "
+                         "and sensor adds)", "met": None, "values": [bytes_long, slope]},
+        ])  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -6,7 +6,7 @@ selection, so it is handed the frequencies armaxmodal selected as its picks
 registry reachable here. Reports time and the frequency / damping errors against the exact
 modes for the bundled supine-human rides (random and sweep) and the Chapter 2 system.
 
-    python scripts/bench_modal_peers.py
+    python benchmarks/bench_modal_peers.py
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ its held-out folds, every effect test of the first round, one fix with its held-
 and the whole `diagnose()` call. The record is the bundled ride, or a copy with an effect
 planted (``--plant periodic``), or any recording (``--data FILE [--input COL]``).
 
-    python scripts/bench_diagnose.py [--plant periodic|delay|none] [--data FILE --input COL]
+    python benchmarks/bench_diagnose.py [--plant periodic|delay|none] [--data FILE --input COL]
 """
 
 from __future__ import annotations

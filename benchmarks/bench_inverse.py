@@ -1,7 +1,7 @@
 """Timing of the inverse methods on the Chapter 2 system (P1 10 % eigenvector noise), side by
 side with the same SDP stated in cvxpy (the modelling-layer peer), on identical data.
 
-    python scripts/bench_inverse.py [--repeat 20]
+    python benchmarks/bench_inverse.py [--repeat 20]
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 masses 76.96 +- 8.71 kg, modes varying like Table 3.2, six subjects with a feet sensor
 (rigid on five, a separate mass on Sub12), with ``manifest.csv`` and ``truth.json``.
 
-    python scripts/make_study.py OUT_FOLDER [--subjects 15] [--seed 2024]
+    python tools/make_study.py OUT_FOLDER [--subjects 15] [--seed 2024]
     armaxmodal study OUT_FOLDER --out OUT_FOLDER/results --lump legs,feet
 """
 

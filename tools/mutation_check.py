@@ -4,7 +4,7 @@ Each mutant is a one-line change a tired developer could make; the script applie
 working tree, runs the test files that cover that code, restores the file, and reports
 whether a test failed (killed) or not (survived).
 
-    python scripts/mutation_check.py [--tests tests/estimate/test_guards.py tests/estimate/test_fit.py ...]
+    python tools/mutation_check.py [--tests tests/estimate/test_guards.py tests/estimate/test_fit.py ...]
 """
 
 from __future__ import annotations

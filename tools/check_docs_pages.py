@@ -3,7 +3,7 @@ and every figure it shows exists; no example printed a traceback or an object's 
 Markdown table row was left as raw text (a blank line inside a table ends it). Run by .ci/run
 after the build.
 
-Run:  python scripts/check_docs_pages.py [docs/_build/html]
+Run:  python tools/check_docs_pages.py [docs/_build/html]
 """
 
 from __future__ import annotations

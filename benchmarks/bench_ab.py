@@ -6,7 +6,7 @@ earlier. Each checkout runs as its own warm process (one untimed run first fills
 cache); the record is any file the command reads.
 
     git worktree add /tmp/before <commit>
-    python scripts/bench_ab.py RECORD /tmp/before . [--runs 8]
+    python benchmarks/bench_ab.py RECORD /tmp/before . [--runs 8]
 """
 
 from __future__ import annotations
