@@ -83,8 +83,8 @@ def main() -> None:
             f"{len(rec.sensors)} chain record")  # fmt: skip
     measured = f"{min(ratios):.2f}-{max(ratios):.2f} ({len(ratios)} runs; " + ", ".join(
         f"{a:.2f} against {b:.2f} CPU-s" for a, b in cpu) + ")"  # fmt: skip
-    save("ratio", [{"what": what, "goal": "<= 2 (retired: the delay choice is necessary work)",
-                    "measured": measured, "met": max(ratios) <= 2.0, "values": ratios}])  # fmt: skip
+    save("ratio", [{"what": what, "goal": "none (the goal of 2 is retired: the delay choice is necessary work)",
+                    "measured": measured, "met": None, "values": ratios}])  # fmt: skip
 
 
 if __name__ == "__main__":
