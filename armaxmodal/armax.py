@@ -1,6 +1,6 @@
 """ARMAX models ``A(q) y = q^-nk B(q) u + C(q) e`` (thesis Eqs. 3.9-3.14).
 
-One :class:`ArmaxModel` describes one output sensor (the thesis's diagonal A, Eq. 3.11).
+One ``ArmaxModel`` describes one output sensor (the thesis's diagonal A, Eq. 3.11).
 ``B`` has ``nb`` coefficients per input on lags ``nk .. nk + nb - 1``: ``nk = 0`` with a
 ``b0`` term is the biproper acceleration-in/acceleration-out case, ``nk < 0`` adds
 non-causal taps (band-limited sampled data).

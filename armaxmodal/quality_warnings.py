@@ -319,7 +319,7 @@ UNCERTAIN_CODES = tuple(c.code for c in CODES if c.uncertain)
 
 @dataclass(frozen=True)
 class QualityWarning:
-    """One data-quality finding: ``code`` (see :data:`WARNING_CODES`), the channels it
+    """One data-quality finding: ``code`` (see ``WARNING_CODES``), the channels it
     concerns, a sentence with the measured number, and that number (``value``, its unit in
     the message)."""
 

@@ -1,10 +1,10 @@
 """Shared statistics and thresholds: the numbers several stages use, in one place.
 
-* :data:`Z95` -- the 95 % two-sided normal quantile, for every interval and its inverse.
-* :func:`welch_nperseg` -- the Welch segment rule of the spectra the checks and figures use.
-* The coherence levels, each named by what it admits: :data:`H1_COHERENCE`,
-  :data:`QUASI_STATIC_COHERENCE`, :data:`MISFIT_COHERENCE`, :data:`SECOND_INPUT_COHERENCE`.
-* :data:`MAX_DAMPING` -- the damping above which a pole is no vibration mode here.
+* ``Z95`` -- the 95 % two-sided normal quantile, for every interval and its inverse.
+* ``welch_nperseg`` -- the Welch segment rule of the spectra the checks and figures use.
+* The coherence levels, each named by what it admits: ``H1_COHERENCE``,
+  ``QUASI_STATIC_COHERENCE``, ``MISFIT_COHERENCE``, ``SECOND_INPUT_COHERENCE``.
+* ``MAX_DAMPING`` -- the damping above which a pole is no vibration mode here.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Welch spectra: auto and cross spectral densities of an input and several outputs, and their
 coherence. Numpy only, so that a :class:`~armaxmodal.recording.Recording` can carry its own
-(:meth:`~armaxmodal.recording.Recording.welch`): every stage that holds the record reads the
+(:meth:`~armaxmodal.Recording.welch`): every stage that holds the record reads the
 spectra computed for it once, instead of recomputing them."""
 
 from __future__ import annotations

@@ -1,7 +1,8 @@
 """Close the loop with measured data: find the residual, name the effect the model lacks, add
 it, refit and report the error before and after.
 
-* :func:`diagnose` -- the loop (:mod:`.loop`); :class:`Diagnosis` its result and JSON (:mod:`.result`).
+* :func:`~armaxmodal.diagnosis.diagnose` -- the loop (:mod:`.loop`);
+  :class:`~armaxmodal.diagnosis.Diagnosis` its result and JSON (:mod:`armaxmodal.diagnosis.result`).
 * :mod:`.effects` -- the registry: one entry per effect (its test, fix, tier, criterion, keep rule).
 * :mod:`.model` -- the ARMAX model plus added effects, fitted and held out on blocked folds.
 * :mod:`.evidence`, :mod:`.joint_forces`, :mod:`.delays`, :mod:`.missing_mode` -- the residual

@@ -2,7 +2,7 @@
 
 A fix is kept when the held-out error of the outputs it concerns falls significantly (one-sided
 Diebold-Mariano on the squared one-step or simulation error) and BIC falls; an effect's own rule
-may replace that (:data:`~.effects.REGISTRY`): a fact of the record (a clipped or stuck run) need
+may replace that (``effects.REGISTRY``): a fact of the record (a clipped or stuck run) need
 only not hurt, and a delay within B's reach need only be no worse.
 """
 

@@ -13,7 +13,7 @@ just inside it (once each for continuous data, a few times for a coarse quantise
 or recorder that saturates piles every sample beyond its range onto one value. The test
 counts the samples at each rail and compares them with the mean count of the
 ``NEIGHBOUR_LEVELS`` distinct values just inside it: Poisson, so the p-value is
-``P(N >= k | lambda)`` (:func:`armaxmodal.prepare.quality.rail_pileup`, which the pre-fit warning
+``P(N >= k | lambda)`` (``armaxmodal.prepare.quality.rail_pileup``, which the pre-fit warning
 uses too, at a stricter p: it is one test of many, this one is corrected for them).
 """
 

@@ -1,9 +1,9 @@
 """Channels out of time: a sensor or the input late (or early) against the others.
 
 Two tests. The phase slope of the quasi-static transmissibility times a delay to a fraction
-of a sample whatever ``nk`` the model needed (:func:`delay_findings`); the residual-input
+of a sample whatever ``nk`` the model needed (``delay_findings``); the residual-input
 cross-correlation beyond the model's non-causal taps finds leads too long for that slope
-(:func:`lead_findings`). Outputs that lag alike -- a delay within the spread their own
+(``lead_findings``). Outputs that lag alike -- a delay within the spread their own
 intervals allow -- are one effect on the input, named once with one delay and its interval:
 moving one channel explains them all, and it is the recorder's offset between the base and
 the body, not four sensors' faults.

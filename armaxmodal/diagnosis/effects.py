@@ -1,13 +1,13 @@
 """The registry of diagnosis effects: one entry per effect, holding all the loop knows of it.
 
-An entry (:class:`EffectKind`) gives the effect's test (a finder that reads the fitted model's
-residual and returns :class:`~.finding.Finding` objects), its place in a round (``tier``: a wrong
+An entry (``EffectKind``) gives the effect's test (a finder that reads the fitted model's
+residual and returns ``Finding`` objects), its place in a round (``tier``: a wrong
 linear part fires every later test, so linear and structural effects come first), the error that
 judges its fix (``criterion``), the fix (``add``: the model spec with the effect added; ``refit``:
 how that is fitted), what the refit says of it (``parameters``) and the rule that keeps it
 (``keep``). Adding an effect means adding an entry here, its finder and its fix, and their tests.
 
-:func:`run_tests` runs every entry's test once per round, in the registry's order. A test may
+``run_tests`` runs every entry's test once per round, in the registry's order. A test may
 name more than one effect (the joint-force test names a stiffness or a damping nonlinearity):
 it runs once and counts once in the Bonferroni correction (sensors x tests).
 """

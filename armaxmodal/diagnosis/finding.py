@@ -1,4 +1,4 @@
-"""What a test of the residual reports: :class:`Finding` (its own module, so each family of
+"""What a test of the residual reports: ``Finding`` (its own module, so each family of
 tests can build one without importing the others)."""
 
 from __future__ import annotations

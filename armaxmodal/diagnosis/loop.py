@@ -2,8 +2,9 @@
 held-out error says so, repeat (at most a few rounds).
 
 What each effect is -- its test, fix, tier, criterion and keep rule -- is the registry's
-(:mod:`.effects`); the rule that keeps a fix is :mod:`.acceptance`'s; the report is
-:mod:`.result`'s and the noise floor it is read against :mod:`.noise_floor`'s.
+(:mod:`~armaxmodal.diagnosis.effects`); the rule that keeps a fix is
+:mod:`~armaxmodal.diagnosis.acceptance`'s; the report is :mod:`~armaxmodal.diagnosis.result`'s and the
+noise floor it is read against :mod:`~armaxmodal.diagnosis.noise_floor`'s.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """A mode the model lacks: the model's FRF against the measured H1, beyond the H1's own
-random error (Bendat & Piersol's ``sqrt((1 - g^2) / (g^2 n_d))``, :func:`armaxmodal.prepare.frf.h1_relative_error`)."""
+random error (Bendat & Piersol's ``sqrt((1 - g^2) / (g^2 n_d))``, ``armaxmodal.prepare.frf.h1_relative_error``)."""
 
 from __future__ import annotations
 

@@ -7,13 +7,13 @@ An effect is added without touching the numba fitter:
 * additive output disturbances ``y = G u + H e + phi theta`` (offset, drift, sinusoids) are
   estimated by backfitting: ``theta`` from least squares of the output on the regressors,
   ARMAX fitted to ``y - phi theta``, ``theta`` again from the simulation residual, three
-  passes (see :func:`_disturbance_ls` for why not GLS);
+  passes (see ``_disturbance_ls`` for why not GLS);
 * a richer noise model raises ``nc``;
 * a clipped output's samples at its rail, and a faulty sensor's stuck or glitched samples,
   are treated as missing: filled by the model's one-step prediction and refitted (a few
   passes), and left out of every error (:mod:`.clipping`, :mod:`.faults`).
 
-Held-out errors (see :func:`held_out`) come from two blocked folds: a model fitted on one half
+Held-out errors (see ``held_out``) come from two blocked folds: a model fitted on one half
 of the record predicts the other half. Its one-step predictions there use the measured past,
 so no start-up transient enters; only the parameters come from the other half.
 """

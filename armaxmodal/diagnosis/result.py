@@ -1,5 +1,6 @@
 """What the diagnosis found: the stages (a fitted model with its held-out errors), the effects
-kept, and the report (:class:`Diagnosis`, whose ``to_dict`` is the JSON of ``armaxmodal diagnose``)."""
+kept, and the report (:class:`~armaxmodal.diagnosis.Diagnosis`, whose ``to_dict`` is the JSON of
+``armaxmodal diagnose``)."""
 
 from __future__ import annotations
 
@@ -72,13 +73,14 @@ class Effect:
 
 @dataclass(frozen=True)
 class Diagnosis:
-    """What :func:`diagnose` found. ``to_dict`` is the JSON contract of ``armaxmodal diagnose``."""
+    """What :func:`~armaxmodal.diagnosis.diagnose` found. ``to_dict`` is the JSON contract of
+    ``armaxmodal diagnose``."""
 
     baseline: Stage
     final: Stage
     effects: tuple[Effect, ...]
     unconfirmed: tuple[dict, ...]
-    #: ``{output: RMS}``, ``None`` where the record cannot resolve it (:func:`~.noise_floor.noise_floor`).
+    #: ``{output: RMS}``, ``None`` where the record cannot resolve it (``noise_floor.noise_floor``).
     noise_floor: dict
     recording: Recording
     original_fs: float

@@ -1,8 +1,8 @@
 """ARMAX models by the prediction-error method (thesis Chapter 3).
 
-* :func:`fit_armax` -- one model per sensor (the thesis's diagonal A) or all sensors sharing
-  the poles, by Levenberg-Marquardt on numba kernels; :class:`ArmaxFit` the result.
-* :func:`choose_orders` -- orders and delay by an information criterion.
+* :func:`~armaxmodal.fit_armax` -- one model per sensor (the thesis's diagonal A) or all sensors sharing
+  the poles, by Levenberg-Marquardt on numba kernels; :class:`~armaxmodal.ArmaxFit` the result.
+* :func:`~armaxmodal.choose_orders` -- orders and delay by an information criterion.
 * :mod:`.pool` -- the worker threads every sweep runs on.
 """
 

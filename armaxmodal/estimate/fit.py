@@ -1,4 +1,4 @@
-"""The prediction-error fit of ARMAX models (thesis Section 3.3.2): :func:`fit_armax`, the
+"""The prediction-error fit of ARMAX models (thesis Section 3.3.2): :func:`~armaxmodal.fit_armax`, the
 public call, validates the data and the orders, picks the start, runs the Levenberg-Marquardt
 loop of :mod:`armaxmodal.estimate.pem` per sensor or with the poles shared, and assembles the
 :class:`~armaxmodal.estimate.result.ArmaxFit`.
@@ -115,7 +115,7 @@ def fit_resumable(
     data, orders, *, fs=None, shared_poles=False, output_error=False, max_iter=100, tol=1e-6, stop="expected",
     warn=True, start=None, resume=None, covariance=True,
 ):  # fmt: skip
-    """:func:`fit_armax`'s work, returning ``(fit, checkpoint)``. Shared-pole fits only:
+    """:func:`~armaxmodal.fit_armax`'s work, returning ``(fit, checkpoint)``. Shared-pole fits only:
     ``resume`` (the ``checkpoint`` of an earlier fit of the same data, orders and form)
     continues that fit, and ``covariance=False`` leaves the covariances out (empty) for a
     fit judged by its criterion alone; ``checkpoint`` is None for per-sensor fits."""
@@ -184,7 +184,7 @@ def _check_record_supports(n, n_eff, orders, n_in, n_out, shared_poles) -> None:
 
 
 def _assemble(thetas, info, orders, output_error, u, y, fs, sensors, inputs, t0, lead, shared_poles):
-    """The :class:`ArmaxFit` of fitted parameter vectors, and which of its models are valid."""
+    """The :class:`~armaxmodal.ArmaxFit` of fitted parameter vectors, and which of its models are valid."""
     na, nb, nc, nk = orders
     models = []
     for k, theta in enumerate(thetas):
@@ -337,7 +337,7 @@ def covariance_at(
     data : Recording or (u, y)
         The input and outputs that drive the gradient (use noise-free or measured data).
     shared_poles : bool
-        Pool the A parameters over sensors as :func:`fit_armax` does.
+        Pool the A parameters over sensors as :func:`~armaxmodal.fit_armax` does.
     output_error : bool
         The output-error parametrisation ``[a, b]`` with ``C = A`` fixed.
 

@@ -64,7 +64,7 @@ class OrderChoice:
 def information_criterion(fit: ArmaxFit, kind: str = "bic", unit: np.ndarray | None = None) -> float:
     """BIC (or AIC) of a fit from its per-sensor mean squared prediction errors.
 
-    ``unit`` (per sensor, e.g. :func:`output_mean_squares`) divides each sensor's prediction
+    ``unit`` (per sensor, e.g. ``output_mean_squares``) divides each sensor's prediction
     error variance. Candidates whose delays differ are fitted on windows a few samples apart,
     and ``n log V`` then carries ``n log s^2`` when the data are scaled by ``s``: a record in
     cm/s^2 chose a wider delay than the same record in m/s^2. Measured in the outputs' own
@@ -82,7 +82,7 @@ def information_criterion(fit: ArmaxFit, kind: str = "bic", unit: np.ndarray | N
 
 
 def output_mean_squares(recording: Recording) -> np.ndarray:
-    """Each output's mean square over the record, the unit :func:`information_criterion`
+    """Each output's mean square over the record, the unit :func:`~armaxmodal.estimate.information_criterion`
     measures prediction errors in when candidates' windows differ (``(n_sensors,)``)."""
     ms = np.mean(np.square(recording.response), axis=0)
     return np.where(ms > 0, ms, 1.0)
@@ -128,7 +128,7 @@ def choose_orders(
         Choose for the shared-pole form (default) or the per-sensor form.
     criterion : {"bic", "aic"}
         Computed with each sensor's prediction errors in units of its mean square
-        (:func:`information_criterion`'s ``unit``), so that the choice does not depend on
+        (:func:`~armaxmodal.estimate.information_criterion`'s ``unit``), so that the choice does not depend on
         the data's unit.
     n_jobs : int, optional
         Worker threads (default: all cores; 1 runs in this thread).

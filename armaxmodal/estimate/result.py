@@ -1,4 +1,4 @@
-"""The result of a fit: :class:`ArmaxFit`, its models, losses, convergence, covariances and the
+"""The result of a fit: :class:`~armaxmodal.ArmaxFit`, its models, losses, convergence, covariances and the
 modes of its poles with their delta-method intervals.
 """
 
@@ -23,7 +23,7 @@ _MODE_COLUMNS = [
 
 @dataclass(frozen=True)
 class ArmaxFit:
-    """Result of :func:`fit_armax`.
+    """Result of :func:`~armaxmodal.fit_armax`.
 
     Attributes
     ----------

@@ -2,7 +2,7 @@
 
 The design variables are offsets of the eigenvector components' phases from their measured
 values (norms kept; one reference component per mode fixed). For each trial the convex
-inner problem (:func:`inner_solve`) gives M, C and K, and the cost compares the model's
+inner problem (:func:`~armaxmodal.inverse.inner_solve`) gives M, C and K, and the cost compares the model's
 response with the measured one: Eq. (2.26), the summed complex EPFRF misfit (the
 transmissibility misfit is the same number, T = 1 - EPFRF), or the transmissibility-
 magnitude misfit of Section 4.3.3. The thesis stops at 50 iterations or cost <= 0.05.

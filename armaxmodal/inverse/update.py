@@ -11,7 +11,7 @@ protocol this halves the matrix errors against differences scaled by the measure
 and brings them to the Cramér-Rao bound (scripts/inverse_study.py). Frequencies, damping,
 shapes and transmissibility do not change when M, C and K are scaled together, so the
 first mass is held at 1 during the fit and the scale is applied at the end (a mass in kg,
-or the total mass). Started from :func:`inner_solve` unless a start is given.
+or the total mass). Started from :func:`~armaxmodal.inverse.inner_solve` unless a start is given.
 """
 
 from __future__ import annotations
@@ -86,13 +86,13 @@ def model_update(
         Noise levels, all relative standard deviations: ``freq``, ``damping`` (scalars or one
         per mode), ``shape`` (of each shape component, complex rms) and ``frf`` (of each
         transmissibility value, complex rms; a scalar or an array shaped like T, e.g. from the
-        coherence, see :func:`armaxmodal.prepare.frf.h1_relative_error`). Defaults: 1 %, 5 %, 5 %, 5 %.
+        coherence, see ``armaxmodal.prepare.frf.h1_relative_error``). Defaults: 1 %, 5 %, 5 %, 5 %.
     shape_magnitude_only, frf_magnitude_only : bool
         Use magnitudes only for that block (phases not trusted).
     mass_ratio_bounds, m1, total_mass, names
-        As :func:`inner_solve`.
+        As :func:`~armaxmodal.inverse.inner_solve`.
     start : InverseSolution, optional
-        Starting model (default: :func:`inner_solve` on the modes).
+        Starting model (default: :func:`~armaxmodal.inverse.inner_solve` on the modes).
 
     Examples
     --------

@@ -49,7 +49,7 @@ def read_xsens(
         Name of the sensor on the base (the input).
     axis : str
         Column to use, default ``Acc_X`` (m/s^2, includes gravity: it is removed as an
-        offset by :func:`armaxmodal.prepare.preparation.prepare`).
+        offset by :func:`~armaxmodal.prepare.prepare`).
     max_gap : int
         Longest run of dropped packets bridged by interpolation.
 

@@ -2,7 +2,7 @@
 Morlet scalograms and wavelet coherence (Eqs. 5.2-5.5), and a plain-language verdict
 (thesis Chapter 5).
 
-* :func:`lump_check` -- the verdict and its evidence.
+* :func:`~armaxmodal.lumping.lump_check` -- the verdict and its evidence.
 * :func:`relative_transmissibility` -- Eq. 5.1 with its coherence.
 * :func:`scalogram`, :func:`wavelet_coherence` -- Morlet (omega_0 = 5) CWT and squared
   wavelet coherence with phase lag and red-noise significance, on pycwt.

@@ -63,7 +63,7 @@ def relative_transmissibility(rec: Recording, a: str, b: str, nperseg: int | Non
 
 @dataclass(frozen=True)
 class LumpCheck:
-    """The answer and its evidence (see :func:`lump_check`)."""
+    """The answer and its evidence (see :func:`~armaxmodal.lumping.lump_check`)."""
 
     a: str
     b: str

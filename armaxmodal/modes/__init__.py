@@ -1,14 +1,14 @@
 """From fits to modes (thesis Sections 3.3-3.4).
 
-* :func:`stabilisation_diagram` -- the order sweep and its pole table (:mod:`.diagram`,
+* :func:`~armaxmodal.stabilisation_diagram` -- the order sweep and its pole table (:mod:`.diagram`,
   :mod:`.poles`).
-* :func:`select_modes` -- the physical modes picked from it (:mod:`.selection`,
+* :func:`~armaxmodal.select_modes` -- the physical modes picked from it (:mod:`.selection`,
   :mod:`.clusters`, :mod:`.completeness`, the support tests in :mod:`.support`), refitted in the
   frequency domain (:mod:`.refine`), counted by nested tests of the maximum-likelihood modal
   model (:mod:`.modal_model`, :mod:`.mode_count`, :mod:`.counted`), with intervals widened by
   the segment spread (:mod:`.spread`) and judged by the modal-model check (:mod:`.modal_check`,
   on the coherent lines of :mod:`.lines`).
-* :func:`identify` -- one model, its modes and the same check.
+* :func:`~armaxmodal.identify` -- one model, its modes and the same check.
 """
 
 from armaxmodal.modes.diagram import StabilisationDiagram, choose_nk, stabilisation_diagram

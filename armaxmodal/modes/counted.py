@@ -2,7 +2,7 @@
 model (:mod:`armaxmodal.modes.mode_count`), written back as the selection's rows, shapes and notes.
 
 Poles the model needs but that are no modes of the band -- above the fitted band (they stand
-for the modes above it, an upper residual), damped beyond :data:`armaxmodal.stats.MAX_DAMPING`,
+for the modes above it, an upper residual), damped beyond ``armaxmodal.stats.MAX_DAMPING``,
 or lines at the damping floor -- stay in the model and are not reported.
 """
 

@@ -3,7 +3,7 @@
 The model order is unknown: too low misses modes, too high adds spurious poles. The sweep
 fits the shared-pole model (the default source of modes) and every sensor alone for
 ``na`` over a range, with the documented rules ``nb = na + 1 - nk`` and ``nc = na``, and one
-input delay ``nk`` chosen by BIC at a middle order (:func:`choose_nk`). Physical poles stay
+input delay ``nk`` chosen by BIC at a middle order (:func:`~armaxmodal.modes.choose_nk`). Physical poles stay
 put as the order grows; :mod:`armaxmodal.modes.poles` classes each one.
 """
 
@@ -77,7 +77,7 @@ class StabilisationDiagram:
     orders : list of Orders
     tolerances : Tolerances
     recording : Recording
-        The record the sweep fitted (after :func:`armaxmodal.prepare.preparation.prepare`).
+        The record the sweep fitted (after :func:`~armaxmodal.prepare.prepare`).
     preparation : Preparation or None
         What was done to the record first, with the quality warnings.
     """
@@ -202,18 +202,18 @@ def stabilisation_diagram(
     orders : iterable of int, optional
         The ``na`` values; ``nb`` and ``nc`` follow the module's rules. Orders given are
         refused when the record cannot support the highest; the default,
-        :data:`DEFAULT_ORDERS`, is capped at what the record supports (``orders_capped``).
+        ``DEFAULT_ORDERS``, is capped at what the record supports (``orders_capped``).
     band : (lo, hi), optional
         Frequency band of interest, Hz: sets the analysis rate and, in :func:`select_modes`,
         the band modes are taken from.
     detrend, resample, align
-        Preparation of the record (:func:`armaxmodal.prepare.preparation.prepare`): remove each
+        Preparation of the record (:func:`~armaxmodal.prepare.prepare`): remove each
         channel's mean (or ``"linear"`` trend, or ``"none"``), resample a record sampled far
         above its band, align channels late by whole samples.
     prepared : bool
         The record is already prepared: fit it as it is (no checks, no warnings).
     nk : int, optional
-        Input delay; by default chosen by BIC (:func:`choose_nk`).
+        Input delay; by default chosen by BIC (:func:`~armaxmodal.modes.choose_nk`).
     per_sensor : bool
         Also sweep every sensor alone (the thesis's per-sensor view, Table 3.2).
     per_sensor_max_order : int
@@ -296,7 +296,7 @@ def _supported_top_order(recording: Recording) -> int:
 
 
 def _default_orders(recording: Recording, preparation: Preparation | None) -> tuple[list, tuple]:
-    """:data:`DEFAULT_ORDERS`, capped at what the record supports (the user typed none, so a
+    """``DEFAULT_ORDERS``, capped at what the record supports (the user typed none, so a
     short record is no error of theirs) with an ``orders_capped`` note; uncapped when the
     record supports them all. Below :data:`MIN_DEFAULT_TOP` the sweep is refused as usual."""
     top = _supported_top_order(recording)

@@ -62,7 +62,7 @@ class Identification:
         """Data-quality warnings found while preparing the record; ``unexplained_peak`` for
         each clear, coherent FRF peak no reported mode explains (as :func:`select_modes`
         gives: a fixed or BIC-chosen order can leave a mode out); and ``oversampled`` when
-        every mode lies below a tenth of the Nyquist frequency (:func:`oversampling_note`).
+        every mode lies below a tenth of the Nyquist frequency (``oversampling_note``).
         Computed once (the peak check takes spectra)."""
         from armaxmodal.modes.frf_check import unexplained_peaks
 
@@ -78,7 +78,7 @@ class Identification:
 
     @cached_property
     def check(self) -> ModalCheck:
-        """The modal-model check of the reported modes (:func:`armaxmodal.modes.modal_check.check_modes`)."""
+        """The modal-model check of the reported modes (:func:`~armaxmodal.modes.check_modes`)."""
         band = None if self.preparation is None else self.preparation.band
         return check_modes(self.recording, self.modes.freq_hz.to_numpy(), self.modes.damping.to_numpy(), band)
 
@@ -136,14 +136,14 @@ def identify(
     ----------
     recording : Recording
     orders : (na, nb, nc, nk), optional
-        Fixed orders; by default chosen by BIC (:func:`armaxmodal.estimate.orders.choose_orders`).
+        Fixed orders; by default chosen by BIC (:func:`~armaxmodal.choose_orders`).
     band : (lo, hi), optional
         Frequency band of interest, Hz (default: 0 to 0.45 fs).
     max_damping : float
         Poles damped more than this are not reported as modes.
     progress : bool
         Show a progress bar during the automatic order search.
-    detrend, align : see :func:`armaxmodal.prepare.preparation.prepare`
+    detrend, align : see :func:`~armaxmodal.prepare.prepare`
         Each channel's mean is removed by default so gravity and offsets do not bias the modes.
     resample : bool, optional
         Resample to a rate suited to the band. Default: only when the orders are chosen

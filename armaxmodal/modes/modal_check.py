@@ -2,7 +2,7 @@
 
 Least-squares frequency-domain (LSFD) fit of each output's H1 with the selected poles held
 fixed, on the lines of the band where that output's coherence is at least
-:data:`H1_COHERENCE` (Heylen, Lammens & Sas, *Modal Analysis Theory and Testing*, Sec. A.3;
+``H1_COHERENCE`` (Heylen, Lammens & Sas, *Modal Analysis Theory and Testing*, Sec. A.3;
 the residual terms as in Peeters et al.'s PolyMAX)::
 
     H_k(w) = exp(-i w tau_k) [ sum_m r_mk / (iw - l_m) + conj(r_mk) / (iw - conj(l_m))
@@ -11,7 +11,7 @@ the residual terms as in Peeters et al.'s PolyMAX)::
 ``r_mk`` complex residues, ``U_k`` the upper residual (modes above the band, and the direct
 term of an absolute-acceleration transmissibility, which tends to 1 below the first mode),
 ``L_k`` the lower residual (modes below the band), ``tau_k`` the output's delay against the
-input (searched over +-:data:`MAX_DELAY_SAMPLES`). A truncated modal sum without these terms
+input (searched over +-``MAX_DELAY_SAMPLES``). A truncated modal sum without these terms
 goes to 0 below the first mode where a base-excited structure's transmissibility is 1, and
 a sensor's delay adds a phase no modal sum has: without them a check fails right answers.
 
@@ -19,9 +19,9 @@ The statistic per output is the relative RMS misfit ``|H_fit - H1| / |H1|`` over
 lines, reported beside the H1's own random error in the same norm (Bendat & Piersol,
 *Random Data*, Sec. 9.2.4, from the coherence). The part of the misfit the random error
 does not account for, ``sqrt(max(e^2 - e_random^2, 0))``, is the *model error*; the modes
-explain the record when it is at most :data:`MODEL_ERROR_LIMIT` on every output.
+explain the record when it is at most ``MODEL_ERROR_LIMIT`` on every output.
 
-:func:`armaxmodal.modes.support.mode_support` gives the evidence :func:`armaxmodal.select_modes`
+``armaxmodal.modes.support.mode_support`` gives the evidence :func:`armaxmodal.select_modes`
 keeps a mode by: how much this check worsens without it (with a neighbour inside its half-power
 band refitted in its place, so that one half of a split peak is not needed when the other
 can take the whole peak).
@@ -83,7 +83,7 @@ class ModalCheck:
     poles : (n_modes,) complex ndarray
         The selected poles, rad/s.
     unconfirmed_hz : tuple of float
-        Modes (Hz) with no coherent line of any output near them (:func:`confirmed_modes`):
+        Modes (Hz) with no coherent line of any output near them (``confirmed_modes``):
         the record cannot confirm them, whatever the misfit.
     """
 
@@ -102,7 +102,7 @@ class ModalCheck:
 
     @property
     def passed(self) -> bool:
-        """Every checked output's model error within :data:`MODEL_ERROR_LIMIT` and every mode
+        """Every checked output's model error within ``MODEL_ERROR_LIMIT`` and every mode
         confirmed (False when no output has coherent lines: nothing shows that the modes
         explain the record)."""
         checked = np.isfinite(self.model_error)
@@ -111,7 +111,7 @@ class ModalCheck:
 
     @property
     def failing(self) -> tuple:
-        """The checked outputs whose model error exceeds :data:`MODEL_ERROR_LIMIT`."""
+        """The checked outputs whose model error exceeds ``MODEL_ERROR_LIMIT``."""
         return tuple(s for s, e in zip(self.sensors, self.model_error, strict=True) if e > MODEL_ERROR_LIMIT)
 
     @property

@@ -114,11 +114,11 @@ class ModeCount:
     alternatives : tuple of (float, ModalModel)
         The models with one mode fewer or more that the record cannot tell from the chosen one:
         each converged, with its criterion's difference from the chosen model's (under
-        :data:`DECISIVE_BIC`). The reported intervals cover their modes
-        (:func:`armaxmodal.modes.counted.counted_modes`).
+        ``DECISIVE_BIC``). The reported intervals cover their modes
+        (``armaxmodal.modes.counted.counted_modes``).
     carried_away : tuple of (float, float)
         Starting modes the search carried to where no mode is founded, and which were left out
-        of the chosen model: (start Hz, where it went Hz). See :func:`_without_unfounded`.
+        of the chosen model: (start Hz, where it went Hz). See ``_without_unfounded``.
     """
 
     model: ModalModel
@@ -298,7 +298,7 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     """The chosen model without the starting poles the search carried beyond :data:`SAME_MODE_FREQ`
     of every start to where no mode is founded, refitted to convergence. A pole reported there is
     a new pole and must show what a mode has: a damping the record resolves, and the same
-    frequency and damping in both halves of the record (:meth:`_Search.in_both_halves`; without
+    frequency and damping in both halves of the record (``_Search.in_both_halves``; without
     ``halves``, stability across the diagram's orders, ``supported``).
 
     Not the diagram's support where the halves can judge: the modal model moves a pole exactly
@@ -331,7 +331,7 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
 def _equally_good(search: _Search, chosen: ModalModel, rise: np.ndarray, addition: ModalModel | None):
     """The models with one mode fewer (each mode whose removal the criterion barely resists) or
     one more (the best addition, when it barely loses), converged on the chosen model's weights
-    and kept when their criterion stays within :data:`DECISIVE_BIC` of the chosen one's:
+    and kept when their criterion stays within ``DECISIVE_BIC`` of the chosen one's:
     ``[(difference, model), ...]``. Only an undecided count costs these fits."""
     here, out = search.bic(chosen), []
     starts = [(np.delete(chosen.freq_hz, m), np.delete(chosen.damping, m)) for m in np.flatnonzero(rise < DECISIVE_BIC)]
@@ -434,7 +434,7 @@ def count_modes(
         Cap on residual evaluations per fit.
     halves : tuple of DftLines
         The lines of the record's two halves: the new poles of an addition the whole record
-        accepts must be the same in each (:meth:`_Search.in_both_halves`). Empty: not asked.
+        accepts must be the same in each (``_Search.in_both_halves``). Empty: not asked.
     supported : callable, optional
         ``supported(freq_hz, damping)``: is a pole there stable across the model orders of the
         diagram? An addition's new poles must be (a ghost that soaks up a nonlinearity beside a

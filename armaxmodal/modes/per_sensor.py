@@ -1,9 +1,9 @@
 """Each sensor's own view of the selected modes (thesis Section 3.3.4).
 
-* :func:`per_sensor_table` -- Table 3.2: each sensor's own frequency and damping of every
+* ``per_sensor_table`` -- Table 3.2: each sensor's own frequency and damping of every
   selected mode (gaps where the sensor does not show it) and the Eq. 3.35-3.36
   residue-weighted averages.
-* :func:`supplement_shapes` -- a sensor whose own model does not show a mode leaves a gap in
+* ``supplement_shapes`` -- a sensor whose own model does not show a mode leaves a gap in
   that mode's shape (the 'X' of Table 3.2). Eq. (3.34) fills it from the measured
   transmissibility at the damped natural frequency, ``phi_p = T_pl s_ql phi_l`` with the
   scale ``s_ql = |phi_q / phi_l| / |T_ql|`` taken from a known neighbour to reduce the

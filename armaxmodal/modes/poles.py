@@ -1,8 +1,8 @@
 """The pole table of a sweep and its rules (thesis Section 3.3.2).
 
-One row per pole of every fit (:func:`pole_rows`), its stability class against the nearest
-pole of the previous order of the same source (:func:`stability_classes`: ``new``, ``f``,
-``f+d``, ``f+d+v``) and the reason it is rejected, if any (:func:`rejection_reasons`). The
+One row per pole of every fit (``pole_rows``), its stability class against the nearest
+pole of the previous order of the same source (``stability_classes``: ``new``, ``f``,
+``f+d``, ``f+d+v``) and the reason it is rejected, if any (``rejection_reasons``). The
 thresholds are the :class:`Tolerances`.
 """
 

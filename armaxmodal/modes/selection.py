@@ -1,6 +1,6 @@
 """Automatic mode selection from a stabilisation diagram (thesis Section 3.4).
 
-:func:`select_modes` clusters the stable shared-pole estimates across orders, keeps the
+:func:`~armaxmodal.select_modes` clusters the stable shared-pole estimates across orders, keeps the
 clusters supported by a good share of the orders, reports each from its lowest-BIC fit,
 refits them to the recording's DFT, lets the modal-model check drop or add modes, and widens
 the intervals by the segment spread. It is deterministic: the same data gives the same
@@ -94,13 +94,13 @@ class ModeSelection:
         """The modal-model check's relative misfit (:mod:`armaxmodal.modes.modal_check`): the
         largest output's relative RMS difference between the measured H1 and its LSFD fit
         by the selected poles with residual terms and a delay. Computed once, in
-        :func:`select_modes`: the CLI, the figure and the JSON report the same number."""
+        :func:`~armaxmodal.select_modes`: the CLI, the figure and the JSON report the same number."""
         return self.check.overall_error if self.check is not None else float("nan")
 
     @property
     def quality(self) -> str:
         """``"poor"`` when the modal-model check fails; ``"uncertain"`` when it passes but a
-        warning of :data:`armaxmodal.quality_warnings.UNCERTAIN_CODES` stands (the record does not decide
+        warning of ``armaxmodal.quality_warnings.UNCERTAIN_CODES`` stands (the record does not decide
         the number of modes, two modes are closer than it separates, or the preparation found a
         fault that moves modes); else ``"good"``."""
         if self.check is None or not self.check.passed:
@@ -227,7 +227,7 @@ def select_modes(
         Frequency band in Hz (default: the diagram's band, if it was given one).
     refine : bool
         Refit the selected modes to the recording's DFT under the inter-sample behaviour the
-        data choose (:func:`armaxmodal.modes.refine.refine_modes`) and report the refit when the
+        data choose (``armaxmodal.modes.refine.refine_modes``) and report the refit when the
         recording is band-limited, where the discrete ARMAX class is biased.
     segments : int
         Refit each mode's representative orders on this many disjoint segments and widen
@@ -237,7 +237,7 @@ def select_modes(
         worker that has one core already, e.g. a study's).
     picks : sequence of float, optional
         Frequencies (Hz) picked by hand: each takes the nearest cluster of the diagram holding
-        poles of at least 3 orders within :data:`~armaxmodal.modes.picks.PICK_REACH` (a
+        poles of at least 3 orders within ``armaxmodal.modes.picks.PICK_REACH`` (a
         :class:`~armaxmodal.exceptions.PickError` says when none does). The picks are refitted,
         checked and judged as automatic modes are, but none is dropped or added: a pick the
         record does not need is said to be (``pick_not_supported``). Not with ``n_modes``.
@@ -315,7 +315,7 @@ def select_modes(
 
 def _with_picks(diagram, work: WorkingSelection, picked, nas, clustering, band, n_jobs=None) -> WorkingSelection:
     """The picks as the modes reported. A pick is the automatic mode within
-    :data:`~armaxmodal.modes.picks.PICK_REACH` of it or of its cluster; a pick no automatic mode
+    ``armaxmodal.modes.picks.PICK_REACH`` of it or of its cluster; a pick no automatic mode
     answers is added from its cluster. The modal model is then fitted with every mode and pole
     of the automatic one kept as it stands, so that the modes not picked do not bias the picked
     ones (:func:`~armaxmodal.modes.counted.counted_modes` with ``picks``)."""

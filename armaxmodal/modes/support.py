@@ -2,12 +2,12 @@
 
 Every rule that keeps, drops or admits a mode on the record's evidence, in one place:
 
-* :func:`mode_support` -- the modal-model check's misfit with and without a mode, a neighbour
-  refitted in its place (:class:`ModeSupport`: needed when the rise is large and significant),
+* ``mode_support`` -- the modal-model check's misfit with and without a mode, a neighbour
+  refitted in its place (``ModeSupport``: needed when the rise is large and significant),
   which :mod:`armaxmodal.modes.completeness` uses to drop and add modes;
-* :func:`peak_support` -- a clear, coherent FRF peak a mode explains (a weakly supported
+* ``peak_support`` -- a clear, coherent FRF peak a mode explains (a weakly supported
   cluster of the diagram is rescued by one, :mod:`armaxmodal.modes.clusters`);
-* :func:`stable_in_diagram` -- a pole is stable across the diagram's orders (the maximum-likelihood
+* ``stable_in_diagram`` -- a pole is stable across the diagram's orders (the maximum-likelihood
   count admits only such new poles, :mod:`armaxmodal.modes.mode_count`).
 
 The count's own tests (damping resolved, the same mode in both halves of the record) act on the
@@ -96,7 +96,7 @@ def nearest_neighbour(freq_hz, damping, m: int) -> int | None:
 def mode_support(
     recording: Recording, freq_hz, damping, m: int, check: ModalCheck, band=None, *, reach: str = "overlapping"
 ) -> ModeSupport:
-    """How much the check of ``check`` needs mode ``m`` (see :class:`ModeSupport`).
+    """How much the check of ``check`` needs mode ``m`` (see ``ModeSupport``).
 
     The fit without the mode keeps each output's delay. A neighbour -- ``reach="overlapping"``:
     a mode whose half-power band overlaps this one's (:func:`overlapping_neighbour`);

@@ -1,5 +1,5 @@
 """Detrending: each channel's mean or least-squares line removed, and a level shift where a
-sensor's offset jumps mid-record (:func:`level_shifts`; MATLAB's ``detrend`` with breakpoints,
+sensor's offset jumps mid-record (``level_shifts``; MATLAB's ``detrend`` with breakpoints,
 the breakpoints found). Gravity on an accelerometer and sensor offsets would otherwise bias
 the modes."""
 
@@ -149,7 +149,7 @@ def _segment_means(x: np.ndarray, breaks: list[int]) -> np.ndarray:
 
 
 def _step_notes(names, steps, data, fs: float, removed: bool) -> list[QualityWarning]:
-    """One ``offset_step`` warning listing every level shift found (see :func:`level_shifts`)."""
+    """One ``offset_step`` warning listing every level shift found (see ``level_shifts``)."""
     listed, channels, worst = [], [], 0.0
     for name, found, col in zip(names, steps, data.T, strict=True):
         if not found:

@@ -1,8 +1,8 @@
 """Frequency responses from data and from modes.
 
-* :func:`measured_frf` -- H1 estimate (Welch cross-spectrum over input auto-spectrum) of every
+* ``measured_frf`` -- H1 estimate (Welch cross-spectrum over input auto-spectrum) of every
   output over the base input, with the coherence.
-* :func:`modal_frf` -- the absolute-acceleration transmissibility rebuilt from modes (Eqs.
+* ``modal_frf`` -- the absolute-acceleration transmissibility rebuilt from modes (Eqs.
   3.25-3.26 with the continuous residue ``-lambda^2 M`` of an acceleration output).
 """
 
@@ -21,7 +21,7 @@ __all__ = ["excited_band", "measured_frf", "modal_frf"]
 
 
 def default_nperseg(recording) -> int:
-    """Welch segment length of :func:`measured_frf`: about 10 s (a power of two), at most an
+    """Welch segment length of ``measured_frf``: about 10 s (a power of two), at most an
     eighth of the record."""
     return welch_nperseg(recording.n_samples, recording.fs)
 
@@ -40,7 +40,7 @@ def h1_relative_error(coherence: np.ndarray, n_samples: int, nperseg: int) -> np
     """Relative random error (complex rms) of an H1 estimate: ``sqrt((1 - g^2) / (g^2 n_d))``
     (Bendat & Piersol, Random Data, Sec. 9.2.4: sqrt(1 - g^2) / (|g| sqrt(2 n_d)) for the
     magnitude and for the phase in radians), with n_d the number of Welch segments
-    (50 % overlap, as :func:`measured_frf`). Shape of ``coherence``."""
+    (50 % overlap, as ``measured_frf``). Shape of ``coherence``."""
     n_segments = max(1, (n_samples - nperseg) // (nperseg // 2) + 1)
     g2 = np.clip(np.asarray(coherence, dtype=float), 1e-6, 1.0 - 1e-12)
     return np.sqrt((1.0 - g2) / (g2 * n_segments))

@@ -10,7 +10,7 @@ The test: a quantised or slow channel repeats values too, but at no particular p
 channel repeats at the same phases of a k-sample cycle (k = 2 for half rate; for 100 Hz held
 to 120 Hz, once every 6 samples at one phase). So the zero steps' positions modulo k are
 tested for uniformity (chi-square, k - 1 degrees of freedom) for every k up to
-:data:`MAX_CYCLE`; the channel's own rate is the record's times its share of non-zero steps.
+``MAX_CYCLE``; the channel's own rate is the record's times its share of non-zero steps.
 A linearly interpolated channel does the same with its second differences: the filled
 samples lie on the straight line through their neighbours.
 """

@@ -3,7 +3,7 @@
 In this order, every step stated in the result (and in the JSON):
 
 1. the band is validated (finite, ``0 <= lo < hi <=`` Nyquist) before any work;
-2. :func:`armaxmodal.prepare.checks.check_quality` on the raw record;
+2. :func:`~armaxmodal.prepare.check_quality` on the raw record;
 3. outputs that duplicate another channel are left out (a copy adds no information and,
    pooled with its original, gives zero-width intervals), and so are outputs that do not
    respond to the input while another does (pooled, they bend the shared poles);

@@ -1,6 +1,6 @@
 """Data-quality checks run before any fit: facts with a number, never guesses.
 
-Each check returns :class:`QualityWarning` records (a code from :data:`WARNING_CODES`, the
+Each check returns :class:`~armaxmodal.QualityWarning` records (a code from ``WARNING_CODES``, the
 channels concerned, a sentence with the measured number). The checks need nothing but the
 recording:
 

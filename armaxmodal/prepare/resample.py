@@ -1,6 +1,6 @@
 """Resampling to the band: a record sampled far above its band is brought to about
 ``fs = band_hi / 0.4`` with scipy's polyphase anti-alias filter (a Kaiser-windowed FIR of zero
-phase, written out in :func:`decimate`). High orders would otherwise be spent on the empty
+phase, written out in ``decimate``). High orders would otherwise be spent on the empty
 spectrum above the band, and one low order no longer resolves close modes at 400 Hz that it
 resolves at 50 Hz."""
 

@@ -10,9 +10,9 @@ in mg, two of the four modes were merged away with no warning), and the shapes a
 inverse problem's residues come out wrong by that factor.
 
 The check needs a quasi-static band (the lowest coherent lines, where at least half of the
-other outputs read ``|T|`` within :data:`~armaxmodal.prepare.delay.QUASI_STATIC_MAGNITUDE` of 1);
+other outputs read ``|T|`` within ``armaxmodal.prepare.delay.QUASI_STATIC_MAGNITUDE`` of 1);
 without one (a force input, a ride starting above the first mode) it says nothing. When the
-ratio matches a unit conversion within :data:`UNIT_MATCH`, :func:`armaxmodal.prepare.preparation.prepare`
+ratio matches a unit conversion within ``UNIT_MATCH``, :func:`~armaxmodal.prepare.prepare`
 converts the channel by that exact factor (by the measured ratio where two conversions are
 that near, mg and Gal) and says so; otherwise the warning stands alone.
 """
@@ -52,7 +52,7 @@ UNIT_CONVERSIONS = {
 
 def unit_conversion(ratio: float) -> tuple[float, str] | None:
     """What to divide an output by whose quasi-static ratio to the others is ``ratio``, and
-    why: the unit conversion within :data:`UNIT_MATCH` of it, or the measured ratio itself
+    why: the unit conversion within ``UNIT_MATCH`` of it, or the measured ratio itself
     when several are (mg and Gal differ by 2 %, within the ratio's own scatter of 1-2 %);
     None when no conversion is near."""
     near = _near_conversions(ratio)

@@ -88,7 +88,7 @@ def run_study(
     Parameters
     ----------
     source : path
-        Manifest CSV or folder (see :func:`armaxmodal.study.manifest.read_manifest`).
+        Manifest CSV or folder (see :func:`~armaxmodal.study.read_manifest`).
     out : path
         The study folder: each finished recording is cached in ``out/.cache`` (keyed by the
         file's content hash and the settings) so an interrupted study resumes where it stopped.
@@ -101,7 +101,7 @@ def run_study(
         A tqdm bar over recordings.
     model : bool
         Also fit the chain model of each ride's average subject and scale it to every subject
-        (:func:`armaxmodal.study.model.average_subject_models`).
+        (``armaxmodal.study.model.average_subject_models``).
 
     Returns
     -------

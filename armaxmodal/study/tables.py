@@ -1,7 +1,7 @@
 """A study's tables: modes matched across recordings, Table 3.2 per sensor, Table 3.3 per
 subject and across subjects, and the Fig. 3.7 geometric-mean mode shapes.
 
-:func:`summarise_subjects` is Table 3.3 from per-subject results the caller already has: per
+:func:`~armaxmodal.study.summarise_subjects` is Table 3.3 from per-subject results the caller already has: per
 subject the |M|-weighted frequency and damping (Eqs. 3.35-3.36), then the mean and standard
 deviation over subjects, and the geometric-mean mode-shape magnitudes (Fig. 3.7)."""
 
@@ -63,7 +63,7 @@ def match_modes(freqs: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray]]:
 
     The reference is the per-rank median of the recordings with the most common number of
     modes; each recording's modes are assigned to reference modes by least total
-    log-frequency distance (Hungarian algorithm), within :data:`MATCH_RATIO`.
+    log-frequency distance (Hungarian algorithm), within ``MATCH_RATIO``.
 
     Parameters
     ----------
@@ -93,7 +93,7 @@ def match_modes(freqs: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray]]:
 
 
 def build_tables(recordings: list[dict], sensors) -> StudyTables:
-    """All tables from the analysed recordings (see :class:`StudyTables`)."""
+    """All tables from the analysed recordings (see :class:`~armaxmodal.study.StudyTables`)."""
     mode_rows, sensor_rows, shape_rows, notes = [], [], [], []
     for ride in sorted({r["ride"] for r in recordings}):
         group = [r for r in recordings if r["ride"] == ride]

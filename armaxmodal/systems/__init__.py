@@ -1,9 +1,10 @@
 """Systems with known truth: chain structures and their exact modes, the thesis's datasets,
 and base-excitation simulation (what every test compares against).
 
-* :class:`Structure` -- M, C, K of a base-excited chain; :class:`ExactModes` its modes.
-* :func:`supine_human`, :func:`chapter2_system`, :func:`supine_with_feet` -- the thesis's systems.
-* :func:`simulate_recording` -- a ride of a structure, band-limited or held.
+* :class:`~armaxmodal.Structure` -- M, C, K of a base-excited chain; :class:`~armaxmodal.ExactModes` its modes.
+* :func:`~armaxmodal.supine_human`, :func:`~armaxmodal.chapter2_system`,
+  :func:`~armaxmodal.supine_with_feet` -- the thesis's systems.
+* :func:`~armaxmodal.simulate_recording` -- a ride of a structure, band-limited or held.
 """
 
 from armaxmodal.systems.datasets import chapter2_system, supine_human, supine_with_feet

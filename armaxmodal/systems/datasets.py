@@ -1,7 +1,7 @@
 """Reference structures and published numbers from the source thesis.
 
-- :func:`chapter2_system`: the four-DOF system of Section 2.3.1 (Table 2.1).
-- :func:`supine_human`: the four-DOF supine-human chain of Section 4.4 (Tables 4.3-4.4).
+- :func:`~armaxmodal.chapter2_system`: the four-DOF system of Section 2.3.1 (Table 2.1).
+- :func:`~armaxmodal.supine_human`: the four-DOF supine-human chain of Section 4.4 (Tables 4.3-4.4).
 
 The C matrix printed in Section 4.4 is not symmetric (a 0 stands where -40.29 belongs) and
 its c_s2 entry reads 50.30 while Table 4.4 and the printed diagonal both give 45.3; with

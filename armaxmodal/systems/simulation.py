@@ -201,7 +201,7 @@ def simulate_recording(
     oversample: int | None = None,
     meta: dict | None = None,
 ) -> Recording:
-    """Simulate, add sensor noise and wrap the result in a :class:`Recording`.
+    """Simulate, add sensor noise and wrap the result in a :class:`~armaxmodal.Recording`.
 
     ``noise`` and ``input_noise`` are white Gaussian noise levels relative to each
     channel's RMS (0.05 = 5 %). The noiseless input drives the structure; the recorded

@@ -1,0 +1,38 @@
+"""The docs page checker (tools/check_docs_pages.py) on hand-written HTML: what it must catch and
+what it must leave alone. The checker itself runs on the built site in .ci/run."""
+
+import importlib.util
+from pathlib import Path
+
+_spec = importlib.util.spec_from_file_location(
+    "check_docs_pages", Path(__file__).resolve().parents[1] / "tools" / "check_docs_pages.py"
+)
+checker = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(checker)
+
+LINKED = (
+    '<a class="reference internal" href="generated/armaxmodal.fit_armax.html" title="armaxmodal.fit_armax">'
+    '<code class="xref py py-func docutils literal notranslate"><span class="pre">fit_armax()</span></code></a>'
+)
+BARE = '<code class="xref py py-func docutils literal notranslate"><span class="pre">fit_armx()</span></code>'
+
+
+def test_a_reference_that_did_not_resolve_is_named():
+    assert checker.unresolved_references(f"<p>see {LINKED} and {BARE}</p>") == ["fit_armx()"]
+
+
+def test_linked_references_and_builtins_pass():
+    builtin = '<code class="xref py py-class docutils literal notranslate"><span class="pre">ValueError</span></code>'
+    assert checker.unresolved_references(f"<p>{LINKED}, raises {builtin}</p>") == []
+
+
+def test_raw_table_rows_and_object_reprs_are_named():
+    dom = (
+        "<p>| a | b |</p><pre>&lt;matplotlib.legend.Legend object at 0x7f00ab&gt;</pre>"
+        "<table><tr><td>ok</td></tr></table>"
+    )
+    found = checker.shown_as_text(dom)
+    assert found == [
+        "prints an object's repr: &lt;matplotlib.legend.Legend object at 0x7f00ab&gt;",
+        "a table row shown as raw text: | a | b |",
+    ]
