@@ -98,7 +98,18 @@ class Recording:
         return np.arange(self.n_samples) / self.fs
 
     def channel(self, name: str) -> np.ndarray:
-        """One output by name."""
+        """One output by name.
+
+        Parameters
+        ----------
+        name : str
+            A sensor's name.
+
+        Returns
+        -------
+        (n_samples,) ndarray
+            That sensor's samples, in the recording's units.
+        """
         return self.response[:, self._sensor_index(name)]
 
     def welch(self, nperseg: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -130,7 +141,18 @@ class Recording:
         return self._spectra[nperseg]
 
     def select(self, sensors: Sequence[str]) -> Recording:
-        """A recording with only the named outputs, in the given order."""
+        """A recording with only the named outputs, in the given order.
+
+        Parameters
+        ----------
+        sensors : sequence of str
+            The outputs to keep, each named once.
+
+        Returns
+        -------
+        Recording
+            The same input, sampling and metadata with only those outputs.
+        """
         idx = [self._sensor_index(s) for s in sensors]
         return Recording(
             self.fs,
@@ -144,7 +166,13 @@ class Recording:
         )
 
     def to_frame(self) -> pd.DataFrame:
-        """Columns ``time``, the input, then each sensor."""
+        """Columns ``time``, the input, then each sensor.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per sample.
+        """
         data = {"time": self.time, self.input_name: self.base}
         data.update({s: self.response[:, i] for i, s in enumerate(self.sensors)})
         return pd.DataFrame(data)

@@ -92,7 +92,19 @@ class Diagnosis:
         return self.baseline.model.signals.sensors
 
     def modes(self, stage: Stage) -> pd.DataFrame:
-        """The physical modes of a stage's model (identify's rejection rules)."""
+        """The physical modes of a stage's model (identify's rejection rules).
+
+        Parameters
+        ----------
+        stage : Stage
+            One of the diagnosis's stages (``baseline`` or ``final``).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per physical mode: ``freq_hz``, ``damping`` and the 95 % interval of the
+            frequency.
+        """
         return stage_modes(stage, self.recording)
 
     def _repr_html_(self) -> str:

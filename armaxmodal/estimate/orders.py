@@ -30,12 +30,36 @@ __all__ = ["choose_orders", "OrderChoice", "Orders", "default_nb", "default_nc"]
 
 
 def default_nb(na: int, nk: int) -> int:
-    """``na + 1 - nk`` B coefficients (see the module docstring)."""
+    """``na + 1 - nk`` B coefficients (see the module docstring).
+
+    Parameters
+    ----------
+    na : int
+        Order of A.
+    nk : int
+        Input delay in samples (negative: non-causal taps of a band-limited input).
+
+    Returns
+    -------
+    int
+        The number of B coefficients.
+    """
     return na + 1 - min(nk, 0)
 
 
 def default_nc(na: int) -> int:
-    """``nc = na``."""
+    """``nc = na``.
+
+    Parameters
+    ----------
+    na : int
+        Order of A.
+
+    Returns
+    -------
+    int
+        The order of C.
+    """
     return na
 
 
@@ -69,6 +93,19 @@ def information_criterion(fit: ArmaxFit, kind: str = "bic", unit: np.ndarray | N
     and ``n log V`` then carries ``n log s^2`` when the data are scaled by ``s``: a record in
     cm/s^2 chose a wider delay than the same record in m/s^2. Measured in the outputs' own
     mean square, the criterion is the same in every unit.
+
+    Parameters
+    ----------
+    fit : ArmaxFit
+    kind : {"bic", "aic"}
+    unit : (n_sensors,) ndarray, optional
+        Each sensor's output mean square, dividing its prediction-error variance (default: 1,
+        the criterion in the data's own units).
+
+    Returns
+    -------
+    float
+        The criterion, summed over sensors; smaller is better.
     """
     n = fit.n_samples
     k = len(fit.models)
@@ -134,6 +171,8 @@ def choose_orders(
         Worker threads (default: all cores; 1 runs in this thread).
     progress : bool
         Show a progress bar.
+    max_iter : int
+        Cap on Gauss-Newton iterations of each candidate's fit.
 
     Returns
     -------

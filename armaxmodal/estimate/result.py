@@ -72,6 +72,16 @@ class ArmaxFit:
         Columns: sensor, freq_hz, damping, damped_freq_hz, freq_ci95_lo/hi, damping_ci95_lo/hi
         (delta method on the A covariance), residue (complex, first input), residue_mag,
         residue_phase_deg. ``band`` keeps poles whose frequency lies in it (Hz).
+
+        Parameters
+        ----------
+        band : (lo, hi), optional
+            Keep the poles whose frequency (Hz) lies in it (default: all).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per sensor and pole, the columns above.
         """
         rows = []
         na = self.orders[0]
@@ -104,7 +114,13 @@ class ArmaxFit:
         return frame.reset_index(drop=True)
 
     def to_frame(self) -> pd.DataFrame:
-        """One row per sensor: orders, loss, noise variance, fit %, iterations, convergence."""
+        """One row per sensor: orders, loss, noise variance, fit %, iterations, convergence.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per sensor: its orders, loss, fit and convergence.
+        """
         na, nb, nc, nk = self.orders
         return pd.DataFrame(
             {

@@ -7,7 +7,7 @@ interchangeably. For a chain (Fig. 4.3) M, C and K are linear in the masses, spr
 dampers, so with non-negative values and mass-ratio bounds (Eq. 2.18) this is a bounded
 linear least-squares problem -- convex, with a unique answer once the scale is fixed by
 one mass -- solved exactly by scipy's BVLS. The printed form (minimise (M11 - 1)^2 subject
-to |residual| <= t) has a continuum of optima; it is not reproduced.
+to ``|residual| <= t``) has a continuum of optima; it is not reproduced.
 """
 
 from __future__ import annotations

@@ -65,6 +65,15 @@ def evphc(
     starts : int
         The measured phases plus ``starts - 1`` random offsets.
     max_iter, cost_tol : as the thesis (50 iterations or cost <= 0.05).
+    seed : int
+        Seed of the random starting phases.
+    mass_ratio_bounds, m1, total_mass, names
+        As :func:`~armaxmodal.inverse.inner_solve`.
+
+    Returns
+    -------
+    InverseSolution
+        The chain's masses, springs and dampers with their standard errors, and the cost.
 
     Examples
     --------

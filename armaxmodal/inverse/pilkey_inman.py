@@ -30,6 +30,15 @@ def pia(eigenvalues, shapes, mass, *, tol: float = 1e-4, max_iter: int = 500, na
         Known masses, kg.
     tol : float
         Relative change of C that ends the iteration.
+    max_iter : int
+        Cap on iterations.
+    names : sequence of str, optional
+        The DOFs' names.
+
+    Returns
+    -------
+    InverseSolution
+        The chain's damping and stiffness with the given masses.
 
     Examples
     --------

@@ -49,7 +49,14 @@ class InverseSolution:
     std: ChainComponents | None = None
 
     def to_frame(self) -> pd.DataFrame:
-        """Chain components (or matrix diagonals) and the recovered modes, one row each."""
+        """Chain components (or matrix diagonals) and the recovered modes, one row each.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per mass, spring and damper (with its standard error where known), then one
+            per recovered mode; ``method`` names the solver.
+        """
         if self.components is not None:
             comp = self.components.to_frame()
             if self.std is not None:

@@ -93,6 +93,13 @@ def model_update(
         As :func:`~armaxmodal.inverse.inner_solve`.
     start : InverseSolution, optional
         Starting model (default: :func:`~armaxmodal.inverse.inner_solve` on the modes).
+    max_nfev : int
+        Cap on residual evaluations of the least-squares fit.
+
+    Returns
+    -------
+    InverseSolution
+        The updated chain with its standard errors and misfits.
 
     Examples
     --------

@@ -14,7 +14,20 @@ from armaxmodal.systems.structure import Structure
 
 def scale_to_subject(structure: Structure, mass_kg: float) -> Structure:
     """Multiply M, C and K by ``alpha = m_subject / m_model`` (Eq. 4.7): same modes, the
-    subject's mass."""
+
+    Parameters
+    ----------
+    structure : Structure
+        The identified (or average) model.
+    mass_kg : float
+        The subject's mass.
+
+    Returns
+    -------
+    Structure
+        The scaled model.
+    subject's mass.
+    """
     if not (np.isfinite(mass_kg) and mass_kg > 0):
         raise DataError(f"mass_kg: expected a positive subject mass in kg, got {mass_kg!r}.")
     alpha = mass_kg / structure.masses.sum()
@@ -27,6 +40,20 @@ def predict_recording(structure: Structure, recording: Recording, hold: str = "b
     Returns a frame with, per sensor, the NRMSE fit in percent
     ``100 (1 - |y - y_hat| / |y - mean y|)`` and the correlation; the predicted signals are in
     ``frame.attrs["prediction"]`` ((n_samples, n_sensors)).
+
+    Parameters
+    ----------
+    structure : Structure
+        The chain model; its DOF names must include the recording's sensors.
+    recording : Recording
+        A measured ride.
+    hold : {"bandlimited", "zoh"}
+        How the input behaves between samples.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per sensor: ``fit_percent`` and ``correlation``.
     """
     missing = [s for s in recording.sensors if s not in structure.names]
     if missing:

@@ -61,6 +61,19 @@ def write_all(outputs) -> list[Path]:
 def write_recording_csv(recording: Recording, path: str | os.PathLike, float_format: str = "%.9g") -> Path:
     """Write ``time``, the input and every sensor as CSV, with subject lines if known.
 
+    Parameters
+    ----------
+    recording : Recording
+    path : str or path-like
+        The CSV file to write (its folder must exist).
+    float_format : str
+        printf-style format of every value (the default keeps 9 significant digits).
+
+    Returns
+    -------
+    Path
+        The file written.
+
     Examples
     --------
     >>> import tempfile, pathlib
@@ -88,6 +101,17 @@ def write_recording_csv(recording: Recording, path: str | os.PathLike, float_for
 
 def write_recording_uff(recording: Recording, path: str | os.PathLike) -> Path:
     """Write every channel (input first) as a type-58 time-response data set.
+
+    Parameters
+    ----------
+    recording : Recording
+    path : str or path-like
+        The UFF file to write (its folder must exist).
+
+    Returns
+    -------
+    Path
+        The file written.
 
     Examples
     --------
@@ -153,7 +177,20 @@ def strict_json(obj):
 
 def write_json(obj, path: str | os.PathLike) -> Path:
     """Write ``obj`` as indented strict JSON (numpy values converted, NaN and infinities as
-    ``null``; ``allow_nan=False`` so a bare NaN can never slip through)."""
+
+    Parameters
+    ----------
+    obj : dict, list or scalar
+        What to write; numpy arrays and scalars are converted.
+    path : str or path-like
+        The JSON file to write.
+
+    Returns
+    -------
+    Path
+        The file written.
+    ``null``; ``allow_nan=False`` so a bare NaN can never slip through).
+    """
     clean = strict_json(obj)
 
     def write(tmp: str) -> None:

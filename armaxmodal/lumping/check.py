@@ -36,6 +36,14 @@ def relative_transmissibility(rec: Recording, a: str, b: str, nperseg: int | Non
     reference would be pulled below 1 by ``a``'s own sensor noise wherever the relative
     motion is small.
 
+    Parameters
+    ----------
+    rec : Recording
+    a, b : str
+        The two sensors' names.
+    nperseg : int, optional
+        Welch segment length (default: the recording's own).
+
     Returns
     -------
     freq_hz : (n_freq,) ndarray
@@ -80,7 +88,13 @@ class LumpCheck:
     scalograms: dict | None = None
 
     def to_dict(self) -> dict:
-        """JSON-ready: the verdict, its sentence, and the numbers behind them."""
+        """JSON-ready: the verdict, its sentence, and the numbers behind them.
+
+        Returns
+        -------
+        dict
+            Strict-JSON-ready (no NaN).
+        """
         use = self._used()
         gain = np.abs(self.transmissibility[use])
         phase = np.degrees(np.angle(self.transmissibility[use]))
@@ -105,7 +119,13 @@ class LumpCheck:
         return (f >= self.band[0]) & (f <= self.band[1]) & (self.measurable >= LIMITS["measurable"])
 
     def first_disagreement(self) -> float | None:
-        """Lowest frequency (Hz) of the first run of two or more disagreeing frequencies."""
+        """Lowest frequency (Hz) of the first run of two or more disagreeing frequencies.
+
+        Returns
+        -------
+        float or None
+            Hz; None when no two neighbouring frequencies disagree.
+        """
         use = np.flatnonzero(self._used())
         bad = use[~self.agrees[use]]
         runs = bad[np.flatnonzero(np.diff(bad) == 1)] if bad.size > 1 else np.array([], int)

@@ -59,7 +59,12 @@ class Scalogram:
         return np.abs(self.coefficients) ** 2
 
     def inside_coi(self) -> np.ndarray:
-        """(n_scales, n) bool: where the transform is free of edge effects."""
+        """(n_scales, n) bool: where the transform is free of edge effects.
+
+        Returns
+        -------
+        (n_scales, n) bool ndarray
+        """
         return self.freq_hz[:, None] >= self.coi_hz[None, :]
 
 
@@ -106,6 +111,11 @@ def scalogram(x, fs: float, band: tuple[float, float]) -> Scalogram:
         Sampling rate, Hz.
     band : (lo, hi)
         Frequencies to cover, Hz.
+
+    Returns
+    -------
+    Scalogram
+        The wavelet coefficients, frequencies and cone of influence.
     """
     x = np.asarray(x, dtype=float)
     s0, dj, j = _scales(fs, band[0], band[1], x.size)
@@ -137,6 +147,15 @@ def wavelet_coherence(
     significance : float or None
         Confidence of the red-noise level (AR(1) noise with each signal's lag-1
         autocorrelation, ``mc`` Monte Carlo pairs); None skips it.
+    mc : int
+        Monte Carlo pairs for the significance level.
+    seed : int
+        Seed of those pairs.
+
+    Returns
+    -------
+    WaveletCoherence
+        Coherence, phase, frequencies, cone of influence and significance level.
     """
     x, y = (np.asarray(v, dtype=float) for v in (x, y))
     if x.shape != y.shape or x.ndim != 1:

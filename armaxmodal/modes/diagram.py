@@ -99,7 +99,14 @@ class StabilisationDiagram:
         return found + disturbance_lines(self.poles, self.tolerances.min_energy, self.recording, SHARED)
 
     def to_frame(self) -> pd.DataFrame:
-        """The tidy pole table without the complex columns (for CSV)."""
+        """The tidy pole table without the complex columns (for CSV).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per pole of every order (the pole CSV): order, frequency, damping, class and
+            why a pole was rejected.
+        """
         return self.poles.drop(columns=["pole", "vector"])
 
     def plot(self, selection=None, ax=None):
@@ -143,6 +150,22 @@ def choose_nk(recording: Recording, nk_values=NK_SEARCH, na_values=DELAY_CHOICE_
 
     The delay and the order interact (band-limited data trade non-causal taps for poles), so
     they are chosen jointly; one order alone can pick a delay that biases heavily damped modes.
+
+    Parameters
+    ----------
+    recording : Recording
+        The prepared record.
+    nk_values : iterable of int
+        The delays to try, in samples (negative: non-causal taps).
+    na_values : iterable of int
+        The orders each delay is fitted at.
+    n_jobs : int, optional
+        Worker processes (default: all cores).
+
+    Returns
+    -------
+    int
+        The delay, in samples.
     """
     return _choose_nk(recording, nk_values, na_values, n_jobs)[0]
 
@@ -228,6 +251,12 @@ def stabilisation_diagram(
         Worker threads (default: all cores).
     progress : bool
         Show progress bars (the delay choice's fits, then the sweep's).
+
+    Returns
+    -------
+    StabilisationDiagram
+        The fits of every order, their poles with stability classes, the preparation and its
+        warnings.
 
     Examples
     --------

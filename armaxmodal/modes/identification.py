@@ -88,7 +88,13 @@ class Identification:
         return "good" if self.check.passed else "poor"
 
     def to_dict(self) -> dict:
-        """The JSON contract: fs, input, outputs, modes (with shapes) and per_sensor rows."""
+        """The JSON contract: fs, input, outputs, modes (with shapes) and per_sensor rows.
+
+        Returns
+        -------
+        dict
+            Strict-JSON-ready (no NaN), as ``schemas/identify.schema.json`` describes.
+        """
         rec = self.recording
         modes = [mode_record(row, self.shapes[:, i], rec.sensors) for i, row in enumerate(self.modes.itertuples())]
         per_sensor = [

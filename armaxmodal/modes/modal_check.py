@@ -121,7 +121,18 @@ class ModalCheck:
         return float(finite.max()) if finite.size else float("nan")
 
     def frf(self, freq_hz) -> np.ndarray:
-        """The fitted FRF, delays included, at ``freq_hz`` (Hz): ``(n_freq, n_sensors)``."""
+        """The fitted FRF, delays included, at ``freq_hz`` (Hz): ``(n_freq, n_sensors)``.
+
+        Parameters
+        ----------
+        freq_hz : (n_freq,) array_like
+            Frequencies, Hz.
+
+        Returns
+        -------
+        (n_freq, n_sensors) complex ndarray
+            Each sensor's FRF over the input.
+        """
         f = np.asarray(freq_hz, dtype=float)
         s = 2j * np.pi * f[:, None]
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -130,7 +141,13 @@ class ModalCheck:
             return np.exp(-s * self.delay_s) * (modal + upper + lower / s**2)
 
     def warnings(self) -> list[QualityWarning]:
-        """``modes_do_not_explain_frf`` when the check fails, naming the outputs and bands."""
+        """``modes_do_not_explain_frf`` when the check fails, naming the outputs and bands.
+
+        Returns
+        -------
+        list of QualityWarning
+            What the check found wrong, one warning per code.
+        """
         if self.passed:
             return []
         found = []
@@ -165,7 +182,13 @@ class ModalCheck:
 
     def to_dict(self) -> dict:
         """The JSON form: per output its misfit, the H1's random error, the model error, the
-        delay and the lines; the limit; the bands."""
+
+        Returns
+        -------
+        dict
+            The check's misfits, verdict and warnings, strict-JSON-ready.
+        delay and the lines; the limit; the bands.
+        """
         return {
             "limit": MODEL_ERROR_LIMIT,
             "passed": self.passed,

@@ -105,12 +105,34 @@ class DftLines:
 
     def noise_weighted(self, model: ModalModel) -> DftLines:
         """The same lines with each sensor weighted by one over its noise level as ``model``
-        leaves it (its residual's RMS per real number)."""
+
+        Parameters
+        ----------
+        model : ModalModel
+            A model fitted to these lines.
+
+        Returns
+        -------
+        DftLines
+            The same lines, re-weighted.
+        leaves it (its residual's RMS per real number).
+        """
         level = np.sqrt(model.rss / model.n_real)
         return self.weighted(1.0 / np.where(level > 0, level, 1.0))
 
     def weighted(self, weights: np.ndarray) -> DftLines:
-        """The same lines with each sensor multiplied by ``weights`` (replacing the old ones)."""
+        """The same lines with each sensor multiplied by ``weights`` (replacing the old ones).
+
+        Parameters
+        ----------
+        weights : (n_sensors,) ndarray
+            One positive weight per sensor.
+
+        Returns
+        -------
+        DftLines
+            The same lines, re-weighted.
+        """
         y = self.y / self.weights * weights
         return DftLines(self.s, self.z_inv, self.u, y, np.asarray(weights, float), self.dt, self.band_hz)
 
@@ -166,7 +188,18 @@ class ModalModel:
         """Schwarz's criterion ``-2 ln L + p ln N`` (Schwarz 1978), with ``N`` the real numbers
         fitted. ``n_effective`` (the real numbers of independent information, at most ``N``)
         scales the likelihood and sets the penalty where the residual is correlated across
-        lines (:func:`armaxmodal.modes.mode_count.effective_fraction`)."""
+
+        Parameters
+        ----------
+        n_effective : float, optional
+            Real numbers of independent information (default: all fitted).
+
+        Returns
+        -------
+        float
+            The criterion; smaller is better.
+        lines (:func:`armaxmodal.modes.mode_count.effective_fraction`).
+        """
         n_total = self.n_real * self.rss.size
         n_eff = n_total if n_effective is None else min(float(n_effective), n_total)
         return self.neg2_loglik * n_eff / n_total + self.n_params * np.log(n_eff)

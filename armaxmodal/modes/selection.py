@@ -137,6 +137,16 @@ class ModeSelection:
         ``shapes="shared"`` reports the shared-pole residues (complete by construction);
         ``"per_sensor"`` each sensor's own residue, with gaps filled by Eq. (3.34) and
         flagged ``supplemented``.
+
+        Parameters
+        ----------
+        shapes : {"shared", "per_sensor"}
+            Which residues give the mode shapes.
+
+        Returns
+        -------
+        dict
+            Strict-JSON-ready (no NaN), as ``schemas/stabilise.schema.json`` describes.
         """
         if shapes not in ("shared", "per_sensor"):
             raise ValueError(f"shapes: expected 'shared' or 'per_sensor', got {shapes!r}.")
@@ -245,6 +255,20 @@ def select_modes(
         Show a count of the fits the selection runs (finishing fits, the refit and the
         segment refits: on a long record they take as long as the sweep). A count, not a
         fraction: how many there are is known only as the selection goes.
+    min_support : float
+        Fraction of the swept orders a cluster must hold poles of to be a mode.
+    cluster_freq : float
+        Relative frequency distance within which a pole joins a cluster.
+    cluster_damping : float
+        Relative damping distance within which a pole joins a cluster.
+    merge_mac : float
+        Shape agreement (MAC) above which two close modes are one mode split.
+
+    Returns
+    -------
+    ModeSelection
+        The modes with their intervals and shapes, the modal-model check, the count's
+        evidence and the verdict.
 
     Examples
     --------

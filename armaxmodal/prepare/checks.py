@@ -23,6 +23,11 @@ __all__ = ["check_quality"]
 def check_quality(recording: Recording) -> list[QualityWarning]:
     """Every pre-fit check on ``recording`` (see :mod:`armaxmodal.prepare.quality`).
 
+    Parameters
+    ----------
+    recording : Recording
+        The record as read (before any preparation).
+
     Returns
     -------
     list of QualityWarning

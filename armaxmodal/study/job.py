@@ -52,7 +52,13 @@ class StudySettings:
         return {**asdict(self), "armaxmodal_version": __version__}
 
     def key(self) -> str:
-        """Hash of everything that changes a recording's result."""
+        """Hash of everything that changes a recording's result.
+
+        Returns
+        -------
+        str
+            The first 16 hex digits of the settings' SHA-256.
+        """
         return hashlib.sha256(json.dumps(self.to_dict(), sort_keys=True).encode()).hexdigest()[:16]
 
 
@@ -62,6 +68,13 @@ def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[st
     The modes come from ``sensors`` (the study's common set); the lumping check may use
     any of the recording's channels. Runs single-threaded (one BLAS thread, no inner process
     pool): the study parallelises over recordings, and the result is the same wherever it runs.
+
+    Parameters
+    ----------
+    rec : Recording
+    settings : StudySettings
+    sensors : tuple of str
+        The study's common sensors.
 
     Returns
     -------

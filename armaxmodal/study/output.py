@@ -39,6 +39,14 @@ def write_study(study: Study, out: str | Path, report: str | Path | None = None)
     ``shapes.csv``, ``lump.csv`` (when asked), ``study.json``, ``shapes_<ride>.png`` and the
     HTML report (default ``out/report.html``) -- all staged, then moved in together.
 
+    Parameters
+    ----------
+    study : Study
+    out : str or Path
+        The folder for the tables and figures (created).
+    report : str or Path, optional
+        Where the HTML report goes (default ``out/report.html``).
+
     Returns
     -------
     list of Path

@@ -53,7 +53,13 @@ class Study:
     scaled: list[dict] | None = None
 
     def to_dict(self) -> dict:
-        """The ``study.json`` contract: settings, recordings, failures, summary."""
+        """The ``study.json`` contract: settings, recordings, failures, summary.
+
+        Returns
+        -------
+        dict
+            Strict-JSON-ready (no NaN): what ``study.json`` holds.
+        """
         recordings = [{k: v for k, v in r.items() if k != "figure_png"} for r in self.recordings]
         return strict_json(
             {

@@ -108,6 +108,27 @@ def make_study(
     Subjects are numbered from 1; ``feet_subjects`` carry a feet sensor, rigid unless also in
     ``separate_feet``. Returns the truth: per subject its mass, feet, chain and body modes,
     and per ride the across-subject mean and sample SD of the modes (Table 3.3 form).
+
+    Parameters
+    ----------
+    out : str or Path
+        The folder to write (created).
+    n_subjects : int
+    feet_subjects : tuple of int
+        Subjects with a feet sensor.
+    separate_feet : tuple of int
+        Subjects whose feet move on their own spring (others' feet are rigid).
+    rides : tuple of {"sweep", "random"}
+    fs : float
+        Sampling rate, Hz.
+    duration : float
+        Length of each ride, s.
+    seed : int
+
+    Returns
+    -------
+    dict
+        The truth written to ``truth.json``.
     """
     out = Path(out)
     rng = np.random.default_rng(seed)

@@ -1,9 +1,10 @@
 """A study's tables: modes matched across recordings, Table 3.2 per sensor, Table 3.3 per
 subject and across subjects, and the Fig. 3.7 geometric-mean mode shapes.
 
-:func:`~armaxmodal.study.summarise_subjects` is Table 3.3 from per-subject results the caller already has: per
-subject the |M|-weighted frequency and damping (Eqs. 3.35-3.36), then the mean and standard
-deviation over subjects, and the geometric-mean mode-shape magnitudes (Fig. 3.7)."""
+:func:`~armaxmodal.study.summarise_subjects` is Table 3.3 from per-subject results the caller
+already has: per subject the ``|M|``-weighted frequency and damping (Eqs. 3.35-3.36), then the
+mean and standard deviation over subjects, and the geometric-mean mode-shape magnitudes
+(Fig. 3.7)."""
 
 from __future__ import annotations
 
@@ -93,7 +94,19 @@ def match_modes(freqs: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray]]:
 
 
 def build_tables(recordings: list[dict], sensors) -> StudyTables:
-    """All tables from the analysed recordings (see :class:`~armaxmodal.study.StudyTables`)."""
+    """All tables from the analysed recordings (see :class:`~armaxmodal.study.StudyTables`).
+
+    Parameters
+    ----------
+    recordings : list of dict
+        :func:`~armaxmodal.study.analyse_recording`'s results, each with its manifest entry.
+    sensors : tuple of str
+        The study's common sensors.
+
+    Returns
+    -------
+    StudyTables
+    """
     mode_rows, sensor_rows, shape_rows, notes = [], [], [], []
     for ride in sorted({r["ride"] for r in recordings}):
         group = [r for r in recordings if r["ride"] == ride]

@@ -87,6 +87,10 @@ TABLE_4_4 = {
 def chapter2_system() -> Structure:
     """The four-DOF base-excited system of Section 2.3.1 (kg, N s/m, N/m).
 
+    Returns
+    -------
+    Structure
+
     Examples
     --------
     >>> import numpy as np
@@ -117,6 +121,10 @@ def chapter2_system() -> Structure:
 
 def supine_human() -> Structure:
     """The supine-human chain of Section 4.4 (head, chest, pelvis, legs), symmetric C.
+
+    Returns
+    -------
+    Structure
 
     Examples
     --------
@@ -153,6 +161,10 @@ def supine_with_feet() -> Structure:
     40 kN/m and 250 N s/m, to the legs 20 kN/m and 60 N s/m; not from the thesis, which
     names the feet as an optional fifth sensor): modes 6.89, 8.36, 13.54, 16.25 and
     24.84 Hz, damping 0.26-0.40, the fifth near the 28 Hz edge of the thesis's rides.
+
+    Returns
+    -------
+    Structure
 
     Examples
     --------

@@ -207,6 +207,28 @@ def simulate_recording(
     channel's RMS (0.05 = 5 %). The noiseless input drives the structure; the recorded
     input carries its own noise, as a platform sensor's would.
 
+    Parameters
+    ----------
+    structure : Structure
+    base_acceleration : (n_samples,) array_like
+        Base acceleration in m/s^2 sampled at ``fs``.
+    fs : float
+        Sampling rate in Hz.
+    noise : float
+        Sensor noise of every output, relative to its RMS.
+    input_noise : float
+        Noise of the recorded input, relative to its RMS.
+    seed : int, optional
+        Seed of both noises.
+    hold, quantity, frame, oversample
+        As :func:`~armaxmodal.simulate`.
+    meta : dict, optional
+        Added to the recording's metadata (beside the structure's truth).
+
+    Returns
+    -------
+    Recording
+
     Examples
     --------
     >>> import armaxmodal as am
@@ -236,6 +258,18 @@ def simulate_recording(
 
 def add_noise(x, level: float, rng: np.random.Generator) -> np.ndarray:
     """``x`` plus white Gaussian noise of standard deviation ``level`` x RMS per column.
+
+    Parameters
+    ----------
+    x : (n_samples,) or (n_samples, n_channels) array_like
+    level : float
+        Standard deviation relative to each column's RMS.
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    ndarray
+        Shaped like ``x``.
 
     Examples
     --------
@@ -313,6 +347,18 @@ def random_vibration(
 
     Built on the FFT grid of the record, so it is exactly periodic and band-limited: the
     ``bandlimited`` simulation interpolates it without error.
+
+    Parameters
+    ----------
+    fs : float
+        Sampling rate, Hz.
+    duration : float
+        Length, s.
+    band : (lo, hi)
+        The flat band, Hz.
+    rms : float
+        RMS, m/s^2.
+    seed : int, optional
 
     Returns
     -------

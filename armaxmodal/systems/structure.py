@@ -79,7 +79,13 @@ class ChainComponents:
     names: tuple[str, ...]
 
     def to_frame(self) -> pd.DataFrame:
-        """One row per component: kind ('mass', 'k', 'c', 'k_s', 'c_s'), location, value, unit."""
+        """One row per component: kind ('mass', 'k', 'c', 'k_s', 'c_s'), location, value, unit.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``component`` (the kind above), ``location``, ``value`` and ``unit``.
+        """
         rows = []
         units = {"masses": "kg", "k": "N/m", "c": "N*s/m", "k_s": "N/m", "c_s": "N*s/m"}
         for kind, label in (("masses", "mass"), ("k", "k"), ("c", "c")):
@@ -126,7 +132,13 @@ class ExactModes:
     names: tuple[str, ...]
 
     def to_frame(self) -> pd.DataFrame:
-        """One row per mode: frequency (Hz), damping ratio, damped frequency (Hz)."""
+        """One row per mode: frequency (Hz), damping ratio, damped frequency (Hz).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per mode.
+        """
         return pd.DataFrame(
             {
                 "mode": np.arange(1, self.freq_hz.size + 1),
@@ -137,7 +149,13 @@ class ExactModes:
         )
 
     def to_dict(self) -> dict:
-        """JSON-ready dictionary (shapes as magnitude and phase in degrees per location)."""
+        """JSON-ready dictionary (shapes as magnitude and phase in degrees per location).
+
+        Returns
+        -------
+        dict
+            Strict-JSON-ready.
+        """
         return {
             "modes": [
                 {
@@ -245,14 +263,26 @@ class Structure:
 
     def chain_components(self) -> ChainComponents:
         """Springs and dampers of the chain these matrices describe; raises
-        :class:`StructureError` if C or K couple non-neighbouring masses."""
+
+        Returns
+        -------
+        ChainComponents
+            Each mass, spring and damper of the chain by name.
+        :class:`StructureError` if C or K couple non-neighbouring masses.
+        """
         k, k_s = _chain_parts(self.K, "K")
         c, c_s = _chain_parts(self.C, "C")
         return ChainComponents(self.masses, k, c, k_s, c_s, self.names)
 
     # -- exact modal solution -----------------------------------------------------------
     def modes(self) -> ExactModes:
-        """Complex modes from the first-order (state-space) eigenproblem."""
+        """Complex modes from the first-order (state-space) eigenproblem.
+
+        Returns
+        -------
+        ExactModes
+            Eigenvalues, natural frequencies, damping ratios and shapes of the fixed-base system.
+        """
         n = self.n_dof
         m_inv = 1.0 / np.diag(self.M)
         a = np.block([[np.zeros((n, n)), np.eye(n)], [-m_inv[:, None] * self.K, -m_inv[:, None] * self.C]])
@@ -283,13 +313,33 @@ class Structure:
 
     # -- frequency responses ------------------------------------------------------------
     def frf(self, freq_hz) -> np.ndarray:
-        """Receptance ``H(w) = (K + iwC - w^2 M)^-1`` (Eq. 2.19), shape (n_freq, n, n), m/N."""
+        """Receptance ``H(w) = (K + iwC - w^2 M)^-1`` (Eq. 2.19), shape (n_freq, n, n), m/N.
+
+        Parameters
+        ----------
+        freq_hz : (n_freq,) array_like
+            Frequencies, Hz.
+
+        Returns
+        -------
+        (n_freq, n, n) complex ndarray
+        """
         w = 2 * np.pi * np.atleast_1d(np.asarray(freq_hz, dtype=float))
         dyn = self.K[None] + 1j * w[:, None, None] * self.C[None] - (w**2)[:, None, None] * self.M[None]
         return np.linalg.inv(dyn)
 
     def epfrf(self, freq_hz) -> np.ndarray:
-        """EPFRF ``-w^2 H(w) M e`` (Eqs. 2.20-2.22), shape (n_freq, n_dof), dimensionless."""
+        """EPFRF ``-w^2 H(w) M e`` (Eqs. 2.20-2.22), shape (n_freq, n_dof), dimensionless.
+
+        Parameters
+        ----------
+        freq_hz : (n_freq,) array_like
+            Frequencies, Hz.
+
+        Returns
+        -------
+        (n_freq, n_dof) complex ndarray
+        """
         w = 2 * np.pi * np.atleast_1d(np.asarray(freq_hz, dtype=float))
         w2 = (w**2)[:, None, None]
         dyn = self.K[None] + 1j * w[:, None, None] * self.C[None] - w2 * self.M[None]
@@ -302,6 +352,17 @@ class Structure:
         With ``reference=None`` each output over the base acceleration, ``1 - EPFRF``
         (-> 1 at low frequency). With a DOF name or index ``l``, ``T_kl = U_k / U_l``
         between outputs (Eqs. 3.29-3.31).
+
+        Parameters
+        ----------
+        freq_hz : (n_freq,) array_like
+            Frequencies, Hz.
+        reference : str or int, optional
+            The output to divide by (default: the base).
+
+        Returns
+        -------
+        (n_freq, n_dof) complex ndarray
         """
         t_base = 1.0 - self.epfrf(freq_hz)
         if reference is None:
@@ -327,6 +388,17 @@ class Structure:
         States are ``[u_r, u_r']`` (relative displacement and velocity), plus the base
         displacement and velocity ``[u_g, u_g']`` when absolute displacement or velocity is
         asked for. Returns ``(A, B, C, D)`` with B of shape (n_states, 1) and D (n_dof, 1).
+
+        Parameters
+        ----------
+        quantity : {"acceleration", "velocity", "displacement"}
+            What C and D output (m/s^2, m/s, m).
+        frame : {"absolute", "relative"}
+            Inertial, or relative to the base.
+
+        Returns
+        -------
+        A, B, C, D : ndarray
         """
         if quantity not in QUANTITIES:
             raise ValueError(f"quantity: expected one of {QUANTITIES}, got {quantity!r}.")
