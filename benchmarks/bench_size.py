@@ -1,5 +1,5 @@
-"""How `armaxmodal stabilise` scales with the record (issue 13's performance target: up to
-20,000 samples x 5 sensors in under 5 s warm on 2 cores, linear in the samples beyond).
+"""How `armaxmodal stabilise` scales with the record: wall time per sample as the record grows
+(linear beyond 20,000 samples x 5 sensors is the goal), saved in ``results/size.json``.
 
 Builds a five-mass chain (modes 6.6-14.4 Hz, damping 7-10 %) ridden by random base
 acceleration at 100 Hz (0.5-40 Hz, band-limited, 5 % sensor noise) for several record
@@ -23,6 +23,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from results import save  # benchmarks/results.py, beside this script
 
 import armaxmodal as am
 from armaxmodal.systems.datasets import five_mass_chain
@@ -76,6 +77,17 @@ def stages(rec: am.Recording) -> None:
         print(f"  {name}: {t1 - t0:.2f} s")
 
 
+def size_rows(times: dict[int, float]) -> list[dict]:
+    """Each length's wall time per sample over the shortest's: at most 1 is linear or better."""
+    first = min(times)
+    return [{
+        "what": f"wall time per sample of `stabilise` at {n:,} x 5 over {first:,} x 5 (five-mass chain, 100 Hz)",
+        "goal": "<= 1 (linear)",
+        "measured": f"{(t / n) / (times[first] / first):.2f} ({t:.1f} s against {times[first]:.1f} s)",
+        "met": (t / n) / (times[first] / first) <= 1.0, "values": [t, times[first]],
+    } for n, t in sorted(times.items()) if n != first]  # fmt: skip
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--samples", default="5000,10000,20000,40000")
@@ -86,6 +98,7 @@ def main() -> None:
     print(f"exact modes: {np.round(truth, 2).tolist()} Hz")
     print("| samples x sensors | wall time (s) | s per 1,000 samples | modes found (Hz) |")
     print("|---|---|---|---|")
+    times = {}
     with tempfile.TemporaryDirectory() as tmp:
         for i, n in enumerate(sizes):
             path = Path(tmp) / f"r{n}.csv"
@@ -96,6 +109,8 @@ def main() -> None:
             elapsed = run_cli(path, out)
             found = [round(m["freq_hz"], 2) for m in json.loads(out.read_text())["modes"]] if out.exists() else []
             print(f"| {n} x 5 | {elapsed:.1f} | {1000 * elapsed / n:.2f} | {found} |", flush=True)
+            times[n] = elapsed
+    save("size", size_rows(times))
     if args.stages:
         print(f"stages at {sizes[-1]} samples:")
         stages(recording(sizes[-1]))
