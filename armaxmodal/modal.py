@@ -18,6 +18,7 @@ __all__ = [
     "thesis_frequency_damping",
     "pole_uncertainty",
     "mode_record",
+    "modal_frf",
     "normalised_shape",
 ]
 
@@ -148,3 +149,14 @@ def mode_record(row, shape: np.ndarray, sensors, supplemented=None) -> dict:
             for s, v, f in zip(sensors, shape, flags, strict=True)
         },
     }
+
+
+def modal_frf(freq_hz, freqs, dampings, shapes):
+    """Absolute-acceleration transmissibility synthesised from modes: ``sum r/(iw - lambda) + c.c.``
+    with ``r = -lambda^2 M`` (M: EPFRF modal constants). Shape (n_freq, n_sensors)."""
+    w = 2j * np.pi * np.asarray(freq_hz)[:, None, None]
+    wn = 2 * np.pi * np.asarray(freqs)
+    lam = -np.asarray(dampings) * wn + 1j * wn * np.sqrt(1 - np.asarray(dampings) ** 2)
+    r = -(lam**2)[None, :] * shapes  # (n_sensors, n_modes)
+    out = r[None] / (w - lam[None, None]) + np.conj(r)[None] / (w - np.conj(lam)[None, None])
+    return out.sum(axis=2)

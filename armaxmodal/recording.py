@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
 
 from armaxmodal._validate import as_signal_matrix, as_signal_vector, check_amplitude, check_fs, check_not_constant
 from armaxmodal.exceptions import DataError
-from armaxmodal.welch import welch_spectra
+from armaxmodal.spectra import welch_spectra
 
 __all__ = ["Recording"]
 
@@ -139,6 +139,23 @@ class Recording:
                 array.flags.writeable = False  # shared by every stage that reads them
             self._spectra[nperseg] = spectra
         return self._spectra[nperseg]
+
+    def with_meta(self, meta: dict) -> Recording:
+        """The same record with other metadata, sharing the spectra computed so far (the samples
+        are the same, so are their spectra).
+
+        Parameters
+        ----------
+        meta : dict
+            The new metadata (replaces the old).
+
+        Returns
+        -------
+        Recording
+        """
+        out = replace(self, meta=meta)
+        out._spectra.update(self._spectra)
+        return out
 
     def select(self, sensors: Sequence[str]) -> Recording:
         """A recording with only the named outputs, in the given order.

@@ -208,13 +208,13 @@ MUTANTS = [
     ),
     # periodic disturbances seen by the sweep
     (
-        "armaxmodal/prepare/disturbance.py",
+        "armaxmodal/modes/disturbance.py",
         "(pooled.damping.abs() < UNDAMPED_LINE) & (pooled.energy < min_energy * strongest)",
         "(pooled.damping.abs() < UNDAMPED_LINE)",
         "a driven lightly damped mode called a disturbance (line)",
     ),
     (
-        "armaxmodal/prepare/disturbance.py",
+        "armaxmodal/modes/disturbance.py",
         "if prominence >= INPUT_LINE_RATIO:",
         "if prominence < INPUT_LINE_RATIO:",
         "input's own line stated backwards (line)",
@@ -412,13 +412,13 @@ MUTANTS = [
         "Welch rule rounds down (layout)",
     ),
     (
-        "armaxmodal/prepare/frf.py",
+        "armaxmodal/spectra.py",
         "float(fs), int(nperseg))",
         "float(fs), 0)",
         "spectra cache ignores the segment (layout)",
     ),
     (
-        "armaxmodal/prepare/frf.py",
+        "armaxmodal/spectra.py",
         "return x.shape, x.dtype.str, hashlib",
         "return x.shape, x.dtype.str, len",
         "spectra cache ignores the content (layout)",

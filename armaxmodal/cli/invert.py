@@ -92,7 +92,7 @@ def _read_modes(path: str) -> dict:
 def _measured_transmissibility(args, sensors: list, sigma: dict) -> tuple:
     """The recording and its coherent H1 lines ``(freq_hz, T)``; the H1's relative error goes
     into ``sigma["frf"]``."""
-    from armaxmodal.prepare.frf import default_nperseg, h1_relative_error, measured_frf
+    from armaxmodal.spectra import default_nperseg, h1_relative_error, measured_frf
 
     rec = read_recording(args.recording, input=args.input, fs=args.fs)
     if set(rec.sensors) != set(sensors):

@@ -143,7 +143,7 @@ def _uff_writer(selection):
     """``write(tmp)`` of the modes (UFF 55) and, per sensor, the measured H1 and the modal model's
     FRF on the check's lines inside its band (UFF 58)."""
     from armaxmodal.io.uff_modes import write_modes_uff
-    from armaxmodal.prepare.frf import excited_band, measured_frf
+    from armaxmodal.spectra import excited_band, measured_frf
 
     rec, check, modes = selection.diagram.recording, selection.check, selection.modes
     frfs = []

@@ -41,7 +41,7 @@ def deflections(fitted: FittedModel, integrations: int = 2) -> dict[tuple[str, s
     each sensor relative to the base and each pair of sensors, (n,) each, keyed by (sensor,
     other or input). They come from the simulated relative accelerations integrated in the
     frequency domain, from half the lowest mode (and the input's excited band) up."""
-    from armaxmodal.prepare.frf import excited_band
+    from armaxmodal.spectra import excited_band
 
     s = fitted.signals
     rel = fitted.simulated() - s.u[:, None]

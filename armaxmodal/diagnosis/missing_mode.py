@@ -1,14 +1,13 @@
 """A mode the model lacks: the model's FRF against the measured H1, beyond the H1's own
-random error (Bendat & Piersol's ``sqrt((1 - g^2) / (g^2 n_d))``, ``armaxmodal.prepare.frf.h1_relative_error``)."""
+random error (Bendat & Piersol's ``sqrt((1 - g^2) / (g^2 n_d))``, ``armaxmodal.spectra.h1_relative_error``)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from armaxmodal.diagnosis.model import FittedModel, usable
-from armaxmodal.prepare.frf import h1_relative_error
+from armaxmodal.spectra import coherence, h1_relative_error, welch_spectra
 from armaxmodal.stats import MISFIT_COHERENCE, welch_nperseg
-from armaxmodal.welch import coherence, welch_spectra
 
 __all__ = ["mode_findings", "added_modes", "MODEL_CLASS_FLOOR"]
 

@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 
 from armaxmodal.diagnosis.model import PiecewiseModel, Signals
+from armaxmodal.spectra import coherence, welch_spectra
 from armaxmodal.stats import welch_nperseg
-from armaxmodal.welch import coherence, welch_spectra
 
 __all__ = ["FLOOR_SETTLED", "extra_input_response", "noise_floor"]
 

@@ -7,7 +7,7 @@ import numpy as np
 from scipy import stats
 
 from armaxmodal.diagnosis.model import usable
-from armaxmodal.prepare.frf import measured_frf
+from armaxmodal.spectra import measured_frf
 from armaxmodal.stats import welch_nperseg
 
 __all__ = ["plot_diagnosis"]

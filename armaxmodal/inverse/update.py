@@ -86,7 +86,7 @@ def model_update(
         Noise levels, all relative standard deviations: ``freq``, ``damping`` (scalars or one
         per mode), ``shape`` (of each shape component, complex rms) and ``frf`` (of each
         transmissibility value, complex rms; a scalar or an array shaped like T, e.g. from the
-        coherence, see ``armaxmodal.prepare.frf.h1_relative_error``). Defaults: 1 %, 5 %, 5 %, 5 %.
+        coherence, see ``armaxmodal.spectra.h1_relative_error``). Defaults: 1 %, 5 %, 5 %, 5 %.
     shape_magnitude_only, frf_magnitude_only : bool
         Use magnitudes only for that block (phases not trusted).
     mass_ratio_bounds, m1, total_mass, names

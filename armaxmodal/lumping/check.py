@@ -14,10 +14,9 @@ import numpy as np
 
 from armaxmodal.exceptions import DataError
 from armaxmodal.lumping.wavelet import WaveletCoherence, scalogram, wavelet_coherence
-from armaxmodal.prepare.frf import excited_band
 from armaxmodal.recording import Recording
+from armaxmodal.spectra import excited_band, welch_spectra
 from armaxmodal.stats import H1_COHERENCE, welch_nperseg
-from armaxmodal.welch import welch_spectra
 
 __all__ = ["LumpCheck", "lump_check", "relative_transmissibility", "LIMITS"]
 

@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 
 from armaxmodal.modes.lines import PEAK_RESOLUTION, measured_h1, resolving_nperseg
-from armaxmodal.prepare.frf import excited_band
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
+from armaxmodal.spectra import excited_band
 from armaxmodal.stats import H1_COHERENCE
 
 __all__ = ["unexplained_peaks", "coherent_peaks", "explains"]

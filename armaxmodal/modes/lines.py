@@ -12,10 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from armaxmodal.prepare.frf import excited_band, h1_relative_error
 from armaxmodal.recording import Recording
+from armaxmodal.spectra import coherence, excited_band, h1_relative_error
 from armaxmodal.stats import H1_COHERENCE
-from armaxmodal.welch import coherence
 
 __all__ = ["CHECK_RESOLUTION", "CoherentLines", "PEAK_RESOLUTION", "Resolution", "coherent_lines", "measured_h1",
            "resolving_nperseg"]  # fmt: skip

@@ -68,7 +68,7 @@ def transmissibility_at(recording, freq_hz: float) -> np.ndarray:
     Uses four averages only, for a fine frequency grid: a lightly damped resonance is
     narrower than the default plotting resolution, and Eq. (3.33) is read right at it.
     """
-    from armaxmodal.prepare.frf import measured_frf
+    from armaxmodal.spectra import measured_frf
 
     f, h, _ = measured_frf(recording, nperseg=max(recording.n_samples // 4, 16))
     return np.array(

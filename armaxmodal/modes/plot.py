@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from armaxmodal.modes.modal_check import MODEL_ERROR_LIMIT
-from armaxmodal.prepare.frf import excited_band, measured_frf
+from armaxmodal.spectra import excited_band, measured_frf
 from armaxmodal.stats import H1_COHERENCE as COHERENT
 
 __all__ = ["plot_stabilisation", "plot_prediction"]

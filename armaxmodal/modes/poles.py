@@ -14,8 +14,8 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.estimate.result import ArmaxFit
-from armaxmodal.prepare.frf import excited_band
 from armaxmodal.recording import Recording
+from armaxmodal.spectra import excited_band
 from armaxmodal.stats import MAX_DAMPING, Z95
 
 __all__ = ["Tolerances", "pole_rows", "stability_classes", "rejection_reasons", "mac", "POLE_COLUMNS"]

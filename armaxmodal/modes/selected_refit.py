@@ -21,9 +21,9 @@ from armaxmodal.modes.spread import (
     split_segments,
 )
 from armaxmodal.modes.working import WorkingSelection
-from armaxmodal.prepare.frf import excited_band
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
+from armaxmodal.spectra import excited_band
 from armaxmodal.stats import Z95
 
 

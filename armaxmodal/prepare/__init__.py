@@ -3,7 +3,9 @@
 * :func:`prepare` -- checks, level shifts, detrending, alignment of late channels and
   resampling to the analysis band; :class:`Preparation` says what was done.
 * :func:`check_quality` -- the pre-fit checks (:mod:`.quality`, :mod:`.held`, :mod:`.units`).
-* :mod:`.frf` -- Welch spectra, H1 and coherence, shared by every later stage.
+
+The record's spectra are not this stage's: they are the record's own (:mod:`armaxmodal.spectra`,
+:meth:`~armaxmodal.Recording.welch`), computed once and read by every stage.
 """
 
 from armaxmodal.prepare.checks import check_quality

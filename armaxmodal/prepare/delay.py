@@ -19,8 +19,8 @@ import numpy as np
 
 from armaxmodal.quality_warnings import QualityWarning, not_run
 from armaxmodal.recording import Recording
+from armaxmodal.spectra import coherence, welch_segments
 from armaxmodal.stats import QUASI_STATIC_COHERENCE, welch_nperseg
-from armaxmodal.welch import coherence, welch_segments
 
 __all__ = [
     "DELAY_ALPHA", "MIN_DELAY_SAMPLES", "QUASI_STATIC_MAGNITUDE", "DelayEstimate", "delay_and_inversion",

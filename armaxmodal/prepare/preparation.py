@@ -166,7 +166,7 @@ def prepare(
             found.append(note)
             analysis_fs = rec.fs
     meta = dict(rec.meta, preprocessing={"detrend": detrend, "analysis_fs": analysis_fs})
-    rec = replace(rec, meta=meta)
+    rec = rec.with_meta(meta)  # keeps the spectra the steps above computed
     return Preparation(rec, recording.fs, analysis_fs, band, detrend, dropped, shifts, tuple(found))
 
 

@@ -24,7 +24,7 @@ recording:
 * ``held_samples`` -- a channel sampled at a lower rate and held to the record's
   (:mod:`armaxmodal.prepare.held`): its repeats keep to a cycle.
 
-The sweep adds ``periodic_disturbance`` (:mod:`armaxmodal.prepare.disturbance`); preparation
+The sweep adds ``periodic_disturbance`` (:mod:`armaxmodal.modes.disturbance`); preparation
 (:mod:`armaxmodal.prepare.preparation`) adds ``offset_removed``, ``offset_step``, ``drift``,
 ``trend_removed`` and ``resampled``.
 """
@@ -35,8 +35,8 @@ import numpy as np
 
 from armaxmodal.quality_warnings import QualityWarning, not_run
 from armaxmodal.recording import Recording
+from armaxmodal.spectra import coherence, welch_spectra
 from armaxmodal.stats import welch_nperseg
-from armaxmodal.welch import coherence, welch_spectra
 
 __all__ = [
     "CLIP_MIN_SAMPLES", "INCOHERENT", "NEIGHBOUR_LEVELS", "STUCK_EDGE_MIN", "STUCK_MIN_RUN", "clipped_channels",
@@ -78,16 +78,16 @@ CLIP_PILEUP_P = 1e-4
 CLIP_HELD_P = 0.01
 
 
-
-
 def input_coherence(u: np.ndarray, y: np.ndarray, fs: float) -> np.ndarray:
     """Each output's magnitude-squared coherence with the input (Welch, 10 s segments at most
     an eighth of the record), averaged with the input's power as weight: the share of the
     output, at the frequencies the input drives, that a linear response to it explains, (K,)."""
     y = np.asarray(y, float).reshape(len(u), -1)
-    nperseg = welch_nperseg(len(u), fs)
-    _, puu, puy, pyy = welch_spectra(u, y, fs, nperseg)
-    coh = coherence(puu, puy, pyy)
+    _, puu, puy, pyy = welch_spectra(u, y, fs, welch_nperseg(len(u), fs))
+    return _power_weighted(puu, coherence(puu, puy, pyy))
+
+
+def _power_weighted(puu: np.ndarray, coh: np.ndarray) -> np.ndarray:
     return puu @ coh / max(float(puu.sum()), 1e-300)
 
 
@@ -95,7 +95,8 @@ def incoherent_outputs(recording: Recording) -> list[QualityWarning]:
     """Outputs whose coherence with the input (:func:`input_coherence`) is below ``INCOHERENT``."""
     if recording.n_samples < 128:
         return [not_run("incoherent_output", recording.sensors, f"{recording.n_samples} samples, fewer than 128")]
-    levels = input_coherence(recording.base, recording.response, recording.fs)
+    _, puu, puy, pyy = recording.welch(welch_nperseg(recording.n_samples, recording.fs))  # the record's own
+    levels = _power_weighted(puu, coherence(puu, puy, pyy))
     low = [(name, float(c)) for name, c in zip(recording.sensors, levels, strict=True) if c < INCOHERENT]
     if not low:
         return []

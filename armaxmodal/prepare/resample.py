@@ -26,7 +26,7 @@ def resample_to_band(rec: Recording, band) -> tuple[Recording, QualityWarning | 
     """Decimate by the largest whole factor that keeps the band's upper edge at
     :data:`BAND_FRACTION_OF_FS` of the new rate; the band is the user's or the input's
     excited band (within 30 dB of its peak)."""
-    from armaxmodal.prepare.frf import excited_band
+    from armaxmodal.spectra import excited_band
 
     hi = band[1] if band is not None else excited_band(rec)[1]
     factor = int(np.floor(BAND_FRACTION_OF_FS * rec.fs / max(hi, 1e-9)))

@@ -12,7 +12,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import armaxmodal as am
-from armaxmodal.prepare.frf import measured_frf
+from armaxmodal.spectra import measured_frf
 
 human = am.supine_human()
 print(human.modes().to_frame().round(4))

@@ -18,7 +18,7 @@ from armaxmodal.estimate.orders import default_nb
 from armaxmodal.modal import discrete_modal_parameters, pole_uncertainty
 from armaxmodal.modes.poles import Tolerances, mac, rejection_reasons
 from armaxmodal.modes.refine import refine_modes
-from armaxmodal.prepare.frf import excited_band
+from armaxmodal.spectra import excited_band
 
 FS = 60.0
 

@@ -416,7 +416,7 @@ def test_the_figure_draws_the_h1_and_coherence_the_check_judged(diagram, monkeyp
     import matplotlib.pyplot as plt
 
     import armaxmodal.modes.plot as plot
-    from armaxmodal.prepare.frf import measured_frf
+    from armaxmodal.spectra import measured_frf
 
     asked = []
 
@@ -442,7 +442,7 @@ def test_the_frf_axis_spans_the_curves_inside_the_input_band():
     import matplotlib.pyplot as plt
 
     from armaxmodal.modes.plot import _limit_frf_axis
-    from armaxmodal.prepare.frf import excited_band, measured_frf
+    from armaxmodal.spectra import excited_band, measured_frf
 
     s, _ = _two_mode_ride(30.0)
     ride = am.simulate_recording(s, am.random_vibration(50.0, 30.0, (0.5, 16.0), seed=3), 50.0, noise=0.05, seed=4)
@@ -498,7 +498,7 @@ def test_a_line_the_input_does_not_drive_is_named_as_a_periodic_disturbance(ride
 def test_a_structure_damped_below_the_line_threshold_is_not_a_disturbance():
     """Modes at 0.066 % and 0.089 % damping are as undamped as a hum, but the input drives
     them (residues 11 % and 100 % of the strongest): modes, never a periodic disturbance."""
-    from armaxmodal.prepare.disturbance import UNDAMPED_LINE
+    from armaxmodal.modes.disturbance import UNDAMPED_LINE
 
     s = am.Structure.from_chain([10.0, 5.0], [8000.0, 0.0], [0.5, 0.0], [12000.0], [0.3], ("m1", "m2"))
     assert max(s.modes().damping) < UNDAMPED_LINE

@@ -7,7 +7,7 @@ import pytest
 
 import armaxmodal as am
 from armaxmodal.modes.refine import refine_modes
-from armaxmodal.prepare.frf import excited_band
+from armaxmodal.spectra import excited_band
 
 
 def _start(fixtures_dir, name):

@@ -168,7 +168,7 @@ def _band_limited(fs: float = 100.0, n: int = 6000) -> am.Recording:
 
 def test_rejection_reasons_each_at_its_threshold():
     from armaxmodal.modes.poles import UNRESOLVED_DAMPING, rejection_reasons
-    from armaxmodal.prepare.frf import excited_band
+    from armaxmodal.spectra import excited_band
 
     rec = _band_limited()
     lo, hi = excited_band(rec)
@@ -409,7 +409,7 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     from types import SimpleNamespace
 
     import armaxmodal.modes.selected_refit as st
-    from armaxmodal.prepare.frf import excited_band
+    from armaxmodal.spectra import excited_band
 
     rec = _recording(2000)
     lo, hi = excited_band(rec)

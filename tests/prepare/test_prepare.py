@@ -13,8 +13,8 @@ from armaxmodal.modes.diagram import stabilisation_diagram
 from armaxmodal.modes.selection import select_modes
 from armaxmodal.prepare.checks import check_quality
 from armaxmodal.prepare.delay import estimate_delays
-from armaxmodal.prepare.frf import excited_band
 from armaxmodal.prepare.preparation import check_band, prepare
+from armaxmodal.spectra import excited_band
 
 FIXTURES = ["supine_random", "supine_sweep", "supine_random_zoh", "chapter2_random_zoh"]
 # a delay estimate is right when it is within this many samples of the planted one

@@ -1,15 +1,28 @@
-"""Welch spectra: auto and cross spectral densities of an input and several outputs, and their
-coherence. Numpy only, so that a :class:`~armaxmodal.recording.Recording` can carry its own
-(:meth:`~armaxmodal.Recording.welch`): every stage that holds the record reads the
-spectra computed for it once, instead of recomputing them."""
+"""A record's spectra: Welch auto and cross spectral densities of an input and several outputs,
+the coherence, the H1 estimate with its random error, and the band the input excites.
+
+Numpy only, and in the base layer, so that a :class:`~armaxmodal.Recording` carries its own
+(:meth:`~armaxmodal.Recording.welch`, computed at the first call for a segment length and kept):
+the preparation's checks, the sweep, the selection, the modal-model check, the diagnosis and the
+figures all read the spectra computed once for the record they hold, and no stage reaches back
+to an earlier one to get them."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from armaxmodal.exceptions import DataError
+from armaxmodal.stats import welch_nperseg
 
-__all__ = ["coherence", "welch_segments", "welch_spectra"]
+__all__ = [
+    "coherence",
+    "default_nperseg",
+    "excited_band",
+    "h1_relative_error",
+    "measured_frf",
+    "welch_segments",
+    "welch_spectra",
+]
 
 
 def welch_spectra(u: np.ndarray, y: np.ndarray, fs: float, nperseg: int):
@@ -88,3 +101,36 @@ def coherence(puu: np.ndarray, puy: np.ndarray, pyy: np.ndarray) -> np.ndarray:
     """Magnitude-squared coherence ``|Puy|^2 / (Puu Pyy)`` of :func:`welch_spectra`'s output,
     (n_freq, K); zero where a spectrum vanishes."""
     return np.abs(puy) ** 2 / np.maximum(puu[:, None] * pyy, 1e-300)
+
+
+def default_nperseg(recording) -> int:
+    """Welch segment length of ``measured_frf``: about 10 s (a power of two), at most an
+    eighth of the record."""
+    return welch_nperseg(recording.n_samples, recording.fs)
+
+
+def measured_frf(recording, nperseg: int | None = None):
+    """H1 estimate of each output over the input and the coherence.
+
+    Returns ``(freq_hz, H (n_freq, n_sensors) complex, coherence (n_freq, n_sensors))``.
+    """
+    n = default_nperseg(recording) if nperseg is None else nperseg
+    f, puu, puy, pyy = recording.welch(n)
+    return f, puy / puu[:, None], np.abs(puy) ** 2 / (puu[:, None] * pyy)
+
+
+def h1_relative_error(coherence: np.ndarray, n_samples: int, nperseg: int) -> np.ndarray:
+    """Relative random error (complex rms) of an H1 estimate: ``sqrt((1 - g^2) / (g^2 n_d))``
+    (Bendat & Piersol, Random Data, Sec. 9.2.4: sqrt(1 - g^2) / (|g| sqrt(2 n_d)) for the
+    magnitude and for the phase in radians), with n_d the number of Welch segments
+    (50 % overlap, as ``measured_frf``). Shape of ``coherence``."""
+    n_segments = max(1, (n_samples - nperseg) // (nperseg // 2) + 1)
+    g2 = np.clip(np.asarray(coherence, dtype=float), 1e-6, 1.0 - 1e-12)
+    return np.sqrt((1.0 - g2) / (g2 * n_segments))
+
+
+def excited_band(recording, min_db: float = -30.0) -> tuple[float, float]:
+    """Lowest and highest frequency (Hz) where the input PSD is within ``min_db`` of its peak."""
+    f, pxx, _, _ = recording.welch(min(recording.n_samples, 1024))
+    live = f[pxx >= pxx.max() * 10 ** (min_db / 10)]
+    return float(live.min()), float(live.max())

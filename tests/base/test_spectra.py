@@ -2,7 +2,8 @@ import numpy as np
 import pytest
 
 import armaxmodal as am
-from armaxmodal.prepare.frf import measured_frf, modal_frf
+from armaxmodal.modal import modal_frf
+from armaxmodal.spectra import measured_frf
 
 # Normalised random error of an H1 magnitude (Bendat & Piersol): sqrt(1 - g^2) / (|g| sqrt(2 nd)).
 # Welch with 50 % overlap: count independent averages conservatively as half the segments.
@@ -36,7 +37,7 @@ def test_h1_estimate_matches_the_exact_transmissibility():
 def test_h1_relative_error_matches_the_scatter_around_the_true_transmissibility(fixtures_dir):
     """Bendat & Piersol's random error of H1, from the coherence, against the actual scatter
     of the H1 estimate around the exact transmissibility of the simulated ride."""
-    from armaxmodal.prepare.frf import default_nperseg, h1_relative_error, measured_frf
+    from armaxmodal.spectra import default_nperseg, h1_relative_error, measured_frf
 
     rec = am.read_recording(fixtures_dir / "supine_random.csv")
     f, h, coh = measured_frf(rec)
@@ -52,7 +53,7 @@ def test_h1_relative_error_matches_the_scatter_around_the_true_transmissibility(
 def test_welch_spectra_equal_scipy_welch_and_csd(nperseg):
     import scipy.signal
 
-    from armaxmodal.welch import welch_spectra
+    from armaxmodal.spectra import welch_spectra
 
     rng = np.random.default_rng(3)
     u = rng.standard_normal(5000) + 0.3
@@ -94,7 +95,7 @@ def test_a_recording_computes_its_spectra_once_per_segment_length():
     from dataclasses import replace
 
     from armaxmodal.recording import Recording
-    from armaxmodal.welch import welch_segments, welch_spectra
+    from armaxmodal.spectra import welch_segments, welch_spectra
 
     rng = np.random.default_rng(4)
     u, y = rng.standard_normal(4000), rng.standard_normal((4000, 3))
