@@ -402,7 +402,7 @@ MUTANTS = [
         "bad = peak > MAX_AMPLITUDE",
         "tiny amplitudes pass (loop delay)",
     ),
-    # issue 28's shared numbers and fallbacks (run with --match "(layout)" --tests tests/prepare/test_frf.py
+    # issue 28's shared numbers and fallbacks (run with --match "(layout)" --tests tests/base/test_spectra.py
     # tests/prepare/test_prepare.py tests/inverse/test_inverse.py tests/lumping/test_lumping.py
     # tests/modes/test_stabilisation.py::test_a_refit_that_cannot_be_made_is_said_not_taken_for_refine_false)
     (
@@ -687,6 +687,18 @@ MUTANTS = [
         "if near:",
         "if False:",
         "a left-out start with a peak there stays decided (count)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        'for rank, rejected in enumerate(("", WEAK_RESIDUE)):',
+        'for rank, rejected in enumerate(("",)):',
+        "a stable cluster with small residues never tried as an addition (count)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "found.append((rank, -len(members), f, float(sub.damping.median())))",
+        "found.append((-rank, -len(members), f, float(sub.damping.median())))",
+        "the weak clusters tried before the clean ones (count)",
     ),
     # the diagnosis registry and the joint-force test (issue 38); run with --match "(registry)"
     # --tests tests/diagnosis/test_diagnose_delays.py tests/diagnosis/test_diagnose.py -k (as pytest
