@@ -700,6 +700,30 @@ MUTANTS = [
         "found.append((-rank, -len(members), f, float(sub.damping.median())))",
         "the weak clusters tried before the clean ones (count)",
     ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "if not search.in_both_halves(model, _new_poles(current.freq_hz, model.freq_hz), halves):",
+        "if False:",
+        "the likelihood's mode not asked to be the same in both halves (count)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "if addition is None or addition[2] is None or gain > -DECISIVE_BIC or len(halves) != 2:",
+        "if addition is None or addition[2] is None or len(halves) != 2:",
+        "the likelihood flag where BIC is undecided anyway (count)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "if dof <= 0 or chdtrc(dof, ratio) >= LIKELIHOOD_ALPHA:",
+        "if dof <= 0 or chdtrc(2 * dof, ratio) >= LIKELIHOOD_ALPHA:",
+        "the likelihood ratio's degrees of freedom doubled (count)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "    if count.wanted:",
+        "    if False:",
+        "the likelihood's wanted mode not said (count)",
+    ),
     # the diagnosis registry and the joint-force test (issue 38); run with --match "(registry)"
     # --tests tests/diagnosis/test_diagnose_delays.py tests/diagnosis/test_diagnose.py -k (as pytest
     # takes it): "friction or cubic or registry or clipping or joint_ride or kept_only or corrected or waits_for

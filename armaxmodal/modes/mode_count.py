@@ -33,17 +33,33 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.special import chdtrc
 
 from armaxmodal._threads import single_blas_thread
 from armaxmodal.modes.modal_model import DAMPING_BOUNDS, DftLines, ModalModel, fit_modal_model
 from armaxmodal.stats import MAX_DAMPING, Z95
 
-__all__ = ["DECISIVE_BIC", "ModeCount", "Step", "agree_in_halves", "count_modes", "effective_fraction", "matched_poles",
-           "reported"]  # fmt: skip
+__all__ = [
+    "DECISIVE_BIC",
+    "LIKELIHOOD_ALPHA",
+    "ModeCount",
+    "Step",
+    "agree_in_halves",
+    "count_modes",
+    "effective_fraction",
+    "matched_poles",
+    "reported",
+]
 
 #: a change of the criterion this large is "very strong" evidence (Kass & Raftery 1995): a
 #: mode's removal, or a candidate's addition, that moves it less leaves the count undecided
 DECISIVE_BIC = 10.0
+#: a refused addition whose likelihood ratio a chi-square of its parameters puts beyond this
+#: probability leaves the count undecided (when its mode is the same in both halves). BIC's
+#: penalty grows with the data, so a weakly seen mode can raise the likelihood far beyond chance
+#: and still lose on BIC; 1e-6 keeps the largest of a handful of candidates at chance (the
+#: battery's 46 bodies: at most the 1e-3 quantile) far below it
+LIKELIHOOD_ALPHA = 1e-6
 #: the residual's correlation across lines is summed up to this many lines (Bartlett's window):
 #: the widest structure of model error is a resonance's half-power band, 2 xi f = 3-10 Hz
 #: for the bodies, i.e. hundreds of lines; the sum stops earlier at the first negative value
@@ -119,6 +135,10 @@ class ModeCount:
     carried_away : tuple of (float, float)
         Starting modes the search carried to where no mode is founded, and which were left out
         of the chosen model: (start Hz, where it went Hz). See ``_without_unfounded``.
+    wanted : tuple of (float, float, int, float)
+        The best addition BIC refuses decisively while its likelihood ratio is significant
+        (beyond :data:`LIKELIHOOD_ALPHA`) and its mode is the same in both halves: (new pole Hz,
+        likelihood ratio, its parameters, the criterion's rise). Empty: none.
     """
 
     model: ModalModel
@@ -132,6 +152,7 @@ class ModeCount:
     unconfirmed_hz: tuple[float, ...] = ()
     alternatives: tuple[tuple[float, ModalModel], ...] = ()
     carried_away: tuple[tuple[float, float], ...] = ()
+    wanted: tuple = ()
 
 
 def effective_fraction(residual: np.ndarray, max_lag: int = MAX_CORRELATION_LAG) -> float:
@@ -404,6 +425,23 @@ def residual_peak(model: ModalModel, data: DftLines, width_lines: int = 9) -> tu
     return f, float(np.clip(width / (2 * f), 0.01, 0.5))
 
 
+def _wanted(search: _Search, current: ModalModel, addition, gain: float, new_hz: float, halves) -> tuple:
+    """The refused addition the likelihood wants (see :attr:`ModeCount.wanted`), or ``()``. The
+    likelihood ratio is ``-2 ln L`` of the current model less the addition's, on the effective
+    lines; it is a chi-square of the parameters one mode adds where the record holds no more."""
+    if addition is None or addition[2] is None or gain > -DECISIVE_BIC or len(halves) != 2:
+        return ()
+    model = addition[2]
+    dof = model.n_params - current.n_params
+    ratio = (search.bic(current) - current.n_params * np.log(search.n_eff)) - (
+        search.bic(model) - model.n_params * np.log(search.n_eff))
+    if dof <= 0 or chdtrc(dof, ratio) >= LIKELIHOOD_ALPHA:
+        return ()
+    if not search.in_both_halves(model, _new_poles(current.freq_hz, model.freq_hz), halves):
+        return ()
+    return (new_hz, float(ratio), int(dof), float(-gain))
+
+
 @single_blas_thread
 def count_modes(
     data: DftLines,
@@ -503,5 +541,6 @@ def count_modes(
         rise, gain, new_hz = _margins(search, here, current, removed, best_removal, best_addition)
     close = best_addition[2] if best_addition is not None and gain > -DECISIVE_BIC else None
     alternatives = _equally_good(search, current, rise, close)
+    wanted = _wanted(search, current, best_addition, gain, new_hz, halves) if searching else ()
     return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
-                     tuple(unconfirmed), alternatives, carried_away)  # fmt: skip
+                     tuple(unconfirmed), alternatives, carried_away, wanted)  # fmt: skip

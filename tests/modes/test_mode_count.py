@@ -472,18 +472,68 @@ def test_a_stable_cluster_with_a_small_residue_is_tried_as_an_addition_after_the
     assert [round(f, 1) for f, _ in found] == [20.0, 9.7]
 
 
-def test_a_weakly_seen_mode_the_sweep_rejects_at_every_order_is_counted():
-    """A five-mass chain (modes 6.6-14.4 Hz, damping 7-10 %) on a 400 s ride at 100 Hz: its
-    9.75 Hz mode is stable at nine orders with a small residue at each, and the nested tests
-    need it (before, the count never tried it and reported four modes, ``quality: good``)."""
+def _five_mass_ride(seconds: float):
+    """``benchmarks/bench_size.py``'s five-mass chain (modes 6.6-14.4 Hz, damping 7-10 %) on a
+    band-limited ride at 100 Hz with 5 % sensor noise, and its exact modes."""
     from armaxmodal.systems.datasets import five_mass_chain
 
     chain = five_mass_chain()
-    ride = am.random_vibration(100.0, 400.0, (0.5, 40.0), seed=1)
-    rec = am.simulate_recording(chain, ride, 100.0, noise=0.05, seed=2, hold="bandlimited")
+    ride = am.random_vibration(100.0, seconds, (0.5, 40.0), seed=1)
+    return am.simulate_recording(chain, ride, 100.0, noise=0.05, seed=2, hold="bandlimited"), chain.modes()
+
+
+def test_a_weakly_seen_mode_the_sweep_rejects_at_every_order_is_counted():
+    """On a 400 s ride the chain's 9.75 Hz mode is stable at nine orders with a small residue at
+    each, and the nested tests need it (before, the count never tried it and reported four
+    modes, ``quality: good``)."""
+    rec, truth = _five_mass_ride(400.0)
     selection = am.select_modes(am.stabilisation_diagram(rec))
-    truth = chain.modes()
     found = selection.modes.freq_hz.to_numpy()
     assert found.size == truth.freq_hz.size, found
     assert np.all(np.abs(found / truth.freq_hz - 1) < FREQ_TOL), found
     assert np.all(np.abs(selection.modes.damping.to_numpy() / truth.damping - 1) < DAMPING_TOL)
+
+
+def test_a_mode_the_likelihood_wants_and_bic_refuses_leaves_the_count_undecided():
+    """On a 50 s ride the same mode raises the likelihood far beyond chance (a ratio of about 180
+    for 22 parameters) but less than BIC's penalty: four modes are reported, and the verdict
+    says the record may hold one more, where it is."""
+    rec, truth = _five_mass_ride(50.0)
+    selection = am.select_modes(am.stabilisation_diagram(rec))
+    assert selection.modes.shape[0] == 4
+    assert selection.quality == "uncertain"
+    wanted = [w for w in selection.warnings if w.code == "count_undecided" and "likelihood ratio" in w.message]
+    assert len(wanted) == 1 and abs(wanted[0].value / truth.freq_hz[2] - 1) < 0.05, wanted
+
+
+def _search(bic, n_eff, halves_agree):
+    def in_both_halves(model, new, halves):
+        return halves_agree
+
+    return SimpleNamespace(bic=bic, n_eff=n_eff, in_both_halves=in_both_halves)
+
+
+@pytest.mark.parametrize(
+    ("ratio", "halves_agree", "wanted"),
+    [
+        (180.0, True, True),  # the five-mass chain's 50 s ride
+        (75.0, True, True),  # beyond the 1e-6 quantile of a chi-square of 22 (68.9), not of 44
+        (180.0, False, False),  # not the same mode in both halves
+        (30.0, True, False),  # a chance ratio for 22 parameters (p 0.12)
+        (248.0, True, False),  # BIC rises by 5 only: the equally-good rule's case, not this one
+    ],
+)
+def test_the_likelihood_ratio_flag_needs_a_significant_ratio_a_decisive_bic_and_both_halves(ratio, halves_agree,
+                                                                                              wanted):
+    from armaxmodal.modes.mode_count import _wanted
+
+    n_eff = 1e5  # BIC's penalty for one mode of 22 parameters: 22 ln(1e5) = 253
+    current = SimpleNamespace(n_params=88, freq_hz=np.array([6.6, 7.7, 11.1, 14.4]))
+    added = SimpleNamespace(n_params=110, freq_hz=np.array([6.6, 7.7, 9.6, 11.1, 14.4]))
+    bic = {id(current): 1000.0 + 88 * np.log(n_eff), id(added): 1000.0 - ratio + 110 * np.log(n_eff)}
+    gain = bic[id(current)] - bic[id(added)]
+    search = _search(lambda model: bic[id(model)], n_eff, halves_agree)
+    got = _wanted(search, current, ("add", 9.6, added), gain, 9.6, ("first half", "second half"))
+    assert bool(got) == wanted
+    if wanted:
+        assert got[0] == 9.6 and np.isclose(got[1], ratio) and got[2] == 22 and np.isclose(got[3], -gain)
