@@ -52,3 +52,11 @@ def test_every_module_has_its_page():
     lines = (root / "docs" / "modules.rst").read_text().splitlines()
     listed = [line.strip() for line in lines if line.startswith("   armaxmodal.")]  # the autosummary entries
     assert sorted(listed) == sorted(modules)
+
+
+def test_issue_numbers_and_outside_paths_are_named():
+    assert checker.internals("<p>fixed (issue 29), data in <code>../shared/realdata</code></p>") == [
+        "shows the project's bookkeeping: '../shared'",
+        "shows the project's bookkeeping: 'issue 29'",
+    ]
+    assert checker.internals("<p>an issue of damping; 29 modes</p>") == []

@@ -51,6 +51,17 @@ OBJECT_REPR = re.compile(r"&lt;[\w.]+ object at 0x[0-9a-f]+&gt;")
 RAW_TABLE_ROW = re.compile(r"<p>\s*\|(?:(?!</p>).)*\|\s*</p>", re.S)
 
 
+#: the development's own bookkeeping, which a user page should not show: issue numbers and paths
+#: outside the repository (the changelog, a dated development record, may name issues)
+INTERNALS = re.compile(r"\bissues? #?\d+|\.\./shared|/work/")
+
+
+def internals(dom: str) -> list[str]:
+    """Issue numbers and paths outside the repository in a page's text."""
+    text = re.sub(r"<[^>]+>", " ", dom)
+    return [f"shows the project's bookkeeping: {m!r}" for m in sorted(set(INTERNALS.findall(text)))]
+
+
 def shown_as_text(dom: str) -> list[str]:
     """What a reader sees as debris: object reprs, and table rows left as raw text."""
     found = [f"prints an object's repr: {r}" for r in sorted(set(OBJECT_REPR.findall(dom)))]
@@ -102,6 +113,8 @@ def problems(site: Path, browser: str) -> list[str]:
         if "Traceback (most recent call last)" in dom:
             found.append(f"{name}: shows a traceback")
         found += [f"{name}: {problem}" for problem in shown_as_text(dom)]
+        if name != "changelog.html":
+            found += [f"{name}: {problem}" for problem in internals(dom)]
         figure = "sphx-glr-single-img" in dom or "sphx-glr-multi-img" in dom
         if name.startswith("auto_examples/plot_") and not figure:
             found.append(f"{name}: no figure")

@@ -137,7 +137,7 @@ class ModeCount:
         of the chosen model: (start Hz, where it went Hz). See ``_without_unfounded``.
     wanted : tuple of (float, float, int, float)
         The best addition BIC refuses decisively while its likelihood ratio is significant
-        (beyond :data:`LIKELIHOOD_ALPHA`) and its mode is the same in both halves: (new pole Hz,
+        (beyond ``LIKELIHOOD_ALPHA``) and its mode is the same in both halves: (new pole Hz,
         likelihood ratio, its parameters, the criterion's rise). Empty: none.
     """
 
