@@ -18,6 +18,7 @@ from pathlib import Path
 
 PAGES = {
     "index.html": "armaxmodal",
+    "install.html": "Install",
     "getting_started.html": "Getting started",
     "user_guide/index.html": "User guide",
     "auto_examples/index.html": "Examples",
