@@ -16,6 +16,10 @@ An effect is added without touching the numba fitter:
 Held-out errors (see ``held_out``) come from two blocked folds: a model fitted on one half
 of the record predicts the other half. Its one-step predictions there use the measured past,
 so no start-up transient enters; only the parameters come from the other half.
+
+One module of about 550 lines on purpose: the plain and the piecewise model are fitted and
+held out through the same interface (``fit_model``, ``held_out``, ``HeldOut``), which every
+effect's test and fix calls; apart, the two would have to be kept in step by hand.
 """
 
 from __future__ import annotations

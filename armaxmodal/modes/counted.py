@@ -4,6 +4,9 @@ model (:mod:`armaxmodal.modes.mode_count`), written back as the selection's rows
 Poles the model needs but that are no modes of the band -- above the fitted band (they stand
 for the modes above it, an upper residual), damped beyond ``armaxmodal.stats.MAX_DAMPING``,
 or lines at the damping floor -- stay in the model and are not reported.
+
+One module of about 490 lines on purpose: each rule here turns the count into rows and notes
+of the one working selection, and they run in the order ``counted_modes`` states.
 """
 
 from __future__ import annotations

@@ -25,6 +25,10 @@ are kept that soak up structured error. :func:`effective_fraction` measures how 
 lines are independent from the residual's own correlation across lines (Bartlett's
 effective sample size of a correlated sequence), and both the likelihood and the penalty use
 that number. On a simulated record with white noise it is 1 and the criterion is plain BIC.
+
+One module of about 550 lines on purpose: the search's parts (candidates, margins, the
+check of unfounded poles, the equally good models, the likelihood's flag) all read and advance
+one ``_Search`` state, under the rules these notes state once.
 """
 
 from __future__ import annotations

@@ -5,6 +5,10 @@ clusters supported by a good share of the orders, reports each from its lowest-B
 refits them to the recording's DFT, lets the modal-model check drop or add modes, and widens
 the intervals by the segment spread. It is deterministic: the same data gives the same
 modes. :class:`ModeSelection` is the result and its JSON contract.
+
+One module of about 530 lines on purpose: :class:`ModeSelection` is the JSON contract of
+``stabilise`` and its verdict, and :func:`~armaxmodal.select_modes` the order of the stages that fill it;
+each stage's work is in its own module.
 """
 
 from __future__ import annotations
