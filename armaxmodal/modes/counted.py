@@ -270,15 +270,6 @@ def dropped_where_peaks_remain(count: ModeCount | None, peaks) -> list[QualityWa
     if count is None:
         return []
     notes = []
-    if count.wanted:
-        f, ratio, dof, rise_bic = count.wanted
-        notes.append(QualityWarning(
-            "count_undecided", (),
-            f"the record may hold one mode more near {f:.3f} Hz: adding it raises the likelihood far beyond chance "
-            f"(likelihood ratio {ratio:.1f} for its {dof} parameters, p < {LIKELIHOOD_ALPHA:g}) and the mode is the "
-            f"same in both halves of the record, but the criterion (BIC) rises by {rise_bic:.1f}, so it is not "
-            "reported; pick it (--pick) to see what the record says of it", f,
-        ))  # fmt: skip
     for start, went in count.carried_away:
         near = [p.value for p in peaks
                 if min(abs(np.log(p.value / start)), abs(np.log(p.value / went))) <= SAME_ROW_FREQ]  # fmt: skip
@@ -449,6 +440,15 @@ def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
             "count_undecided", (),
             f"the record does not rule out one mode more (near {f:.3f} Hz): adding it changes the criterion by "
             f"{-count.best_addition:+.1f}, less than {DECISIVE_BIC:g} either way", f,
+        ))  # fmt: skip
+    if count.wanted:
+        f, ratio, dof, rise_bic = count.wanted
+        notes.append(QualityWarning(
+            "count_undecided", (),
+            f"the record may hold one mode more near {f:.3f} Hz: adding it raises the likelihood far beyond chance "
+            f"(likelihood ratio {ratio:.1f} for its {dof} parameters, p < {LIKELIHOOD_ALPHA:g}) and the mode is the "
+            f"same in both halves of the record, but the criterion (BIC) rises by {rise_bic:.1f}, so it is not "
+            "reported; pick it (--pick) to see what the record says of it", f,
         ))  # fmt: skip
     for start, went in count.carried_away:
         notes.append(QualityWarning(
