@@ -51,3 +51,16 @@ def test_parameters_and_returns_are_documented(name):
     if not _returns_nothing(name):
         found += [f"{code}: {message}" for code, message in errors if code == "RT01"]
     assert not found, f"{name}: " + "; ".join(found)
+
+
+@pytest.mark.parametrize("name", _documented())
+def test_every_returned_and_parameter_type_is_a_type(name):
+    """A sentence left after the last section reads as one more entry, its text as the type: a
+    type never ends a sentence."""
+    from numpydoc.docscrape import FunctionDoc
+
+    doc = FunctionDoc(_object(name))
+    entries = [*doc["Parameters"], *doc["Returns"]]
+    sentences = [f"{entry.name} : {entry.type}".strip(" :") for entry in entries
+                 if (entry.type or entry.name).rstrip().endswith(".")]  # fmt: skip
+    assert not sentences, f"{name}: " + "; ".join(sentences)

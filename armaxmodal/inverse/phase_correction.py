@@ -64,7 +64,8 @@ def evphc(
         offsets): the thesis keeps norms, but identified magnitudes are noisy too.
     starts : int
         The measured phases plus ``starts - 1`` random offsets.
-    max_iter, cost_tol : as the thesis (50 iterations or cost <= 0.05).
+    max_iter, cost_tol : int, float
+        As the thesis: at most 50 iterations, or stop at a cost of 0.05.
     seed : int
         Seed of the random starting phases.
     mass_ratio_bounds, m1, total_mass, names

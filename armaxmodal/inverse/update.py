@@ -291,10 +291,12 @@ def weight_sweep(eigenvalues, shapes, frf, weights=None, **kwargs):
 
     Parameters
     ----------
-    eigenvalues, shapes, frf : as :func:`model_update`.
+    eigenvalues, shapes, frf
+        As :func:`~armaxmodal.inverse.model_update`.
     weights : sequence of float
         Multipliers of the FRF block's weight (its noise level is divided by each).
-    **kwargs : passed to :func:`model_update`.
+    **kwargs
+        Passed to :func:`~armaxmodal.inverse.model_update`.
 
     Returns
     -------

@@ -14,6 +14,7 @@ from armaxmodal.systems.structure import Structure
 
 def scale_to_subject(structure: Structure, mass_kg: float) -> Structure:
     """Multiply M, C and K by ``alpha = m_subject / m_model`` (Eq. 4.7): same modes, the
+    subject's mass.
 
     Parameters
     ----------
@@ -26,7 +27,6 @@ def scale_to_subject(structure: Structure, mass_kg: float) -> Structure:
     -------
     Structure
         The scaled model.
-    subject's mass.
     """
     if not (np.isfinite(mass_kg) and mass_kg > 0):
         raise DataError(f"mass_kg: expected a positive subject mass in kg, got {mass_kg!r}.")

@@ -177,6 +177,7 @@ def strict_json(obj):
 
 def write_json(obj, path: str | os.PathLike) -> Path:
     """Write ``obj`` as indented strict JSON (numpy values converted, NaN and infinities as
+    ``null``; ``allow_nan=False`` so a bare NaN can never slip through).
 
     Parameters
     ----------
@@ -189,7 +190,6 @@ def write_json(obj, path: str | os.PathLike) -> Path:
     -------
     Path
         The file written.
-    ``null``; ``allow_nan=False`` so a bare NaN can never slip through).
     """
     clean = strict_json(obj)
 

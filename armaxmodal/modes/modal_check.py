@@ -182,12 +182,12 @@ class ModalCheck:
 
     def to_dict(self) -> dict:
         """The JSON form: per output its misfit, the H1's random error, the model error, the
+        delay and the lines; the limit; the bands.
 
         Returns
         -------
         dict
             The check's misfits, verdict and warnings, strict-JSON-ready.
-        delay and the lines; the limit; the bands.
         """
         return {
             "limit": MODEL_ERROR_LIMIT,

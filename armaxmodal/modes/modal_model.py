@@ -105,6 +105,7 @@ class DftLines:
 
     def noise_weighted(self, model: ModalModel) -> DftLines:
         """The same lines with each sensor weighted by one over its noise level as ``model``
+        leaves it (its residual's RMS per real number).
 
         Parameters
         ----------
@@ -115,7 +116,6 @@ class DftLines:
         -------
         DftLines
             The same lines, re-weighted.
-        leaves it (its residual's RMS per real number).
         """
         level = np.sqrt(model.rss / model.n_real)
         return self.weighted(1.0 / np.where(level > 0, level, 1.0))
@@ -188,6 +188,7 @@ class ModalModel:
         """Schwarz's criterion ``-2 ln L + p ln N`` (Schwarz 1978), with ``N`` the real numbers
         fitted. ``n_effective`` (the real numbers of independent information, at most ``N``)
         scales the likelihood and sets the penalty where the residual is correlated across
+        lines (:func:`armaxmodal.modes.mode_count.effective_fraction`).
 
         Parameters
         ----------
@@ -198,7 +199,6 @@ class ModalModel:
         -------
         float
             The criterion; smaller is better.
-        lines (:func:`armaxmodal.modes.mode_count.effective_fraction`).
         """
         n_total = self.n_real * self.rss.size
         n_eff = n_total if n_effective is None else min(float(n_effective), n_total)

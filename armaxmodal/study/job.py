@@ -78,11 +78,12 @@ def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[st
 
     Returns
     -------
-    dict with ``sensors``, ``fs``, ``analysis_fs``, ``nk``, ``modes`` (one dict per mode:
-    frequency in Hz, damping ratio, 95 % intervals, Eq. 3.35-3.36 weighted values and the
-    normalised shape per sensor), ``per_sensor`` (Table 3.2 rows), ``warnings``,
-    ``reconstruction_error`` and ``quality`` (the modal-model check's misfit and verdict),
-    ``lump`` and ``figure_png`` (base64).
+    dict
+        ``sensors``, ``fs``, ``analysis_fs``, ``nk``, ``modes`` (one dict per mode: frequency in
+        Hz, damping ratio, 95 % intervals, Eq. 3.35-3.36 weighted values and the normalised shape
+        per sensor), ``per_sensor`` (Table 3.2 rows), ``warnings``, ``reconstruction_error`` and
+        ``quality`` (the modal-model check's misfit and verdict), ``lump`` and ``figure_png``
+        (base64).
     """
     from armaxmodal._threads import one_blas_thread
     from armaxmodal.modes.diagram import stabilisation_diagram

@@ -234,8 +234,9 @@ def summarise_subjects(
 
     Returns
     -------
-    dict with ``table`` (one row per subject plus ``Average`` and ``SD`` rows, sample SD)
-    and ``shape_geomean`` ((n_sensors, n_modes), when shapes are given).
+    dict
+        ``table`` (one row per subject plus ``Average`` and ``SD`` rows, sample SD) and
+        ``shape_geomean`` ((n_sensors, n_modes), when shapes are given).
     """
     counts = {len(w) for w in weighted}
     if len(counts) != 1:

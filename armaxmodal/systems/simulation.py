@@ -362,7 +362,8 @@ def random_vibration(
 
     Returns
     -------
-    (round(duration * fs),) ndarray, m/s^2, scaled to the given RMS.
+    (round(duration * fs),) ndarray
+        m/s^2, scaled to the given RMS.
 
     Examples
     --------

@@ -267,12 +267,12 @@ class Structure:
 
     def chain_components(self) -> ChainComponents:
         """Springs and dampers of the chain these matrices describe; raises
+        :class:`StructureError` if C or K couple non-neighbouring masses.
 
         Returns
         -------
         ChainComponents
             Each mass, spring and damper of the chain by name.
-        :class:`StructureError` if C or K couple non-neighbouring masses.
         """
         k, k_s = _chain_parts(self.K, "K")
         c, c_s = _chain_parts(self.C, "C")
