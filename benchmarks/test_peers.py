@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from bench_inverse import BOUNDS
 from bench_pem import NA, NB, NC, ours, pem_loss, scipy_pem
 
 import armaxmodal as am
@@ -38,7 +39,6 @@ WHAT = {
     "sdp-chain": "the inner SDP of EVPHC, chain pattern (Chapter 2 system), against the same SDP in cvxpy + Clarabel",
     "sdp-full": "the inner SDP of EVPHC, full coupling pattern, against the same SDP in cvxpy + Clarabel",
 }
-BOUNDS = [(1.0, 2.5), (3.0, 5.0), (1.0, 2.0)]
 
 
 @pytest.fixture(scope="module")

@@ -534,8 +534,8 @@ MUTANTS = [
     # --match "(count)" --tests tests/modes/test_mode_count.py
     (
         "armaxmodal/modes/modal_model.py",
-        "return self.neg2_loglik * n_eff / n_total + self.n_params * np.log(n_eff)",
-        "return self.neg2_loglik * n_eff / n_total + 2 * self.n_params",
+        "return self.neg2_loglik_on(n_eff) + self.n_params * np.log(n_eff)",
+        "return self.neg2_loglik_on(n_eff) + 2 * self.n_params",
         "AIC's fixed penalty for BIC's (count)",
     ),
     (

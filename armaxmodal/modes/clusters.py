@@ -116,10 +116,11 @@ def why_no_mode(diagram: StabilisationDiagram, band, nas, min_support: float, cl
     return f"no stable mode found{where}: " + "; ".join(facts)
 
 
-def candidate_poles(poles: pd.DataFrame, band) -> pd.DataFrame:
-    """Shared-pole poles that may form a mode: the kept ones and those whose damping the
-    record does not resolve (they count towards support, see :func:`select_modes`)."""
-    cand = poles[(poles.source == SHARED) & poles.rejected.isin(["", UNRESOLVED_DAMPING])]
+def candidate_poles(poles: pd.DataFrame, band, rejected=("", UNRESOLVED_DAMPING)) -> pd.DataFrame:
+    """Shared-pole poles in ``band`` that may form a mode: by default the kept ones and those
+    whose damping the record does not resolve (they count towards support, see
+    :func:`select_modes`); ``rejected`` names the rejection reasons let in."""
+    cand = poles[(poles.source == SHARED) & poles.rejected.isin(list(rejected))]
     if band is not None:
         cand = cand[(cand.freq_hz >= band[0]) & (cand.freq_hz <= band[1])]
     return cand

@@ -16,7 +16,7 @@ from dataclasses import replace
 import numpy as np
 import pandas as pd
 
-from armaxmodal.modes.clusters import cluster_poles
+from armaxmodal.modes.clusters import candidate_poles, cluster_poles
 from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.modal_model import DftLines, fit_modal_model
 from armaxmodal.modes.mode_count import (
@@ -29,7 +29,7 @@ from armaxmodal.modes.mode_count import (
     matched_poles,
     reported,
 )
-from armaxmodal.modes.poles import SHARED, mac
+from armaxmodal.modes.poles import mac
 from armaxmodal.modes.spread import split_segments
 from armaxmodal.modes.support import CANDIDATE_MIN_ORDERS, stable_in_diagram
 from armaxmodal.modes.working import WorkingSelection
@@ -63,10 +63,8 @@ def _candidates(diagram, modes: pd.DataFrame, band, nas, cluster_freq, cluster_d
     weakly driven or weakly seen mode is stable across orders with a small residue at each (a
     five-mass chain's 9.7 Hz at nine orders of a 400 s ride); whether the record needs it is the
     likelihood's to say, as for any addition."""
-    cand = diagram.poles[(diagram.poles.source == SHARED) & (diagram.poles.damping > 0)
-                         & (diagram.poles.damping <= MAX_DAMPING)]  # fmt: skip
-    if band is not None:
-        cand = cand[(cand.freq_hz >= band[0]) & (cand.freq_hz <= band[1])]
+    cand = candidate_poles(diagram.poles, band, rejected=("", WEAK_RESIDUE))
+    cand = cand[(cand.damping > 0) & (cand.damping <= MAX_DAMPING)]
     found = []
     for rank, rejected in enumerate(("", WEAK_RESIDUE)):
         kept = cand[cand.rejected == rejected]

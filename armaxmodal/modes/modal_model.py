@@ -200,9 +200,27 @@ class ModalModel:
         float
             The criterion; smaller is better.
         """
+        n_eff = self._effective(n_effective)
+        return self.neg2_loglik_on(n_eff) + self.n_params * np.log(n_eff)
+
+    def neg2_loglik_on(self, n_effective: float | None = None) -> float:
+        """``-2 ln L`` scaled to ``n_effective`` independent real numbers, as :meth:`bic` uses it:
+        the difference of two models' values is their likelihood ratio on the effective lines.
+
+        Parameters
+        ----------
+        n_effective : float, optional
+            Real numbers of independent information (default: all fitted).
+
+        Returns
+        -------
+        float
+        """
+        return self.neg2_loglik * self._effective(n_effective) / (self.n_real * self.rss.size)
+
+    def _effective(self, n_effective: float | None) -> float:
         n_total = self.n_real * self.rss.size
-        n_eff = n_total if n_effective is None else min(float(n_effective), n_total)
-        return self.neg2_loglik * n_eff / n_total + self.n_params * np.log(n_eff)
+        return n_total if n_effective is None else min(float(n_effective), n_total)
 
 
 class _GramCompressed:

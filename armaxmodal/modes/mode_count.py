@@ -437,8 +437,7 @@ def _wanted(search: _Search, current: ModalModel, addition, gain: float, new_hz:
         return ()
     model = addition[2]
     dof = model.n_params - current.n_params
-    ratio = (search.bic(current) - current.n_params * np.log(search.n_eff)) - (
-        search.bic(model) - model.n_params * np.log(search.n_eff))
+    ratio = current.neg2_loglik_on(search.n_eff) - model.neg2_loglik_on(search.n_eff)
     if dof <= 0 or chdtrc(dof, ratio) >= LIKELIHOOD_ALPHA:
         return ()
     if not search.in_both_halves(model, _new_poles(current.freq_hz, model.freq_hz), halves):

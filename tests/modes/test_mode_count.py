@@ -528,9 +528,11 @@ def test_the_likelihood_ratio_flag_needs_a_significant_ratio_a_decisive_bic_and_
     from armaxmodal.modes.mode_count import _wanted
 
     n_eff = 1e5  # BIC's penalty for one mode of 22 parameters: 22 ln(1e5) = 253
-    current = SimpleNamespace(n_params=88, freq_hz=np.array([6.6, 7.7, 11.1, 14.4]))
-    added = SimpleNamespace(n_params=110, freq_hz=np.array([6.6, 7.7, 9.6, 11.1, 14.4]))
-    bic = {id(current): 1000.0 + 88 * np.log(n_eff), id(added): 1000.0 - ratio + 110 * np.log(n_eff)}
+    current = SimpleNamespace(n_params=88, freq_hz=np.array([6.6, 7.7, 11.1, 14.4]),
+                              neg2_loglik_on=lambda n: 1000.0)  # fmt: skip
+    added = SimpleNamespace(n_params=110, freq_hz=np.array([6.6, 7.7, 9.6, 11.1, 14.4]),
+                            neg2_loglik_on=lambda n: 1000.0 - ratio)  # fmt: skip
+    bic = {id(m): m.neg2_loglik_on(n_eff) + m.n_params * np.log(n_eff) for m in (current, added)}
     gain = bic[id(current)] - bic[id(added)]
     search = _search(lambda model: bic[id(model)], n_eff, halves_agree)
     got = _wanted(search, current, ("add", 9.6, added), gain, 9.6, ("first half", "second half"))
