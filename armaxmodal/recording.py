@@ -51,6 +51,8 @@ class Recording:
     _spectra: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self):
+        if not isinstance(self.meta, dict):
+            raise DataError(f"meta: expected a dict of metadata (subject, units, ...), got {type(self.meta).__name__}.")
         fs = check_fs(self.fs)
         base = as_signal_vector(self.base, f"input '{self.input_name}'")
         sensors = tuple(self.sensors) if self.sensors else ()

@@ -111,3 +111,18 @@ def test_a_recording_computes_its_spectra_once_per_segment_length():
     f, uf, yf, scale = welch_segments(u, y, 50.0, 256)
     np.testing.assert_array_equal(first[1], scale * np.mean(np.abs(uf) ** 2, axis=0))
     np.testing.assert_array_equal(first[2], scale[:, None] * np.mean(np.conj(uf)[:, :, None] * yf, axis=0))
+
+
+def test_other_metadata_keeps_the_spectra_and_wrong_metadata_is_refused(fixtures_dir):
+    from armaxmodal.exceptions import DataError
+    from armaxmodal.spectra import welch_spectra
+
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    first = rec.welch(512)
+    renamed = rec.with_meta({"subject": "S1"})
+    assert renamed.meta == {"subject": "S1"} and renamed.fs == rec.fs
+    assert renamed.welch(512)[2] is first[2]  # shared, not recomputed
+    # and they are the record's spectra
+    np.testing.assert_array_equal(renamed.welch(512)[2], welch_spectra(rec.base, rec.response, rec.fs, 512)[2])
+    with pytest.raises(DataError, match="meta: expected a dict"):
+        rec.with_meta("subject S1")
