@@ -764,6 +764,69 @@ MUTANTS = [
         "f_nl = size * np.tanh((v[i] + (v[j] if j >= 0 else 0.0)) / scale)",
         "friction on the sum of velocities (registry)",
     ),
+    # issue 37's intervals kept as parts and combined on output (run with --match "(intervals)" --tests
+    #   tests/modes/test_intervals.py tests/modes/test_mode_count.py tests/modes/test_spread.py
+    #   tests/modes/test_selection_rules.py tests/cli/test_cli.py)
+    (
+        "armaxmodal/modes/intervals.py",
+        "lo = np.where(np.isnan(other_lo), lo, np.minimum(lo, other_lo))",
+        "lo = lo",
+        "the other structures' reach left out below (intervals)",
+    ),
+    (
+        "armaxmodal/modes/intervals.py",
+        "hi = np.where(np.isnan(other_hi), hi, np.maximum(hi, other_hi))",
+        "hi = np.where(np.isnan(other_hi), hi, np.minimum(hi, other_hi))",
+        "the other structures' reach narrows above (intervals)",
+    ),
+    (
+        "armaxmodal/modes/intervals.py",
+        "lo = np.where(np.isnan(other_lo), lo, np.minimum(lo, other_lo))",
+        "lo = np.fmin(lo, other_lo)",
+        "another structure gives an estimate without a deviation an interval (intervals)",
+    ),
+    (
+        "armaxmodal/modes/intervals.py",
+        "lo = np.where(np.isnan(half), lo, np.fmin(v - half, lo))",
+        "lo = np.where(np.isnan(half), lo, v - half)",
+        "the segments' interval replaces a wider one (intervals)",
+    ),
+    (
+        "armaxmodal/modes/intervals.py",
+        "lo, hi = v - scale * (v - lo), v + scale * (hi - v)",
+        "lo, hi = v - scale * (v - lo), hi",
+        "filled samples widen only the lower side (intervals)",
+    ),
+    (
+        "armaxmodal/modes/selection.py",
+        "modes = with_intervals(work.modes, scale)",
+        "modes = with_intervals(work.modes)",
+        "filled samples not counted in the reported intervals (intervals)",
+    ),
+    (
+        "armaxmodal/modes/spread.py",
+        "halves[q][i] = t_k * s / np.sqrt(n_segments)",
+        "halves[q][i] = t_k * s",
+        "the segments' interval of one segment, not their mean (intervals)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        'reach[f"{q}_other_lo"] = float(np.fmin(reach[f"{q}_other_lo"], lo))',
+        'reach[f"{q}_other_lo"] = float(lo)',
+        "only the last equally good model's reach kept (intervals)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "both.freq_ci95_lo.min(),",
+        "both.freq_ci95_lo.max(),",
+        "the merged row covers only the upper pole below (intervals)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        'rows.loc[a, ["freq_sd", "damping_sd"]] = [one.freq_sd[k], one.damping_sd[k]]',
+        "pass",
+        "the merged row keeps the pair's deviation (intervals)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/estimate/test_guards.py",

@@ -197,9 +197,8 @@ def mode_row(rep: pd.Series, sub: pd.DataFrame, n_orders: int) -> dict:
     return row
 
 
-_ESTIMATE_COLUMNS = (
-    "freq_hz", "damping", "damped_freq_hz", "freq_ci95_lo", "freq_ci95_hi", "damping_ci95_lo", "damping_ci95_hi",
-)  # fmt: skip
+# the interval as its parts: the standard deviations (armaxmodal.modes.intervals)
+_ESTIMATE_COLUMNS = ("freq_hz", "damping", "damped_freq_hz", "freq_sd", "damping_sd")
 
 
 def _finished_pole(diagram: StabilisationDiagram, pole: pd.Series, cache: dict) -> pd.Series:

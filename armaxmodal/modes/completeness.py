@@ -16,7 +16,6 @@ from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_b
 from armaxmodal.modes.working import WorkingSelection
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
-from armaxmodal.stats import Z95
 
 #: a clear, coherent FRF peak no selected mode explains takes a cluster of poles of at least
 #: this many orders within this relative frequency of it, when the modal-model check needs it
@@ -127,8 +126,7 @@ def modes_the_check_adds(diagram, work: WorkingSelection, band, nas, clustering)
         if rep is None or (not at_peak and not rep.damping_ci95_lo > 0):
             continue  # without a peak, a pole whose damping the record does not resolve is no evidence
         row = {**mode_row(rep, sub, len(nas)), "orders_damping_unresolved": 0, "estimator": "armax"}
-        row["freq_sd_armax"] = (row["freq_ci95_hi"] - row["freq_ci95_lo"]) / (2 * Z95)
-        row["damping_sd_armax"] = (row["damping_ci95_hi"] - row["damping_ci95_lo"]) / (2 * Z95)
+        row["freq_sd_armax"], row["damping_sd_armax"] = row["freq_sd"], row["damping_sd"]
         modes = pd.concat([modes, pd.DataFrame([row])], ignore_index=True)
         shapes = np.column_stack([shapes, rep.vector])
         check = check_modes(diagram.recording, modes.freq_hz, modes.damping, band)

@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
+from armaxmodal.modes.intervals import with_intervals
 from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.modal_model import DftLines, fit_modal_model
 from armaxmodal.modes.mode_count import (
@@ -198,13 +199,15 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
         both = rows.loc[[a, b]]
         k = _nearest_pole(one, float(both.freq_hz.mean()))
         f, x = float(one.freq_hz[k]), float(one.damping[k])
-        lo_f, hi_f = f - Z95 * one.freq_sd[k], f + Z95 * one.freq_sd[k]
-        lo_x, hi_x = x - Z95 * one.damping_sd[k], x + Z95 * one.damping_sd[k]
         rows.loc[a, ["freq_hz", "damping", "damped_freq_hz"]] = [f, x, f * np.sqrt(1 - x**2)]
-        rows.loc[a, ["freq_ci95_lo", "freq_ci95_hi"]] = [min(lo_f, both.freq_ci95_lo.min()),
-                                                         max(hi_f, both.freq_ci95_hi.max())]  # fmt: skip
-        rows.loc[a, ["damping_ci95_lo", "damping_ci95_hi"]] = [min(lo_x, both.damping_ci95_lo.min()),
-                                                               max(hi_x, both.damping_ci95_hi.max())]  # fmt: skip
+        rows.loc[a, ["freq_sd", "damping_sd"]] = [one.freq_sd[k], one.damping_sd[k]]
+        both = with_intervals(both)  # the two rows' intervals (each with its other counts) are the other structure's
+        rows.loc[a, ["freq_other_lo", "freq_other_hi", "damping_other_lo", "damping_other_hi"]] = [
+            both.freq_ci95_lo.min(),
+            both.freq_ci95_hi.max(),
+            both.damping_ci95_lo.min(),
+            both.damping_ci95_hi.max(),
+        ]
         rows.loc[a, "structure_widened"] = True
         shapes[:, a] = one.shapes[:, k]
         gone.append(b)
@@ -355,35 +358,40 @@ def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str) -> dict:
     if dist[j] > SAME_ROW_FREQ:  # a mode the diagram's clusters did not hold
         row.update(count=0, support=0.0, freq_spread=np.nan, damping_spread=np.nan, medoid_freq_hz=np.nan,
                    medoid_damping=np.nan, orders_damping_unresolved=0)  # fmt: skip
-    freq_ci, damping_ci, widened = _structure_hull(count, i)
+    other, widened = _other_structures(count, i)
     row.update(
-        freq_hz=f, damping=x, damped_freq_hz=f * np.sqrt(1 - x**2),
-        freq_ci95_lo=freq_ci[0], freq_ci95_hi=freq_ci[1], damping_ci95_lo=damping_ci[0], damping_ci95_hi=damping_ci[1],
-        estimator=f"ml-{hold}", count_undecided=bool(count.removal_rise[i] < DECISIVE_BIC), structure_widened=widened,
+        freq_hz=f, damping=x, damped_freq_hz=f * np.sqrt(1 - x**2), freq_sd=m.freq_sd[i], damping_sd=m.damping_sd[i],
+        **other, estimator=f"ml-{hold}", count_undecided=bool(count.removal_rise[i] < DECISIVE_BIC),
+        structure_widened=widened,
     )  # fmt: skip
     return row
 
 
-def _structure_hull(count: ModeCount, i: int):
-    """Mode ``i``'s 95 % intervals of frequency and damping, widened to the hull of its
-    counterparts' intervals in the equally good models (``count.alternatives``): where the record
-    cannot tell the number of modes, it cannot tell which model's values hold either. A
-    counterpart is the alternative's pole paired with mode ``i`` one to one, within
-    :data:`SAME_ROW_FREQ`; a mode the alternative lacks, or that moved farther (two merged into
-    one), has none. Returns ``((lo, hi), (lo, hi), widened)``."""
+def _other_structures(count: ModeCount, i: int) -> tuple[dict, bool]:
+    """The reach of mode ``i``'s counterparts' 95 % intervals in the equally good models
+    (``count.alternatives``): where the record cannot tell the number of modes, it cannot tell
+    which model's values hold either, so the reported interval covers theirs
+    (:mod:`armaxmodal.modes.intervals`). A counterpart is the alternative's pole paired with mode
+    ``i`` one to one, within :data:`SAME_ROW_FREQ`; a mode the alternative lacks, or that moved
+    farther (two merged into one), has none. Returns ``({q}_other_lo/hi: value, NaN for none;
+    widened)``, ``widened`` when a counterpart's interval reaches beyond the mode's own."""
     m = count.model
-    freq = [m.freq_hz[i] - Z95 * m.freq_sd[i], m.freq_hz[i] + Z95 * m.freq_sd[i]]
-    damping = [m.damping[i] - Z95 * m.damping_sd[i], m.damping[i] + Z95 * m.damping_sd[i]]
+    own = {"freq": [m.freq_hz[i] - Z95 * m.freq_sd[i], m.freq_hz[i] + Z95 * m.freq_sd[i]],
+           "damping": [m.damping[i] - Z95 * m.damping_sd[i], m.damping[i] + Z95 * m.damping_sd[i]]}  # fmt: skip
+    reach = {"freq_other_lo": np.nan, "freq_other_hi": np.nan, "damping_other_lo": np.nan, "damping_other_hi": np.nan}
     widened = False
     for _, alt in count.alternatives:
         for k, j in matched_poles(m.freq_hz, alt.freq_hz):
             if j != i or abs(np.log(alt.freq_hz[k] / m.freq_hz[i])) > SAME_ROW_FREQ:
                 continue
-            for ci, value, sd in ((freq, alt.freq_hz[k], alt.freq_sd[k]), (damping, alt.damping[k], alt.damping_sd[k])):
-                lo, hi = value - Z95 * sd, value + Z95 * sd
+            for q, value, sd in (("freq", alt.freq_hz[k], alt.freq_sd[k]), ("damping", alt.damping[k],
+                                                                              alt.damping_sd[k])):  # fmt: skip
+                lo, hi, ci = value - Z95 * sd, value + Z95 * sd, own[q]
                 widened |= bool(lo < ci[0] or hi > ci[1])
                 ci[:] = [min(ci[0], lo), max(ci[1], hi)]
-    return tuple(freq), tuple(damping), widened
+                reach[f"{q}_other_lo"] = float(np.fmin(reach[f"{q}_other_lo"], lo))
+                reach[f"{q}_other_hi"] = float(np.fmax(reach[f"{q}_other_hi"], hi))
+    return reach, widened
 
 
 def _pick_notes(count: ModeCount, keep: np.ndarray) -> list[QualityWarning]:
@@ -460,7 +468,7 @@ def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
             f"one mode more near {f:.3f} Hz fits the whole record better but not each of its halves: a change "
             "during the record (a drifting frequency, a transient, a nonlinearity), not a mode; left out", f,
         ))  # fmt: skip
-    widened = [count.model.freq_hz[i] for i in np.flatnonzero(keep) if _structure_hull(count, i)[2]]
+    widened = [count.model.freq_hz[i] for i in np.flatnonzero(keep) if _other_structures(count, i)[1]]
     if widened:
         sizes = ", ".join(f"{alt.n_modes} modes ({d:+.1f})" for d, alt in count.alternatives)
         notes.append(QualityWarning(

@@ -24,7 +24,6 @@ from armaxmodal.modes.working import WorkingSelection
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.spectra import excited_band
-from armaxmodal.stats import Z95
 
 
 def refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, orders: dict, n_jobs, bar=None) -> dict:
@@ -129,10 +128,6 @@ def _apply_refinement(modes, shapes, ref, max_freq_change, max_damping_change, r
             f * np.sqrt(1 - x**2),
             "fd-bandlimited",
         ]
-        modes.loc[i, ["freq_ci95_lo", "freq_ci95_hi"]] = [f - Z95 * ref.freq_sd[i], f + Z95 * ref.freq_sd[i]]
-        modes.loc[i, ["damping_ci95_lo", "damping_ci95_hi"]] = [
-            x - Z95 * ref.damping_sd[i],
-            x + Z95 * ref.damping_sd[i],
-        ]
+        modes.loc[i, ["freq_sd", "damping_sd"]] = [ref.freq_sd[i], ref.damping_sd[i]]
         shapes[:, i] = ref.shapes[:, i]
     return modes, shapes

@@ -32,6 +32,7 @@ from armaxmodal.modes.counted import (
 )
 from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.header import oversampling_note, record_header
+from armaxmodal.modes.intervals import with_intervals
 from armaxmodal.modes.modal_check import ModalCheck, check_modes
 from armaxmodal.modes.mode_count import ModeCount
 from armaxmodal.modes.per_sensor import per_sensor_table
@@ -45,7 +46,6 @@ from armaxmodal.modes.spread import (
 )
 from armaxmodal.modes.working import WorkingSelection
 from armaxmodal.quality_warnings import UNCERTAIN_CODES, QualityWarning
-from armaxmodal.stats import Z95
 
 __all__ = ["select_modes", "ModeSelection", "verdict"]
 
@@ -59,8 +59,10 @@ class ModeSelection:
     ----------
     modes : DataFrame
         One row per mode, by frequency: freq_hz, damping, damped_freq_hz and 95 % intervals
-        (from the representative fit), na of that fit, count and support of the cluster,
-        its spread (standard deviation over orders) and medoid.
+        (``*_ci95_lo/hi``), the parts the intervals combine (the estimate's ``freq_sd`` and
+        ``damping_sd``, the other structures' ``*_other_lo/hi``, the segments'
+        ``*_segment_half``: :mod:`armaxmodal.modes.intervals`), na of the representative fit,
+        count and support of the cluster, its spread (standard deviation over orders) and medoid.
     shapes : (n_sensors, n_modes) complex ndarray
         EPFRF modal constants per sensor (Eq. 3.24) from the representative fit.
     per_sensor : DataFrame
@@ -383,38 +385,31 @@ def _automatic(diagram, band, nas, min_support, clustering, merge_mac, n_modes, 
     return modes.loc[order].reset_index(drop=True), [vectors[i] for i in order]
 
 
-def _discount_filled_samples(modes: pd.DataFrame, recording, preparation) -> tuple[pd.DataFrame, list[QualityWarning]]:
-    """The intervals widened for samples the reader filled in (``gap_filled``, ``dropped_packet``):
-    an interpolated sample carries no information, so a record of ``N`` samples with ``k`` filled
-    holds ``N - k`` observations, and a standard deviation the fit computed from ``N`` is too
-    small by ``sqrt(N / (N - k))``. Counted in the record's own samples, before any resampling."""
+def _filled_samples_scale(recording, preparation) -> tuple[float, list[QualityWarning]]:
+    """The factor every interval is widened by for samples the reader filled in (``gap_filled``,
+    ``dropped_packet``): an interpolated sample carries no information, so a record of ``N``
+    samples with ``k`` filled holds ``N - k`` observations, and a standard deviation the fit
+    computed from ``N`` is too small by ``sqrt(N / (N - k))``. Counted in the record's own
+    samples, before any resampling. Returns ``(factor, notes)``; 1 and none without filled samples."""
     filled = sum(w.value or 0.0 for w in recording.meta.get("read_warnings", ())
                  if w.code in ("gap_filled", "dropped_packet"))  # fmt: skip
-    if not filled or modes.empty:
-        return modes, []
+    if not filled:
+        return 1.0, []
     # gap_filled counts one channel's samples; a filled sample of any channel is lost to the fit
     n = recording.duration * (recording.fs if preparation is None else preparation.original_fs)
     factor = float(np.sqrt(n / max(n - filled, 1.0)))
-    modes = modes.copy()
-    for value, lo, hi in (("freq_hz", "freq_ci95_lo", "freq_ci95_hi"), ("damping", "damping_ci95_lo",
-                                                                         "damping_ci95_hi")):  # fmt: skip
-        modes[lo] = modes[value] - factor * (modes[value] - modes[lo])
-        modes[hi] = modes[value] + factor * (modes[hi] - modes[value])
     note = QualityWarning(
         "gap_filled", (),
         f"{filled:g} filled sample(s) carry no information: every interval is widened by {factor:.6f} "
         f"(sqrt(N / (N - filled)), N = {n:.0f})", factor,
     )  # fmt: skip
-    return modes, [note]
+    return factor, [note]
 
 
 def _armax_intervals(modes: pd.DataFrame) -> pd.DataFrame:
-    """The ARMAX fit's standard deviations beside its intervals: the segment refits are ARMAX
-    fits, and their spread is judged against these even where another estimator is reported."""
-    modes = modes.assign(estimator="armax")
-    modes["freq_sd_armax"] = (modes.freq_ci95_hi - modes.freq_ci95_lo) / (2 * Z95)
-    modes["damping_sd_armax"] = (modes.damping_ci95_hi - modes.damping_ci95_lo) / (2 * Z95)
-    return modes
+    """The ARMAX fit's standard deviations kept beside the reported ones: the segment refits are
+    ARMAX fits, and their spread is judged against these even where another estimator is reported."""
+    return modes.assign(estimator="armax", freq_sd_armax=modes.freq_sd, damping_sd_armax=modes.damping_sd)
 
 
 def _by_the_check(diagram, work: WorkingSelection, band, nas, clustering, limits, refine: bool) -> WorkingSelection:
@@ -434,8 +429,9 @@ def _finished(diagram, work: WorkingSelection, band, cluster_freq: float, n_orde
     """The selection with its per-sensor tables and the notes read off the final modes."""
     from armaxmodal.modes.frf_check import unexplained_peaks
 
-    modes, widened = _discount_filled_samples(work.modes, diagram.recording, diagram.preparation)
-    work = replace(work, modes=modes).warned(*widened)
+    scale, widened = _filled_samples_scale(diagram.recording, diagram.preparation)
+    modes = with_intervals(work.modes, scale)  # the intervals' parts combined, once
+    work = replace(work, modes=modes).warned(*(widened if len(modes) else ()))
     shapes = work.shapes
     per_sensor, weighted = per_sensor_table(diagram, modes, shapes, cluster_freq)
     freq, damping = modes.freq_hz.to_numpy(), modes.damping.to_numpy()
@@ -506,7 +502,7 @@ def _not_separated(modes: pd.DataFrame) -> list[QualityWarning]:
         "modes_not_separated", (),
         f"modes at {f[i]:.3f} and {f[j]:.3f} Hz are {gap:.1f} standard deviations of their difference apart (under "
         f"{SEPARATION_SD:g}): the record does not separate them; they may be one mode", float(f[i]),
-    ) for i, j, gap in not_separated(modes)]  # fmt: skip
+    ) for i, j, gap in not_separated(with_intervals(modes))]  # fmt: skip
 
 
 def _unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[QualityWarning]:

@@ -19,7 +19,6 @@ import pandas as pd
 
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
-from armaxmodal.stats import Z95
 
 __all__ = ["segment_spread", "apply_segment_spread", "segment_jobs", "segment_poles", "split_segments", "N_SEGMENTS"]
 
@@ -125,10 +124,12 @@ def segment_poles(parts: list[Recording], job) -> pd.DataFrame | None:
 
 
 def apply_segment_spread(modes: pd.DataFrame, spread: pd.DataFrame, n_segments: int = N_SEGMENTS):
-    """Join the spread to ``modes``, widen the intervals where it dominates, and say so.
+    """Join the spread to ``modes``, set the segments' part of the intervals where it dominates, and say so.
 
-    Returns ``(modes, warnings)``; ``modes`` gains the spread columns and
-    ``model_error_dominates`` (bool).
+    Returns ``(modes, warnings)``; ``modes`` gains the spread columns, ``model_error_dominates``
+    (bool) and ``freq_segment_half`` / ``damping_segment_half``: the half-width of the segments'
+    95 % interval where their spread exceeds the statistical one, else NaN
+    (:mod:`armaxmodal.modes.intervals` takes the hull on output).
     """
     from scipy.special import chdtri, stdtrit  # chi2 and t quantiles without scipy.stats' 0.5 s import
 
@@ -137,26 +138,24 @@ def apply_segment_spread(modes: pd.DataFrame, spread: pd.DataFrame, n_segments: 
     crit = chdtri(n_segments - 1, SPREAD_ALPHA / (2 * max(1, len(modes))))  # upper-tail quantile
     t_k = stdtrit(n_segments - 1, 0.975)
     dominates = np.zeros(len(modes), dtype=bool)
+    halves = {"freq": np.full(len(modes), np.nan), "damping": np.full(len(modes), np.nan)}
     for i, m in modes.iterrows():
-        for value, lo, hi, sd_col, model_sd in (
-            ("freq_hz", "freq_ci95_lo", "freq_ci95_hi", "freq_segment_sd", "freq_sd_armax"),
-            ("damping", "damping_ci95_lo", "damping_ci95_hi", "damping_segment_sd", "damping_sd_armax"),
+        for q, sd_col, model_sd in (
+            ("freq", "freq_segment_sd", "freq_sd_armax"),
+            ("damping", "damping_segment_sd", "damping_sd_armax"),
         ):
             # judged against the interval of the estimator the segments use (ARMAX) when the
             # reported one is another's (the band-limited refit)
-            sigma = m[model_sd] if model_sd in m else (m[hi] - m[lo]) / (2 * Z95)
-            s = m[sd_col]
+            sigma, s = m[model_sd], m[sd_col]
             if not (np.isfinite(s) and sigma > 0) or m.segments_found < n_segments:
                 continue
             if (n_segments - 1) * s**2 / (n_segments * sigma**2) > crit:
                 dominates[i] = True
-                # the segments' interval, or the one already there where it is wider on a side (it
-                # may cover other equally good model structures, modes/counted.py)
-                half = t_k * s / np.sqrt(n_segments)
-                modes.loc[i, [lo, hi]] = [min(m[value] - half, m[lo]), max(m[value] + half, m[hi])]
+                halves[q][i] = t_k * s / np.sqrt(n_segments)
         if dominates[i]:
             flagged.append(i)
     modes["model_error_dominates"] = dominates
+    modes["freq_segment_half"], modes["damping_segment_half"] = halves["freq"], halves["damping"]
     warnings = []
     if flagged:
         listed = "; ".join(

@@ -11,10 +11,11 @@ import armaxmodal as am
 from armaxmodal.modes.counted import (
     _notes,
     _one_where_not_separated,
-    _structure_hull,
+    _other_structures,
     dropped_where_peaks_remain,
     not_separated,
 )
+from armaxmodal.modes.intervals import with_intervals
 from armaxmodal.modes.modal_model import DftLines, fit_modal_model
 from armaxmodal.modes.mode_count import DECISIVE_BIC, ModeCount, count_modes, effective_fraction, reported
 from armaxmodal.modes.selection import ModeSelection, _not_separated
@@ -142,6 +143,16 @@ def test_undecided_counts_and_out_of_band_poles_are_said():
     assert [n.value for n in addition if n.code == "count_undecided"] == [12.0]
 
 
+def _structure_hull(count, i):
+    """Mode ``i``'s reported intervals: its own and the other structures' part, combined on output."""
+    other, widened = _other_structures(count, i)
+    m = count.model
+    row = pd.DataFrame([{"freq_hz": m.freq_hz[i], "damping": m.damping[i], "freq_sd": m.freq_sd[i],
+                         "damping_sd": m.damping_sd[i], **other}])  # fmt: skip
+    out = with_intervals(row).iloc[0]
+    return (out.freq_ci95_lo, out.freq_ci95_hi), (out.damping_ci95_lo, out.damping_ci95_hi), widened
+
+
 def test_intervals_cover_the_equally_good_models():
     # the chosen 5 and 10 Hz; the model with one mode fewer (undecided) holds the 10 Hz mode at
     # 10.4 Hz and damping 0.06: its interval takes in that model's; the 5 Hz mode it lacks keeps its own
@@ -153,6 +164,11 @@ def test_intervals_cover_the_equally_good_models():
     assert damping == pytest.approx((0.05 - Z95 * 0.0005, 0.06 + Z95 * 0.0006))
     assert _structure_hull(count, 0) == (pytest.approx((5 - Z95 * 0.05, 5 + Z95 * 0.05)),
                                          pytest.approx((0.2 - Z95 * 0.002, 0.2 + Z95 * 0.002)), False)  # fmt: skip
+    # two equally good models reach to both sides: the interval covers both (the lower one first)
+    lower = _model([9.7], [0.05])
+    both = _count([DECISIVE_BIC - 2, 80.0], -40.0, freq=(5.0, 10.0), damping=(0.2, 0.05),
+                  alternatives=((1.0, lower), (2.0, fewer)))  # fmt: skip
+    assert _structure_hull(both, 1)[0] == pytest.approx((9.7 - Z95 * 0.097, 10.4 + Z95 * 0.104))
     # a counterpart beyond the clustering's reach (two modes merged into one) is another mode
     merged = ((2.0, _model([10.8], [0.05])),)
     far = _count([1.0, 80.0], -40.0, freq=(5.0, 10.0), damping=(0.2, 0.05), alternatives=merged)
@@ -163,7 +179,7 @@ def test_intervals_cover_the_equally_good_models():
 
 def _modes(f, sd):
     f, sd = np.asarray(f, float), np.asarray(sd, float)
-    return pd.DataFrame({"freq_hz": f, "freq_ci95_lo": f - Z95 * sd, "freq_ci95_hi": f + Z95 * sd})
+    return with_intervals(pd.DataFrame({"freq_hz": f, "freq_sd": sd, "damping": 0.05, "damping_sd": 0.001}))
 
 
 def test_modes_closer_than_three_deviations_are_not_separated():
@@ -174,11 +190,13 @@ def test_modes_closer_than_three_deviations_are_not_separated():
 
 
 def _rows_of(model):
-    """A model's poles as selection rows with its own 95 % intervals."""
-    f, x, sf, sx = model.freq_hz, model.damping, model.freq_sd, model.damping_sd
+    """A model's poles as selection rows with its own standard deviations and no other structure."""
+    f, x = model.freq_hz, model.damping
+    nan = np.full(f.size, np.nan)
     return pd.DataFrame({"freq_hz": f, "damping": x, "damped_freq_hz": f * np.sqrt(1 - x**2),
-                         "freq_ci95_lo": f - Z95 * sf, "freq_ci95_hi": f + Z95 * sf, "damping_ci95_lo": x - Z95 * sx,
-                         "damping_ci95_hi": x + Z95 * sx, "structure_widened": False})  # fmt: skip
+                         "freq_sd": model.freq_sd, "damping_sd": model.damping_sd, "freq_other_lo": nan,
+                         "freq_other_hi": nan, "damping_other_lo": nan, "damping_other_hi": nan,
+                         "structure_widened": False})  # fmt: skip
 
 
 @pytest.mark.parametrize("planted", ["own", "own_other_shape", "hull_only", "none"])
@@ -201,8 +219,8 @@ def test_two_poles_the_record_does_not_separate_are_reported_as_one(supine, supi
     model = replace(started, freq_sd=sd, shapes=shapes)
     rows = _rows_of(model)
     if planted == "hull_only":
-        rows.loc[[1, 2], "freq_ci95_lo"] -= 0.3
-        rows.loc[[1, 2], "freq_ci95_hi"] += 0.3
+        rows.loc[[1, 2], "freq_other_lo"] = rows.freq_hz[[1, 2]] - 0.3
+        rows.loc[[1, 2], "freq_other_hi"] = rows.freq_hz[[1, 2]] + 0.3
     keep = np.ones(model.n_modes, dtype=bool)
     count = SimpleNamespace(model=model)
     out, shapes, notes = _one_where_not_separated(rows, model.shapes, count, keep, supine_ride, data.band_hz, "zoh")
@@ -213,7 +231,8 @@ def test_two_poles_the_record_does_not_separate_are_reported_as_one(supine, supi
     assert len(out) == truth.freq_hz.size and shapes.shape == (4, truth.freq_hz.size)
     assert np.all(np.abs(out.freq_hz / truth.freq_hz - 1) < FREQ_TOL)
     assert np.all(np.abs(out.damping / truth.damping - 1) < DAMPING_TOL)
-    pair = rows.iloc[1:3]  # the merged row covers both poles of the pair and says it was widened
+    pair, out = with_intervals(rows).iloc[1:3], with_intervals(out)  # the merged row covers both poles of the pair
+    assert out.freq_sd[1] < pair.freq_sd.min()  # its own deviation is the one-pole model's, not the pair's
     assert out.freq_ci95_lo[1] <= pair.freq_ci95_lo.min() and out.freq_ci95_hi[1] >= pair.freq_ci95_hi.max()
     assert out.damping_ci95_lo[1] <= pair.damping_ci95_lo.min() and out.damping_ci95_hi[1] >= pair.damping_ci95_hi.max()
     assert out.structure_widened[1] and not out.structure_widened[[0, 2, 3]].any()

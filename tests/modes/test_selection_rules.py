@@ -14,9 +14,11 @@ import armaxmodal as am
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.clusters import _supported, cluster_poles, merge_duplicates
 from armaxmodal.modes.diagram import SAMPLES_PER_PARAMETER, _check_top_order, _nk_edge_warning
+from armaxmodal.modes.intervals import with_intervals
 from armaxmodal.modes.poles import Tolerances, stability_classes
 from armaxmodal.modes.selected_refit import _apply_refinement
 from armaxmodal.modes.working import WorkingSelection
+from armaxmodal.stats import Z95
 
 SHAPE = np.array([1.0 + 0.2j, 0.5 - 0.1j, -0.3 + 0.05j])
 
@@ -117,8 +119,7 @@ def test_refit_is_reported_unless_it_left_the_mode():
     from types import SimpleNamespace
 
     modes = _modes([5.0, 9.0], [0.10, 0.05], [1.0, 1.0]).assign(
-        estimator="armax", damped_freq_hz=0.0, freq_ci95_lo=0.0, freq_ci95_hi=0.0, damping_ci95_lo=0.0,
-        damping_ci95_hi=0.0,
+        estimator="armax", damped_freq_hz=0.0, freq_sd=0.0, damping_sd=0.0,
     )  # fmt: skip
     shapes = np.ones((2, 2), complex)
     ref = SimpleNamespace(
@@ -129,6 +130,7 @@ def test_refit_is_reported_unless_it_left_the_mode():
         shapes=np.full((2, 2), 2.0 + 1j),
     )
     out, out_shapes = _apply_refinement(modes, shapes, ref, 0.05, 0.5)
+    out = with_intervals(out)
     assert out.estimator.tolist() == ["fd-bandlimited", "armax (refit moved too far)"]
     assert out.at[0, "freq_hz"] == 5.1 and out.at[0, "damping"] == 0.12
     assert out.at[0, "damped_freq_hz"] == pytest.approx(5.1 * np.sqrt(1 - 0.12**2))
@@ -285,11 +287,12 @@ def test_mode_row_reports_the_representative_and_the_cluster_medoid_and_spread()
         }
     )
     rep = pd.Series(
-        {"na": 6, "freq_hz": 5.021, "damping": 0.0521, "damped_freq_hz": 5.01, "freq_ci95_lo": 5.0,
-         "freq_ci95_hi": 5.04, "damping_ci95_lo": 0.045, "damping_ci95_hi": 0.059}
+        {"na": 6, "freq_hz": 5.021, "damping": 0.0521, "damped_freq_hz": 5.01, "freq_sd": 0.01, "damping_sd": 0.0035,
+         "freq_ci95_lo": 5.0, "freq_ci95_hi": 5.04}
     )  # fmt: skip
     row = mode_row(rep, sub, 10)
-    assert row["freq_hz"] == 5.021 and row["damping_ci95_hi"] == 0.059 and row["na"] == 6
+    assert row["freq_hz"] == 5.021 and row["damping_sd"] == 0.0035 and row["na"] == 6
+    assert "freq_ci95_lo" not in row  # the interval is kept as its parts, combined on output
     assert (row["count"], row["support"], row["energy"]) == (4, 0.4, 2.5)
     assert row["freq_spread"] == pytest.approx(np.std(sub.freq_hz, ddof=1))
     assert row["damping_spread"] == pytest.approx(np.std(sub.damping, ddof=1))
@@ -454,20 +457,22 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
 
 
 def test_filled_samples_widen_every_interval_by_the_information_they_lack():
-    """720 of 7,200 samples filled: the intervals widen by sqrt(7200 / 6480) about each value."""
+    """720 of 7,200 samples filled: the intervals widen by sqrt(7200 / 6480) about each value,
+    the other structures' part included (an asymmetric interval stays asymmetric)."""
     from types import SimpleNamespace
 
-    from armaxmodal.modes.selection import _discount_filled_samples
+    from armaxmodal.modes.selection import _filled_samples_scale
 
     filled = am.QualityWarning("gap_filled", ("head",), "x", 700.0)
     bridged = am.QualityWarning("dropped_packet", ("head",), "y", 20.0)
     rec = SimpleNamespace(duration=120.0, fs=20.0, meta={"read_warnings": [filled, bridged]})
-    modes = pd.DataFrame({"freq_hz": [5.0], "freq_ci95_lo": [4.9], "freq_ci95_hi": [5.2], "damping": [0.1],
-                          "damping_ci95_lo": [0.09], "damping_ci95_hi": [0.1]})  # fmt: skip
-    out, (note,) = _discount_filled_samples(modes, rec, SimpleNamespace(original_fs=60.0))  # resampled 60 -> 20 Hz
-    k = np.sqrt(7200 / 6480)
-    assert note.value == pytest.approx(k)
+    modes = pd.DataFrame({"freq_hz": [5.0], "freq_sd": [0.1 / Z95], "freq_other_hi": [5.2], "damping": [0.1],
+                          "damping_sd": [0.01 / Z95], "damping_other_hi": [0.1]})  # fmt: skip
+    k, (note,) = _filled_samples_scale(rec, SimpleNamespace(original_fs=60.0))  # resampled 60 -> 20 Hz
+    assert k == pytest.approx(np.sqrt(7200 / 6480)) and note.value == k
+    out = with_intervals(modes, k)
     np.testing.assert_allclose(out[["freq_ci95_lo", "freq_ci95_hi"]].to_numpy(), [[5 - 0.1 * k, 5 + 0.2 * k]])
-    np.testing.assert_allclose(out[["damping_ci95_lo", "damping_ci95_hi"]].to_numpy(), [[0.1 - 0.01 * k, 0.1]])
+    damping_ci = out[["damping_ci95_lo", "damping_ci95_hi"]].to_numpy()
+    np.testing.assert_allclose(damping_ci, [[0.1 - 0.01 * k, 0.1 + 0.01 * k]])
     rec.meta = {}
-    assert _discount_filled_samples(modes, rec, None) == (modes, [])
+    assert _filled_samples_scale(rec, None) == (1.0, [])

@@ -6,8 +6,10 @@ import pytest
 
 import armaxmodal as am
 from armaxmodal.modes.diagram import stabilisation_diagram
+from armaxmodal.modes.intervals import with_intervals
 from armaxmodal.modes.selection import select_modes
 from armaxmodal.modes.spread import apply_segment_spread
+from armaxmodal.stats import Z95
 
 FS = 60.0
 # the stiffer half of the changing ride: every spring 12 % stiffer (modes about 6 % higher)
@@ -54,15 +56,16 @@ def test_widening_follows_the_chi_square_rule():
     from scipy.stats import chi2, t
 
     sigma = 0.01
-    base = {"freq_hz": 5.0, "damping": 0.2, "freq_ci95_lo": 5 - 1.96 * sigma, "freq_ci95_hi": 5 + 1.96 * sigma,
-            "damping_ci95_lo": 0.19, "damping_ci95_hi": 0.21}  # fmt: skip
+    base = {"freq_hz": 5.0, "damping": 0.2, "freq_sd": sigma, "freq_sd_armax": sigma, "damping_sd": 0.005,
+            "damping_sd_armax": 0.005}  # fmt: skip
     crit = chi2.ppf(1 - 0.01 / 2, 2)
     s_edge = sigma * np.sqrt(3 * crit / 2)
     for s, flagged in ((0.98 * s_edge, False), (1.02 * s_edge, True)):
         spread = pd.DataFrame([{"freq_segment_sd": s, "damping_segment_sd": 0.0, "segments_found": 3}])
         out, notes = apply_segment_spread(pd.DataFrame([base]), spread)
+        out = with_intervals(out)
         assert bool(out.model_error_dominates.iloc[0]) is flagged
         assert [w.code for w in notes] == (["model_error_dominates"] if flagged else [])
         half = (out.freq_ci95_hi.iloc[0] - out.freq_ci95_lo.iloc[0]) / 2
-        want = max(t.ppf(0.975, 2) * s / np.sqrt(3), 1.96 * sigma) if flagged else 1.96 * sigma
+        want = max(t.ppf(0.975, 2) * s / np.sqrt(3), Z95 * sigma) if flagged else Z95 * sigma
         assert half == pytest.approx(want, rel=1e-9)

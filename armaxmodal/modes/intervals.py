@@ -1,0 +1,78 @@
+"""A mode's 95 % intervals, kept as their parts while the selection works and combined once, on output.
+
+Each quantity ``q`` (``freq`` for ``freq_hz``, ``damping``) of a selection row has three parts:
+
+``{q}_sd``
+    the standard deviation of the reported value, from its estimator's information matrix (the
+    ARMAX fit's, the band-limited refit's or the modal model's, whichever ``estimator`` names);
+``{q}_other_lo``, ``{q}_other_hi``
+    the reach of the same mode's 95 % intervals in the other model structures the record finds
+    as good (:mod:`armaxmodal.modes.counted`: another number of modes, two poles reported as one);
+    NaN where there are none;
+``{q}_segment_half``
+    the half-width of the disjoint segments' interval where their spread exceeds the statistical
+    one (:mod:`armaxmodal.modes.spread`); NaN where it does not.
+
+The interval is the hull of ``value ± Z95 sd`` and the other two, scaled about the value by the
+share of the record's samples that carry information (filled samples do not). Each stage sets its
+own part and leaves the others', so no stage has to undo or re-derive another's widening.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from armaxmodal.stats import Z95
+
+__all__ = ["QUANTITIES", "interval_columns", "with_intervals"]
+
+#: ``(part prefix, value column)`` of each quantity that has an interval
+QUANTITIES = (("freq", "freq_hz"), ("damping", "damping"))
+
+
+def interval_columns(q: str) -> tuple[str, str]:
+    """The output columns ``({q}_ci95_lo, {q}_ci95_hi)`` of quantity ``q``."""
+    return f"{q}_ci95_lo", f"{q}_ci95_hi"
+
+
+def with_intervals(modes: pd.DataFrame, scale: float = 1.0) -> pd.DataFrame:
+    """``modes`` with its 95 % intervals computed from their parts (the module's docstring).
+
+    Parameters
+    ----------
+    modes : DataFrame
+        Selection rows: ``freq_hz``, ``damping``, ``freq_sd`` and ``damping_sd``; the ``other``
+        and ``segment_half`` columns where a stage set them (absent: none).
+    scale : float
+        Factor every interval is widened by about its value (at least 1; 1 leaves them).
+
+    Returns
+    -------
+    DataFrame
+        A copy with ``freq_ci95_lo``, ``freq_ci95_hi``, ``damping_ci95_lo`` and ``damping_ci95_hi``.
+        A NaN standard deviation gives a NaN interval unless the segments' part gives one: the
+        other structures' intervals are not this estimate's.
+    """
+    out = modes.copy()
+    for q, value in QUANTITIES:
+        v = out[value].to_numpy(float)
+        sd = out[f"{q}_sd"].to_numpy(float)
+        lo, hi = v - Z95 * sd, v + Z95 * sd
+        other_lo, other_hi = _part(out, f"{q}_other_lo"), _part(out, f"{q}_other_hi")
+        lo = np.where(np.isnan(other_lo), lo, np.minimum(lo, other_lo))
+        hi = np.where(np.isnan(other_hi), hi, np.maximum(hi, other_hi))
+        half = _part(out, f"{q}_segment_half")
+        lo = np.where(np.isnan(half), lo, np.fmin(v - half, lo))
+        hi = np.where(np.isnan(half), hi, np.fmax(v + half, hi))
+        if scale != 1.0:
+            lo, hi = v - scale * (v - lo), v + scale * (hi - v)
+        out[f"{q}_ci95_lo"], out[f"{q}_ci95_hi"] = lo, hi
+    return out
+
+
+def _part(modes: pd.DataFrame, column: str) -> np.ndarray:
+    """A part's column, all NaN where no stage set it."""
+    if column not in modes:
+        return np.full(len(modes), np.nan)
+    return modes[column].to_numpy(float)
