@@ -26,7 +26,9 @@ class WorkingSelection:
     Attributes
     ----------
     modes : DataFrame
-        One row per mode, by frequency (the columns of :attr:`armaxmodal.ModeSelection.modes`).
+        One row per mode, by frequency: the columns of :attr:`armaxmodal.ModeSelection.modes`
+        but the 95 % intervals, which are kept as their parts until the selection ends
+        (:mod:`armaxmodal.modes.intervals`).
     shapes : (n_sensors, n_modes) complex ndarray
         The modal constants, one column per row of ``modes``.
     refinement : ModalRefinement or None
