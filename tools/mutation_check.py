@@ -827,6 +827,44 @@ MUTANTS = [
         "pass",
         "the merged row keeps the pair's deviation (intervals)",
     ),
+    # issue 37's stand-ins: an unfounded pole the model needs stays in it, unreported (run with
+    #   --match "(stand-in)" --tests tests/modes/test_mode_count.py)
+    (
+        "armaxmodal/modes/mode_count.py",
+        "if rise >= DECISIVE_BIC:",
+        "if rise >= -np.inf:",
+        "every unfounded pole kept (stand-in)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "if rise >= DECISIVE_BIC:",
+        "if False:",
+        "no unfounded pole kept, however needed (stand-in)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "keep &= np.abs(np.log(self.model.freq_hz / went)) > SAME_MODE_FREQ",
+        "keep &= True",
+        "a stand-in reported (stand-in)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "keep = count.reported(data.band_hz)",
+        "keep = reported(count.model, data.band_hz)",
+        "the selection reports the count's stand-ins (stand-in)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "outside = ~reported(count.model, band_hz)",
+        "outside = ~keep",
+        "a stand-in said to lie beyond the band (stand-in)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        'unreported += [(start, went, "kept in the model but not reported") for start, went, _ in count.stand_ins]',
+        "unreported += []",
+        "a stand-in with a coherent peak left says good (stand-in)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/estimate/test_guards.py",

@@ -135,13 +135,13 @@ def counted_modes(
     start_f, start_x = modes.freq_hz.to_numpy(), modes.damping.to_numpy()
     if picked and work.count is not None:  # the poles the selection's model kept unreported stay in it
         model = work.count.model
-        hidden = ~reported(model, band_hz)
+        hidden = ~work.count.reported(band_hz)
         start_f, start_x = np.r_[start_f, model.freq_hz[hidden]], np.r_[start_x, model.damping[hidden]]
     count = count_modes(data, start_f, start_x, candidates, hold=hold, halves=halves, supported=supported,
                         search=not picked, n_jobs=n_jobs)  # fmt: skip
     if part is not rec:
         count = _on_whole_record(count, rec, band_hz, hold)
-    keep = reported(count.model, data.band_hz)
+    keep = count.reported(data.band_hz)
     if picked:
         return _picked_result(work, count, keep, hold, rec, band)
     if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
@@ -262,22 +262,25 @@ def confirmed_where_incoherent(diagram, work: WorkingSelection) -> WorkingSelect
 
 
 def dropped_where_peaks_remain(count: ModeCount | None, peaks) -> list[QualityWarning]:
-    """A ``count_undecided`` note for each starting mode the count left out as unfounded
-    (``count.carried_away``) while the measured FRF keeps a coherent peak that no reported mode
-    explains within :data:`SAME_ROW_FREQ` of where it started or went (``peaks``: the
-    ``unexplained_peak`` notes). The two kinds of evidence disagree: the halves test is weak on a
-    transient input (an earthquake's record), and the H1 still shows a resonance there. Inglewood's
-    5.83 Hz start went to 4.40 Hz and was left out, with coherent peaks left at 5.77 and 4.38 Hz."""
+    """A ``count_undecided`` note for each starting mode the count did not report as unfounded
+    (``count.carried_away``, left out; ``count.stand_ins``, kept in the model unreported) while
+    the measured FRF keeps a coherent peak that no reported mode explains within
+    :data:`SAME_ROW_FREQ` of where it started or went (``peaks``: the ``unexplained_peak`` notes).
+    The two kinds of evidence disagree: the halves test is weak on a transient input (an
+    earthquake's record), and the H1 still shows a resonance there. Inglewood's 5.83 Hz start went
+    to 4.40 Hz, unfounded, with coherent peaks left at 5.77 and 4.38 Hz."""
     if count is None:
         return []
     notes = []
-    for start, went in count.carried_away:
+    unreported = [(start, went, "left out") for start, went in count.carried_away]
+    unreported += [(start, went, "kept in the model but not reported") for start, went, _ in count.stand_ins]
+    for start, went, fate in unreported:
         near = [p.value for p in peaks
                 if min(abs(np.log(p.value / start)), abs(np.log(p.value / went))) <= SAME_ROW_FREQ]  # fmt: skip
         if near:
             notes.append(QualityWarning(
                 "count_undecided", (),
-                f"the starting mode at {start:.3f} Hz was left out (the free fit took it to {went:.3f} Hz, where it "
+                f"the starting mode at {start:.3f} Hz was {fate} (the free fit took it to {went:.3f} Hz, where it "
                 f"is no mode), but the measured FRF keeps a coherent peak no mode explains at "
                 f"{', '.join(f'{f:.2f}' for f in near)} Hz: the record does not decide whether a mode is there; "
                 "compare another record of the structure, or pick it ('--pick') to see what the record says of it",
@@ -477,11 +480,20 @@ def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
             f"in the models the record cannot tell from the chosen one ({sizes} in the criterion): the number of modes "
             "is part of their uncertainty", float(len(widened)),
         ))  # fmt: skip
-    hidden = int((~keep).sum())
+    for start, went, rise_without in count.stand_ins:
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
+            "damping unresolved, or not the same in both halves of the record), but the model needs it (without it "
+            f"the criterion rises by {rise_without:.1f}): it stays in the model, as a pole for what the record does "
+            "not resolve there, and is not reported", went,
+        ))  # fmt: skip
+    outside = ~reported(count.model, band_hz)  # beyond the band, overdamped or lines (not the stand-ins)
+    hidden = int(outside.sum())
     if hidden:
         out = ", ".join(
             f"{f:.3g} Hz (damping {x:.2f})"
-            for f, x in zip(count.model.freq_hz[~keep], count.model.damping[~keep], strict=True)
+            for f, x in zip(count.model.freq_hz[outside], count.model.damping[outside], strict=True)
         )
         notes.append(QualityWarning(
             "mode_count", (),

@@ -1,6 +1,7 @@
 """The maximum-likelihood modal model and the number of modes by nested tests (issue: the seed's
 own bodies): against exact modes of simulated chains, with over- and under-modelling planted."""
 
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -207,7 +208,6 @@ def test_two_poles_the_record_does_not_separate_are_reported_as_one(supine, supi
     exact one, refitted with one pole there, with intervals that cover both poles and a note.
     Shapes that differ (the head mode's for the second) separate them; so do standard deviations of
     0.005 Hz, also when only the rows' intervals (a hull over equally good counts) overlap."""
-    from dataclasses import replace
 
     data, truth = supine
     f, x = np.r_[truth.freq_hz, truth.freq_hz[1] * 1.01], np.r_[truth.damping, truth.damping[1]]
@@ -303,13 +303,29 @@ def bundled_diagram(fixtures_dir):
 
 
 def test_a_model_that_keeps_no_mode_leaves_the_selection_and_says_so(monkeypatch, bundled_diagram):
-    import armaxmodal.modes.counted as counted
-
     before = am.select_modes(bundled_diagram, segments=0)
-    monkeypatch.setattr(counted, "reported", lambda model, band: np.zeros(model.freq_hz.size, dtype=bool))
+    monkeypatch.setattr(ModeCount, "reported", lambda count, band: np.zeros(count.model.freq_hz.size, dtype=bool))
     sel = am.select_modes(bundled_diagram, segments=0)
     assert len(sel.modes) == len(before.modes) == 4 and sel.quality == "uncertain"
     assert "count_undecided" in sel.uncertain_because
+
+
+def test_a_stand_in_stays_out_of_the_selection(monkeypatch, bundled_diagram):
+    """The count's stand-ins are not reported: the bundled ride's 16.23 Hz pole made one (as if
+    the count had found it unfounded but needed) leaves three modes and its note."""
+    import armaxmodal.modes.counted as counted
+
+    real = counted.count_modes
+
+    def with_a_stand_in(*args, **kwargs):
+        count = real(*args, **kwargs)
+        top = float(count.model.freq_hz.max())
+        return replace(count, stand_ins=((top, top, 50.0),))
+
+    monkeypatch.setattr(counted, "count_modes", with_a_stand_in)
+    sel = am.select_modes(bundled_diagram, segments=0)
+    assert len(sel.modes) == 3 and sel.modes.freq_hz.max() < 14.0
+    assert any("stays in the model" in w.message for w in sel.warnings)
 
 
 def test_a_long_record_is_counted_on_its_start_and_fitted_whole(monkeypatch, bundled_diagram):
@@ -383,29 +399,52 @@ def test_a_decided_count_has_no_equally_good_model(monkeypatch, supine):
 
 
 @pytest.mark.parametrize(
-    "stable_there, resolved, dropped", [(False, True, True), (True, False, True), (True, True, False)]
-)
-def test_a_start_mode_the_free_fit_carries_away_must_be_founded(monkeypatch, supine, stable_there, resolved, dropped):
-    """The search's converged model holds the 13 Hz start at 11 Hz: a new pole, which stays only
-    when its damping is resolved and the diagram holds a pole there (as an addition must)."""
+    "stable_there, resolved, needed, outcome",
+    [(False, True, False, "dropped"), (True, False, False, "dropped"), (True, True, False, "kept"),
+     (False, True, True, "stand-in"), (True, False, True, "stand-in")],
+)  # fmt: skip
+def test_a_start_mode_the_free_fit_carries_away_must_be_founded(monkeypatch, supine, stable_there, resolved, needed,
+                                                                outcome):  # fmt: skip
+    """The search's converged model holds the 13 Hz start at 11 Hz: a new pole, which is reported
+    only when its damping is resolved and the diagram holds a pole there (as an addition must).
+    One that is not founded is left out, unless the model needs it (the criterion rises by
+    DECISIVE_BIC or more without it): then it stays in the model, unreported."""
     import armaxmodal.modes.mode_count as mode_count
 
     data, _ = supine
-    moved = _model([5.0, 9.0, 11.0], [0.3, 0.3, 0.3])
+    table = {2: 100.0 + (DECISIVE_BIC + 1 if needed else DECISIVE_BIC - 1), 3: 100.0}
+    moved = _Scored([5.0, 9.0, 11.0], [0.3, 0.3, 0.3], table)
     if not resolved:
         moved.damping_sd = np.array([0.003, 0.003, 0.2])  # 11 Hz: interval reaches below zero
     refits = []
-    monkeypatch.setattr(mode_count, "fit_modal_model", lambda d, f, x, hold, n: refits.append(list(f)) or _model(f, x))
+    monkeypatch.setattr(mode_count, "fit_modal_model",
+                        lambda d, f, x, hold, n: refits.append(list(f)) or _Scored(f, x, table))  # fmt: skip
     search = mode_count._Search(data, "zoh", 1.0, 40)
-    model, carried = mode_count._without_unfounded(search, [5.0, 9.0, 13.0], moved,
-                                                   lambda f, x: stable_there or abs(f - 11.0) > 0.5)  # fmt: skip
-    if dropped:
-        assert carried == ((13.0, 11.0),) and refits == [[5.0, 9.0]] and model.n_modes == 2
+    model, carried, kept = mode_count._without_unfounded(search, [5.0, 9.0, 13.0], moved,
+                                                         lambda f, x: stable_there or abs(f - 11.0) > 0.5)  # fmt: skip
+    if outcome == "dropped":
+        assert carried == ((13.0, 11.0),) and kept == () and refits == [[5.0, 9.0]] and model.n_modes == 2
+    elif outcome == "stand-in":
+        assert carried == () and model is moved and refits == [[5.0, 9.0]]
+        assert kept == ((13.0, 11.0, pytest.approx(DECISIVE_BIC + 1)),)
     else:
-        assert carried == () and model is moved and refits == []
+        assert carried == () and kept == () and model is moved and refits == []
     # a pole that stayed near its start is not judged, however unsupported
-    near = _model([5.0, 9.0, 12.8], [0.3, 0.3, 0.3])
-    assert mode_count._without_unfounded(search, [5.0, 9.0, 13.0], near, lambda f, x: False)[1] == ()
+    near = _Scored([5.0, 9.0, 12.8], [0.3, 0.3, 0.3], table)
+    assert mode_count._without_unfounded(search, [5.0, 9.0, 13.0], near, lambda f, x: False)[1:] == ((), ())
+
+
+def test_a_stand_in_is_in_the_model_but_not_reported_and_is_said():
+    """A stand-in pole (kept in the model, unreported) is neither a reported mode nor listed
+    among the poles beyond the band; its own note says where it went and what it is worth."""
+    count = replace(_count([50.0, 60.0, 70.0], -40.0, freq=(5.0, 12.0, 24.7), damping=(0.2, 0.3, 0.25)),
+                    stand_ins=((21.9, 24.74, 872.5),))  # fmt: skip
+    keep = count.reported((1.0, 26.0))
+    assert keep.tolist() == [True, True, False]
+    notes = _notes(count, keep, (1.0, 26.0))
+    said = [n.message for n in notes if "stays in the model" in n.message]
+    assert len(said) == 1 and "21.900 Hz to 24.740" in said[0] and "872.5" in said[0]
+    assert not any("outside the band" in n.message for n in notes)
 
 
 @pytest.mark.parametrize("same_in_halves", [True, False])
@@ -414,12 +453,13 @@ def test_with_the_halves_a_moved_pole_is_judged_by_them_not_by_the_diagram(monke
     pelvis's 13.50 Hz mode sat at 14.69 Hz in every order): with the halves, they decide."""
     import armaxmodal.modes.mode_count as mode_count
 
-    monkeypatch.setattr(mode_count, "fit_modal_model", lambda d, f, x, hold, n: _model(f, x))
+    table = {2: 100.0, 3: 100.0}  # the model does not need the moved pole
+    monkeypatch.setattr(mode_count, "fit_modal_model", lambda d, f, x, hold, n: _Scored(f, x, table))
     search = mode_count._Search(supine[0], "zoh", 1.0, 40)
     asked = []
     monkeypatch.setattr(search, "in_both_halves", lambda m, new, h: asked.append(list(new)) or same_in_halves)
-    moved = _model([5.0, 9.0, 11.0], [0.3, 0.3, 0.3])
-    model, carried = mode_count._without_unfounded(search, [5.0, 9.0, 13.0], moved, lambda f, x: False, ("a", "b"))
+    moved = _Scored([5.0, 9.0, 11.0], [0.3, 0.3, 0.3], table)
+    model, carried, _ = mode_count._without_unfounded(search, [5.0, 9.0, 13.0], moved, lambda f, x: False, ("a", "b"))
     assert asked == [[2]]  # only the moved pole is put to the halves
     assert (carried == ()) is same_in_halves and model.n_modes == (3 if same_in_halves else 2)
 
@@ -431,7 +471,6 @@ def test_the_modal_model_confirms_a_mode_where_the_h1_is_not_coherent(monkeypatc
                                                                       confirmed):  # fmt: skip
     """A mode the FRF check cannot test (no coherent H1 line near it) is confirmed when the
     likelihood needs it decisively and the record's halves agree on it; else it stays unconfirmed."""
-    from dataclasses import replace
 
     import armaxmodal.modes.counted as counted
     from armaxmodal.modes.working import WorkingSelection
@@ -457,18 +496,24 @@ def test_the_modal_model_confirms_a_mode_where_the_h1_is_not_coherent(monkeypatc
         ((), []),
     ],
 )
-def test_a_start_mode_left_out_where_a_coherent_peak_remains_leaves_the_count_undecided(peaks_hz, near):
+@pytest.mark.parametrize("fate", ["left out", "kept in the model but not reported"])
+def test_a_start_mode_left_out_where_a_coherent_peak_remains_leaves_the_count_undecided(peaks_hz, near, fate):
+    """Left out of the model or kept in it as a stand-in, an unreported start with a coherent
+    peak left where it started or went leaves the count undecided."""
     from armaxmodal.quality_warnings import UNCERTAIN_CODES, QualityWarning
 
     peaks = [QualityWarning("unexplained_peak", ("deck",), "a peak", f) for f in peaks_hz]
-    count = SimpleNamespace(carried_away=((5.826, 4.401),))
+    if fate == "left out":
+        count = SimpleNamespace(carried_away=((5.826, 4.401),), stand_ins=())
+    else:
+        count = SimpleNamespace(carried_away=(), stand_ins=((5.826, 4.401, 136.4),))
     notes = dropped_where_peaks_remain(count, peaks)
     assert [n.code for n in notes] == (["count_undecided"] if near else [])
     if near:
         assert notes[0].value == 5.826 and all(f"{f:.2f}" in notes[0].message for f in near)
-        assert notes[0].code in UNCERTAIN_CODES
+        assert notes[0].code in UNCERTAIN_CODES and f"was {fate} " in notes[0].message
     assert dropped_where_peaks_remain(None, peaks) == []
-    assert dropped_where_peaks_remain(SimpleNamespace(carried_away=()), peaks) == []
+    assert dropped_where_peaks_remain(SimpleNamespace(carried_away=(), stand_ins=()), peaks) == []
 
 
 def _pole_rows(freq_hz, damping, orders, rejected):
