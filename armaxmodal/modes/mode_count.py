@@ -165,7 +165,7 @@ class ModeCount:
 
     def reported(self, band_hz) -> np.ndarray:
         """Which of the model's poles are reported as modes of the band (bool per pole):
-        :func:`reported`'s, but the stand-ins (matched by frequency within :data:`SAME_MODE_FREQ`:
+        :func:`reported`'s, but the stand-ins (matched by frequency within 3 %, ``SAME_MODE_FREQ``:
         a long record's model is refitted to the whole record after the search).
 
         Parameters
