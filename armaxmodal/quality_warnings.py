@@ -168,8 +168,10 @@ CODES: tuple[WarningCode, ...] = (
     ),
     WarningCode(
         "incoherent_output", "preparation",
-        "an output's coherence with the input, averaged over the input's spectrum, below 0.3 (response sensors: "
-        "0.63–1.00 on every measured record here; independent noise 0.07)",
+        "an output's coherence with the input below 0.3 both averaged over the input's spectrum and over the "
+        "output's own, the share of its power the input explains (response sensors: 0.63–1.00 over the input's "
+        "spectrum on every measured record here; independent noise 0.07; a 1 %-damped chain's sensors, which move "
+        "only near their resonances, 0.17–0.30 over the input's spectrum but far more over their own)",
         "left out of the fit while another output responds (pooled, a temperature channel beside the supine ride's "
         "sensors moved its 13.7 Hz mode to 15.0 Hz; left out, the modes are the clean ride's to the last digit); when "
         "no output responds, all are kept and the message says the modes found are not the structure's (a record of "

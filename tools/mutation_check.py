@@ -865,6 +865,26 @@ MUTANTS = [
         "unreported += []",
         "a stand-in with a coherent peak left says good (stand-in)",
     ),
+    # an output is incoherent only when low over the input's spectrum and over its own (run with
+    #   --match "(coherent)" --tests tests/prepare/test_prepare.py)
+    (
+        "armaxmodal/prepare/quality.py",
+        "if c < INCOHERENT and o < INCOHERENT]",
+        "if c < INCOHERENT]",
+        "a lightly damped sensor dropped as incoherent (coherent)",
+    ),
+    (
+        "armaxmodal/prepare/quality.py",
+        "if c < INCOHERENT and o < INCOHERENT]",
+        "if o < INCOHERENT]",
+        "only the output's own spectrum judged (coherent)",
+    ),
+    (
+        "armaxmodal/prepare/quality.py",
+        "own = np.sum(pyy * coh, axis=0) / np.maximum(np.sum(pyy, axis=0), 1e-300)",
+        "own = levels",
+        "the output's own spectrum not weighted (coherent)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/estimate/test_guards.py",

@@ -598,3 +598,34 @@ def test_a_record_sampled_far_above_its_structure_says_so_and_its_advice_finds_t
     # the threshold: the highest mode at 10 % of the Nyquist frequency is not oversampled
     assert oversampling_note(np.array([3.0, 50.0]), 1000.0) == [] and oversampling_note(np.array([]), 1000.0) == []
     assert oversampling_note(np.array([49.9]), 1000.0)[0].value == pytest.approx(0.0998)
+
+
+def test_a_lightly_damped_sensor_is_a_response_though_the_input_drives_it_little_elsewhere():
+    """A 1 %-damped four-mass chain at 400 Hz (a count battery's body, rounded): its first two
+    sensors move at the 13.4 and 20.0 Hz resonances and barely elsewhere, so over the input's
+    0.5-180 Hz their noise floor dominates and their coherence averaged over the input's spectrum
+    is below INCOHERENT. Most of their own power is coherent: they respond, and are kept (leaving
+    them out lost the 27.97 Hz mode)."""
+    from armaxmodal.prepare.quality import INCOHERENT, input_coherence
+
+    s = am.Structure.from_chain([4.818, 8.406, 8.038, 2.565], [22235.9, 54564.2, 92832.2, 42092.7],
+                                [2.721, 6.677, 11.360, 5.151], [73064.8, 28573.6, 58065.6], [8.941, 3.497, 7.105],
+                                ("s0", "s1", "s2", "s3"))  # fmt: skip
+    rec = am.simulate_recording(s, am.random_vibration(400.0, 120.0, (0.5, 180.0), seed=4), 400.0, noise=0.03,
+                                seed=5)  # fmt: skip
+    assert input_coherence(rec.base, rec.response, rec.fs)[:2].max() < INCOHERENT
+    assert [w for w in check_quality(rec) if w.code == "incoherent_output"] == []
+
+
+def test_a_response_sensor_with_a_strong_hum_beyond_the_input_band_still_responds(clean):
+    """The other half of the rule: most of the head sensor's power made a 27 Hz hum, beyond the
+    ride's 0.5-24 Hz, where the input has no power. Over its own spectrum little is coherent; over
+    the input's the head still responds as before, so it is kept (the hum is for the disturbance
+    checks, not a reason to drop the sensor)."""
+    from armaxmodal.prepare.quality import INCOHERENT, input_coherence
+
+    y = clean.response.copy()
+    y[:, 0] += 5 * y[:, 0].std() * np.sin(2 * np.pi * 27.0 * clean.time)
+    hummed = _with(clean, response=y)
+    assert input_coherence(hummed.base, hummed.response, hummed.fs)[0] > 0.75 > INCOHERENT
+    assert [w for w in check_quality(hummed) if w.code == "incoherent_output"] == []
