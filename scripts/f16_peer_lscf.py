@@ -31,6 +31,11 @@ PERIOD, PERIODS, BAND_HZ, ORDERS = 8192, 9, (2.0, 15.0), (40, 50, 60, 70, 80)
 def averaged_frf(path: str) -> tuple[np.ndarray, np.ndarray]:
     """The accelerance FRF (3 outputs, lines in BAND_HZ) of the averaged steady-state periods."""
     d = loadmat(path)
+    missing = [k for k in ("Fs", "Force", "Acceleration") if k not in d]
+    samples = d["Force"].size if "Force" in d else 0
+    if missing or samples != PERIODS * PERIOD:
+        raise SystemExit(f"{path}: not an F16Data_FullMSine file (needs Fs, Force and Acceleration of "
+                         f"{PERIODS} x {PERIOD} samples; missing: {missing or 'none'}, Force: {samples} samples)")  # fmt: skip
     fs = float(d["Fs"][0, 0])
     u = d["Force"][0].reshape(PERIODS, PERIOD)[1:]
     y = d["Acceleration"].reshape(3, PERIODS, PERIOD)[:, 1:]
@@ -43,7 +48,10 @@ def averaged_frf(path: str) -> tuple[np.ndarray, np.ndarray]:
 def lscf_nearest(freq: np.ndarray, frf: np.ndarray, targets: list[float]) -> tuple[np.ndarray, np.ndarray]:
     """Per order of ORDERS, the physical LSCF pole nearest each target: ``(freq_hz, damping)``,
     each of shape ``(len(ORDERS), len(targets))``."""
-    from sdypy import EMA
+    try:
+        from sdypy import EMA
+    except ImportError as err:
+        raise SystemExit("sdypy-EMA is not installed: pip install -e \".[peers]\"") from err
 
     model = EMA.Model(frf=frf, freq=freq, lower=BAND_HZ[0], upper=float(freq[-1]), pol_order_high=max(ORDERS),
                       frf_form="accelerance")  # fmt: skip
@@ -67,7 +75,9 @@ def main() -> None:
     parser.add_argument("mat", help="an F16Data_FullMSine_Level*.mat file")
     parser.add_argument("json", help="the stabilise --json output of the same file")
     args = parser.parse_args()
-    modes = json.load(open(args.json))["modes"]
+    modes = json.load(open(args.json)).get("modes")
+    if not modes:
+        raise SystemExit(f"{args.json}: no modes (the JSON of 'armaxmodal stabilise --json' with modes is needed)")
     f_lscf, x_lscf = lscf_nearest(*averaged_frf(args.mat), [m["freq_hz"] for m in modes])
     print("| product f (Hz) [95 %] | damping | LSCF orders within 1 % | LSCF f (Hz), mean ± SD | damping "
           "| LSCF - product (half-widths) |")
