@@ -35,7 +35,8 @@ def averaged_frf(path: str) -> tuple[np.ndarray, np.ndarray]:
     samples = d["Force"].size if "Force" in d else 0
     if missing or samples != PERIODS * PERIOD:
         raise SystemExit(f"{path}: not an F16Data_FullMSine file (needs Fs, Force and Acceleration of "
-                         f"{PERIODS} x {PERIOD} samples; missing: {missing or 'none'}, Force: {samples} samples)")  # fmt: skip
+                         f"{PERIODS} x {PERIOD} samples; missing: {missing or 'none'}, "
+                         f"Force: {samples} samples)")  # fmt: skip
     fs = float(d["Fs"][0, 0])
     u = d["Force"][0].reshape(PERIODS, PERIOD)[1:]
     y = d["Acceleration"].reshape(3, PERIODS, PERIOD)[:, 1:]
