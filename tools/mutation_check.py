@@ -885,6 +885,20 @@ MUTANTS = [
         "own = levels",
         "the output's own spectrum not weighted (coherent)",
     ),
+    # a counted mode no cluster holds takes none of its neighbour's facts (run with
+    #   --match "(row-facts)" --tests tests/modes/test_mode_count.py)
+    (
+        "armaxmodal/modes/counted.py",
+        "freq_sd_armax=m.freq_sd[i], damping_sd_armax=m.damping_sd[i])",
+        ")",
+        "the neighbour's ARMAX deviation kept (row-facts)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "orders_damping_unresolved=0, energy=np.nan,",
+        "orders_damping_unresolved=0,",
+        "the neighbour's energy kept (row-facts)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/estimate/test_guards.py",

@@ -359,8 +359,11 @@ def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str) -> dict:
     j = int(np.argmin(dist))
     row = modes.iloc[j].to_dict()
     if dist[j] > SAME_ROW_FREQ:  # a mode the diagram's clusters did not hold
+        # nor an ARMAX estimate: the segments' spread is judged against the modal model's own
+        # deviation (as a mode the completeness test adds), not the neighbouring row's
         row.update(count=0, support=0.0, freq_spread=np.nan, damping_spread=np.nan, medoid_freq_hz=np.nan,
-                   medoid_damping=np.nan, orders_damping_unresolved=0)  # fmt: skip
+                   medoid_damping=np.nan, orders_damping_unresolved=0, energy=np.nan,
+                   freq_sd_armax=m.freq_sd[i], damping_sd_armax=m.damping_sd[i])  # fmt: skip
     other, widened = _other_structures(count, i)
     row.update(
         freq_hz=f, damping=x, damped_freq_hz=f * np.sqrt(1 - x**2), freq_sd=m.freq_sd[i], damping_sd=m.damping_sd[i],

@@ -603,3 +603,18 @@ def test_the_likelihood_ratio_flag_needs_a_significant_ratio_a_decisive_bic_and_
     assert bool(got) == wanted
     if wanted:
         assert got[0] == 9.6 and np.isclose(got[1], ratio) and got[2] == 22 and np.isclose(got[3], -gain)
+
+
+def test_a_counted_mode_no_cluster_holds_takes_none_of_its_neighbours_facts():
+    """A mode the diagram's clusters did not hold gets no cluster facts and, as the ARMAX
+    reference the segments' spread is judged against, its own deviation: it once took its
+    neighbour's (0.037 Hz for a 24.8 Hz mode whose own is 0.158 Hz), so the spread flagged it."""
+    from armaxmodal.modes.counted import _row
+
+    modes = pd.DataFrame({"freq_hz": [5.0], "damping": [0.2], "count": [12], "support": [0.8], "energy": [0.3],
+                          "freq_sd_armax": [0.04], "damping_sd_armax": [0.003]})  # fmt: skip
+    count = _count([50.0, 60.0], -40.0, freq=(5.02, 24.8), damping=(0.2, 0.3))
+    held, new = _row(modes, count, 0, "zoh"), _row(modes, count, 1, "zoh")
+    assert (held["count"], held["energy"], held["freq_sd_armax"]) == (12, 0.3, 0.04)
+    assert new["count"] == 0 and np.isnan(new["energy"])
+    assert (new["freq_sd_armax"], new["damping_sd_armax"]) == (count.model.freq_sd[1], count.model.damping_sd[1])
