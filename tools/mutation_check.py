@@ -899,6 +899,51 @@ MUTANTS = [
         "orders_damping_unresolved=0,",
         "the neighbour's energy kept (row-facts)",
     ),
+    # every reported mode split once after the search, for the likelihood's flag (run with
+    #   --match "(split-wanted)" --tests tests/modes/test_mode_count.py)
+    (
+        "armaxmodal/modes/mode_count.py",
+        "        wanted = _split_wanted(search, current, halves, supported)\n",
+        "        pass\n",
+        "no split tried after the search (split-wanted)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "best = min(screened, key=search.bic)",
+        "best = max(screened, key=search.bic)",
+        "the worst split judged (split-wanted)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "    if not search.resolved(model):\n        return ()\n    new = _new_poles",
+        "    new = _new_poles",
+        "a split with its damping unresolved (split-wanted)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "    if not search.in_both_halves(model, _new_poles(current.freq_hz, model.freq_hz), halves):\n"
+        "        return ()\n",
+        "",
+        "the halves not asked (split-wanted)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        'return f"the criterion (BIC) rises by {rise_bic:.1f}, so it is not reported"',
+        'return f"the criterion (BIC) falls by {rise_bic:.1f}, so it is not reported"',
+        "a rise said to be a fall (split-wanted)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "in_diagram = supported is not None and bool(supported(f, x))",
+        "in_diagram = True",
+        "a split's pole said to be a column to pick (split-wanted)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "    if in_diagram:\n",
+        "    if True:\n",
+        "--pick suggested where the diagram has nothing to pick (split-wanted)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/estimate/test_guards.py",

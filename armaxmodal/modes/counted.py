@@ -426,6 +426,21 @@ def _pick_notes(count: ModeCount, keep: np.ndarray) -> list[QualityWarning]:
     return notes
 
 
+def _why_not_reported(rise_bic: float) -> str:
+    if rise_bic > 0:
+        return f"the criterion (BIC) rises by {rise_bic:.1f}, so it is not reported"
+    return ("the search, which splits only the mode nearest the residual's peak, did not try it (with it the "
+            f"criterion falls by {-rise_bic:.1f}), so it is not reported")
+
+
+def _what_to_do(in_diagram: bool) -> str:
+    if in_diagram:
+        return "pick it (--pick) to see what the record says of it"
+    # a split's pole: the ARMAX fits merge it with its neighbour, and a pick takes a diagram's column
+    return ("the diagram holds no stable column there to pick (its ARMAX fits merge it with a neighbour); a longer "
+            "record would decide")
+
+
 def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
     notes = []
     words = {"remove": "left out", "add": "added", "split": "split in two"}
@@ -454,13 +469,12 @@ def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
             f"{-count.best_addition:+.1f}, less than {DECISIVE_BIC:g} either way", f,
         ))  # fmt: skip
     if count.wanted:
-        f, ratio, dof, rise_bic = count.wanted
+        f, ratio, dof, rise_bic, in_diagram = count.wanted
         notes.append(QualityWarning(
             "count_undecided", (),
             f"the record may hold one mode more near {f:.3f} Hz: adding it raises the likelihood far beyond chance "
             f"(likelihood ratio {ratio:.1f} for its {dof} parameters, p < {LIKELIHOOD_ALPHA:g}) and the mode is the "
-            f"same in both halves of the record, but the criterion (BIC) rises by {rise_bic:.1f}, so it is not "
-            "reported; pick it (--pick) to see what the record says of it", f,
+            f"same in both halves of the record, but {_why_not_reported(rise_bic)}; {_what_to_do(in_diagram)}", f,
         ))  # fmt: skip
     for start, went in count.carried_away:
         notes.append(QualityWarning(

@@ -603,6 +603,50 @@ def test_the_likelihood_ratio_flag_needs_a_significant_ratio_a_decisive_bic_and_
     assert bool(got) == wanted
     if wanted:
         assert got[0] == 9.6 and np.isclose(got[1], ratio) and got[2] == 22 and np.isclose(got[3], -gain)
+        assert got[4] is True  # an admissible addition is a stable column of the diagram: it can be picked
+
+
+@pytest.mark.parametrize("merged", [False, True])
+def test_a_split_of_a_mode_the_search_did_not_split_is_tried_for_the_likelihood(supine, supine_ride, merged):
+    """The search splits only the mode nearest the residual's peak; afterwards every reported mode
+    is split once. With the exact four modes no split is wanted (a chance ratio); with the third
+    and fourth (13.5 and 16.2 Hz, damping 0.30 and 0.27) fitted as one, the split that restores them
+    is, with its new pole at one of the two and the same in both halves."""
+    from scipy.special import chdtrc
+
+    from armaxmodal.modes.mode_count import LIKELIHOOD_ALPHA, _Search, _split_wanted
+    from armaxmodal.modes.spread import split_segments
+
+    data, truth = supine
+    f, x = truth.freq_hz.copy(), truth.damping.copy()
+    if merged:
+        f, x = np.r_[f[:2], np.sqrt(f[2] * f[3])], np.r_[x[:2], (x[2] + x[3]) / 2]
+    current = fit_modal_model(data, f, x, "zoh", max_nfev=200)
+    search = _Search(data, "zoh", data.n_real * data.y.shape[1], 40)
+    halves = tuple(DftLines.from_recording(h, data.band_hz).weighted(data.weights)
+                   for h in split_segments(supine_ride, 2))  # fmt: skip
+    got = _split_wanted(search, current, halves, supported=lambda f, x: False)
+    if not merged:
+        assert got == ()
+        return
+    new_hz, ratio, dof, _, in_diagram = got
+    assert in_diagram is False  # the diagram (here: no column anywhere) cannot be picked from
+    assert np.min(np.abs(truth.freq_hz[2:] / new_hz - 1)) < FREQ_TOL, got
+    assert dof == 2 + 4 * data.y.shape[1] and chdtrc(dof, ratio) < LIKELIHOOD_ALPHA
+
+
+@pytest.mark.parametrize(
+    ("rise", "in_diagram", "said"),
+    [(36.5, True, ("rises by 36.5", "--pick")), (-4.0, False, ("falls by 4.0", "no stable column there to pick"))],
+)
+def test_a_wanted_mode_is_said_with_why_it_is_not_reported(rise, in_diagram, said):
+    """A wanted split may lower the criterion (the search never tried it), and may have no column of
+    the diagram a pick could take: the note says which, and what the user can do."""
+    count = replace(_count([50.0, 60.0], -40.0), wanted=(14.5, 191.0, 22, rise, in_diagram))
+    notes = [n for n in _notes(count, np.array([True, False]), (1.0, 25.0)) if n.code == "count_undecided"]
+    assert len(notes) == 1 and notes[0].value == 14.5, notes
+    assert all(s in notes[0].message for s in said), notes[0].message
+    assert ("--pick" in notes[0].message) == in_diagram
 
 
 def test_a_counted_mode_no_cluster_holds_takes_none_of_its_neighbours_facts():
@@ -618,3 +662,60 @@ def test_a_counted_mode_no_cluster_holds_takes_none_of_its_neighbours_facts():
     assert (held["count"], held["energy"], held["freq_sd_armax"]) == (12, 0.3, 0.04)
     assert new["count"] == 0 and np.isnan(new["energy"])
     assert (new["freq_sd_armax"], new["damping_sd_armax"]) == (count.model.freq_sd[1], count.model.damping_sd[1])
+
+
+def test_a_close_pair_reported_as_one_leaves_the_count_undecided_where_the_record_holds_the_second():
+    """A five-segment body of the count battery (seed 424242, #11; exact modes 7.41, 9.22, 14.28,
+    15.40 and 26.05 Hz) on a ride drawn as the battery draws it. The 14.28 and 15.40 Hz modes come
+    out as one near 15.4 Hz, which no judge can fault (within three bounds of each other), but the
+    merged pair pulls the mode above the band, and the search, which splits only the mode nearest
+    the residual's peak, never tries their split: the verdict was ``good``. The split tried after
+    the search names the hidden mode."""
+    from scipy import signal
+
+    body = am.Structure.from_chain(
+        [5.907, 18.835, 26.467, 14.552, 1.9635], [33128.0, 21155.3, 113123.5, 906.86, 17642.9],
+        [306.73, 610.61, 1228.92, 130.24, 54.46], [17992.0, 38317.4, 36724.0, 31903.6],
+        [33.14, 52.95, 323.34, 92.39], ("head", "chest", "pelvis", "legs", "feet"),
+    )  # fmt: skip
+    truth = body.modes().freq_hz
+    rng = np.random.default_rng(2)
+    b, a = signal.butter(4, [0.5 / 30.0, 24.0 / 30.0], btype="band")
+    ride = signal.filtfilt(b, a, rng.standard_normal(7200))
+    rec = am.simulate_recording(body, ride / ride.std(), 60.0, noise=0.03, seed=3)
+    selection = am.select_modes(am.stabilisation_diagram(rec))
+    found = selection.modes.freq_hz.to_numpy()
+    paired = [f for f in found if 0.9 * truth[2] < f < 1.1 * truth[3]]
+    assert len(paired) == 1, found  # the premise: the pair reported as one
+    assert selection.quality == "uncertain"
+    named = [w.value for w in selection.warnings if w.code == "count_undecided" and "likelihood ratio" in w.message]
+    assert len(named) == 1 and abs(named[0] / truth[2] - 1) < 0.05, named
+
+
+@pytest.mark.parametrize("best_resolved", [True, False])
+def test_the_split_of_lowest_criterion_is_the_one_judged(best_resolved):
+    """Of the reported modes' splits, the one of lowest criterion is converged and judged; one
+    whose damping the record does not resolve is no mode, and no other split stands in for it."""
+    from armaxmodal.modes.mode_count import _split_wanted
+
+    n_eff = 1e5
+    current = SimpleNamespace(n_params=44, freq_hz=np.array([6.0, 15.0]), damping=np.array([0.2, 0.3]),
+                              neg2_loglik_on=lambda n: 1000.0)  # fmt: skip
+
+    def split(at, ratio):
+        f = np.sort(np.r_[current.freq_hz, at])
+        return SimpleNamespace(n_params=66, freq_hz=f, damping=np.full(3, 0.25),
+                               neg2_loglik_on=lambda n: 1000.0 - ratio)  # fmt: skip
+
+    low, high = split(14.0, 200.0), split(5.0, 80.0)  # both beyond the 1e-6 quantile of 22 (68.9)
+    bic = {id(m): m.neg2_loglik_on(n_eff) + m.n_params * np.log(n_eff) for m in (current, low, high)}
+    search = SimpleNamespace(
+        n_eff=n_eff, bic=lambda m: bic[id(m)], physical=lambda m: np.ones(m.freq_hz.size, dtype=bool),
+        screened=lambda starts: [high, low], fit=lambda f, x, nfev: low if f[1] == 14.0 else high,
+        resolved=lambda m: best_resolved or m is not low, in_both_halves=lambda m, new, halves: True,
+    )  # fmt: skip
+    got = _split_wanted(search, current, ("first half", "second half"))
+    if best_resolved:
+        assert got[0] == 14.0 and np.isclose(got[1], 200.0), got
+    else:
+        assert got == ()
