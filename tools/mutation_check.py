@@ -903,8 +903,8 @@ MUTANTS = [
     #   --match "(split-wanted)" --tests tests/modes/test_mode_count.py)
     (
         "armaxmodal/modes/mode_count.py",
-        "        wanted = _split_wanted(search, current, halves, supported)\n",
-        "        pass\n",
+        "        wanted, split = _split_wanted(search, current, halves, supported)\n",
+        "        wanted, split = (), None\n",
         "no split tried after the search (split-wanted)",
     ),
     (
@@ -915,8 +915,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/mode_count.py",
-        "    if not search.resolved(model):\n        return ()\n    new = _new_poles",
-        "    new = _new_poles",
+        "if not search.resolved(model) or not new:",
+        "if not new:",
         "a split with its damping unresolved (split-wanted)",
     ),
     (
@@ -943,6 +943,18 @@ MUTANTS = [
         "    if in_diagram:\n",
         "    if True:\n",
         "--pick suggested where the diagram has nothing to pick (split-wanted)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "alternatives += ((wanted[3], split),)",
+        "pass",
+        "a split as good as the chosen model not among the equally good (split-wanted)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "if wanted and abs(wanted[3]) < DECISIVE_BIC:",
+        "if wanted:",
+        "a split BIC decides against among the equally good (split-wanted)",
     ),
 ]
 DEFAULT_TESTS = [

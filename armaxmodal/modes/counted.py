@@ -5,7 +5,7 @@ Poles the model needs but that are no modes of the band -- above the fitted band
 for the modes above it, an upper residual), damped beyond ``armaxmodal.stats.MAX_DAMPING``,
 or lines at the damping floor -- stay in the model and are not reported.
 
-One module of about 490 lines on purpose: each rule here turns the count into rows and notes
+One module of about 520 lines on purpose: each rule here turns the count into rows and notes
 of the one working selection, and they run in the order ``counted_modes`` states.
 """
 

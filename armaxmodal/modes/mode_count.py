@@ -26,7 +26,7 @@ lines are independent from the residual's own correlation across lines (Bartlett
 effective sample size of a correlated sequence), and both the likelihood and the penalty use
 that number. On a simulated record with white noise it is 1 and the criterion is plain BIC.
 
-One module of about 550 lines on purpose: the search's parts (candidates, margins, the
+One module of about 620 lines on purpose: the search's parts (candidates, margins, the
 check of unfounded poles, the equally good models, the likelihood's flag) all read and advance
 one ``_Search`` state, under the rules these notes state once.
 """
@@ -489,8 +489,9 @@ def _likelihood_wants(search: _Search, current: ModalModel, model: ModalModel, n
     return (new_hz, float(ratio), int(dof), float(-gain), bool(in_diagram))
 
 
-def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) -> tuple:
-    """A split the likelihood wants (:attr:`ModeCount.wanted`), or ``()``: every reported mode split
+def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) -> tuple[tuple, ModalModel | None]:
+    """A split the likelihood wants (:attr:`ModeCount.wanted`; ``()`` if none) and its converged
+    model (None if no split converged with its damping resolved): every reported mode split
     in two, the split of lowest criterion converged and judged as :func:`_wanted` judges an
     addition, with its damping resolved. The search splits only the mode nearest the residual's
     peak, and a split is not asked to be stable across the diagram's orders: two modes closer than
@@ -500,21 +501,19 @@ def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) 
     24.77 Hz, damping 0.31 for 0.25, with quality good)."""
     shown = np.flatnonzero(search.physical(current))
     if len(halves) != 2 or shown.size == 0:
-        return ()
+        return (), None
     screened = [fit for fit in search.screened([_split_start(current, m) for m in shown]) if fit is not None]
     if not screened:
-        return ()
+        return (), None
     best = min(screened, key=search.bic)
     model = search.fit(best.freq_hz, best.damping, FINAL_NFEV)
-    if not search.resolved(model):
-        return ()
-    new = _new_poles(current.freq_hz, model.freq_hz)
-    if not new:
-        return ()
+    new = _new_poles(current.freq_hz, model.freq_hz) if model is not None else []
+    if not search.resolved(model) or not new:
+        return (), None
     gain = search.bic(current) - search.bic(model)
     f, x = float(model.freq_hz[new[0]]), float(model.damping[new[0]])
     in_diagram = supported is not None and bool(supported(f, x))
-    return _likelihood_wants(search, current, model, f, gain, halves, in_diagram)
+    return _likelihood_wants(search, current, model, f, gain, halves, in_diagram), model
 
 
 @single_blas_thread
@@ -618,6 +617,8 @@ def count_modes(
     alternatives = _equally_good(search, current, rise, close)
     wanted = _wanted(search, current, best_addition, gain, new_hz, halves) if searching else ()
     if searching and not wanted and close is None:  # one mode more is already undecided: said once
-        wanted = _split_wanted(search, current, halves, supported)
+        wanted, split = _split_wanted(search, current, halves, supported)
+        if wanted and abs(wanted[3]) < DECISIVE_BIC:  # as good as the chosen model: its modes are the record's too
+            alternatives += ((wanted[3], split),)
     return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
                      tuple(unconfirmed), alternatives, carried_away, wanted, stand_ins)  # fmt: skip

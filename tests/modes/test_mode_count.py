@@ -625,7 +625,7 @@ def test_a_split_of_a_mode_the_search_did_not_split_is_tried_for_the_likelihood(
     search = _Search(data, "zoh", data.n_real * data.y.shape[1], 40)
     halves = tuple(DftLines.from_recording(h, data.band_hz).weighted(data.weights)
                    for h in split_segments(supine_ride, 2))  # fmt: skip
-    got = _split_wanted(search, current, halves, supported=lambda f, x: False)
+    got, _ = _split_wanted(search, current, halves, supported=lambda f, x: False)
     if not merged:
         assert got == ()
         return
@@ -690,6 +690,16 @@ def test_a_close_pair_reported_as_one_leaves_the_count_undecided_where_the_recor
     assert selection.quality == "uncertain"
     named = [w.value for w in selection.warnings if w.code == "count_undecided" and "likelihood ratio" in w.message]
     assert len(named) == 1 and abs(named[0] / truth[2] - 1) < 0.05, named
+    # with the split the criterion falls by less than the decisive 10 on this record: the five-mode
+    # model is as good, and every interval covers it; each then holds its exact mode (the merged
+    # one the upper of the pair), the mode above the band's top included, in frequency and damping
+    exact = body.modes()
+    m = selection.modes
+    assert m.structure_widened.all()
+    for _, row in m.iterrows():
+        k = int(np.argmin(np.abs(np.log(truth / row.freq_hz))))
+        assert row.freq_ci95_lo <= truth[k] <= row.freq_ci95_hi, (row.freq_hz, truth[k])
+        assert row.damping_ci95_lo <= exact.damping[k] <= row.damping_ci95_hi, (row.damping, exact.damping[k])
 
 
 @pytest.mark.parametrize("best_resolved", [True, False])
@@ -714,8 +724,23 @@ def test_the_split_of_lowest_criterion_is_the_one_judged(best_resolved):
         screened=lambda starts: [high, low], fit=lambda f, x, nfev: low if f[1] == 14.0 else high,
         resolved=lambda m: best_resolved or m is not low, in_both_halves=lambda m, new, halves: True,
     )  # fmt: skip
-    got = _split_wanted(search, current, ("first half", "second half"))
+    got, model = _split_wanted(search, current, ("first half", "second half"))
     if best_resolved:
-        assert got[0] == 14.0 and np.isclose(got[1], 200.0), got
+        assert got[0] == 14.0 and np.isclose(got[1], 200.0) and model is low, got
     else:
-        assert got == ()
+        assert got == () and model is None
+
+
+@pytest.mark.parametrize(("rise", "joins"), [(-2.9, True), (6.0, True), (40.0, False), (-40.0, False)])
+def test_a_wanted_split_as_good_as_the_chosen_model_is_one_of_the_equally_good(monkeypatch, supine, rise, joins):
+    """A wanted split whose criterion stays within the decisive 10 of the chosen model's is a model
+    the record cannot tell from it: the intervals cover its modes. Beyond that, either way, it is
+    not (a decisive rise is BIC's verdict; a decisive fall the search would have taken had it tried)."""
+    import armaxmodal.modes.mode_count as mode_count
+
+    data, truth = supine
+    split = fit_modal_model(data, truth.freq_hz, truth.damping, "zoh", max_nfev=1)
+    monkeypatch.setattr(mode_count, "_split_wanted", lambda *a, **k: ((14.0, 200.0, 22, rise, False), split))
+    count = count_modes(data, truth.freq_hz, truth.damping, hold="zoh")
+    assert count.wanted == (14.0, 200.0, 22, rise, False)
+    assert any(m is split for _, m in count.alternatives) == joins
