@@ -43,6 +43,11 @@ SLOWEST_FS = 1.0
 
 #: rows missing from a CSV's time column bridged by interpolation; a longer gap is an error
 MAX_BRIDGED_SAMPLES = 3
+#: what a bridged gap means for the result, said with every ``dropped_packet`` note: the bridged
+#: samples are wrong in every channel at one instant and the fit takes them as data (two rows of a
+#: 120 s ride put a mode outside its interval and hid another), so the verdict is ``uncertain``
+BRIDGED = ("bridged by linear interpolation. The bridged samples enter the fit as data and can move modes, so the "
+           "verdict is at most uncertain; cut the record at the gap for a clean fit.")
 
 
 def is_number(text: str) -> bool:
@@ -104,7 +109,7 @@ def bridge_dropped_rows(t: np.ndarray, channels: dict, path: Path, fill_gaps_s: 
             "dropped_packet",
             tuple(channels),
             f"{n} sample(s) missing at {t[i] - t[0]:.3f} s (the time column steps {steps[i]:.6g} s there, "
-            f"{n + 1} samples); bridged by linear interpolation.",
+            f"{n + 1} samples); {BRIDGED}",
             float(n),
         )
         for i, n in gaps

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.exceptions import DataError
-from armaxmodal.io.time_axis import whole_step_gaps
+from armaxmodal.io.time_axis import BRIDGED, whole_step_gaps
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
@@ -91,7 +91,7 @@ def read_xsens(
             QualityWarning(
                 "dropped_packet",
                 (name,),
-                f"'{name}' lost {n} packet(s) at {t:.3f} s; bridged by linear interpolation.",
+                f"'{name}' lost {n} packet(s) at {t:.3f} s; {BRIDGED}",
                 float(n),
             )
             for n, t in gaps
