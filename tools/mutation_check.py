@@ -956,6 +956,15 @@ MUTANTS = [
         "if wanted:",
         "a split BIC decides against among the equally good (split-wanted)",
     ),
+    # a dropped packet is a fault that moves modes (run with
+    #   --match "(dropped)" --tests tests/modes/test_mode_count.py tests/base/test_quality_warnings.py)
+    (
+        "armaxmodal/quality_warnings.py",
+        "Cut the record at the gap and analyse the longer piece, or bridge longer gaps with `--fill-gaps SECONDS`.\",\n"
+        "        uncertain=True,",
+        "Cut the record at the gap and analyse the longer piece, or bridge longer gaps with `--fill-gaps SECONDS`.\",",
+        "a dropped packet leaves the verdict good (dropped)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/estimate/test_guards.py",
