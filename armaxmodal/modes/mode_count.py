@@ -496,8 +496,8 @@ def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) 
     addition, with its damping resolved. The search splits only the mode nearest the residual's
     peak, and a split is not asked to be stable across the diagram's orders: two modes closer than
     the ARMAX fits resolve stand as one column there (a body's 14.28 and 15.40 Hz modes came out as
-    one at 15.45 Hz; split, the likelihood ratio was 191 for 22 parameters, the new pole the same in
-    both halves, while BIC rose by 36, and the merged pair had pulled the 26.05 Hz mode above to
+    one at 15.45 Hz; split, the likelihood ratio was 187 for 22 parameters, the new pole the same in
+    both halves, while BIC rose by 40, and the merged pair had pulled the 26.05 Hz mode above to
     24.77 Hz, damping 0.31 for 0.25, with quality good)."""
     shown = np.flatnonzero(search.physical(current))
     if len(halves) != 2 or shown.size == 0:
