@@ -881,7 +881,7 @@ MUTANTS = [
     ),
     (
         "armaxmodal/prepare/quality.py",
-        "own = np.sum(pyy * coh, axis=0) / np.maximum(np.sum(pyy, axis=0), 1e-300)",
+        "own = _power_weighted(pyy, coh)",
         "own = levels",
         "the output's own spectrum not weighted (coherent)",
     ),

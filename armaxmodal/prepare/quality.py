@@ -16,8 +16,8 @@ recording:
 * ``stuck_samples`` -- a run of equal samples elsewhere, longer than the channel's own rate
   of repeated samples makes likely: a sensor or a recorder that stopped updating.
 * ``incoherent_output`` -- an output whose coherence with the input, averaged over the
-  input's spectrum and over its own, is below ``INCOHERENT``: it is not a response to this input (a wrong
-  column, a dead sensor, a second excitation), and its poles are not the structure's. A
+  input's spectrum and over its own, is below ``INCOHERENT``: it is not a response to this
+  input (a wrong column, a dead sensor, a second excitation), and its poles are not the structure's. A
   record of pure noise once gave two "modes" with intervals and no warning.
 * ``unit_mismatch`` -- an output in other units than the rest, or every output in other
   units than the input (:mod:`armaxmodal.prepare.units`).
@@ -45,9 +45,9 @@ __all__ = [
 ]  # fmt: skip
 
 #: An output less coherent with the input than this (averaged over the input's spectrum, and
-#: over the output's own) is not its response: response sensors read 0.63-1.00 on the measured records (the F-16, the
-#: shake-table IMUs' Northridge and sine rides) and 0.68-1.00 on the fixtures; independent
-#: noise about 0.07 (the estimate's bias with 15 segments).
+#: over the output's own) is not its response: response sensors read 0.63-1.00 on the measured
+#: records (the F-16, the shake-table IMUs' Northridge and sine rides) and 0.68-1.00 on the
+#: fixtures; independent noise about 0.07 (the estimate's bias with 15 segments).
 INCOHERENT = 0.3
 
 #: |correlation| above 1 - this is a copy: two physical sensors never agree this well
@@ -87,8 +87,11 @@ def input_coherence(u: np.ndarray, y: np.ndarray, fs: float) -> np.ndarray:
     return _power_weighted(puu, coherence(puu, puy, pyy))
 
 
-def _power_weighted(puu: np.ndarray, coh: np.ndarray) -> np.ndarray:
-    return puu @ coh / max(float(puu.sum()), 1e-300)
+def _power_weighted(power: np.ndarray, coh: np.ndarray) -> np.ndarray:
+    """Each output's coherence averaged with ``power`` as weight: one spectrum for every output
+    (the input's, (n_freq,)) or one per output (their own, (n_freq, K)); (K,)."""
+    w = power if power.ndim == coh.ndim else power[:, None]
+    return np.sum(w * coh, axis=0) / np.maximum(np.sum(w, axis=0), 1e-300)
 
 
 def incoherent_outputs(recording: Recording) -> list[QualityWarning]:
@@ -103,7 +106,7 @@ def incoherent_outputs(recording: Recording) -> list[QualityWarning]:
     _, puu, puy, pyy = recording.welch(welch_nperseg(recording.n_samples, recording.fs))  # the record's own
     coh = coherence(puu, puy, pyy)
     levels = _power_weighted(puu, coh)
-    own = np.sum(pyy * coh, axis=0) / np.maximum(np.sum(pyy, axis=0), 1e-300)
+    own = _power_weighted(pyy, coh)
     low = [(name, float(c)) for name, c, o in zip(recording.sensors, levels, own, strict=True)
            if c < INCOHERENT and o < INCOHERENT]  # fmt: skip
     if not low:
