@@ -946,13 +946,13 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/mode_count.py",
-        "alternatives += ((wanted[3], split),)",
+        "alternatives += ((wanted.rise, split),)",
         "pass",
         "a split as good as the chosen model not among the equally good (split-wanted)",
     ),
     (
         "armaxmodal/modes/mode_count.py",
-        "if wanted and abs(wanted[3]) < DECISIVE_BIC:",
+        "if wanted and abs(wanted.rise) < DECISIVE_BIC:",
         "if wanted:",
         "a split BIC decides against among the equally good (split-wanted)",
     ),

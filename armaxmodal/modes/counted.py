@@ -469,7 +469,7 @@ def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
             f"{-count.best_addition:+.1f}, less than {DECISIVE_BIC:g} either way", f,
         ))  # fmt: skip
     if count.wanted:
-        f, ratio, dof, rise_bic, in_diagram = count.wanted
+        f, ratio, dof, rise_bic, in_diagram = count.wanted  # a Wanted
         notes.append(QualityWarning(
             "count_undecided", (),
             f"the record may hold one mode more near {f:.3f} Hz: adding it raises the likelihood far beyond chance "

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from scipy.special import chdtrc
@@ -47,6 +48,7 @@ __all__ = [
     "DECISIVE_BIC",
     "LIKELIHOOD_ALPHA",
     "ModeCount",
+    "Wanted",
     "Step",
     "agree_in_halves",
     "count_modes",
@@ -105,6 +107,16 @@ class Step:
     settled_hz: float = float("nan")
 
 
+class Wanted(NamedTuple):
+    """One mode more the likelihood wants and the criterion refuses (:attr:`ModeCount.wanted`)."""
+
+    freq_hz: float  #: where its new pole settled (Hz)
+    ratio: float  #: likelihood ratio over the chosen model, on the effective lines
+    dof: int  #: the parameters one mode adds
+    rise: float  #: the criterion's rise with it (negative: a fall)
+    in_diagram: bool  #: the diagram holds a stable column there to pick
+
+
 @dataclass(frozen=True)
 class ModeCount:
     """The modal model the nested tests chose, with the evidence.
@@ -139,13 +151,11 @@ class ModeCount:
     carried_away : tuple of (float, float)
         Starting modes the search carried to where no mode is founded, and which were left out
         of the chosen model: (start Hz, where it went Hz). See ``_without_unfounded``.
-    wanted : tuple of (float, float, int, float, bool)
+    wanted : Wanted or ()
         The best addition BIC refuses decisively while its likelihood ratio is significant
         (beyond ``LIKELIHOOD_ALPHA``) and its mode is the same in both halves, or else the best
         split of a reported mode that passes the same test (its criterion's change either way:
-        the search splits only one mode): (new pole Hz, likelihood ratio, its parameters, the
-        criterion's rise, negative for a fall, whether the diagram holds a stable column there
-        to pick). Empty: none.
+        the search splits only one mode). Empty: none.
     stand_ins : tuple of (float, float, float)
         Starting modes the search carried to where no mode is founded but which the model needs
         (the criterion rises decisively without them): kept in the model, not reported, as
@@ -163,7 +173,7 @@ class ModeCount:
     unconfirmed_hz: tuple[float, ...] = ()
     alternatives: tuple[tuple[float, ModalModel], ...] = ()
     carried_away: tuple[tuple[float, float], ...] = ()
-    wanted: tuple = ()
+    wanted: Wanted | tuple = ()
     stand_ins: tuple[tuple[float, float, float], ...] = ()
 
     def reported(self, band_hz) -> np.ndarray:
@@ -478,7 +488,7 @@ def _wanted(search: _Search, current: ModalModel, addition, gain: float, new_hz:
 
 def _likelihood_wants(search: _Search, current: ModalModel, model: ModalModel, new_hz: float, gain: float,
                       halves, in_diagram: bool) -> tuple:  # fmt: skip
-    """``(new_hz, ratio, dof, rise, in_diagram)`` when ``model``'s likelihood ratio over ``current`` is beyond
+    """A :class:`Wanted` when ``model``'s likelihood ratio over ``current`` is beyond
     :data:`LIKELIHOOD_ALPHA` and its new poles are the same in both halves, else ``()``."""
     dof = model.n_params - current.n_params
     ratio = current.neg2_loglik_on(search.n_eff) - model.neg2_loglik_on(search.n_eff)
@@ -486,7 +496,7 @@ def _likelihood_wants(search: _Search, current: ModalModel, model: ModalModel, n
         return ()
     if not search.in_both_halves(model, _new_poles(current.freq_hz, model.freq_hz), halves):
         return ()
-    return (new_hz, float(ratio), int(dof), float(-gain), bool(in_diagram))
+    return Wanted(new_hz, float(ratio), int(dof), float(-gain), bool(in_diagram))
 
 
 def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) -> tuple[tuple, ModalModel | None]:
@@ -618,7 +628,7 @@ def count_modes(
     wanted = _wanted(search, current, best_addition, gain, new_hz, halves) if searching else ()
     if searching and not wanted and close is None:  # one mode more is already undecided: said once
         wanted, split = _split_wanted(search, current, halves, supported)
-        if wanted and abs(wanted[3]) < DECISIVE_BIC:  # as good as the chosen model: its modes are the record's too
-            alternatives += ((wanted[3], split),)
+        if wanted and abs(wanted.rise) < DECISIVE_BIC:  # as good as the chosen model: its modes are the record's too
+            alternatives += ((wanted.rise, split),)
     return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
                      tuple(unconfirmed), alternatives, carried_away, wanted, stand_ins)  # fmt: skip

@@ -762,7 +762,8 @@ def test_a_wanted_split_as_good_as_the_chosen_model_is_one_of_the_equally_good(m
 
     data, truth = supine
     split = fit_modal_model(data, truth.freq_hz, truth.damping, "zoh", max_nfev=1)
-    monkeypatch.setattr(mode_count, "_split_wanted", lambda *a, **k: ((14.0, 200.0, 22, rise, False), split))
+    wanted = mode_count.Wanted(14.0, 200.0, 22, rise, False)
+    monkeypatch.setattr(mode_count, "_split_wanted", lambda *a, **k: (wanted, split))
     count = count_modes(data, truth.freq_hz, truth.damping, hold="zoh")
     assert count.wanted == (14.0, 200.0, 22, rise, False)
     assert any(m is split for _, m in count.alternatives) == joins
