@@ -310,6 +310,17 @@ CODES: tuple[WarningCode, ...] = (
         uncertain=True,
     ),
     WarningCode(
+        "estimators_disagree", "selection",
+        "the modal model's frequencies and damping ratios against the diagram's fit of the same modes (the ARMAX fit, "
+        "or its band-limited refit): the sum of their squared standardised differences beyond its χ² 1 % point "
+        "(Hausman's specification test; the F-16's multisine levels: 30–59 for 12 values, the point 26.2)",
+        "every mode's 95 % interval covers both estimators' (`interval_covers_other_estimator` where that widens it): "
+        "the record holds model error (a nonlinearity, the inter-sample behaviour, leakage) that the two weight "
+        "differently, and one record cannot say which is right",
+        "Nothing if a structure like this is expected to be mildly nonlinear; otherwise run `diagnose` to find the "
+        "effect, and compare a record at another excitation level.",
+    ),
+    WarningCode(
         "pick_not_supported", "selection (picks)",
         "without a picked mode (the others refitted free), BIC changes by less than 10: the record does not need it",
         "`\"quality\": \"uncertain\"`: the pick is tentative; pick another column of the diagram, or let the selection"

@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
+from armaxmodal.modes.estimators import EARLIER_COLUMNS, covering_both_estimators, earlier_estimate
 from armaxmodal.modes.intervals import with_intervals
 from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.modal_model import DftLines, fit_modal_model
@@ -148,10 +149,11 @@ def counted_modes(
         return work.warned(_no_mode_kept(count, modes, data.band_hz), count=count)
     rows = pd.DataFrame([_row(modes, count, i, hold) for i in np.flatnonzero(keep)])
     rows, shapes, merged = _one_where_not_separated(rows, count.model.shapes[:, keep], count, keep, rec, band_hz, hold)
+    rows, disagree = covering_both_estimators(rows)
     # where two poles are reported as one, the check fits the model's poles, not the row's
     poles = tuple(zip(count.model.freq_hz[keep].tolist(), count.model.damping[keep].tolist(), strict=True))
     work = work.with_modes(rows, shapes, count=count, check_poles=poles if merged else None)
-    return work.warned(*_notes(count, keep, data.band_hz), *merged)
+    return work.warned(*_notes(count, keep, data.band_hz), *merged, *disagree)
 
 
 def not_separated(modes: pd.DataFrame) -> list[tuple[int, int, float]]:
@@ -328,8 +330,9 @@ def _picked_result(work: WorkingSelection, count: ModeCount, keep: np.ndarray, h
             float(len(others)),
         ))  # fmt: skip
     order = np.argsort([r["freq_hz"] for r in rows])
-    work = work.with_modes(pd.DataFrame([rows[k] for k in order]), np.column_stack([shapes[k] for k in order]),
-                           count=count)  # fmt: skip
+    rows, disagree = covering_both_estimators(pd.DataFrame([rows[k] for k in order]))
+    notes += disagree
+    work = work.with_modes(rows, np.column_stack([shapes[k] for k in order]), count=count)
     if recording is not None:  # the check of the model the picks come from: the picks and the others
         f = np.r_[work.modes.freq_hz.to_numpy(), m.freq_hz[others]]
         x = np.r_[work.modes.damping.to_numpy(), m.damping[others]]
@@ -358,12 +361,14 @@ def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str) -> dict:
     dist = np.abs(modes.freq_hz.to_numpy() / f - 1)
     j = int(np.argmin(dist))
     row = modes.iloc[j].to_dict()
+    row.update(earlier_estimate(row))  # the selection's estimate, for covering_both_estimators
     if dist[j] > SAME_ROW_FREQ:  # a mode the diagram's clusters did not hold
         # nor an ARMAX estimate: the segments' spread is judged against the modal model's own
         # deviation (as a mode the completeness test adds), not the neighbouring row's
         row.update(count=0, support=0.0, freq_spread=np.nan, damping_spread=np.nan, medoid_freq_hz=np.nan,
                    medoid_damping=np.nan, orders_damping_unresolved=0, energy=np.nan,
-                   freq_sd_armax=m.freq_sd[i], damping_sd_armax=m.damping_sd[i])  # fmt: skip
+                   freq_sd_armax=m.freq_sd[i], damping_sd_armax=m.damping_sd[i],
+                   **dict.fromkeys(EARLIER_COLUMNS, np.nan))  # fmt: skip
     other, widened = _other_structures(count, i)
     row.update(
         freq_hz=f, damping=x, damped_freq_hz=f * np.sqrt(1 - x**2), freq_sd=m.freq_sd[i], damping_sd=m.damping_sd[i],

@@ -9,11 +9,14 @@ Each quantity ``q`` (``freq`` for ``freq_hz``, ``damping``) of a selection row h
     the reach of the same mode's 95 % intervals in the other model structures the record finds
     as good (:mod:`armaxmodal.modes.counted`: another number of modes, two poles reported as one);
     NaN where there are none;
+``{q}_estimator_lo``, ``{q}_estimator_hi``
+    the reach of the earlier estimator's 95 % interval (the diagram's fit) where the record shows
+    the two estimators disagree (:mod:`armaxmodal.modes.estimators`); NaN elsewhere;
 ``{q}_segment_half``
     the half-width of the disjoint segments' interval where their spread exceeds the statistical
     one (:mod:`armaxmodal.modes.spread`); NaN where it does not.
 
-The interval is the hull of ``value ± Z95 sd`` and the other two, scaled about the value by the
+The interval is the hull of ``value ± Z95 sd`` and the other three, scaled about the value by the
 share of the record's samples that carry information (filled samples do not). Each stage sets its
 own part and leaves the others', so no stage has to undo or re-derive another's widening.
 """
@@ -42,8 +45,8 @@ def with_intervals(modes: pd.DataFrame, scale: float = 1.0) -> pd.DataFrame:
     Parameters
     ----------
     modes : DataFrame
-        Selection rows: ``freq_hz``, ``damping``, ``freq_sd`` and ``damping_sd``; the ``other``
-        and ``segment_half`` columns where a stage set them (absent: none).
+        Selection rows: ``freq_hz``, ``damping``, ``freq_sd`` and ``damping_sd``; the ``other``,
+        ``estimator`` and ``segment_half`` columns where a stage set them (absent: none).
     scale : float
         Factor every interval is widened by about its value (at least 1; 1 leaves them).
 
@@ -52,16 +55,17 @@ def with_intervals(modes: pd.DataFrame, scale: float = 1.0) -> pd.DataFrame:
     DataFrame
         A copy with ``freq_ci95_lo``, ``freq_ci95_hi``, ``damping_ci95_lo`` and ``damping_ci95_hi``.
         A NaN standard deviation gives a NaN interval unless the segments' part gives one: the
-        other structures' intervals are not this estimate's.
+        other structures' and estimators' intervals are not this estimate's.
     """
     out = modes.copy()
     for q, value in QUANTITIES:
         v = out[value].to_numpy(float)
         sd = out[f"{q}_sd"].to_numpy(float)
         lo, hi = v - Z95 * sd, v + Z95 * sd
-        other_lo, other_hi = _part(out, f"{q}_other_lo"), _part(out, f"{q}_other_hi")
-        lo = np.where(np.isnan(other_lo), lo, np.minimum(lo, other_lo))
-        hi = np.where(np.isnan(other_hi), hi, np.maximum(hi, other_hi))
+        for reach in ("other", "estimator"):
+            reach_lo, reach_hi = _part(out, f"{q}_{reach}_lo"), _part(out, f"{q}_{reach}_hi")
+            lo = np.where(np.isnan(reach_lo), lo, np.minimum(lo, reach_lo))
+            hi = np.where(np.isnan(reach_hi), hi, np.maximum(hi, reach_hi))
         half = _part(out, f"{q}_segment_half")
         lo = np.where(np.isnan(half), lo, np.fmin(v - half, lo))
         hi = np.where(np.isnan(half), hi, np.fmax(v + half, hi))
