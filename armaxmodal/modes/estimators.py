@@ -50,7 +50,8 @@ def earlier_estimate(row: dict) -> dict:
     columns = {}
     for q, value in QUANTITIES:
         columns[f"{q}_earlier"] = float(row[value]) if mine else np.nan
-        columns[f"{q}_earlier_sd"] = float(row[f"{q}_sd"]) if mine else np.nan
+        # a row without a deviation (no interval of its own) is not tested: its z is NaN
+        columns[f"{q}_earlier_sd"] = float(row.get(f"{q}_sd", np.nan)) if mine else np.nan
     return columns
 
 

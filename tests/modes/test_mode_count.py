@@ -656,11 +656,16 @@ def test_a_counted_mode_no_cluster_holds_takes_none_of_its_neighbours_facts():
     from armaxmodal.modes.counted import _row
 
     modes = pd.DataFrame({"freq_hz": [5.0], "damping": [0.2], "count": [12], "support": [0.8], "energy": [0.3],
-                          "freq_sd_armax": [0.04], "damping_sd_armax": [0.003]})  # fmt: skip
+                          "freq_sd": [0.04], "damping_sd": [0.003], "freq_sd_armax": [0.04],
+                          "damping_sd_armax": [0.003], "estimator": ["armax"]})  # fmt: skip
     count = _count([50.0, 60.0], -40.0, freq=(5.02, 24.8), damping=(0.2, 0.3))
     held, new = _row(modes, count, 0, "zoh"), _row(modes, count, 1, "zoh")
     assert (held["count"], held["energy"], held["freq_sd_armax"]) == (12, 0.3, 0.04)
-    assert new["count"] == 0 and np.isnan(new["energy"])
+    # the diagram's estimate of the held mode is kept for the estimators' test, the new mode has none
+    assert [held[k] for k in ("freq_earlier", "freq_earlier_sd", "damping_earlier", "damping_earlier_sd")] == [
+        5.0, 0.04, 0.2, 0.003]
+    assert (held["freq_hz"], held["estimator"]) == (5.02, "ml-zoh")
+    assert new["count"] == 0 and np.isnan(new["energy"]) and np.isnan(new["freq_earlier"])
     assert (new["freq_sd_armax"], new["damping_sd_armax"]) == (count.model.freq_sd[1], count.model.damping_sd[1])
 
 

@@ -1,0 +1,98 @@
+"""Two estimators that disagree (armaxmodal.modes.estimators): Hausman's statistic worked out by hand,
+its level, and the intervals that then cover both estimates."""
+
+import numpy as np
+import pandas as pd
+import pytest
+import scipy.stats
+
+from armaxmodal.modes.estimators import covering_both_estimators, earlier_estimate
+from armaxmodal.modes.intervals import with_intervals
+from armaxmodal.stats import Z95
+
+
+def _rows(shift_sd: float, n: int = 3) -> pd.DataFrame:
+    """``n`` modes whose modal-model frequencies lie ``shift_sd`` standard deviations of the
+    difference above the earlier estimate (SDs 0.03 and 0.04 Hz: the difference's is 0.05) and
+    whose damping ratios agree."""
+    f = 5.0 * np.arange(1, n + 1)
+    return pd.DataFrame({
+        "freq_hz": f + 0.05 * shift_sd, "freq_sd": 0.03, "freq_earlier": f, "freq_earlier_sd": 0.04,
+        "damping": 0.02, "damping_sd": 0.001, "damping_earlier": 0.02, "damping_earlier_sd": 0.002,
+    })  # fmt: skip
+
+
+def _shift_for(p: float, n: int = 3) -> float:
+    """The common shift (in SDs) whose statistic ``n z^2`` sits at the chi-squared(2n) point of ``p``."""
+    return float(np.sqrt(scipy.stats.chi2.isf(p, 2 * n) / n))
+
+
+def test_the_statistic_is_the_sum_of_squared_standardised_differences():
+    out, notes = covering_both_estimators(_rows(3.0))  # 3 frequencies at z = 3: 27 for 6 values
+    assert [n.code for n in notes] == ["estimators_disagree"]
+    assert notes[0].value == pytest.approx(27.0, rel=1e-9)
+    assert "27.0 for 6 values" in notes[0].message and "16.8" in notes[0].message  # chi2(6)'s 1 % point
+
+
+def test_the_test_is_at_one_percent():
+    """Between the 1 % and 0.1 % points the intervals widen; between 5 % and 1 % they do not."""
+    widened, notes = covering_both_estimators(_rows(_shift_for(0.005)))
+    assert notes and widened.estimator_widened.all()
+    kept, none = covering_both_estimators(_rows(_shift_for(0.02)))
+    assert not none and not kept.estimator_widened.any()
+    assert kept[["freq_estimator_lo", "freq_estimator_hi", "damping_estimator_lo"]].isna().all().all()
+
+
+def test_where_they_disagree_every_interval_covers_the_earlier_one():
+    out, _ = covering_both_estimators(_rows(3.0))
+    np.testing.assert_allclose(out.freq_estimator_lo, out.freq_earlier - Z95 * 0.04, rtol=1e-12)
+    np.testing.assert_allclose(out.freq_estimator_hi, out.freq_earlier + Z95 * 0.04, rtol=1e-12)
+    ci = with_intervals(out)
+    # the earlier interval reaches lower than the own (f + 0.15 - 1.96 * 0.03): it sets the low end
+    np.testing.assert_allclose(ci.freq_ci95_lo, out.freq_earlier - Z95 * 0.04, rtol=1e-12)
+    np.testing.assert_allclose(ci.freq_ci95_hi, out.freq_hz + Z95 * 0.03, rtol=1e-12)
+    # the damping agrees, but its earlier interval is the wider: it is covered too
+    np.testing.assert_allclose(ci.damping_ci95_lo, 0.02 - Z95 * 0.002, rtol=1e-12)
+    assert out.estimator_widened.all()
+
+
+def test_a_mode_without_an_earlier_estimate_is_neither_tested_nor_widened():
+    rows = _rows(3.0)
+    rows.loc[1, ["freq_earlier", "freq_earlier_sd", "damping_earlier", "damping_earlier_sd"]] = np.nan
+    out, notes = covering_both_estimators(rows)
+    assert notes[0].value == pytest.approx(18.0, rel=1e-9) and "for 4 values" in notes[0].message
+    assert list(out.estimator_widened) == [True, False, True]
+    assert np.isnan(out.freq_estimator_lo[1])
+    alone, none = covering_both_estimators(rows.drop(columns=["freq_earlier", "freq_earlier_sd", "damping_earlier",
+                                                              "damping_earlier_sd"]))  # fmt: skip
+    assert not none and not alone.estimator_widened.any()
+
+
+def test_the_earlier_estimate_is_the_diagrams_not_the_modal_models():
+    row = {"freq_hz": 7.3, "freq_sd": 0.01, "damping": 0.005, "damping_sd": 0.0002, "estimator": "armax"}
+    assert earlier_estimate(row) == {"freq_earlier": 7.3, "freq_earlier_sd": 0.01, "damping_earlier": 0.005,
+                                     "damping_earlier_sd": 0.0002}  # fmt: skip
+    assert np.isnan(list(earlier_estimate({**row, "estimator": "ml-zoh"}).values())).all()
+
+
+@pytest.mark.parametrize("ratio", [0.0, 0.3])
+def test_a_cubic_spring_makes_the_estimators_disagree_and_its_linear_twin_does_not(ratio):
+    """The supine human with a cubic spring between chest and pelvis (its force 0.3 of the linear
+    spring's at the RMS deflection) and without it: only the nonlinear ride's modal model and ARMAX
+    fit disagree beyond their noise (statistic 77 for its three modes), and there every reported
+    interval holds the ARMAX value its mode was counted from."""
+    import armaxmodal as am
+    from armaxmodal.diagnosis.inject import cubic_spring_ride
+
+    ride = cubic_spring_ride(am.supine_human(), am.random_vibration(60.0, 120.0, seed=1), 60.0, (1, 2), ratio, seed=2)
+    selection = am.select_modes(am.stabilisation_diagram(ride, range(4, 13, 2)))
+    notes = [w for w in selection.warnings if w.code == "estimators_disagree"]
+    m = selection.modes
+    if ratio == 0.0:
+        assert not notes and not m.estimator_widened.any()
+        return
+    assert len(notes) == 1 and notes[0].value > scipy.stats.chi2.isf(0.01, 2 * len(m))
+    assert m.estimator_widened.all()
+    assert ((m.freq_ci95_lo <= m.freq_earlier) & (m.freq_earlier <= m.freq_ci95_hi)).all()
+    assert ((m.damping_ci95_lo <= m.damping_earlier) & (m.damping_earlier <= m.damping_ci95_hi)).all()
+    assert all(r["interval_covers_other_estimator"] for r in selection.to_dict()["modes"])
