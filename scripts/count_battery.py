@@ -163,7 +163,8 @@ def main() -> None:
     parser.add_argument("--only", type=int, nargs="*", help="run these cases only (0-based, in the order printed)")
     parser.add_argument("--save", help="pickle each case's (structure, recording) into this folder")
     args = parser.parse_args()
-    tally = {"cases": 0, "right": 0, "wrong_flagged": 0, "right_flagged": 0, "modes": 0, "covered": 0, "widened": 0}
+    tally = {"cases": 0, "right": 0, "wrong_flagged": 0, "right_flagged": 0, "modes": 0, "covered": 0, "widened": 0,
+             "disagree": 0}
     for index, (name, s, fs, top, rng) in enumerate(cases(args)):
         u = ride(rng, fs, top_hz=top)
         rec = am.simulate_recording(s, u, fs, noise=0.03, seed=int(rng.integers(1 << 30)))
@@ -191,6 +192,7 @@ def main() -> None:
         tally["modes"] += len(sel.modes)
         tally["covered"] += covered
         tally["widened"] += widened
+        tally["disagree"] += any(w.code == "estimators_disagree" for w in sel.warnings)
         because = getattr(sel, "uncertain_because", [])  # the verdict's reasons (absent before the ML step)
         print(f"    found {np.round(sel.modes.freq_hz, 2).tolist()} damping {np.round(sel.modes.damping, 3).tolist()}"
               f" quality {sel.quality} {because} | {'right' if ok else 'WRONG: ' + '; '.join(why)}"
@@ -200,6 +202,7 @@ def main() -> None:
           f"uncertain; {tally['right_flagged']} right ones say poor or uncertain")  # fmt: skip
     print(f"{tally['covered']} of {tally['modes']} reported frequency intervals hold the nearest exact mode; "
           f"{tally['widened']} were widened to other equally good counts")  # fmt: skip
+    print(f"{tally['disagree']} of {tally['cases']} rides say their two estimators disagree (estimators_disagree)")
 
 
 def _interval_coverage(truth, sel) -> tuple[int, int]:

@@ -965,6 +965,65 @@ MUTANTS = [
         "Cut the record at the gap and analyse the longer piece, or bridge longer gaps with `--fill-gaps SECONDS`.\",",
         "a dropped packet leaves the verdict good (dropped)",
     ),
+    # two estimators that disagree: the intervals cover both (run with
+    #   --match "(estimators)" --tests tests/modes/test_estimators.py tests/modes/test_mode_count.py
+    #   -k "estimat or no_cluster_holds")
+    ("armaxmodal/modes/estimators.py", "ALPHA = 0.01", "ALPHA = 0.05", "the test at 5 % (estimators)"),
+    ("armaxmodal/modes/estimators.py", "ALPHA = 0.01", "ALPHA = 0.001", "the test at 0.1 % (estimators)"),
+    (
+        "armaxmodal/modes/estimators.py",
+        'z.append(diff / np.hypot(out[f"{q}_sd"].to_numpy(float), out[f"{q}_earlier_sd"].to_numpy(float)))',
+        'z.append(diff / out[f"{q}_sd"].to_numpy(float))',
+        "the earlier estimate's deviation left out of z (estimators)",
+    ),
+    (
+        "armaxmodal/modes/estimators.py",
+        "critical = float(np.sum(z**2)), float(scipy.stats.chi2.isf(ALPHA, z.size))",
+        "critical = float(np.sum(z**2)), float(scipy.stats.chi2.isf(ALPHA, z.size // 2))",
+        "one degree of freedom a mode, not a value (estimators)",
+    ),
+    (
+        "armaxmodal/modes/estimators.py",
+        "lo, hi = earlier - Z95 * sd, earlier + Z95 * sd",
+        "lo, hi = earlier, earlier",
+        "the earlier value covered, not its interval (estimators)",
+    ),
+    (
+        "armaxmodal/modes/estimators.py",
+        "    z = z[np.isfinite(z)]\n",
+        "",
+        "modes without an earlier estimate counted (estimators)",
+    ),
+    (
+        "armaxmodal/modes/estimators.py",
+        "widened |= np.isfinite(lo) & ((lo < v - own) | (hi > v + own))",
+        "widened |= np.isfinite(lo)",
+        "every tested mode said widened (estimators)",
+    ),
+    (
+        "armaxmodal/modes/estimators.py",
+        'mine = not str(row.get("estimator", "")).startswith("ml-")',
+        "mine = True",
+        "the modal model's own row taken as the earlier estimate (estimators)",
+    ),
+    (
+        "armaxmodal/modes/intervals.py",
+        'for reach in ("other", "estimator"):',
+        'for reach in ("other",):',
+        "the estimator part left out of the interval (estimators)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "    row.update(earlier_estimate(row))  # the selection's estimate, for covering_both_estimators\n",
+        "",
+        "the counted rows keep no earlier estimate (estimators)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "    rows, disagree = covering_both_estimators(rows)\n",
+        "    disagree = []\n",
+        "the estimators' test not run on the counted modes (estimators)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/estimate/test_guards.py",

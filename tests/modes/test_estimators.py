@@ -56,6 +56,15 @@ def test_where_they_disagree_every_interval_covers_the_earlier_one():
     assert out.estimator_widened.all()
 
 
+def test_a_mode_whose_earlier_interval_lies_within_its_own_is_not_said_widened():
+    rows = _rows(4.0)
+    rows.loc[0, ["freq_earlier", "freq_earlier_sd", "damping_earlier_sd"]] = [rows.freq_hz[0], 0.01, 0.0005]
+    out, notes = covering_both_estimators(rows)
+    assert notes and list(out.estimator_widened) == [False, True, True]
+    ci = with_intervals(out)
+    assert ci.freq_ci95_lo[0] == pytest.approx(rows.freq_hz[0] - Z95 * 0.03, rel=1e-12)
+
+
 def test_a_mode_without_an_earlier_estimate_is_neither_tested_nor_widened():
     rows = _rows(3.0)
     rows.loc[1, ["freq_earlier", "freq_earlier_sd", "damping_earlier", "damping_earlier_sd"]] = np.nan
