@@ -192,10 +192,12 @@ def main() -> None:
         tally["modes"] += len(sel.modes)
         tally["covered"] += covered
         tally["widened"] += widened
-        tally["disagree"] += any(w.code == "estimators_disagree" for w in sel.warnings)
+        disagree = [w.value for w in sel.warnings if w.code == "estimators_disagree"]
+        tally["disagree"] += bool(disagree)
         because = getattr(sel, "uncertain_because", [])  # the verdict's reasons (absent before the ML step)
         print(f"    found {np.round(sel.modes.freq_hz, 2).tolist()} damping {np.round(sel.modes.damping, 3).tolist()}"
-              f" quality {sel.quality} {because} | {'right' if ok else 'WRONG: ' + '; '.join(why)}"
+              f" quality {sel.quality} {because}{f' estimators disagree ({disagree[0]:.0f})' if disagree else ''}"
+              f" | {'right' if ok else 'WRONG: ' + '; '.join(why)}"
               f" | {cpu:.1f} CPU-s", flush=True)  # fmt: skip
     wrong = tally["cases"] - tally["right"]
     print(f"\n{tally['right']}/{tally['cases']} right; of {wrong} wrong, {tally['wrong_flagged']} say poor or "
