@@ -93,7 +93,7 @@ def plot_stabilisation(diagram, selection=None, ax=None):
     _limit_frf_axis(ax_f, f, h, lo, min(hi, excited_band(rec)[1]))
     if selection is not None:
         _label_modes(ax, selection.modes)
-    ax_f.set_ylabel("|FRF| (output / base acceleration)")
+    ax_f.set_ylabel(f"|FRF| (output / {rec.input_name})")  # a force or a base acceleration, as the record names it
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = ax_f.get_legend_handles_labels()
     if low.any():  # say what the shading is
