@@ -9,7 +9,7 @@ of them weights by, both are consistent, and their differences are noise: each
 
 is at most standard normal (the two fits share the record, so the difference varies less than the
 sum of the variances says). Where the sum of ``z^2`` over every mode's frequency and damping ratio
-exceeds the :data:`ALPHA` point of its chi-squared distribution -- Hausman's specification test
+exceeds the ``ALPHA`` (1 %) point of its chi-squared distribution -- Hausman's specification test
 (Econometrica 46 (1978) 1251), with the two estimates taken as independent, which makes it
 conservative -- the record holds model error that the two estimators weight differently: a
 nonlinearity, a hold the model lacks, leakage. One record cannot say which estimator is then right,
