@@ -315,8 +315,8 @@ CODES: tuple[WarningCode, ...] = (
         "or its band-limited refit): the sum of their squared standardised differences beyond its χ² 1 % point "
         "(Hausman's specification test; the F-16's multisine levels: 30–59 for 12 values, the point 26.2)",
         "every mode's 95 % interval covers both estimators' (`interval_covers_other_estimator` where that widens it): "
-        "the record holds model error (a nonlinearity, the inter-sample behaviour, leakage) that the two weight "
-        "differently, and one record cannot say which is right",
+        "one of them is biased, by model error the two weight differently (a nonlinearity, the inter-sample "
+        "behaviour, leakage) or by orders too low for a mode, and one record cannot say which",
         "Nothing if a structure like this is expected to be mildly nonlinear; otherwise run `diagnose` to find the "
         "effect, and compare a record at another excitation level.",
     ),

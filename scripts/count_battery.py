@@ -22,6 +22,7 @@ one. A wrong result must say ``poor`` or ``uncertain``.
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numpy as np
@@ -163,6 +164,8 @@ def main() -> None:
     parser.add_argument("--only", type=int, nargs="*", help="run these cases only (0-based, in the order printed)")
     parser.add_argument("--save", help="pickle each case's (structure, recording) into this folder")
     args = parser.parse_args()
+    if args.save:
+        os.makedirs(args.save, exist_ok=True)
     tally = {"cases": 0, "right": 0, "wrong_flagged": 0, "right_flagged": 0, "modes": 0, "covered": 0, "widened": 0,
              "disagree": 0}
     for index, (name, s, fs, top, rng) in enumerate(cases(args)):

@@ -11,8 +11,9 @@ is at most standard normal (the two fits share the record, so the difference var
 sum of the variances says). Where the sum of ``z^2`` over every mode's frequency and damping ratio
 exceeds the ``ALPHA`` (1 %) point of its chi-squared distribution -- Hausman's specification test
 (Econometrica 46 (1978) 1251), with the two estimates taken as independent, which makes it
-conservative -- the record holds model error that the two estimators weight differently: a
-nonlinearity, a hold the model lacks, leakage. One record cannot say which estimator is then right,
+conservative -- one of them is biased on this record: by model error the two weight differently
+(a nonlinearity, a hold the model lacks, leakage), or by diagram orders too low for a mode (a light
+chain's top mode, 10 of its SDs off in the ARMAX fit). One record cannot say which is then right,
 so every mode's 95 % interval covers the earlier estimator's 95 % interval too (the
 ``{q}_estimator_lo/hi`` parts of :mod:`armaxmodal.modes.intervals`), and an
 ``estimators_disagree`` note gives the statistic.
@@ -102,8 +103,9 @@ def covering_both_estimators(rows: pd.DataFrame) -> tuple[pd.DataFrame, list[Qua
         "estimators_disagree", (),
         f"the modal model's modes and the diagram's fit of them differ beyond their noise (sum of squared "
         f"standardised differences {statistic:.1f} for {z.size} values, its {100 * (1 - ALPHA):g} % point "
-        f"{critical:.1f}): model error (a nonlinearity, the inter-sample behaviour, leakage) that the two estimators "
-        "weight differently, which one record cannot attribute. Every mode's interval covers both estimates"
+        f"{critical:.1f}): one of them is biased here, by model error the two weight differently (a nonlinearity, the "
+        "inter-sample behaviour, leakage) or by orders too low for a mode. One record cannot say which, so every "
+        "mode's interval covers both estimates"
         + (f"; widened at {where} Hz" if where else ""),
         statistic,
     )  # fmt: skip
