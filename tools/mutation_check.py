@@ -1014,8 +1014,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/counted.py",
-        "    row.update(earlier_estimate(row))  # the selection's estimate, for covering_both_estimators\n",
-        "",
+        "        row.update(earlier_estimate(row))\n",
+        "        pass\n",
         "the counted rows keep no earlier estimate (estimators)",
     ),
     (

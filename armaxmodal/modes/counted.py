@@ -361,8 +361,9 @@ def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str) -> dict:
     dist = np.abs(modes.freq_hz.to_numpy() / f - 1)
     j = int(np.argmin(dist))
     row = modes.iloc[j].to_dict()
-    row.update(earlier_estimate(row))  # the selection's estimate, for covering_both_estimators
-    if dist[j] > SAME_ROW_FREQ:  # a mode the diagram's clusters did not hold
+    if dist[j] <= SAME_ROW_FREQ:  # the selection's estimate of this mode, for covering_both_estimators
+        row.update(earlier_estimate(row))
+    else:  # a mode the diagram's clusters did not hold
         # nor an ARMAX estimate: the segments' spread is judged against the modal model's own
         # deviation (as a mode the completeness test adds), not the neighbouring row's
         row.update(count=0, support=0.0, freq_spread=np.nan, damping_spread=np.nan, medoid_freq_hz=np.nan,
