@@ -8,7 +8,7 @@ from armaxmodal.cli.common import DETREND_HELP, add_data_args, load_recording, p
 from armaxmodal.cli.stabilise import print_check
 from armaxmodal.exceptions import OrderError
 from armaxmodal.io.write import write_all, write_json
-from armaxmodal.modes.selection import verdict
+from armaxmodal.modes.result import verdict
 
 
 def add_parser(sub, parents) -> None:

@@ -65,7 +65,7 @@ def add_parser(sub, parents) -> None:
 def run(args) -> int:
     from armaxmodal.modes.diagram import stabilisation_diagram
     from armaxmodal.modes.picks import check_picks
-    from armaxmodal.modes.selection import select_modes
+    from armaxmodal.modes.pipeline import select_modes
     from armaxmodal.prepare.preparation import check_band
 
     plot_format = output_format(args.plot) if args.plot else None

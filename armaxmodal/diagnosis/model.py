@@ -32,6 +32,7 @@ from scipy.signal import lfilter
 from armaxmodal.diagnosis.clipping import IMPUTE_PASSES, clipped_mask, fill_by_prediction
 from armaxmodal.estimate.fit import fit_armax
 from armaxmodal.estimate.result import ArmaxFit
+from armaxmodal.modes.settings import DEFAULTS
 
 __all__ = ["Signals", "ModelSpec", "FittedModel", "fit_model", "held_out", "HeldOut", "counted", "as_inputs"]
 
@@ -365,7 +366,8 @@ def _fit_once(spec: ModelSpec, signals: Signals, window, start: FittedModel | No
 #: A pole pair within this distance (Hz) of a modelled line (or a real root near 1 with a
 #: modelled trend) and damped less than UNDAMPED duplicates the disturbance.
 LINE_MERGE_HZ = 0.05
-UNDAMPED = 2e-3
+#: a line is a pole damped below this: the one rule of the mode selection's (LineSettings.undamped)
+UNDAMPED = DEFAULTS.lines.undamped
 
 
 def response_free_of(

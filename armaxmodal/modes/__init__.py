@@ -2,7 +2,8 @@
 
 * :func:`~armaxmodal.stabilisation_diagram` -- the order sweep and its pole table (:mod:`.diagram`,
   :mod:`.poles`).
-* :func:`~armaxmodal.select_modes` -- the physical modes picked from it (:mod:`.selection`,
+* :func:`~armaxmodal.select_modes` -- the physical modes picked from it by named stages
+  (:mod:`.pipeline`, every threshold in :mod:`.settings`, the result in :mod:`.result`;
   :mod:`.clusters`, :mod:`.completeness`, the support tests in :mod:`.support`), refitted in the
   frequency domain (:mod:`.refine`), counted by nested tests of the maximum-likelihood modal
   model (:mod:`.modal_model`, :mod:`.mode_count`, :mod:`.counted`), with intervals widened by
@@ -14,8 +15,9 @@
 from armaxmodal.modes.diagram import StabilisationDiagram, choose_nk, stabilisation_diagram
 from armaxmodal.modes.identification import Identification, identify
 from armaxmodal.modes.modal_check import ModalCheck, check_modes
+from armaxmodal.modes.pipeline import select_modes
 from armaxmodal.modes.poles import Tolerances
-from armaxmodal.modes.selection import ModeSelection, select_modes
+from armaxmodal.modes.result import ModeSelection
 
 __all__ = [
     "Identification",

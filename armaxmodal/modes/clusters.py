@@ -16,12 +16,10 @@ from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.estimate.result import ArmaxFit
 from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.poles import SHARED, UNRESOLVED_DAMPING, mac, pole_rows
+from armaxmodal.modes.settings import DEFAULTS, ClusterSettings
 from armaxmodal.modes.support import peak_support
 from armaxmodal.recording import Recording
 from armaxmodal.stats import Z95
-
-#: a finished fit's pole farther than this (relative frequency) is another pole, not this one finished
-FINISHED_MAX_SHIFT = 0.05
 
 
 def order_criteria(diagram: StabilisationDiagram) -> dict[int, float]:
@@ -31,22 +29,22 @@ def order_criteria(diagram: StabilisationDiagram) -> dict[int, float]:
     return {na: information_criterion(fit, unit=unit) for (src, na), fit in diagram.fits.items() if src == SHARED}
 
 
-def clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_damping, n_jobs, bar=None):
+def clustered_modes(diagram, band, nas, cluster: ClusterSettings, n_jobs, bar=None):
     """One mode per supported cluster (the kept poles', then the rescued lightly damped
     ones), each from its representative fit: ``(modes, shape vectors)``. ``bar`` (tqdm)
     counts the finishing fits."""
     cand = candidate_poles(diagram.poles, band)
-    clusters = cluster_poles(cand[cand.rejected == ""], nas, cluster_freq, cluster_damping)
-    clusters = [c for c in clusters if _supported(len(c), len(nas), min_support)]
+    clusters = cluster_poles(cand[cand.rejected == ""], nas, cluster.freq, cluster.damping)
+    clusters = [c for c in clusters if _supported(len(c), len(nas), cluster)]
     left = cand.drop(index=[m for c in clusters for m in c])
-    clusters += _rescued_clusters(diagram, left, nas, cluster_freq, min_support, band)
+    clusters += _rescued_clusters(diagram, left, nas, cluster, band)
     bic = order_criteria(diagram)
     firsts = [_ranked(cand.loc[c][cand.loc[c].damping > 0], bic) for c in clusters]
     finished = _finish_fits(diagram, {ranked[0] for ranked in firsts if ranked}, n_jobs, bar)
     rows, vectors = [], []
     for members in clusters:
         sub = cand.loc[members]
-        rep = representative_pole(diagram, sub[sub.damping > 0], bic, finished)
+        rep = representative_pole(diagram, sub[sub.damping > 0], bic, finished, cluster.finished_max_shift)
         if rep is None:
             continue
         rows.append({**mode_row(rep, sub, len(nas)), "orders_damping_unresolved": int((sub.damping <= 0).sum())})
@@ -54,12 +52,13 @@ def clustered_modes(diagram, band, nas, min_support, cluster_freq, cluster_dampi
     return pd.DataFrame(rows), vectors
 
 
-def representative_pole(diagram, resolved: pd.DataFrame, bic: dict, finished: dict) -> pd.Series | None:
+def representative_pole(diagram, resolved: pd.DataFrame, bic: dict, finished: dict,
+                        max_shift: float = DEFAULTS.cluster.finished_max_shift) -> pd.Series | None:
     """The cluster's pole from the fit of lowest BIC, finished to full convergence; the next
     order's when finishing takes a lightly damped pole's damping to zero or below (None when
     every one does: the record gives this mode no damping estimate)."""
     for na in _ranked(resolved, bic):
-        rep = _finished_pole(diagram, resolved[resolved.na == na].iloc[0], finished)
+        rep = _finished_pole(diagram, resolved[resolved.na == na].iloc[0], finished, max_shift)
         if rep.damping > 0:
             return rep
     return None
@@ -85,14 +84,13 @@ def _finished_poles(recording: Recording, fit: ArmaxFit) -> pd.DataFrame:
     return pd.DataFrame(pole_rows(done, SHARED))
 
 
-def _supported(count: int, n_orders: int, min_support: float) -> bool:
-    """A cluster is a mode when it holds poles of at least three orders and ``min_support``
-    of the swept ones."""
-    return count >= 3 and count / n_orders >= min_support
+def _supported(count: int, n_orders: int, cluster: ClusterSettings) -> bool:
+    """A cluster is a mode when it holds poles of at least ``cluster.min_orders`` orders and
+    ``cluster.min_support`` of the swept ones."""
+    return count >= cluster.min_orders and count / n_orders >= cluster.min_support
 
 
-def why_no_mode(diagram: StabilisationDiagram, band, nas, min_support: float, cluster_freq: float,
-                cluster_damping: float) -> str:
+def why_no_mode(diagram: StabilisationDiagram, band, nas, cluster: ClusterSettings) -> str:
     """Why no cluster of the diagram is a mode, in a sentence: the shared poles in the band,
     those rejected and for what, and how many orders the best-supported cluster of the rest
     holds against the support a mode needs."""
@@ -106,8 +104,8 @@ def why_no_mode(diagram: StabilisationDiagram, band, nas, min_support: float, cl
     said = "; ".join(f"{why}: {n}" for why, n in reasons.items())
     facts = [f"of {len(shared)} shared poles{where}, {int(reasons.sum())} were rejected{f' ({said})' if said else ''}"]
     cand = candidate_poles(diagram.poles, band)
-    clusters = cluster_poles(cand[cand.rejected == ""], nas, cluster_freq, cluster_damping)
-    need = max(3, int(np.ceil(min_support * len(nas))))
+    clusters = cluster_poles(cand[cand.rejected == ""], nas, cluster.freq, cluster.damping)
+    need = max(cluster.min_orders, int(np.ceil(cluster.min_support * len(nas))))
     if clusters:
         best = max(clusters, key=len)
         f = float(cand.loc[best].freq_hz.median())
@@ -160,7 +158,7 @@ def cluster_poles(cand: pd.DataFrame, nas, cluster_freq: float, cluster_damping:
     return clusters
 
 
-def _rescued_clusters(diagram, rest: pd.DataFrame, nas, cluster_freq: float, min_support: float, band) -> list:
+def _rescued_clusters(diagram, rest: pd.DataFrame, nas, cluster: ClusterSettings, band) -> list:
     """Lightly damped modes the damping rule splits: poles the selection left, whose damping
     the record does not resolve (the 95 % interval reaches zero, or the estimate crosses it),
     grouped by frequency alone. A group is a mode when it has the usual support, a positive
@@ -168,9 +166,9 @@ def _rescued_clusters(diagram, rest: pd.DataFrame, nas, cluster_freq: float, min
     own evidence, which noise poles lack."""
     light = rest[rest.damping - Z95 * rest.damping_sd <= 0]
     found = []
-    for members in cluster_poles(light, nas, cluster_freq, None):
+    for members in cluster_poles(light, nas, cluster.freq, None):
         sub = light.loc[members]
-        if not _supported(len(members), len(nas), min_support) or not (sub.damping > 0).any():
+        if not _supported(len(members), len(nas), cluster) or not (sub.damping > 0).any():
             continue
         if peak_support(diagram.recording, float(sub.freq_hz.median()), 0.0, band) is not None:
             found.append(members)
@@ -201,9 +199,10 @@ def mode_row(rep: pd.Series, sub: pd.DataFrame, n_orders: int) -> dict:
 _ESTIMATE_COLUMNS = ("freq_hz", "damping", "damped_freq_hz", "freq_sd", "damping_sd")
 
 
-def _finished_pole(diagram: StabilisationDiagram, pole: pd.Series, cache: dict) -> pd.Series:
+def _finished_pole(diagram: StabilisationDiagram, pole: pd.Series, cache: dict, max_shift: float) -> pd.Series:
     """The pole as estimated by its order's fit continued to :func:`fit_armax`'s default
-    tolerance (the sweep stops its fits early); ``cache`` holds the finished fits' poles."""
+    tolerance (the sweep stops its fits early); ``cache`` holds the finished fits' poles. A
+    finished pole farther than ``max_shift`` (relative frequency) is another pole."""
     na = int(pole.na)
     if na not in cache:
         cache[na] = _finished_poles(diagram.recording, diagram.fits[(SHARED, na)])
@@ -211,7 +210,7 @@ def _finished_pole(diagram: StabilisationDiagram, pole: pd.Series, cache: dict) 
     if poles.empty:
         return pole
     nearest = poles.iloc[int(np.argmin(np.abs(poles.pole.to_numpy() - pole.pole)))]
-    if abs(nearest.freq_hz / pole.freq_hz - 1) > FINISHED_MAX_SHIFT:
+    if abs(nearest.freq_hz / pole.freq_hz - 1) > max_shift:
         return pole  # finishing moved this pole away (a weak one): the sweep's estimate stands
     # the finished estimate, with the diagram's own columns (class, rejection) kept
     return pd.concat([nearest, pole.drop(nearest.index, errors="ignore")])

@@ -13,7 +13,8 @@ import pandas as pd
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, order_criteria, representative_pole
 from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_band, selection_job
-from armaxmodal.modes.working import WorkingSelection
+from armaxmodal.modes.settings import ClusterSettings
+from armaxmodal.modes.state import SelectionState
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
@@ -36,7 +37,7 @@ EDGE_FRACTION = 0.95
 DUPLICATE_FREQ = 0.01
 
 
-def modes_the_record_needs(recording: Recording, work: WorkingSelection, band) -> WorkingSelection:
+def modes_the_record_needs(recording: Recording, work: SelectionState, band) -> SelectionState:
     """Selection by the data: drop, one at a time and least supported first, every mode the
     modal-model check does not need (:func:`armaxmodal.modes.support.mode_support`: leaving it
     out, a neighbour inside its half-power band refitted in its place, raises no output's
@@ -82,7 +83,7 @@ def modes_the_record_needs(recording: Recording, work: WorkingSelection, band) -
         work = work.kept(i for i in range(len(modes)) if i != m).warned(note)
 
 
-def refit_with_added(diagram, work: WorkingSelection, band, limits) -> WorkingSelection:
+def refit_with_added(diagram, work: SelectionState, band, limits) -> SelectionState:
     """The frequency-domain refit again, of every mode once the check has added some: a mode
     missing from a refit biases its neighbours (a five-segment chain's 13.5 Hz mode came out
     at 12.5 Hz while the 24.8 Hz one was missing, and its refit was refused as too far; now
@@ -95,7 +96,7 @@ def refit_with_added(diagram, work: WorkingSelection, band, limits) -> WorkingSe
     return replace(work, check=check_modes(diagram.recording, work.modes.freq_hz, work.modes.damping, band))
 
 
-def modes_the_check_adds(diagram, work: WorkingSelection, band, nas, clustering) -> WorkingSelection:
+def modes_the_check_adds(diagram, work: SelectionState, band, nas, cluster: ClusterSettings) -> SelectionState:
     """Stable clusters the support rule left out enter when the modal-model check needs them
     (as :func:`modes_the_record_needs` judges, but with the nearest mode refitted in its place,
     not only an overlapping one: one at a time, the largest first): the
@@ -110,7 +111,7 @@ def modes_the_check_adds(diagram, work: WorkingSelection, band, nas, clustering)
 
     bic = order_criteria(diagram)
     modes, shapes, check = work.modes, work.shapes, work.check
-    for sub, at_peak in _left_out_clusters(diagram, modes, band, nas, clustering):
+    for sub, at_peak in _left_out_clusters(diagram, modes, band, nas, cluster):
         # the cluster's centre is tried: its lowest-BIC pole may sit at its edge
         centre = float(sub.freq_hz.median()), float(sub.damping.median())
         if np.any(np.abs(modes.freq_hz.to_numpy() / centre[0] - 1) <= DUPLICATE_FREQ):
@@ -133,12 +134,12 @@ def modes_the_check_adds(diagram, work: WorkingSelection, band, nas, clustering)
     return work.with_modes(modes, shapes, check=check).kept(modes.sort_values("freq_hz").index)
 
 
-def _left_out_clusters(diagram, modes: pd.DataFrame, band, nas, clustering) -> list[tuple[pd.DataFrame, bool]]:
+def _left_out_clusters(diagram, modes: pd.DataFrame, band, nas, cluster: ClusterSettings
+                       ) -> list[tuple[pd.DataFrame, bool]]:  # fmt: skip
     """The candidate clusters of :func:`modes_the_check_adds`, the largest first, each with
     whether it stands at an unexplained peak."""
     from armaxmodal.modes.frf_check import unexplained_peaks
 
-    cluster_freq, cluster_damping = clustering
     cand = candidate_poles(diagram.poles, band)
     cand = cand[cand.damping > 0]
     found = []
@@ -151,8 +152,8 @@ def _left_out_clusters(diagram, modes: pd.DataFrame, band, nas, clustering) -> l
     top = EDGE_FRACTION * refit_band(diagram.recording, band)[1]
     kept = cand[(cand.rejected == "") & (cand.freq_hz <= top)]
     selected = modes.freq_hz.to_numpy()
-    for members in cluster_poles(kept, nas, cluster_freq, cluster_damping):
+    for members in cluster_poles(kept, nas, cluster.freq, cluster.damping):
         sub = kept.loc[members]
-        if len(members) >= 3 and np.min(np.abs(selected / sub.freq_hz.median() - 1)) > cluster_freq:
+        if len(members) >= cluster.min_orders and np.min(np.abs(selected / sub.freq_hz.median() - 1)) > cluster.freq:
             found.append((sub, False))
     return sorted(found, key=lambda item: len(item[0]), reverse=True)

@@ -18,13 +18,10 @@ import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
 from armaxmodal.modes.estimators import EARLIER_COLUMNS, covering_both_estimators, earlier_estimate
-from armaxmodal.modes.intervals import with_intervals
+from armaxmodal.modes.intervals import not_separated, with_intervals
 from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.modal_model import DftLines, fit_modal_model
 from armaxmodal.modes.mode_count import (
-    DECISIVE_BIC,
-    FINAL_NFEV,
-    LIKELIHOOD_ALPHA,
     ModeCount,
     agree_in_halves,
     count_modes,
@@ -32,73 +29,60 @@ from armaxmodal.modes.mode_count import (
     reported,
 )
 from armaxmodal.modes.poles import mac
+from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
 from armaxmodal.modes.spread import split_segments
-from armaxmodal.modes.support import CANDIDATE_MIN_ORDERS, stable_in_diagram
-from armaxmodal.modes.working import WorkingSelection
+from armaxmodal.modes.state import SelectionState
+from armaxmodal.modes.support import stable_in_diagram
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.stats import MAX_DAMPING, Z95
 
-__all__ = ["SEPARATION_SD", "confirmed_where_incoherent", "counted_modes", "dropped_where_peaks_remain",
-           "not_separated"]  # fmt: skip
+__all__ = ["confirmed_where_incoherent", "counted_modes", "dropped_where_peaks_remain"]
 
-#: a counted mode within this relative frequency of a selected one keeps that row's cluster
-#: facts (orders, support, spread); the clustering's own reach
-SAME_ROW_FREQ = 0.05
-#: the nested tests run on at most this many samples of a record (18 min at 60 Hz, 9 at 120 Hz:
-#: every body's modes are counted on less); a longer record's chosen model is fitted whole
-COUNT_MAX_SAMPLES = 65_536
-#: left-out clusters of the diagram tried as additions: the largest few (each costs a fit)
-MAX_CANDIDATES = 3
 #: the sweep's rejection that leaves a stable cluster a candidate still (poles/rejection_reasons)
 WEAK_RESIDUE = "negligible residue"
-#: two modes closer than this many standard deviations of their difference are not separated
-#: by the record (a difference 3 SD from zero is the usual resolution rule)
-SEPARATION_SD = 3.0
-#: two modes whose shapes agree this well (MAC) are not told apart by their shapes either (the
-#: selection's own ``merge_mac`` default)
-SAME_SHAPE_MAC = 0.8
 
 
-def _candidates(diagram, modes: pd.DataFrame, band, nas, cluster_freq, cluster_damping) -> list[tuple[float, float]]:
+def _candidates(diagram, modes: pd.DataFrame, band, nas, settings: SelectionSettings = DEFAULTS
+                ) -> list[tuple[float, float]]:  # fmt: skip
     """The diagram's stable clusters the selection left out: (Hz, ratio), the clean ones first
     (largest first), then those whose every pole the sweep rejected only for a small residue. A
     weakly driven or weakly seen mode is stable across orders with a small residue at each (a
     five-mass chain's 9.7 Hz at nine orders of a 400 s ride); whether the record needs it is the
     likelihood's to say, as for any addition."""
+    cluster = settings.cluster
     cand = candidate_poles(diagram.poles, band, rejected=("", WEAK_RESIDUE))
     cand = cand[(cand.damping > 0) & (cand.damping <= MAX_DAMPING)]
     found = []
     for rank, rejected in enumerate(("", WEAK_RESIDUE)):
         kept = cand[cand.rejected == rejected]
-        for members in cluster_poles(kept, nas, cluster_freq, cluster_damping):
+        for members in cluster_poles(kept, nas, cluster.freq, cluster.damping):
             sub = kept.loc[members]
             f = float(sub.freq_hz.median())
             taken = [g for _, _, g, _ in found] + list(modes.freq_hz.to_numpy())
-            if len(members) >= CANDIDATE_MIN_ORDERS and np.min(np.abs(np.asarray(taken) / f - 1)) > cluster_freq:
+            if len(members) >= cluster.min_orders and np.min(np.abs(np.asarray(taken) / f - 1)) > cluster.freq:
                 found.append((rank, -len(members), f, float(sub.damping.median())))
-    return [(f, x) for _, _, f, x in sorted(found)[:MAX_CANDIDATES]]
+    return [(f, x) for _, _, f, x in sorted(found)[: settings.count.max_candidates]]
 
 
 def _on_whole_record(count: ModeCount, rec, band_hz, hold: str) -> ModeCount:
     """The counted model fitted to the whole record from where the search left it."""
-    from dataclasses import replace
-
     whole = DftLines.from_recording(rec, band_hz)
     start = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, max_nfev=1)
     whole = whole.noise_weighted(start)
-    return replace(count, model=fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, FINAL_NFEV))
+    final = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, count.settings.final_nfev)
+    return replace(count, model=final)
 
 
 def counted_modes(
-    diagram, work: WorkingSelection, band_hz, hold: str, nas, clustering, band=None, *, picked: bool = False,
-    n_jobs: int | None = None,
-) -> WorkingSelection:
+    diagram, work: SelectionState, band_hz, hold: str, nas, settings: SelectionSettings = DEFAULTS, band=None, *,
+    picked: bool = False, n_jobs: int | None = None,
+) -> SelectionState:
     """Count the modes from the selection's and return them as the selection reports modes.
 
     Parameters
     ----------
     diagram : StabilisationDiagram
-    work : WorkingSelection
+    work : SelectionState
         The selection so far (its modes the start, one row per mode as
         :func:`armaxmodal.select_modes` builds them).
     band_hz : (float, float)
@@ -107,8 +91,8 @@ def counted_modes(
         The inter-sample assumption the refit chose.
     nas : list of int
         The diagram's orders.
-    clustering : (float, float)
-        The clustering's relative frequency and damping reach.
+    settings : SelectionSettings
+        The count's thresholds, and the clustering's reaches and the orders a stable pole needs.
     band : (float, float), optional
         The user's band, for the left-out clusters.
     picked : bool
@@ -121,61 +105,53 @@ def counted_modes(
 
     Returns
     -------
-    WorkingSelection
+    SelectionState
         The counted modes with the count and its notes. When the model keeps no mode in the band,
         the modes stay the selection's, and a ``count_undecided`` note says so.
     """
     rec, modes = diagram.recording, work.modes
-    # the search runs on the record's first COUNT_MAX_SAMPLES; the chosen model is then fitted
-    # to the whole record, so a long ride costs one fit more, not a search more
-    part = rec if rec.n_samples <= COUNT_MAX_SAMPLES else split_segments(rec, rec.n_samples // COUNT_MAX_SAMPLES)[0]
+    # the search runs on the record's first settings.count.max_samples; the chosen model is then
+    # fitted to the whole record, so a long ride costs one fit more, not a search more
+    part = _counted_part(rec, settings.count.max_samples)
     data = DftLines.from_recording(part, band_hz)
-    candidates = _candidates(diagram, modes, band, nas, *clustering)
+    candidates = _candidates(diagram, modes, band, nas, settings)
     halves = tuple(DftLines.from_recording(half, band_hz) for half in split_segments(part, 2))
-    supported = stable_in_diagram(diagram, band, *clustering)
+    supported = stable_in_diagram(diagram, band, settings.cluster)
     start_f, start_x = modes.freq_hz.to_numpy(), modes.damping.to_numpy()
     if picked and work.count is not None:  # the poles the selection's model kept unreported stay in it
         model = work.count.model
         hidden = ~work.count.reported(band_hz)
         start_f, start_x = np.r_[start_f, model.freq_hz[hidden]], np.r_[start_x, model.damping[hidden]]
     count = count_modes(data, start_f, start_x, candidates, hold=hold, halves=halves, supported=supported,
-                        search=not picked, n_jobs=n_jobs)  # fmt: skip
+                        search=not picked, n_jobs=n_jobs, settings=settings.count, lines=settings.lines)  # fmt: skip
     if part is not rec:
         count = _on_whole_record(count, rec, band_hz, hold)
     keep = count.reported(data.band_hz)
+    same_row = settings.cluster.same_row_freq
     if picked:
-        return _picked_result(work, count, keep, hold, rec, band)
+        return _picked_result(work, count, keep, hold, settings, rec, band)
     if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
         return work.warned(_no_mode_kept(count, modes, data.band_hz), count=count)
-    rows = pd.DataFrame([_row(modes, count, i, hold) for i in np.flatnonzero(keep)])
-    rows, shapes, merged = _one_where_not_separated(rows, count.model.shapes[:, keep], count, keep, rec, band_hz, hold)
-    rows, disagree = covering_both_estimators(rows)
+    rows = pd.DataFrame([_row(modes, count, i, hold, same_row) for i in np.flatnonzero(keep)])
+    rows, shapes, merged = _one_where_not_separated(rows, count.model.shapes[:, keep], count, keep, rec, band_hz, hold,
+                                                    settings)  # fmt: skip
+    rows, disagree = covering_both_estimators(rows, settings.intervals.estimators_alpha)
     # where two poles are reported as one, the check fits the model's poles, not the row's
     poles = tuple(zip(count.model.freq_hz[keep].tolist(), count.model.damping[keep].tolist(), strict=True))
     work = work.with_modes(rows, shapes, count=count, check_poles=poles if merged else None)
-    return work.warned(*_notes(count, keep, data.band_hz), *merged, *disagree)
+    return work.warned(*_notes(count, keep, data.band_hz, same_row), *merged, *disagree)
 
 
-def not_separated(modes: pd.DataFrame) -> list[tuple[int, int, float]]:
-    """The neighbouring rows ``(i, i + 1, gap in SD)`` whose frequencies differ by less than
-    :data:`SEPARATION_SD` standard deviations of the difference (each SD from its 95 % interval),
-    taken left to right without overlap."""
-    f = modes.freq_hz.to_numpy()
-    sd = (modes.freq_ci95_hi.to_numpy() - modes.freq_ci95_lo.to_numpy()) / (2 * Z95)
-    pairs, i = [], 0
-    while i < len(f) - 1:
-        gap = (f[i + 1] - f[i]) / float(np.hypot(sd[i], sd[i + 1]))
-        if gap < SEPARATION_SD:
-            pairs.append((i, i + 1, float(gap)))
-            i += 1
-        i += 1
-    return pairs
+def _counted_part(rec, max_samples: int):
+    """The part of the record the nested tests run on: the whole, or its first of equal parts of at
+    most ``max_samples`` samples."""
+    return rec if rec.n_samples <= max_samples else split_segments(rec, rec.n_samples // max_samples)[0]
 
 
 def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: ModeCount, keep: np.ndarray, rec,
-                             band_hz, hold: str):  # fmt: skip
+                             band_hz, hold: str, settings: SelectionSettings = DEFAULTS):  # fmt: skip
     """Two counted modes the record does not separate -- neither by frequency (:func:`not_separated`,
-    on the model's own intervals) nor by shape (MAC at least :data:`SAME_SHAPE_MAC`) -- reported as
+    on the model's own intervals) nor by shape (MAC at least the merge's ``merge_mac``) -- reported as
     one: the
     model with one pole there (either of the two taken out, the rest refitted free; the lower
     criterion), whose mode's intervals are widened to cover both. The likelihood may need two poles
@@ -188,14 +164,15 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
     # pair at its highest level, 0.2 SD apart, has one shape as far as three sensors can tell
     own = pd.DataFrame({"freq_hz": m.freq_hz[poles], "freq_ci95_lo": m.freq_hz[poles] - Z95 * m.freq_sd[poles],
                         "freq_ci95_hi": m.freq_hz[poles] + Z95 * m.freq_sd[poles]})  # fmt: skip
-    pairs = [(a, b, gap) for a, b, gap in not_separated(own) if mac(m.shapes[:, poles[a]], m.shapes[:, poles[b]])
-             >= SAME_SHAPE_MAC]  # fmt: skip
+    level, same_shape = settings.count.separation_sd, settings.cluster.merge_mac
+    pairs = [(a, b, gap) for a, b, gap in not_separated(own, level)
+             if mac(m.shapes[:, poles[a]], m.shapes[:, poles[b]]) >= same_shape]  # fmt: skip
     if not pairs:
         return rows, shapes, []
     data = DftLines.from_recording(rec, band_hz).noise_weighted(count.model)
     rows, shapes, notes, gone = rows.copy(), shapes.copy(), [], []
     for a, b, gap in pairs:
-        fits = [fit_modal_model(data, np.delete(m.freq_hz, k), np.delete(m.damping, k), hold, FINAL_NFEV)
+        fits = [fit_modal_model(data, np.delete(m.freq_hz, k), np.delete(m.damping, k), hold, settings.count.final_nfev)
                 for k in (poles[a], poles[b])]  # fmt: skip
         one = min(fits, key=lambda fit: fit.bic())
         both = rows.loc[[a, b]]
@@ -216,8 +193,8 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
         notes.append(QualityWarning(
             "modes_not_separated", (),
             f"the modal model needs two poles at {both.freq_hz.iloc[0]:.3f} and {both.freq_hz.iloc[1]:.3f} Hz, but "
-            f"they are {gap:.1f} standard deviations of their difference apart (under {SEPARATION_SD:g}) and their "
-            f"shapes agree (MAC at least {SAME_SHAPE_MAC:g}): the record does not separate them. Reported as one mode "
+            f"they are {gap:.1f} standard deviations of their difference apart (under {level:g}) and their "
+            f"shapes agree (MAC at least {same_shape:g}): the record does not separate them. Reported as one mode "
             f"at {f:.3f} Hz (damping {x:.3g}, the model with one pole there), its intervals covering both: one "
             "resonance whose frequency moves during the record (a nonlinearity, a change) or two modes this record "
             "cannot resolve", f,
@@ -230,10 +207,10 @@ def _nearest_pole(model, f: float) -> int:
     return int(np.argmin(np.abs(np.log(model.freq_hz / f))))
 
 
-def confirmed_where_incoherent(diagram, work: WorkingSelection) -> WorkingSelection:
+def confirmed_where_incoherent(diagram, work: SelectionState, settings: SelectionSettings = DEFAULTS) -> SelectionState:
     """The modes the modal-model check leaves unconfirmed (no coherent H1 line near them) that the
     maximum-likelihood modal model confirms: the likelihood needs it decisively (its removal raises
-    the criterion by :data:`~armaxmodal.modes.mode_count.DECISIVE_BIC` or more) and the record's two
+    the criterion by the count's ``decisive_bic`` or more) and the record's two
     halves give it the same frequency and damping. The modal model fits the DFT of the record, not
     its H1, and has no coherence to lose near a sharp peak (the stiff 3-storey frame's 39.67 Hz
     mode, damping 0.006, under Northridge: no coherent line within 1.3 Hz of it)."""
@@ -241,14 +218,15 @@ def confirmed_where_incoherent(diagram, work: WorkingSelection) -> WorkingSelect
     if check is None or count is None or not check.unconfirmed_hz:
         return work
     rec, m, hold = diagram.recording, count.model, work.refinement.hold
-    part = rec if rec.n_samples <= COUNT_MAX_SAMPLES else split_segments(rec, rec.n_samples // COUNT_MAX_SAMPLES)[0]
+    part = _counted_part(rec, count.settings.max_samples)
     data = DftLines.from_recording(part, work.refinement.band_hz).noise_weighted(m)
     halves = tuple(DftLines.from_recording(half, work.refinement.band_hz) for half in split_segments(part, 2))
-    agree = agree_in_halves(data, m, halves, hold)
+    agree = agree_in_halves(data, m, halves, hold, count.settings.halves_nfev, count.settings.halves_sd)
+    reach, decisive = settings.cluster.same_row_freq, count.settings.decisive_bic
     confirmed, notes = [], []
     for f in check.unconfirmed_hz:
         i = int(np.argmin(np.abs(m.freq_hz - f)))
-        if abs(m.freq_hz[i] / f - 1) <= SAME_ROW_FREQ and count.removal_rise[i] >= DECISIVE_BIC and agree[i]:
+        if abs(m.freq_hz[i] / f - 1) <= reach and count.removal_rise[i] >= decisive and agree[i]:
             confirmed.append(f)
             notes.append(QualityWarning(
                 "mode_count", (),
@@ -263,11 +241,11 @@ def confirmed_where_incoherent(diagram, work: WorkingSelection) -> WorkingSelect
     return replace(work, check=replace(check, unconfirmed_hz=left)).warned(*notes)
 
 
-def dropped_where_peaks_remain(count: ModeCount | None, peaks) -> list[QualityWarning]:
+def dropped_where_peaks_remain(count: ModeCount | None, peaks, same_row_freq: float) -> list[QualityWarning]:
     """A ``count_undecided`` note for each starting mode the count did not report as unfounded
     (``count.carried_away``, left out; ``count.stand_ins``, kept in the model unreported) while
     the measured FRF keeps a coherent peak that no reported mode explains within
-    :data:`SAME_ROW_FREQ` of where it started or went (``peaks``: the ``unexplained_peak`` notes).
+    ``same_row_freq`` of where it started or went (``peaks``: the ``unexplained_peak`` notes).
     The two kinds of evidence disagree: the halves test is weak on a transient input (an
     earthquake's record), and the H1 still shows a resonance there. Inglewood's 5.83 Hz start went
     to 4.40 Hz, unfounded, with coherent peaks left at 5.77 and 4.38 Hz."""
@@ -278,7 +256,7 @@ def dropped_where_peaks_remain(count: ModeCount | None, peaks) -> list[QualityWa
     unreported += [(start, went, "kept in the model but not reported") for start, went, _ in count.stand_ins]
     for start, went, fate in unreported:
         near = [p.value for p in peaks
-                if min(abs(np.log(p.value / start)), abs(np.log(p.value / went))) <= SAME_ROW_FREQ]  # fmt: skip
+                if min(abs(np.log(p.value / start)), abs(np.log(p.value / went))) <= same_row_freq]  # fmt: skip
         if near:
             notes.append(QualityWarning(
                 "count_undecided", (),
@@ -291,13 +269,13 @@ def dropped_where_peaks_remain(count: ModeCount | None, peaks) -> list[QualityWa
     return notes
 
 
-def _picked_result(work: WorkingSelection, count: ModeCount, keep: np.ndarray, hold: str, recording=None,
-                   band=None) -> WorkingSelection:  # fmt: skip
+def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hold: str, settings: SelectionSettings,
+                   recording=None, band=None) -> SelectionState:  # fmt: skip
     """The picked rows (finite ``picked_hz``) reported: from the modal model where it keeps the pick
     as a mode of the band, else as the selection had it (the diagram's or the refit's values) with a
     ``pick_not_supported`` note that says where the model took it. The rows not picked stay in the
     model, said in a note; the check (with ``recording``) judges every mode of the model in the band."""
-    m, rows, shapes = count.model, [], []
+    m, rows, shapes, same_row = count.model, [], [], settings.cluster.same_row_freq
     picked = np.isfinite(work.modes.picked_hz.to_numpy())
     pairs = dict((j, i) for i, j in matched_poles(work.modes.freq_hz.to_numpy(), m.freq_hz))  # row -> pole
     picked_poles = np.zeros(m.n_modes, dtype=bool)
@@ -307,7 +285,7 @@ def _picked_result(work: WorkingSelection, count: ModeCount, keep: np.ndarray, h
     for j in np.flatnonzero(picked):
         i = pairs[j]
         if keep[i]:
-            rows.append({**_row(work.modes, count, i, hold), "picked_hz": work.modes.picked_hz.iloc[j]})
+            rows.append({**_row(work.modes, count, i, hold, same_row), "picked_hz": work.modes.picked_hz.iloc[j]})
             shapes.append(m.shapes[:, i])
             continue
         row = work.modes.iloc[j].to_dict()
@@ -330,7 +308,8 @@ def _picked_result(work: WorkingSelection, count: ModeCount, keep: np.ndarray, h
             float(len(others)),
         ))  # fmt: skip
     order = np.argsort([r["freq_hz"] for r in rows])
-    rows, disagree = covering_both_estimators(pd.DataFrame([rows[k] for k in order]))
+    rows = pd.DataFrame([rows[k] for k in order])
+    rows, disagree = covering_both_estimators(rows, settings.intervals.estimators_alpha)
     notes += disagree
     work = work.with_modes(rows, np.column_stack([shapes[k] for k in order]), count=count)
     if recording is not None:  # the check of the model the picks come from: the picks and the others
@@ -353,15 +332,15 @@ def _no_mode_kept(count: ModeCount, modes: pd.DataFrame, band_hz) -> QualityWarn
     )
 
 
-def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str) -> dict:
+def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str, same_row_freq: float) -> dict:
     """Mode ``i`` of the counted model as a selection row: the nearest selected row's cluster
-    facts when it lies within :data:`SAME_ROW_FREQ`, else none (``count`` 0)."""
+    facts when it lies within ``same_row_freq``, else none (``count`` 0)."""
     m = count.model
     f, x = m.freq_hz[i], m.damping[i]
     dist = np.abs(modes.freq_hz.to_numpy() / f - 1)
     j = int(np.argmin(dist))
     row = modes.iloc[j].to_dict()
-    if dist[j] <= SAME_ROW_FREQ:  # the selection's estimate of this mode, for covering_both_estimators
+    if dist[j] <= same_row_freq:  # the selection's estimate of this mode, for covering_both_estimators
         row.update(earlier_estimate(row))
     else:  # a mode the diagram's clusters did not hold
         # nor an ARMAX estimate: the segments' spread is judged against the modal model's own
@@ -370,21 +349,21 @@ def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str) -> dict:
                    medoid_damping=np.nan, orders_damping_unresolved=0, energy=np.nan,
                    freq_sd_armax=m.freq_sd[i], damping_sd_armax=m.damping_sd[i],
                    **dict.fromkeys(EARLIER_COLUMNS, np.nan))  # fmt: skip
-    other, widened = _other_structures(count, i)
+    other, widened = _other_structures(count, i, same_row_freq)
     row.update(
         freq_hz=f, damping=x, damped_freq_hz=f * np.sqrt(1 - x**2), freq_sd=m.freq_sd[i], damping_sd=m.damping_sd[i],
-        **other, estimator=f"ml-{hold}", count_undecided=bool(count.removal_rise[i] < DECISIVE_BIC),
+        **other, estimator=f"ml-{hold}", count_undecided=bool(count.removal_rise[i] < count.settings.decisive_bic),
         structure_widened=widened,
     )  # fmt: skip
     return row
 
 
-def _other_structures(count: ModeCount, i: int) -> tuple[dict, bool]:
+def _other_structures(count: ModeCount, i: int, same_row_freq: float) -> tuple[dict, bool]:
     """The reach of mode ``i``'s counterparts' 95 % intervals in the equally good models
     (``count.alternatives``): where the record cannot tell the number of modes, it cannot tell
     which model's values hold either, so the reported interval covers theirs
     (:mod:`armaxmodal.modes.intervals`). A counterpart is the alternative's pole paired with mode
-    ``i`` one to one, within :data:`SAME_ROW_FREQ`; a mode the alternative lacks, or that moved
+    ``i`` one to one, within ``same_row_freq``; a mode the alternative lacks, or that moved
     farther (two merged into one), has none. Returns ``({q}_other_lo/hi: value, NaN for none;
     widened)``, ``widened`` when a counterpart's interval reaches beyond the mode's own."""
     m = count.model
@@ -394,7 +373,7 @@ def _other_structures(count: ModeCount, i: int) -> tuple[dict, bool]:
     widened = False
     for _, alt in count.alternatives:
         for k, j in matched_poles(m.freq_hz, alt.freq_hz):
-            if j != i or abs(np.log(alt.freq_hz[k] / m.freq_hz[i])) > SAME_ROW_FREQ:
+            if j != i or abs(np.log(alt.freq_hz[k] / m.freq_hz[i])) > same_row_freq:
                 continue
             for q, value, sd in (("freq", alt.freq_hz[k], alt.freq_sd[k]), ("damping", alt.damping[k],
                                                                               alt.damping_sd[k])):  # fmt: skip
@@ -408,21 +387,22 @@ def _other_structures(count: ModeCount, i: int) -> tuple[dict, bool]:
 
 def _pick_notes(count: ModeCount, keep: np.ndarray) -> list[QualityWarning]:
     """What the record says of modes picked by hand: a ``pick_not_supported`` note for each pick
-    whose removal (the rest refitted free) raises the criterion by less than :data:`DECISIVE_BIC`
+    whose removal (the rest refitted free) raises the criterion by less than the count's ``decisive_bic``
     (``keep``: the picked poles, by pole), and a ``mode_count`` note when one mode more than the
     model holds lowers it by more."""
+    decisive = count.settings.decisive_bic
     notes = []
     for i in np.flatnonzero(keep):
         rise = float(count.removal_rise[i])
-        if rise < DECISIVE_BIC:
+        if rise < decisive:
             f = float(count.model.freq_hz[i])
             notes.append(QualityWarning(
                 "pick_not_supported", (),
                 f"the record does not support the mode picked at {f:.3f} Hz: without it (the other modes refitted "
-                f"free) the information criterion changes by {rise:+.1f}, less than the {DECISIVE_BIC:g} a needed "
+                f"free) the information criterion changes by {rise:+.1f}, less than the {decisive:g} a needed "
                 "mode raises it; treat it as tentative, or pick another column of the diagram", f,
             ))  # fmt: skip
-    if count.best_addition > DECISIVE_BIC and np.isfinite(count.best_addition_hz):
+    if count.best_addition > decisive and np.isfinite(count.best_addition_hz):
         f = count.best_addition_hz
         notes.append(QualityWarning(
             "mode_count", (),
@@ -447,11 +427,12 @@ def _what_to_do(in_diagram: bool) -> str:
             "record would decide")
 
 
-def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
+def _notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: float) -> list[QualityWarning]:
+    decisive = count.settings.decisive_bic
     notes = []
     words = {"remove": "left out", "add": "added", "split": "split in two"}
     for step in count.steps:
-        moved = np.isfinite(step.settled_hz) and abs(np.log(step.settled_hz / step.freq_hz)) > SAME_ROW_FREQ
+        moved = np.isfinite(step.settled_hz) and abs(np.log(step.settled_hz / step.freq_hz)) > same_row_freq
         where = f" (its new pole settled at {step.settled_hz:.3f} Hz)" if moved else ""
         notes.append(QualityWarning(
             "mode_count", (),
@@ -460,27 +441,28 @@ def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
             float(step.freq_hz),
         ))  # fmt: skip
     rise = float(count.removal_rise.min()) if count.removal_rise.size else np.inf
-    if rise < DECISIVE_BIC:
+    if rise < decisive:
         notes.append(QualityWarning(
             "count_undecided", (),
             f"the record does not decide the number of modes: with one mode fewer (the rest refitted free) the "
-            f"criterion rises by only {rise:.1f} (under {DECISIVE_BIC:g}, Kass & Raftery's 'very strong'); "
+            f"criterion rises by only {rise:.1f} (under {decisive:g}, Kass & Raftery's 'very strong'); "
             "treat the weakest mode as tentative", rise,
         ))  # fmt: skip
-    if count.best_addition > -DECISIVE_BIC and np.isfinite(count.best_addition_hz):
+    if count.best_addition > -decisive and np.isfinite(count.best_addition_hz):
         f = count.best_addition_hz
         notes.append(QualityWarning(
             "count_undecided", (),
             f"the record does not rule out one mode more (near {f:.3f} Hz): adding it changes the criterion by "
-            f"{-count.best_addition:+.1f}, less than {DECISIVE_BIC:g} either way", f,
+            f"{-count.best_addition:+.1f}, less than {decisive:g} either way", f,
         ))  # fmt: skip
     if count.wanted:
         f, ratio, dof, rise_bic, in_diagram = count.wanted  # a Wanted
         notes.append(QualityWarning(
             "count_undecided", (),
             f"the record may hold one mode more near {f:.3f} Hz: adding it raises the likelihood far beyond chance "
-            f"(likelihood ratio {ratio:.1f} for its {dof} parameters, p < {LIKELIHOOD_ALPHA:g}) and the mode is the "
-            f"same in both halves of the record, but {_why_not_reported(rise_bic)}; {_what_to_do(in_diagram)}", f,
+            f"(likelihood ratio {ratio:.1f} for its {dof} parameters, p < {count.settings.likelihood_alpha:g}) and the "
+            f"mode is the same in both halves of the record, but {_why_not_reported(rise_bic)}; "
+            f"{_what_to_do(in_diagram)}", f,
         ))  # fmt: skip
     for start, went in count.carried_away:
         notes.append(QualityWarning(
@@ -494,7 +476,7 @@ def _notes(count: ModeCount, keep: np.ndarray, band_hz) -> list[QualityWarning]:
             f"one mode more near {f:.3f} Hz fits the whole record better but not each of its halves: a change "
             "during the record (a drifting frequency, a transient, a nonlinearity), not a mode; left out", f,
         ))  # fmt: skip
-    widened = [count.model.freq_hz[i] for i in np.flatnonzero(keep) if _other_structures(count, i)[1]]
+    widened = [count.model.freq_hz[i] for i in np.flatnonzero(keep) if _other_structures(count, i, same_row_freq)[1]]
     if widened:
         sizes = ", ".join(f"{alt.n_modes} modes ({d:+.1f})" for d, alt in count.alternatives)
         notes.append(QualityWarning(

@@ -14,25 +14,16 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from armaxmodal.modes.settings import DEFAULTS, LineSettings
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
-__all__ = ["UNDAMPED_LINE", "disturbance_lines"]
-
-#: |damping| below this is a line, not a structural mode: a hum on a fixture copy's output
-#: gave 5e-5-3e-4 at every order, a line on the input alone up to 1.7e-3; the lightest mode
-#: of the measured records is 4.8e-3 (the F-16's torsion). The diagnosis's UNDAMPED is the same.
-UNDAMPED_LINE = 2e-3
-#: poles of one line across orders agree to this relative frequency (the hum: 3e-4)
-LINE_FREQ_TOL = 1e-3
-#: the input carries the line too when its PSD there stands this far above the median of the
-#: neighbouring lines (10 dB; a Welch average of seven segments exceeds it by chance with
-#: probability ~1e-9)
-INPUT_LINE_RATIO = 10.0
+__all__ = ["disturbance_lines"]
 
 
 def disturbance_lines(
-    poles: pd.DataFrame, min_energy: float, recording: Recording, shared: str = "shared", min_support: float = 0.4
+    poles: pd.DataFrame, min_energy: float, recording: Recording, shared: str = "shared", min_support: float = 0.4,
+    lines: LineSettings = DEFAULTS.lines,
 ) -> list[QualityWarning]:
     """One ``periodic_disturbance`` warning per line of the shared-pole sweep.
 
@@ -50,6 +41,8 @@ def disturbance_lines(
         The ``source`` of the shared-pole fits; every other source is one sensor's sweep.
     min_support : float
         Share of the swept orders at which the line must appear (as for a mode).
+    lines : LineSettings
+        What a line is: damped below ``lines.undamped``, its poles within ``lines.freq_tol``.
 
     Returns
     -------
@@ -60,20 +53,20 @@ def disturbance_lines(
     pooled = poles[poles.source == shared]
     n_orders = pooled.na.nunique()
     strongest = pooled.groupby("na").energy.transform("max")
-    undriven = pooled[(pooled.damping.abs() < UNDAMPED_LINE) & (pooled.energy < min_energy * strongest)]
-    single = poles[(poles.source != shared) & (poles.damping.abs() < UNDAMPED_LINE)]
+    undriven = pooled[(pooled.damping.abs() < lines.undamped) & (pooled.energy < min_energy * strongest)]
+    single = poles[(poles.source != shared) & (poles.damping.abs() < lines.undamped)]
     warnings = []
-    for members in _groups(undriven.freq_hz.to_numpy()):
+    for members in _groups(undriven.freq_hz.to_numpy(), lines.freq_tol):
         line = undriven.iloc[members]
         count = line.na.nunique()
         if count < max(3, min_support * n_orders):
             continue
         freq = float(np.median(line.freq_hz))
-        near = np.abs(single.freq_hz.to_numpy() / freq - 1) < LINE_FREQ_TOL
+        near = np.abs(single.freq_hz.to_numpy() / freq - 1) < lines.freq_tol
         channels = tuple(dict.fromkeys(single.source[near]))
         seen = f"sensors whose own sweep shows it: {', '.join(channels)}" if channels else "no sensor alone shows it"
         prominence = _input_prominence(recording, freq)
-        if prominence >= INPUT_LINE_RATIO:
+        if prominence >= lines.input_ratio:
             where = (
                 f"the input carries the line too ({10 * np.log10(prominence):.0f} dB above its neighbouring lines) "
                 "but the outputs do not follow it as a response: a disturbance on the input sensor, or on every "
@@ -112,12 +105,12 @@ def _input_prominence(recording: Recording, freq: float) -> float:
     return peak / float(np.median(around)) if around.size and np.median(around) > 0 else np.inf
 
 
-def _groups(freqs: np.ndarray) -> list[list[int]]:
-    """Indices of ``freqs`` grouped by relative distance below LINE_FREQ_TOL (in order)."""
+def _groups(freqs: np.ndarray, tol: float) -> list[list[int]]:
+    """Indices of ``freqs`` grouped by relative distance below ``tol`` (in order)."""
     order = np.argsort(freqs)
     groups: list[list[int]] = []
     for i in order:
-        if groups and freqs[i] / freqs[groups[-1][-1]] - 1 < LINE_FREQ_TOL:
+        if groups and freqs[i] / freqs[groups[-1][-1]] - 1 < tol:
             groups[-1].append(int(i))
         else:
             groups.append([int(i)])

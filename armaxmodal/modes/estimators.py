@@ -9,7 +9,7 @@ of them weights by, both are consistent, and their differences are noise: each
 
 is at most standard normal (the two fits share the record, so the difference varies less than the
 sum of the variances says). Where the sum of ``z^2`` over every mode's frequency and damping ratio
-exceeds the ``ALPHA`` (1 %) point of its chi-squared distribution -- Hausman's specification test
+exceeds the ``estimators_alpha`` (1 %) point of its chi-squared distribution -- Hausman's specification test
 (Econometrica 46 (1978) 1251), with the two estimates taken as independent, which makes it
 conservative -- one of them is biased on this record: by model error the two weight differently
 (a nonlinearity, a hold the model lacks, leakage), or by diagram orders too low for a mode (a light
@@ -32,13 +32,12 @@ import pandas as pd
 import scipy.stats
 
 from armaxmodal.modes.intervals import QUANTITIES
+from armaxmodal.modes.settings import DEFAULTS
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.stats import Z95
 
-__all__ = ["ALPHA", "EARLIER_COLUMNS", "covering_both_estimators", "earlier_estimate"]
+__all__ = ["EARLIER_COLUMNS", "covering_both_estimators", "earlier_estimate"]
 
-#: the test's level: the one the segments' test of model error uses (:mod:`armaxmodal.modes.spread`)
-ALPHA = 0.01
 #: the columns a counted row keeps of the selection's earlier estimate of its mode
 EARLIER_COLUMNS = tuple(f"{q}_{part}" for q, _ in QUANTITIES for part in ("earlier", "earlier_sd"))
 
@@ -56,7 +55,8 @@ def earlier_estimate(row: dict) -> dict:
     return columns
 
 
-def covering_both_estimators(rows: pd.DataFrame) -> tuple[pd.DataFrame, list[QualityWarning]]:
+def covering_both_estimators(rows: pd.DataFrame, alpha: float = DEFAULTS.intervals.estimators_alpha
+                             ) -> tuple[pd.DataFrame, list[QualityWarning]]:  # fmt: skip
     """Counted ``rows`` (with :data:`EARLIER_COLUMNS`) with their intervals covering the earlier
     estimator's where the record shows the two disagree (the module's docstring).
 
@@ -65,6 +65,8 @@ def covering_both_estimators(rows: pd.DataFrame) -> tuple[pd.DataFrame, list[Qua
     rows : DataFrame
         The counted modes: ``freq_hz``, ``damping``, ``freq_sd``, ``damping_sd`` and the
         earlier estimate's columns (NaN where a mode has none).
+    alpha : float
+        The test's level (:class:`~armaxmodal.modes.settings.IntervalSettings`).
 
     Returns
     -------
@@ -87,7 +89,7 @@ def covering_both_estimators(rows: pd.DataFrame) -> tuple[pd.DataFrame, list[Qua
     out["estimator_widened"] = False
     if z.size == 0:
         return out, []
-    statistic, critical = float(np.sum(z**2)), float(scipy.stats.chi2.isf(ALPHA, z.size))
+    statistic, critical = float(np.sum(z**2)), float(scipy.stats.chi2.isf(alpha, z.size))
     if statistic <= critical:
         return out, []
     widened = np.zeros(len(out), dtype=bool)
@@ -102,7 +104,7 @@ def covering_both_estimators(rows: pd.DataFrame) -> tuple[pd.DataFrame, list[Qua
     note = QualityWarning(
         "estimators_disagree", (),
         f"the modal model's modes and the diagram's fit of them differ beyond their noise (sum of squared "
-        f"standardised differences {statistic:.1f} for {z.size} values, its {100 * (1 - ALPHA):g} % point "
+        f"standardised differences {statistic:.1f} for {z.size} values, its {100 * (1 - alpha):g} % point "
         f"{critical:.1f}): one of them is biased here, by model error the two weight differently (a nonlinearity, the "
         "inter-sample behaviour, leakage) or by orders too low for a mode. One record cannot say which, so every "
         "mode's interval covers both estimates"

@@ -28,7 +28,7 @@ import pandas as pd
 
 from armaxmodal.stats import Z95
 
-__all__ = ["QUANTITIES", "interval_columns", "with_intervals"]
+__all__ = ["QUANTITIES", "interval_columns", "not_separated", "with_intervals"]
 
 #: ``(part prefix, value column)`` of each quantity that has an interval
 QUANTITIES = (("freq", "freq_hz"), ("damping", "damping"))
@@ -80,3 +80,19 @@ def _part(modes: pd.DataFrame, column: str) -> np.ndarray:
     if column not in modes:
         return np.full(len(modes), np.nan)
     return modes[column].to_numpy(float)
+
+
+def not_separated(modes: pd.DataFrame, separation_sd: float) -> list[tuple[int, int, float]]:
+    """The neighbouring rows ``(i, i + 1, gap in SD)`` whose frequencies differ by less than
+    ``separation_sd`` standard deviations of the difference (each SD from its 95 % interval),
+    taken left to right without overlap."""
+    f = modes.freq_hz.to_numpy()
+    sd = (modes.freq_ci95_hi.to_numpy() - modes.freq_ci95_lo.to_numpy()) / (2 * Z95)
+    pairs, i = [], 0
+    while i < len(f) - 1:
+        gap = (f[i + 1] - f[i]) / float(np.hypot(sd[i], sd[i + 1]))
+        if gap < separation_sd:
+            pairs.append((i, i + 1, float(gap)))
+            i += 1
+        i += 1
+    return pairs

@@ -40,13 +40,11 @@ from typing import NamedTuple
 import numpy as np
 from scipy.special import chdtrc
 
-from armaxmodal._threads import single_blas_thread
-from armaxmodal.modes.modal_model import DAMPING_BOUNDS, DftLines, ModalModel, fit_modal_model
+from armaxmodal.modes.modal_model import DftLines, ModalModel, fit_modal_model
+from armaxmodal.modes.settings import DEFAULTS, CountSettings, LineSettings
 from armaxmodal.stats import MAX_DAMPING, Z95
 
 __all__ = [
-    "DECISIVE_BIC",
-    "LIKELIHOOD_ALPHA",
     "ModeCount",
     "Wanted",
     "Step",
@@ -57,42 +55,16 @@ __all__ = [
     "reported",
 ]
 
-#: a change of the criterion this large is "very strong" evidence (Kass & Raftery 1995): a
-#: mode's removal, or a candidate's addition, that moves it less leaves the count undecided
-DECISIVE_BIC = 10.0
-#: a refused addition whose likelihood ratio a chi-square of its parameters puts beyond this
-#: probability leaves the count undecided (when its mode is the same in both halves). BIC's
-#: penalty grows with the data, so a weakly seen mode can raise the likelihood far beyond chance
-#: and still lose on BIC; 1e-6 keeps the largest of a handful of candidates at chance (the
-#: battery's 46 bodies: at most the 1e-3 quantile) far below it
-LIKELIHOOD_ALPHA = 1e-6
-#: the residual's correlation across lines is summed up to this many lines (Bartlett's window):
-#: the widest structure of model error is a resonance's half-power band, 2 xi f = 3-10 Hz
-#: for the bodies, i.e. hundreds of lines; the sum stops earlier at the first negative value
-MAX_CORRELATION_LAG = 400
-#: search steps at most (each accepted step changes the count by one)
-MAX_STEPS = 6
-#: residual evaluations of a screening fit: the candidates are compared after this many steps
-#: from their starts, and the best of each kind is then iterated to convergence
-SCREEN_NFEV = 10
-#: a new pole's frequency and damping in the record's two halves may differ by this many
-#: standard deviations of their difference (a two-sided 1 % test would take 2.6)
-HALVES_SD = 3.0
-#: residual evaluations of the chosen model's last fit, to convergence
-FINAL_NFEV = 200
-#: a candidate addition within this relative frequency of a mode is that mode
-SAME_MODE_FREQ = 0.03
-#: a pole damped this little sits at the fit's floor (:data:`~armaxmodal.modes.modal_model.DAMPING_BOUNDS`):
-#: a line, a periodic disturbance or a frequency that moves, not a mode (the supine ride's 0.3 m/s^2
-#: hum at 12.5 Hz came out at 12.500 Hz, damping 1e-4; the bodies' modes are damped 0.3 % and more)
-LINE_DAMPING = 2 * DAMPING_BOUNDS[0]
+#: the count's thresholds when none are given (:class:`~armaxmodal.modes.settings.CountSettings`)
+COUNT = DEFAULTS.count
 
 
-def reported(model, band_hz) -> np.ndarray:
+def reported(model, band_hz, lines: LineSettings = DEFAULTS.lines) -> np.ndarray:
     """Which of a model's poles are modes of the band (bool per pole): not beyond it, not damped
-    beyond :data:`~armaxmodal.stats.MAX_DAMPING`, and not a line (damping at the fit's floor)."""
+    beyond :data:`~armaxmodal.stats.MAX_DAMPING`, and not a line (damped at the fit's floor,
+    ``lines.at_fit_floor``)."""
     f, x = model.freq_hz, model.damping
-    return (f >= band_hz[0]) & (f <= band_hz[1]) & (x <= MAX_DAMPING) & (x > LINE_DAMPING)
+    return (f >= band_hz[0]) & (f <= band_hz[1]) & (x <= MAX_DAMPING) & (x > lines.at_fit_floor)
 
 
 @dataclass(frozen=True)
@@ -146,14 +118,14 @@ class ModeCount:
     alternatives : tuple of (float, ModalModel)
         The models with one mode fewer or more that the record cannot tell from the chosen one:
         each converged, with its criterion's difference from the chosen model's (under
-        ``DECISIVE_BIC``). The reported intervals cover their modes
+        ``settings.decisive_bic``). The reported intervals cover their modes
         (``armaxmodal.modes.counted.counted_modes``).
     carried_away : tuple of (float, float)
         Starting modes the search carried to where no mode is founded, and which were left out
         of the chosen model: (start Hz, where it went Hz). See ``_without_unfounded``.
     wanted : Wanted or ()
         The best addition BIC refuses decisively while its likelihood ratio is significant
-        (beyond ``LIKELIHOOD_ALPHA``) and its mode is the same in both halves, or else the best
+        (beyond ``settings.likelihood_alpha``) and its mode is the same in both halves, or else the best
         split of a reported mode that passes the same test (its criterion's change either way:
         the search splits only one mode). Empty: none.
     stand_ins : tuple of (float, float, float)
@@ -175,10 +147,12 @@ class ModeCount:
     carried_away: tuple[tuple[float, float], ...] = ()
     wanted: Wanted | tuple = ()
     stand_ins: tuple[tuple[float, float, float], ...] = ()
+    settings: CountSettings = COUNT
+    lines: LineSettings = DEFAULTS.lines
 
     def reported(self, band_hz) -> np.ndarray:
         """Which of the model's poles are reported as modes of the band (bool per pole):
-        :func:`reported`'s, but the stand-ins (matched by frequency within 3 %, ``SAME_MODE_FREQ``:
+        :func:`reported`'s, but the stand-ins (matched by frequency within ``settings.same_mode_freq``:
         a long record's model is refitted to the whole record after the search).
 
         Parameters
@@ -190,13 +164,13 @@ class ModeCount:
         -------
         (n_modes,) bool ndarray
         """
-        keep = reported(self.model, band_hz)
+        keep = reported(self.model, band_hz, self.lines)
         for _, went, _ in self.stand_ins:
-            keep &= np.abs(np.log(self.model.freq_hz / went)) > SAME_MODE_FREQ
+            keep &= np.abs(np.log(self.model.freq_hz / went)) > self.settings.same_mode_freq
         return keep
 
 
-def effective_fraction(residual: np.ndarray, max_lag: int = MAX_CORRELATION_LAG) -> float:
+def effective_fraction(residual: np.ndarray, max_lag: int = COUNT.max_correlation_lag) -> float:
     """The fraction of DFT lines that are independent, from the residual's correlation across
     lines: ``1 / (1 + 2 sum_k rho_k)`` (Bartlett's effective sample size), the sum over lags
     ``k = 1, 2, ...`` up to the first non-positive ``rho_k`` or ``max_lag``.
@@ -231,14 +205,16 @@ def effective_fraction(residual: np.ndarray, max_lag: int = MAX_CORRELATION_LAG)
 
 class _Search:
     """The fits of one search: every candidate from the current model's poles, screened with a
-    few steps (:data:`SCREEN_NFEV`) and the best of each kind taken to convergence."""
+    few steps (``settings.screen_nfev``) and the best of each kind taken to convergence."""
 
-    def __init__(self, data: DftLines, hold: str, n_effective: float, max_nfev: int, n_jobs: int | None = 1):
+    def __init__(self, data: DftLines, hold: str, n_effective: float, max_nfev: int, n_jobs: int | None = 1,
+                 settings: CountSettings = COUNT, lines: LineSettings = DEFAULTS.lines):  # fmt: skip
         self.data, self.hold, self.n_eff, self.max_nfev, self.n_jobs = data, hold, n_effective, max_nfev, n_jobs
+        self.cfg, self.lines = settings, lines
         self.trials = 0
 
     def screened(self, starts: list[tuple[np.ndarray, np.ndarray]]) -> list[ModalModel | None]:
-        """Each start ``(freq_hz, damping)`` fitted for :data:`SCREEN_NFEV` steps, over the worker
+        """Each start ``(freq_hz, damping)`` fitted for ``settings.screen_nfev`` steps, over the worker
         threads: the fits are independent, and numpy releases the interpreter in their large
         array work (the count's screening is most of its time on a long record)."""
         from armaxmodal.estimate.pool import parallel_map
@@ -247,7 +223,7 @@ class _Search:
 
         def one(start):
             f, x = start
-            return fit_modal_model(self.data, f, x, self.hold, SCREEN_NFEV) if len(f) else None
+            return fit_modal_model(self.data, f, x, self.hold, self.cfg.screen_nfev) if len(f) else None
 
         return parallel_map(one, starts, self.n_jobs, min_items=2)
 
@@ -307,11 +283,11 @@ class _Search:
     def in_both_halves(self, trial: ModalModel, new: list[int], halves) -> bool:
         """The new poles of ``trial`` (indices ``new``) have the same frequency and damping in
         each half of the record, the model fitted there from the whole record's values, within
-        :data:`HALVES_SD` standard deviations of the difference: a mode of the structure is the
+        ``settings.halves_sd`` standard deviations of the difference: a mode of the structure is the
         same mode in both halves, while a pole that soaks up a change during the record or a
         nonlinearity (a drifting frequency, a doublet beside a real mode) lands elsewhere."""
         self.trials += 2
-        agree = agree_in_halves(self.data, trial, halves, self.hold, self.max_nfev)
+        agree = agree_in_halves(self.data, trial, halves, self.hold, self.max_nfev, self.cfg.halves_sd)
         return all(agree[i] for i in new)
 
     def removals(self, current: ModalModel) -> list[tuple[str, float, ModalModel | None]]:
@@ -325,7 +301,7 @@ class _Search:
         mode cost twice the fits and found nothing more on the bodies' battery.)"""
         trials = []
         for f, x in candidates:
-            if current.n_modes and np.min(np.abs(current.freq_hz / f - 1)) <= SAME_MODE_FREQ:
+            if current.n_modes and np.min(np.abs(current.freq_hz / f - 1)) <= self.cfg.same_mode_freq:
                 continue
             trials.append(("add", float(f), np.r_[current.freq_hz, f], np.r_[current.damping, x]))
         for m in [_nearest(current.freq_hz, peak_hz)] if current.n_modes else []:
@@ -361,7 +337,7 @@ def _margins(search: _Search, here: float, current: ModalModel, removed, best_re
 
 
 def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, halves=()):
-    """The chosen model without the starting poles the search carried beyond :data:`SAME_MODE_FREQ`
+    """The chosen model without the starting poles the search carried beyond ``settings.same_mode_freq``
     of every start to where no mode is founded, refitted to convergence. A pole reported there is
     a new pole and must show what a mode has: a damping the record resolves, and the same
     frequency and damping in both halves of the record (``_Search.in_both_halves``; without
@@ -374,12 +350,12 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     which the halves do not share. Judged on the converged model only: on the way, a moved pole
     may stand in for a mode not yet added (a body's 15.78 Hz start stood at 19.99 Hz until the
     mode above the band was added, then came back). Such poles the model needs (the criterion rises
-    by :data:`DECISIVE_BIC` or more without them) stay in it, unreported. Returns ``(model, left
+    by ``settings.decisive_bic`` or more without them) stay in it, unreported. Returns ``(model, left
     out: ((start Hz, Hz), ...), kept unreported: ((start Hz, Hz, rise), ...))``."""
     start_hz = np.atleast_1d(np.asarray(start_hz, float))
-    shown = reported(model, search.data.band_hz)
+    shown = reported(model, search.data.band_hz, search.lines)
     moved = [(i, j) for i, j in matched_poles(start_hz, model.freq_hz)
-             if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > SAME_MODE_FREQ]  # fmt: skip
+             if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > search.cfg.same_mode_freq]  # fmt: skip
     unfounded = []
     for i, j in moved:
         f, x = model.freq_hz[i], model.damping[i]
@@ -392,9 +368,9 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     keep = np.setdiff1d(np.arange(model.n_modes), [i for i, _ in unfounded])
     if not unfounded or keep.size == 0:  # nothing else to stand on: the search's model stays
         return model, (), ()
-    without = search.fit(model.freq_hz[keep], model.damping[keep], FINAL_NFEV)
+    without = search.fit(model.freq_hz[keep], model.damping[keep], search.cfg.final_nfev)
     rise = search.bic(without) - search.bic(model)
-    if rise >= DECISIVE_BIC:  # the model needs them: they stay in it, unreported (a body's mode at
+    if rise >= search.cfg.decisive_bic:  # the model needs them: they stay in it, unreported (a body's mode at
         # 23.93 Hz, near the band's top, came out at 24.74 Hz with its damping unresolved; without
         # it the 13.93 and 16.43 Hz modes collapsed into one at 16.20 Hz, BIC +873)
         return model, (), tuple((*moved, float(rise)) for _, moved in unfounded)
@@ -404,23 +380,24 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
 def _equally_good(search: _Search, chosen: ModalModel, rise: np.ndarray, addition: ModalModel | None):
     """The models with one mode fewer (each mode whose removal the criterion barely resists) or
     one more (the best addition, when it barely loses), converged on the chosen model's weights
-    and kept when their criterion stays within ``DECISIVE_BIC`` of the chosen one's:
+    and kept when their criterion stays within ``settings.decisive_bic`` of the chosen one's:
     ``[(difference, model), ...]``. Only an undecided count costs these fits."""
-    here, out = search.bic(chosen), []
-    starts = [(np.delete(chosen.freq_hz, m), np.delete(chosen.damping, m)) for m in np.flatnonzero(rise < DECISIVE_BIC)]
+    here, out, decisive = search.bic(chosen), [], search.cfg.decisive_bic
+    starts = [(np.delete(chosen.freq_hz, m), np.delete(chosen.damping, m)) for m in np.flatnonzero(rise < decisive)]
     if addition is not None:
         starts.append((addition.freq_hz, addition.damping))
     for freq_hz, damping in starts:
-        model = search.fit(freq_hz, damping, FINAL_NFEV)
-        if model is not None and abs(search.bic(model) - here) < DECISIVE_BIC:
+        model = search.fit(freq_hz, damping, search.cfg.final_nfev)
+        if model is not None and abs(search.bic(model) - here) < decisive:
             out.append((float(search.bic(model) - here), model))
     return tuple(out)
 
 
-def agree_in_halves(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: int = 40) -> np.ndarray:
+def agree_in_halves(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: int = COUNT.halves_nfev,
+                    halves_sd: float = COUNT.halves_sd) -> np.ndarray:  # fmt: skip
     """Per pole of ``model``: the record's two halves (``halves``, lines weighted as ``data``),
     each fitted from ``model``'s poles, give the same frequency and damping within
-    :data:`HALVES_SD` standard deviations of the difference (each half's pole the one nearest
+    ``halves_sd`` standard deviations of the difference (each half's pole the one nearest
     the model's). Two fits.
 
     Returns
@@ -433,7 +410,7 @@ def agree_in_halves(data: DftLines, model: ModalModel, halves, hold: str, max_nf
         j, k = _nearest(a.freq_hz, f), _nearest(b.freq_hz, f)
         for one, two, sd_one, sd_two in ((a.freq_hz, b.freq_hz, a.freq_sd, b.freq_sd),
                                          (a.damping, b.damping, a.damping_sd, b.damping_sd)):  # fmt: skip
-            agree[i] &= bool(abs(one[j] - two[k]) <= HALVES_SD * np.hypot(sd_one[j], sd_two[k]))
+            agree[i] &= bool(abs(one[j] - two[k]) <= halves_sd * np.hypot(sd_one[j], sd_two[k]))
     return agree
 
 
@@ -460,7 +437,7 @@ def _new_poles(old_hz: np.ndarray, new_hz: np.ndarray) -> list[int]:
     return [i for i in range(len(new_hz)) if i not in paired]
 
 
-def residual_peak(model: ModalModel, data: DftLines, width_lines: int = 9) -> tuple[float, float]:
+def residual_peak(model: ModalModel, data: DftLines, width_lines: int = COUNT.peak_width_lines) -> tuple[float, float]:
     """Where the model misses most: the line of the largest residual power (summed over
     sensors, smoothed over ``width_lines``), with a damping from its width; (Hz, ratio)."""
     power = np.sum(np.abs(model.residual) ** 2, axis=1)
@@ -481,7 +458,7 @@ def _wanted(search: _Search, current: ModalModel, addition, gain: float, new_hz:
     """The refused addition the likelihood wants (see :attr:`ModeCount.wanted`), or ``()``. The
     likelihood ratio is ``-2 ln L`` of the current model less the addition's, on the effective
     lines; it is a chi-square of the parameters one mode adds where the record holds no more."""
-    if addition is None or addition[2] is None or gain > -DECISIVE_BIC or len(halves) != 2:
+    if addition is None or addition[2] is None or gain > -search.cfg.decisive_bic or len(halves) != 2:
         return ()
     return _likelihood_wants(search, current, addition[2], new_hz, gain, halves, in_diagram=True)
 
@@ -489,10 +466,10 @@ def _wanted(search: _Search, current: ModalModel, addition, gain: float, new_hz:
 def _likelihood_wants(search: _Search, current: ModalModel, model: ModalModel, new_hz: float, gain: float,
                       halves, in_diagram: bool) -> tuple:  # fmt: skip
     """A :class:`Wanted` when ``model``'s likelihood ratio over ``current`` is beyond
-    :data:`LIKELIHOOD_ALPHA` and its new poles are the same in both halves, else ``()``."""
+    ``settings.likelihood_alpha`` and its new poles are the same in both halves, else ``()``."""
     dof = model.n_params - current.n_params
     ratio = current.neg2_loglik_on(search.n_eff) - model.neg2_loglik_on(search.n_eff)
-    if dof <= 0 or chdtrc(dof, ratio) >= LIKELIHOOD_ALPHA:
+    if dof <= 0 or chdtrc(dof, ratio) >= search.cfg.likelihood_alpha:
         return ()
     if not search.in_both_halves(model, _new_poles(current.freq_hz, model.freq_hz), halves):
         return ()
@@ -516,7 +493,7 @@ def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) 
     if not screened:
         return (), None
     best = min(screened, key=search.bic)
-    model = search.fit(best.freq_hz, best.damping, FINAL_NFEV)
+    model = search.fit(best.freq_hz, best.damping, search.cfg.final_nfev)
     new = _new_poles(current.freq_hz, model.freq_hz) if model is not None else []
     if not search.resolved(model) or not new:
         return (), None
@@ -526,7 +503,6 @@ def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) 
     return _likelihood_wants(search, current, model, f, gain, halves, in_diagram), model
 
 
-@single_blas_thread
 def count_modes(
     data: DftLines,
     freq_hz,
@@ -539,6 +515,8 @@ def count_modes(
     supported: Callable[[float, float], bool] | None = None,
     search: bool = True,
     n_jobs: int | None = None,
+    settings: CountSettings = COUNT,
+    lines: LineSettings = DEFAULTS.lines,
 ) -> ModeCount:
     """Choose the number of modes by nested tests of free refits (see the module notes).
 
@@ -566,6 +544,10 @@ def count_modes(
         measured (each mode's removal, the best addition), but no step is taken and no mode left out.
     n_jobs : int, optional
         Worker threads for the screening fits (default: all cores).
+    settings : CountSettings
+        The count's thresholds (:mod:`armaxmodal.modes.settings`).
+    lines : LineSettings
+        Which poles are lines, not modes.
 
     Returns
     -------
@@ -577,11 +559,12 @@ def count_modes(
     data = data.noise_weighted(start_model)
     start_model = fit_modal_model(data, start_model.freq_hz, start_model.damping, hold, max_nfev)
     fraction = effective_fraction(start_model.residual)
-    searching, search = search, _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev, n_jobs)
+    searching, search = search, _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev, n_jobs,
+                                        settings, lines)  # fmt: skip
     # a starting mode the free fit carried away (a weak mode's pole to beyond the band) is tried
     # again as an addition
     lost = [(f, x) for f, x in zip(np.atleast_1d(freq_hz), np.atleast_1d(damping), strict=True)
-            if np.min(np.abs(np.log(start_model.freq_hz / f))) > SAME_MODE_FREQ]  # fmt: skip
+            if np.min(np.abs(np.log(start_model.freq_hz / f))) > settings.same_mode_freq]  # fmt: skip
     current, steps, candidates, unconfirmed = start_model, [], list(candidates) + lost, []
 
     def neighbours():
@@ -604,7 +587,7 @@ def count_modes(
     while True:
         here, removed, best_removal, best_addition = neighbours()
         better = [t for t in (best_removal, best_addition) if t is not None and search.bic(t[2]) < here]
-        if not better or len(steps) == (MAX_STEPS if searching else 0):
+        if not better or len(steps) == (settings.max_steps if searching else 0):
             break
         step = min(better, key=lambda t: search.bic(t[2]))
         new = _new_poles(current.freq_hz, step[2].freq_hz)
@@ -615,7 +598,7 @@ def count_modes(
     # the reported model is the likelihood's maximum, not where the search's cap left it (a body's
     # fifth mode stood at 23.73 Hz after the search and 24.35 Hz converged, for the exact 25.48)
     search.data = data.noise_weighted(current)  # the weights the chosen model's own levels give
-    final = search.fit(current.freq_hz, current.damping, FINAL_NFEV)
+    final = search.fit(current.freq_hz, current.damping, settings.final_nfev)
     if search.bic(final) < here:
         rise, gain, current = rise + here - search.bic(final), gain - (here - search.bic(final)), final
     current, carried_away, stand_ins = (_without_unfounded(search, freq_hz, current, supported, halves)
@@ -623,12 +606,13 @@ def count_modes(
     if carried_away:  # the model lost a pole: its neighbours are judged again, from where it stands
         here, removed, best_removal, best_addition = neighbours()
         rise, gain, new_hz = _margins(search, here, current, removed, best_removal, best_addition)
-    close = best_addition[2] if best_addition is not None and gain > -DECISIVE_BIC else None
+    close = best_addition[2] if best_addition is not None and gain > -settings.decisive_bic else None
     alternatives = _equally_good(search, current, rise, close)
     wanted = _wanted(search, current, best_addition, gain, new_hz, halves) if searching else ()
     if searching and not wanted and close is None:  # one mode more is already undecided: said once
         wanted, split = _split_wanted(search, current, halves, supported)
-        if wanted and abs(wanted.rise) < DECISIVE_BIC:  # as good as the chosen model: its modes are the record's too
+        # as good as the chosen model: its modes are the record's too
+        if wanted and abs(wanted.rise) < settings.decisive_bic:
             alternatives += ((wanted.rise, split),)
     return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
-                     tuple(unconfirmed), alternatives, carried_away, wanted, stand_ins)  # fmt: skip
+                     tuple(unconfirmed), alternatives, carried_away, wanted, stand_ins, settings, lines)  # fmt: skip

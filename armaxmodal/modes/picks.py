@@ -13,16 +13,12 @@ import pandas as pd
 
 from armaxmodal.exceptions import PickError
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, order_criteria, representative_pole
-from armaxmodal.modes.support import CANDIDATE_MIN_ORDERS
+from armaxmodal.modes.settings import DEFAULTS, ClusterSettings
 
-__all__ = ["PICK_REACH", "check_picks", "picked_modes"]
-
-#: a pick takes a cluster whose median frequency lies within this relative distance of it: the
-#: clustering's own reach, so a pick never takes a column the diagram shows as another mode's
-PICK_REACH = 0.05
+__all__ = ["check_picks", "picked_modes"]
 
 
-def check_picks(picks, band, fs: float) -> np.ndarray:
+def check_picks(picks, band, fs: float, cluster: ClusterSettings = DEFAULTS.cluster) -> np.ndarray:
     """The picked frequencies (Hz) as a sorted array, refused with the reason when one is not a
     finite positive number, lies outside ``band`` (Hz) or at or above the Nyquist frequency, or
     when two picks would take one cluster.
@@ -34,6 +30,8 @@ def check_picks(picks, band, fs: float) -> np.ndarray:
     band : (float, float) or None
     fs : float
         Sampling rate of the analysed record, Hz.
+    cluster : ClusterSettings
+        The clustering's settings (a pick's reach is its frequency reach).
 
     Returns
     -------
@@ -54,19 +52,20 @@ def check_picks(picks, band, fs: float) -> np.ndarray:
     if outside.size:
         raise PickError(f"picks {outside.tolist()} Hz lie outside the band {band[0]:g}-{band[1]:g} Hz; pick inside "
                         "it, or widen --band.")  # fmt: skip
-    close = np.flatnonzero(np.diff(values) / values[:-1] <= PICK_REACH)
+    close = np.flatnonzero(np.diff(values) / values[:-1] <= cluster.pick_reach)
     if close.size:
         i = int(close[0])
         raise PickError(
-            f"picks {values[i]:g} and {values[i + 1]:g} Hz are within {100 * PICK_REACH:g} % of each other: both "
-            "would take the same cluster of the diagram; give one."
+            f"picks {values[i]:g} and {values[i + 1]:g} Hz are within {100 * cluster.pick_reach:g} % of each other: "
+            "both would take the same cluster of the diagram; give one."
         )
     return values
 
 
-def picked_modes(diagram, picks: np.ndarray, band, nas, clustering) -> tuple[pd.DataFrame, list[np.ndarray]]:
+def picked_modes(diagram, picks: np.ndarray, band, nas, cluster: ClusterSettings = DEFAULTS.cluster
+                 ) -> tuple[pd.DataFrame, list[np.ndarray]]:  # fmt: skip
     """For each pick, the nearest cluster of the diagram's shared poles that holds poles of at
-    least :data:`~armaxmodal.modes.support.CANDIDATE_MIN_ORDERS` orders, reported from its
+    least ``cluster.min_orders`` orders, reported from its
     lowest-BIC fit as an automatic mode is (:func:`armaxmodal.modes.clusters.mode_row`).
 
     Parameters
@@ -77,8 +76,8 @@ def picked_modes(diagram, picks: np.ndarray, band, nas, clustering) -> tuple[pd.
     band : (float, float) or None
     nas : list of int
         The diagram's orders.
-    clustering : (float, float)
-        The clustering's relative frequency and damping reach.
+    cluster : ClusterSettings
+        The clustering's settings.
 
     Returns
     -------
@@ -89,26 +88,28 @@ def picked_modes(diagram, picks: np.ndarray, band, nas, clustering) -> tuple[pd.
     Raises
     ------
     PickError
-        When no such cluster lies within :data:`PICK_REACH` of a pick, naming the nearest.
+        When no such cluster lies within the clustering's reach of a pick, naming the nearest.
     """
     cand = candidate_poles(diagram.poles, band)
     kept = cand[(cand.rejected == "") & (cand.damping > 0)]
-    clusters = [c for c in cluster_poles(kept, nas, *clustering) if len(set(kept.loc[c].na)) >= CANDIDATE_MIN_ORDERS]
+    clusters = cluster_poles(kept, nas, cluster.freq, cluster.damping)
+    clusters = [c for c in clusters if len(set(kept.loc[c].na)) >= cluster.min_orders]
     centres = np.array([float(kept.loc[c].freq_hz.median()) for c in clusters])
     bic = order_criteria(diagram)
     rows, vectors = [], []
     for f in picks:
         if not centres.size:
-            raise PickError(f"pick {f:g} Hz: the diagram holds no pole stable over {CANDIDATE_MIN_ORDERS} orders "
+            raise PickError(f"pick {f:g} Hz: the diagram holds no pole stable over {cluster.min_orders} orders "
                             "in the band; extend --orders or check that the input excites the structure.")  # fmt: skip
         k = int(np.argmin(np.abs(np.log(centres / f))))
-        if abs(centres[k] / f - 1) > PICK_REACH:
+        if abs(centres[k] / f - 1) > cluster.pick_reach:
             raise PickError(
-                f"pick {f:g} Hz: no stable cluster of the diagram within {100 * PICK_REACH:g} % (the nearest is at "
-                f"{centres[k]:.3f} Hz, {len(clusters[k])} orders); pick a column of the diagram, or extend --orders."
+                f"pick {f:g} Hz: no stable cluster of the diagram within {100 * cluster.pick_reach:g} % (the nearest "
+                f"is at {centres[k]:.3f} Hz, {len(clusters[k])} orders); pick a column of the diagram, or extend "
+                "--orders."
             )
         sub = kept.loc[clusters[k]]
-        rep = representative_pole(diagram, sub, bic, {})
+        rep = representative_pole(diagram, sub, bic, {}, cluster.finished_max_shift)
         if rep is None:
             raise PickError(
                 f"pick {f:g} Hz: the cluster at {centres[k]:.3f} Hz has no order whose fit keeps a positive damping "

@@ -20,7 +20,7 @@ from armaxmodal.modes.spread import (
     segment_poles,
     split_segments,
 )
-from armaxmodal.modes.working import WorkingSelection
+from armaxmodal.modes.state import SelectionState
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.spectra import excited_band
@@ -78,8 +78,8 @@ class RefitFailure:
 
 
 def refined_modes(
-    diagram, work: WorkingSelection, refinement, cluster_freq, cluster_damping, merge_mac, relaxed=False
-) -> WorkingSelection:
+    diagram, work: SelectionState, refinement, cluster_freq, cluster_damping, merge_mac, relaxed=False
+) -> SelectionState:
     """The frequency-domain refit (:func:`armaxmodal.modes.refine.refine_modes`, or a
     :class:`RefitFailure` when it could not be made, which leaves the selection without one)
     reported for a band-limited record, and kept as the selection's ``refinement``.

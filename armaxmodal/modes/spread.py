@@ -17,16 +17,14 @@ from functools import partial
 import numpy as np
 import pandas as pd
 
+from armaxmodal.modes.settings import DEFAULTS
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
 __all__ = ["segment_spread", "apply_segment_spread", "segment_jobs", "segment_poles", "split_segments", "N_SEGMENTS"]
 
+#: the record's parts the spread is measured over, when not given (``select_modes(segments=...)``)
 N_SEGMENTS = 3
-#: family-wise false-alarm rate of the spread test over all modes and both parameters
-SPREAD_ALPHA = 0.01
-#: a segment pole is the mode's when within this relative frequency of it
-MATCH_FREQ = 0.05
 
 
 def split_segments(recording: Recording, k: int = N_SEGMENTS) -> list[Recording]:
@@ -46,6 +44,7 @@ def segment_spread(
     n_segments: int = N_SEGMENTS,
     n_jobs: int | None = None,
     fitted: dict | None = None,
+    match_freq: float = DEFAULTS.intervals.match_freq,
 ):
     """Between-segment standard deviation of each mode's frequency and damping.
 
@@ -63,12 +62,14 @@ def segment_spread(
     fitted : dict, optional
         Segment poles already computed, ``{(orders, k): poles}`` (:func:`segment_poles`);
         the jobs not in it are fitted here.
+    match_freq : float
+        A segment's pole is the mode's when within this relative frequency of it.
 
     Returns
     -------
     DataFrame
         Per mode: ``freq_segment_sd`` (Hz), ``damping_segment_sd``, ``segments_found``
-        (segments in which a pole within 5 % of the mode's frequency was found).
+        (segments in which a pole within ``match_freq`` of the mode's frequency was found).
     """
     from armaxmodal.estimate.pool import parallel_map
 
@@ -91,7 +92,7 @@ def segment_spread(
         for poles in poles_by_orders[orders]:
             if poles is None or poles.empty:
                 continue
-            ok = poles[(poles.damping > 0) & (np.abs(poles.freq_hz / mode.freq_hz - 1) <= MATCH_FREQ)]
+            ok = poles[(poles.damping > 0) & (np.abs(poles.freq_hz / mode.freq_hz - 1) <= match_freq)]
             if ok.empty:
                 continue
             near = ok.iloc[int(np.argmin(np.abs(ok.freq_hz - mode.freq_hz)))]
@@ -123,8 +124,10 @@ def segment_poles(parts: list[Recording], job) -> pd.DataFrame | None:
     return pd.DataFrame(pole_rows(fit, SHARED)) if fit is not None else None
 
 
-def apply_segment_spread(modes: pd.DataFrame, spread: pd.DataFrame, n_segments: int = N_SEGMENTS):
+def apply_segment_spread(modes: pd.DataFrame, spread: pd.DataFrame, n_segments: int = N_SEGMENTS,
+                         alpha: float = DEFAULTS.intervals.spread_alpha):  # fmt: skip
     """Join the spread to ``modes``, set the segments' part of the intervals where it dominates, and say so.
+    ``alpha``: the test's family-wise false-alarm rate over all modes and both parameters.
 
     Returns ``(modes, warnings)``; ``modes`` gains the spread columns, ``model_error_dominates``
     (bool) and ``freq_segment_half`` / ``damping_segment_half``: the half-width of the segments'
@@ -135,7 +138,7 @@ def apply_segment_spread(modes: pd.DataFrame, spread: pd.DataFrame, n_segments: 
 
     modes = pd.concat([modes.reset_index(drop=True), spread.reset_index(drop=True)], axis=1)
     flagged = []
-    crit = chdtri(n_segments - 1, SPREAD_ALPHA / (2 * max(1, len(modes))))  # upper-tail quantile
+    crit = chdtri(n_segments - 1, alpha / (2 * max(1, len(modes))))  # upper-tail quantile
     t_k = stdtrit(n_segments - 1, 0.975)
     dominates = np.zeros(len(modes), dtype=bool)
     halves = {"freq": np.full(len(modes), np.nan), "damping": np.full(len(modes), np.nan)}

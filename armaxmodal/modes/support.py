@@ -24,9 +24,10 @@ from armaxmodal.modes.frf_check import coherent_peaks, explains
 from armaxmodal.modes.lines import coherent_lines, resolving_nperseg
 from armaxmodal.modes.modal_check import ModalCheck, poles_of, rss_at
 from armaxmodal.modes.poles import SHARED
+from armaxmodal.modes.settings import ClusterSettings
 from armaxmodal.recording import Recording
 
-__all__ = ["CANDIDATE_MIN_ORDERS", "MODEL_ERROR_RISE", "ModeSupport", "mode_support", "nearest_neighbour",
+__all__ = ["MODEL_ERROR_RISE", "ModeSupport", "mode_support", "nearest_neighbour",
            "overlapping_neighbour", "peak_support", "stable_in_diagram"]  # fmt: skip
 
 #: a mode is kept when leaving it out raises the misfit of some output by at least this
@@ -44,9 +45,6 @@ NEIGHBOUR_BANDWIDTHS = 3.0
 #: supine ride, heavily damped modes overlap, and a neighbour free to move 30 % took over
 #: 5.8 Hz, then 7.6 and 8.3 Hz in turn, leaving two of four modes
 NEIGHBOUR_MAX_SHIFT = 0.05
-#: a pole is stable across the diagram when poles of at least this many orders lie near it (a
-#: left-out cluster is tried as an addition only then, :mod:`armaxmodal.modes.counted`)
-CANDIDATE_MIN_ORDERS = 3
 
 
 @dataclass(frozen=True)
@@ -160,8 +158,8 @@ def peak_support(recording: Recording, freq_hz: float, damping: float, band=None
     return max(near, key=lambda p: p[2])[0] if near else None
 
 
-def stable_in_diagram(diagram, band, cluster_freq: float, cluster_damping: float):
-    """``supported(f, x)``: poles of at least :data:`CANDIDATE_MIN_ORDERS` orders of the diagram
+def stable_in_diagram(diagram, band, cluster: ClusterSettings):
+    """``supported(f, x)``: poles of at least ``cluster.min_orders`` orders of the diagram
     lie within the clustering's reach of frequency ``f`` (Hz) and damping ``x``. Poles rejected
     for their residue count: stability across orders is the pole's, and a weakly driven mode (a
     light chain's 9.32 Hz, rejected as a negligible residue at every order) is still a mode."""
@@ -172,7 +170,7 @@ def stable_in_diagram(diagram, band, cluster_freq: float, cluster_damping: float
     f, x, na = kept.freq_hz.to_numpy(), kept.damping.to_numpy(), kept.na.to_numpy()
 
     def supported(freq_hz: float, damping: float) -> bool:
-        near = (np.abs(f / freq_hz - 1) <= cluster_freq) & (np.abs(x / damping - 1) <= cluster_damping)
-        return len(set(na[near].tolist())) >= CANDIDATE_MIN_ORDERS
+        near = (np.abs(f / freq_hz - 1) <= cluster.freq) & (np.abs(x / damping - 1) <= cluster.damping)
+        return len(set(na[near].tolist())) >= cluster.min_orders
 
     return supported

@@ -87,7 +87,7 @@ def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[st
     """
     from armaxmodal._threads import one_blas_thread
     from armaxmodal.modes.diagram import stabilisation_diagram
-    from armaxmodal.modes.selection import select_modes
+    from armaxmodal.modes.pipeline import select_modes
 
     start = time.perf_counter()
     orders = None if settings.orders is None else range(settings.orders[0], settings.orders[1] + 1, 2)

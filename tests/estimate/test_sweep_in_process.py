@@ -23,8 +23,8 @@ from armaxmodal.modes.diagram import (
     stabilisation_diagram,
     sweep_fit,
 )
+from armaxmodal.modes.pipeline import select_modes
 from armaxmodal.modes.poles import SHARED
-from armaxmodal.modes.selection import select_modes
 from armaxmodal.modes.spread import N_SEGMENTS
 from armaxmodal.recording import Recording
 
@@ -498,7 +498,9 @@ def test_a_line_the_input_does_not_drive_is_named_as_a_periodic_disturbance(ride
 def test_a_structure_damped_below_the_line_threshold_is_not_a_disturbance():
     """Modes at 0.066 % and 0.089 % damping are as undamped as a hum, but the input drives
     them (residues 11 % and 100 % of the strongest): modes, never a periodic disturbance."""
-    from armaxmodal.modes.disturbance import UNDAMPED_LINE
+    from armaxmodal.modes.settings import DEFAULTS
+
+    UNDAMPED_LINE = DEFAULTS.lines.undamped
 
     s = am.Structure.from_chain([10.0, 5.0], [8000.0, 0.0], [0.5, 0.0], [12000.0], [0.3], ("m1", "m2"))
     assert max(s.modes().damping) < UNDAMPED_LINE

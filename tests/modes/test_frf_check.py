@@ -12,7 +12,7 @@ import armaxmodal as am
 from armaxmodal.modes.diagram import stabilisation_diagram
 from armaxmodal.modes.frf_check import peak_prominences, unexplained_peaks
 from armaxmodal.modes.lines import resolving_nperseg
-from armaxmodal.modes.selection import select_modes
+from armaxmodal.modes.pipeline import select_modes
 
 
 @pytest.fixture(scope="module")

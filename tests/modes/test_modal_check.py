@@ -12,7 +12,8 @@ import armaxmodal as am
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.diagram import DEFAULT_ORDERS, stabilisation_diagram
 from armaxmodal.modes.modal_check import MODEL_ERROR_LIMIT, ModalCheck, check_modes
-from armaxmodal.modes.selection import select_modes
+from armaxmodal.modes.pipeline import select_modes
+from armaxmodal.modes.settings import ClusterSettings
 from armaxmodal.recording import Recording
 
 #: the exact modes of the lightly damped ride leave 10 % beyond the H1's random error: the
@@ -90,7 +91,7 @@ def test_the_verdict_is_the_limit_on_every_checked_output():
 
 def test_a_cluster_the_support_rule_left_out_enters_when_the_check_needs_it(light_ride):
     from armaxmodal.modes.completeness import modes_the_check_adds
-    from armaxmodal.modes.working import WorkingSelection
+    from armaxmodal.modes.state import SelectionState
 
     s, rec = light_ride
     diagram = stabilisation_diagram(rec, range(2, 21, 2), per_sensor=False)
@@ -100,8 +101,8 @@ def test_a_cluster_the_support_rule_left_out_enters_when_the_check_needs_it(ligh
     nas = sorted(o.na for o in diagram.orders)
     one = sel.modes.iloc[[0]].reset_index(drop=True)
     check = check_modes(rec, one.freq_hz, one.damping)
-    start = WorkingSelection(one, sel.shapes[:, [0]], check=check)
-    added = modes_the_check_adds(diagram, start, None, nas, (0.05, 0.5))
+    start = SelectionState(one, sel.shapes[:, [0]], check=check)
+    added = modes_the_check_adds(diagram, start, None, nas, ClusterSettings())
     np.testing.assert_allclose(added.modes.freq_hz, truth, rtol=0.01)
     assert added.shapes.shape == (2, 2) and added.check.passed
 

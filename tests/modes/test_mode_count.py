@@ -14,13 +14,16 @@ from armaxmodal.modes.counted import (
     _one_where_not_separated,
     _other_structures,
     dropped_where_peaks_remain,
-    not_separated,
 )
-from armaxmodal.modes.intervals import with_intervals
+from armaxmodal.modes.intervals import not_separated, with_intervals
 from armaxmodal.modes.modal_model import DftLines, fit_modal_model
-from armaxmodal.modes.mode_count import DECISIVE_BIC, ModeCount, count_modes, effective_fraction, reported
-from armaxmodal.modes.selection import ModeSelection, _not_separated
+from armaxmodal.modes.mode_count import ModeCount, count_modes, effective_fraction, reported
+from armaxmodal.modes.result import ModeSelection, not_separated_notes
+from armaxmodal.modes.settings import ClusterSettings, CountSettings, SelectionSettings
 from armaxmodal.stats import Z95
+
+DECISIVE_BIC = CountSettings().decisive_bic  # the count's own level
+SAME_ROW = ClusterSettings().same_row_freq  # the clustering's reach
 
 #: the supine chain's exact modes are found within these (the issue's limits; its bounds on a
 #: 120 s ride are 0.1-1.5 % in frequency)
@@ -136,17 +139,17 @@ def _count(rise, best_addition, best_hz=12.0, freq=(5.0, 30.0), damping=(0.2, 0.
 def test_undecided_counts_and_out_of_band_poles_are_said():
     keep = reported(SimpleNamespace(freq_hz=np.array([5.0, 30.0, 10.0]), damping=np.array([0.2, 0.3, 0.9])), (1, 25))
     assert keep.tolist() == [True, False, False]  # above the band; damped beyond MAX_DAMPING
-    decided = _notes(_count([50.0, 60.0], -40.0), np.array([True, False]), (1.0, 25.0))
+    decided = _notes(_count([50.0, 60.0], -40.0), np.array([True, False]), (1.0, 25.0), SAME_ROW)
     assert [n.code for n in decided] == ["mode_count"]  # only the out-of-band pole
-    removal = _notes(_count([DECISIVE_BIC - 1, 60.0], -40.0), np.array([True, False]), (1.0, 25.0))
+    removal = _notes(_count([DECISIVE_BIC - 1, 60.0], -40.0), np.array([True, False]), (1.0, 25.0), SAME_ROW)
     assert "count_undecided" in [n.code for n in removal]
-    addition = _notes(_count([50.0, 60.0], -DECISIVE_BIC + 1), np.array([True, False]), (1.0, 25.0))
+    addition = _notes(_count([50.0, 60.0], -DECISIVE_BIC + 1), np.array([True, False]), (1.0, 25.0), SAME_ROW)
     assert [n.value for n in addition if n.code == "count_undecided"] == [12.0]
 
 
 def _structure_hull(count, i):
     """Mode ``i``'s reported intervals: its own and the other structures' part, combined on output."""
-    other, widened = _other_structures(count, i)
+    other, widened = _other_structures(count, i, SAME_ROW)
     m = count.model
     row = pd.DataFrame([{"freq_hz": m.freq_hz[i], "damping": m.damping[i], "freq_sd": m.freq_sd[i],
                          "damping_sd": m.damping_sd[i], **other}])  # fmt: skip
@@ -174,7 +177,8 @@ def test_intervals_cover_the_equally_good_models():
     merged = ((2.0, _model([10.8], [0.05])),)
     far = _count([1.0, 80.0], -40.0, freq=(5.0, 10.0), damping=(0.2, 0.05), alternatives=merged)
     assert _structure_hull(far, 1)[2] is False
-    codes = [n.message for n in _notes(count, np.array([True, True]), (1.0, 25.0)) if "also cover" in n.message]
+    notes = _notes(count, np.array([True, True]), (1.0, 25.0), SAME_ROW)
+    codes = [n.message for n in notes if "also cover" in n.message]
     assert len(codes) == 1 and "10.000 Hz" in codes[0] and "5.000" not in codes[0]
 
 
@@ -184,10 +188,11 @@ def _modes(f, sd):
 
 
 def test_modes_closer_than_three_deviations_are_not_separated():
-    assert [n.value for n in _not_separated(_modes([10.0, 10.5, 20.0], [0.2, 0.2, 0.2]))] == [10.0]
-    assert _not_separated(_modes([10.0, 10.5], [0.05, 0.05])) == []  # 7 SD apart
+    assert [n.value for n in not_separated_notes(_modes([10.0, 10.5, 20.0], [0.2, 0.2, 0.2]), 3.0)] == [10.0]
+    assert not_separated_notes(_modes([10.0, 10.5], [0.05, 0.05]), 3.0) == []  # 7 SD apart
     # taken left to right without overlap: a run of three gives the first pair only
-    assert not_separated(_modes([10.0, 10.1, 10.2, 30.0], [0.2, 0.2, 0.2, 0.2])) == [(0, 1, pytest.approx(0.354, 1e-2))]
+    run = _modes([10.0, 10.1, 10.2, 30.0], [0.2, 0.2, 0.2, 0.2])
+    assert not_separated(run, 3.0) == [(0, 1, pytest.approx(0.354, 1e-2))]
 
 
 def _rows_of(model):
@@ -328,17 +333,15 @@ def test_a_stand_in_stays_out_of_the_selection(monkeypatch, bundled_diagram):
     assert any("stays in the model" in w.message for w in sel.warnings)
 
 
-def test_a_long_record_is_counted_on_its_start_and_fitted_whole(monkeypatch, bundled_diagram):
-    """Past :data:`COUNT_MAX_SAMPLES` the search runs on the record's start and the chosen model
+def test_a_long_record_is_counted_on_its_start_and_fitted_whole(bundled_diagram):
+    """Past ``CountSettings.max_samples`` the search runs on the record's start and the chosen model
     is fitted to the whole record: the bundled ride counted on its first half gives the exact
     modes, with intervals from all of it (narrower than the half's own)."""
-    import armaxmodal.modes.counted as counted
-
     diagram = bundled_diagram
     rec = diagram.recording
     whole = am.select_modes(diagram, segments=0)
-    monkeypatch.setattr(counted, "COUNT_MAX_SAMPLES", rec.n_samples // 2)
-    part = am.select_modes(diagram, segments=0)
+    half = SelectionSettings(count=CountSettings(max_samples=rec.n_samples // 2))
+    part = am.select_modes(diagram, segments=0, settings=half)
     exact = am.supine_human().modes()
     assert len(part.modes) == 4
     assert np.all(np.abs(part.modes.freq_hz / exact.freq_hz - 1) < FREQ_TOL)
@@ -441,7 +444,7 @@ def test_a_stand_in_is_in_the_model_but_not_reported_and_is_said():
                     stand_ins=((21.9, 24.74, 872.5),))  # fmt: skip
     keep = count.reported((1.0, 26.0))
     assert keep.tolist() == [True, True, False]
-    notes = _notes(count, keep, (1.0, 26.0))
+    notes = _notes(count, keep, (1.0, 26.0), SAME_ROW)
     said = [n.message for n in notes if "stays in the model" in n.message]
     assert len(said) == 1 and "21.900 Hz to 24.740" in said[0] and "872.5" in said[0]
     assert not any("outside the band" in n.message for n in notes)
@@ -473,16 +476,16 @@ def test_the_modal_model_confirms_a_mode_where_the_h1_is_not_coherent(monkeypatc
     likelihood needs it decisively and the record's halves agree on it; else it stays unconfirmed."""
 
     import armaxmodal.modes.counted as counted
-    from armaxmodal.modes.working import WorkingSelection
+    from armaxmodal.modes.state import SelectionState
 
     sel = am.select_modes(bundled_diagram, segments=0)
     f0 = float(sel.modes.freq_hz[0])
     count = replace(sel.count, removal_rise=np.full(sel.count.model.n_modes, rise))
     check = replace(sel.check, unconfirmed_hz=(f0,))
     assert not check.passed
-    monkeypatch.setattr(counted, "agree_in_halves", lambda d, m, h, hold: np.full(m.n_modes, halves_agree))
+    monkeypatch.setattr(counted, "agree_in_halves", lambda d, m, h, hold, *limits: np.full(m.n_modes, halves_agree))
     work = counted.confirmed_where_incoherent(
-        bundled_diagram, WorkingSelection(sel.modes, sel.shapes, sel.refinement, check, count)
+        bundled_diagram, SelectionState(sel.modes, sel.shapes, sel.refinement, check, count)
     )
     assert work.check.passed is confirmed and (work.check.unconfirmed_hz == ()) is confirmed
     assert [n.value for n in work.warnings] == ([f0] if confirmed else [])
@@ -507,13 +510,13 @@ def test_a_start_mode_left_out_where_a_coherent_peak_remains_leaves_the_count_un
         count = SimpleNamespace(carried_away=((5.826, 4.401),), stand_ins=())
     else:
         count = SimpleNamespace(carried_away=(), stand_ins=((5.826, 4.401, 136.4),))
-    notes = dropped_where_peaks_remain(count, peaks)
+    notes = dropped_where_peaks_remain(count, peaks, SAME_ROW)
     assert [n.code for n in notes] == (["count_undecided"] if near else [])
     if near:
         assert notes[0].value == 5.826 and all(f"{f:.2f}" in notes[0].message for f in near)
         assert notes[0].code in UNCERTAIN_CODES and f"was {fate} " in notes[0].message
-    assert dropped_where_peaks_remain(None, peaks) == []
-    assert dropped_where_peaks_remain(SimpleNamespace(carried_away=(), stand_ins=()), peaks) == []
+    assert dropped_where_peaks_remain(None, peaks, SAME_ROW) == []
+    assert dropped_where_peaks_remain(SimpleNamespace(carried_away=(), stand_ins=()), peaks, SAME_ROW) == []
 
 
 def _pole_rows(freq_hz, damping, orders, rejected):
@@ -532,7 +535,7 @@ def test_a_stable_cluster_with_a_small_residue_is_tried_as_an_addition_after_the
             + _pole_rows(12.0, 0.05, orders[:2], "negligible residue"))  # two orders only
     diagram = SimpleNamespace(poles=pd.DataFrame(rows))
     modes = pd.DataFrame({"freq_hz": [6.56, 14.4]})
-    found = _candidates(diagram, modes, None, orders, 0.05, 0.5)
+    found = _candidates(diagram, modes, None, orders, SelectionSettings())
     assert [round(f, 1) for f, _ in found] == [20.0, 9.7]
 
 
@@ -574,7 +577,7 @@ def _search(bic, n_eff, halves_agree):
     def in_both_halves(model, new, halves):
         return halves_agree
 
-    return SimpleNamespace(bic=bic, n_eff=n_eff, in_both_halves=in_both_halves)
+    return SimpleNamespace(bic=bic, n_eff=n_eff, in_both_halves=in_both_halves, cfg=CountSettings())
 
 
 @pytest.mark.parametrize(
@@ -614,7 +617,7 @@ def test_a_split_of_a_mode_the_search_did_not_split_is_tried_for_the_likelihood(
     is, with its new pole at one of the two and the same in both halves."""
     from scipy.special import chdtrc
 
-    from armaxmodal.modes.mode_count import LIKELIHOOD_ALPHA, _Search, _split_wanted
+    from armaxmodal.modes.mode_count import _Search, _split_wanted
     from armaxmodal.modes.spread import split_segments
 
     data, truth = supine
@@ -632,7 +635,7 @@ def test_a_split_of_a_mode_the_search_did_not_split_is_tried_for_the_likelihood(
     new_hz, ratio, dof, _, in_diagram = got
     assert in_diagram is False  # the diagram (here: no column anywhere) cannot be picked from
     assert np.min(np.abs(truth.freq_hz[2:] / new_hz - 1)) < FREQ_TOL, got
-    assert dof == 2 + 4 * data.y.shape[1] and chdtrc(dof, ratio) < LIKELIHOOD_ALPHA
+    assert dof == 2 + 4 * data.y.shape[1] and chdtrc(dof, ratio) < CountSettings().likelihood_alpha
 
 
 @pytest.mark.parametrize(
@@ -643,7 +646,7 @@ def test_a_wanted_mode_is_said_with_why_it_is_not_reported(rise, in_diagram, sai
     """A wanted split may lower the criterion (the search never tried it), and may have no column of
     the diagram a pick could take: the note says which, and what the user can do."""
     count = replace(_count([50.0, 60.0], -40.0), wanted=(14.5, 191.0, 22, rise, in_diagram))
-    notes = [n for n in _notes(count, np.array([True, False]), (1.0, 25.0)) if n.code == "count_undecided"]
+    notes = [n for n in _notes(count, np.array([True, False]), (1.0, 25.0), SAME_ROW) if n.code == "count_undecided"]
     assert len(notes) == 1 and notes[0].value == 14.5, notes
     assert all(s in notes[0].message for s in said), notes[0].message
     assert ("--pick" in notes[0].message) == in_diagram
@@ -659,7 +662,7 @@ def test_a_counted_mode_no_cluster_holds_takes_none_of_its_neighbours_facts():
                           "freq_sd": [0.04], "damping_sd": [0.003], "freq_sd_armax": [0.04],
                           "damping_sd_armax": [0.003], "estimator": ["armax"]})  # fmt: skip
     count = _count([50.0, 60.0], -40.0, freq=(5.02, 24.8), damping=(0.2, 0.3))
-    held, new = _row(modes, count, 0, "zoh"), _row(modes, count, 1, "zoh")
+    held, new = _row(modes, count, 0, "zoh", SAME_ROW), _row(modes, count, 1, "zoh", SAME_ROW)
     assert (held["count"], held["energy"], held["freq_sd_armax"]) == (12, 0.3, 0.04)
     # the diagram's estimate of the held mode is kept for the estimators' test, the new mode has none
     assert [held[k] for k in ("freq_earlier", "freq_earlier_sd", "damping_earlier", "damping_earlier_sd")] == [
@@ -750,6 +753,7 @@ def test_the_split_of_lowest_criterion_is_the_one_judged(best_resolved):
         n_eff=n_eff, bic=lambda m: bic[id(m)], physical=lambda m: np.ones(m.freq_hz.size, dtype=bool),
         screened=lambda starts: [high, low], fit=lambda f, x, nfev: low if f[1] == 14.0 else high,
         resolved=lambda m: best_resolved or m is not low, in_both_halves=lambda m, new, halves: True,
+        cfg=CountSettings(),
     )  # fmt: skip
     got, model = _split_wanted(search, current, ("first half", "second half"))
     if best_resolved:

@@ -11,8 +11,9 @@ import pytest
 import armaxmodal as am
 from armaxmodal.cli.main import main
 from armaxmodal.modes.counted import _picked_result
-from armaxmodal.modes.picks import PICK_REACH, check_picks
-from armaxmodal.modes.working import WorkingSelection
+from armaxmodal.modes.picks import check_picks
+from armaxmodal.modes.settings import ClusterSettings, CountSettings, SelectionSettings
+from armaxmodal.modes.state import SelectionState
 
 
 @pytest.fixture(scope="module")
@@ -62,7 +63,10 @@ def test_picks_are_checked_against_the_band_and_nyquist():
         check_picks([31.0], None, 60.0)
     with pytest.raises(am.PickError, match="the band 1-20 Hz"):
         check_picks([0.5], (1.0, 20.0), 60.0)
-    assert check_picks([10.0, 10.0 * (1 + PICK_REACH) * 1.001], None, 60.0).size == 2  # just apart
+    reach = ClusterSettings().pick_reach
+    assert check_picks([10.0, 10.0 * (1 + reach) * 1.001], None, 60.0).size == 2  # just apart
+    # the reach is the clustering's: a narrower clustering lets closer picks stand apart
+    assert check_picks([10.0, 10.4], None, 60.0, ClusterSettings(freq=0.03)).size == 2
 
 
 def test_a_pick_the_modal_model_takes_out_of_the_band_is_reported_and_said():
@@ -71,14 +75,14 @@ def test_a_pick_the_modal_model_takes_out_of_the_band_is_reported_and_said():
     12 Hz mode not picked stays in the model, unreported, and is named."""
     modes = pd.DataFrame({"freq_hz": [5.0, 9.0, 12.0], "damping": [0.1, 0.05, 0.05], "count": [6, 4, 5],
                           "picked_hz": [5.1, 9.0, np.nan]})  # fmt: skip
-    work = WorkingSelection(modes, np.array([[1.0, 2.0, 5.0]], dtype=complex))
+    work = SelectionState(modes, np.array([[1.0, 2.0, 5.0]], dtype=complex))
     model = SimpleNamespace(
         freq_hz=np.array([5.1, 20.0, 12.1]), damping=np.array([0.1, 1e-4, 0.05]), freq_sd=np.full(3, 0.01),
         damping_sd=np.array([0.001, 0.0, 0.001]), shapes=np.array([[3.0, 4.0, 6.0]], dtype=complex), n_modes=3,
     )  # fmt: skip
     count = SimpleNamespace(model=model, removal_rise=np.array([80.0, -3.0, 60.0]), alternatives=(),
-                            best_addition=-50.0, best_addition_hz=np.nan)  # fmt: skip
-    out = _picked_result(work, count, np.array([True, False, True]), "bandlimited")
+                            best_addition=-50.0, best_addition_hz=np.nan, settings=CountSettings())  # fmt: skip
+    out = _picked_result(work, count, np.array([True, False, True]), "bandlimited", SelectionSettings())
     assert out.modes.freq_hz.tolist() == [5.1, 9.0] and out.shapes.tolist() == [[3.0, 2.0]]
     assert out.modes.count_undecided.tolist() == [False, True] and out.modes.picked_hz.tolist() == [5.1, 9.0]
     (said,) = [n for n in out.warnings if n.code == "pick_not_supported"]
@@ -110,7 +114,8 @@ def test_a_pick_the_record_does_not_need_is_said():
     from armaxmodal.modes.counted import _pick_notes
 
     model = SimpleNamespace(freq_hz=np.array([5.0, 9.0]), damping=np.array([0.1, 0.05]))
-    count = SimpleNamespace(model=model, removal_rise=np.array([4.0, 80.0]), best_addition=-30.0, best_addition_hz=7.0)
+    count = SimpleNamespace(model=model, removal_rise=np.array([4.0, 80.0]), best_addition=-30.0, best_addition_hz=7.0,
+                            settings=CountSettings())  # fmt: skip
     (note,) = _pick_notes(count, np.array([True, True]))
     assert note.code == "pick_not_supported" and note.value == 5.0 and "+4.0" in note.message
     assert _pick_notes(count, np.array([False, True])) == []  # only the picked poles are judged
@@ -127,7 +132,7 @@ def test_the_picks_model_keeps_the_poles_the_automatic_model_hides(monkeypatch, 
     sel = am.select_modes(diagram, segments=0)
     beyond = SimpleNamespace(freq_hz=np.r_[sel.count.model.freq_hz, 40.0], damping=np.r_[sel.count.model.damping, 0.1])
     modes = sel.modes.assign(picked_hz=[5.9, 8.2, np.nan, np.nan])
-    work = WorkingSelection(modes, sel.shapes, sel.refinement, sel.check, replace(sel.count, model=beyond))
+    work = SelectionState(modes, sel.shapes, sel.refinement, sel.check, replace(sel.count, model=beyond))
     seen = []
 
     def stop(data, freq_hz, damping, *args, search=True, **kwargs):
@@ -136,6 +141,7 @@ def test_the_picks_model_keeps_the_poles_the_automatic_model_hides(monkeypatch, 
 
     monkeypatch.setattr(counted, "count_modes", stop)
     with pytest.raises(KeyboardInterrupt):
-        counted.counted_modes(diagram, work, sel.refinement.band_hz, "bandlimited", [2, 4], (0.05, 0.5), picked=True)
+        counted.counted_modes(diagram, work, sel.refinement.band_hz, "bandlimited", [2, 4], SelectionSettings(),
+                              picked=True)
     (starts, search), = seen
     assert starts[-1] == 40.0 and len(starts) == 5 and search is False

@@ -17,7 +17,8 @@ from armaxmodal.modes.diagram import SAMPLES_PER_PARAMETER, _check_top_order, _n
 from armaxmodal.modes.intervals import with_intervals
 from armaxmodal.modes.poles import Tolerances, stability_classes
 from armaxmodal.modes.selected_refit import _apply_refinement
-from armaxmodal.modes.working import WorkingSelection
+from armaxmodal.modes.settings import ClusterSettings
+from armaxmodal.modes.state import SelectionState
 from armaxmodal.stats import Z95
 
 SHAPE = np.array([1.0 + 0.2j, 0.5 - 0.1j, -0.3 + 0.05j])
@@ -71,7 +72,9 @@ def test_clusters_take_one_pole_per_order_within_frequency_and_damping():
         assert poles.loc[c, "na"].is_unique
     # by frequency alone the odd-damping pole joins nothing new: the 9 Hz cluster has its na = 6 already
     assert sorted(len(c) for c in cluster_poles(poles, [2, 4, 6, 8], 0.05, None)) == [1, 1, 4, 4]
-    assert _supported(3, 7, 0.4) and not _supported(2, 4, 0.4) and not _supported(3, 10, 0.4)
+    c = ClusterSettings()
+    assert _supported(3, 7, c) and not _supported(2, 4, c) and not _supported(3, 10, c)
+    assert _supported(2, 4, ClusterSettings(min_orders=2))  # the orders a stable pole needs are a setting
 
 
 def _modes(freqs, dampings, support):
@@ -244,7 +247,7 @@ def test_delay_edge_warning_says_the_range_and_what_to_do():
 
 
 def test_finite_or_none_keeps_numbers_and_drops_nan_and_inf():
-    from armaxmodal.modes.selection import _finite_or_none
+    from armaxmodal.modes.result import _finite_or_none
 
     assert _finite_or_none(np.float64(2.5)) == 2.5 and type(_finite_or_none(np.float64(2.5))) is float
     assert _finite_or_none(float("nan")) is None and _finite_or_none(np.inf) is None
@@ -316,7 +319,7 @@ def _notes_modes(**overrides):
 
 
 def test_unresolved_damping_notes_state_the_facts_and_the_reason():
-    from armaxmodal.modes.selection import _unresolved_damping_notes
+    from armaxmodal.modes.result import unresolved_damping_notes as _unresolved_damping_notes
 
     assert _unresolved_damping_notes(_notes_modes(), 10) == []  # a resolved damping: no note
     (note,) = _unresolved_damping_notes(_notes_modes(damping_ci95_lo=0.0), 10)  # interval reaches zero
@@ -401,11 +404,13 @@ def test_finished_pole_takes_the_nearest_finished_estimate_within_five_percent()
     finished = pd.DataFrame([pole(5.1, 0.05), pole(9.0, 0.02), pole(20.0, 0.1)])
     diagram = SimpleNamespace()  # the cache holds order 8: nothing is fitted
     sweep = pole(5.0, 0.06, cls="f+d", rejected="")
-    out = _finished_pole(diagram, sweep, {8: finished})
+    reach = ClusterSettings().finished_max_shift  # 5 %
+    out = _finished_pole(diagram, sweep, {8: finished}, reach)
     assert (out.freq_hz, out.damping, out.cls, out.rejected) == (5.1, 0.05, "f+d", "")
-    assert _finished_pole(diagram, pole(9.4, 0.02), {8: finished}).freq_hz == 9.0  # 4.3 % away: taken
-    assert _finished_pole(diagram, pole(8.5, 0.02), {8: finished}).freq_hz == 8.5  # 5.9 %: the sweep's stands
-    assert _finished_pole(diagram, sweep, {8: finished.iloc[:0]}).freq_hz == 5.0  # nothing finished
+    assert _finished_pole(diagram, pole(9.4, 0.02), {8: finished}, reach).freq_hz == 9.0  # 4.3 % away: taken
+    assert _finished_pole(diagram, pole(8.5, 0.02), {8: finished}, reach).freq_hz == 8.5  # 5.9 %: the sweep's stands
+    assert _finished_pole(diagram, pole(9.4, 0.02), {8: finished}, 0.04).freq_hz == 9.4  # the reach is a setting
+    assert _finished_pole(diagram, sweep, {8: finished.iloc[:0]}, reach).freq_hz == 5.0  # nothing finished
 
 
 def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_data(monkeypatch):
@@ -430,7 +435,7 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     hold = "zoh"
     ref = st.selection_job(rec, [], modes, ("refit", (4.0, 12.0)))
     assert seen[-1] == (4.0, 12.0) and ref.hold == "zoh"
-    work = WorkingSelection(modes, shapes)
+    work = SelectionState(modes, shapes)
     out = st.refined_modes(diagram, work, ref, 0.05, 0.5, 0.8)
     # a held input: the ARMAX values are reported
     assert out.refinement is ref and out.modes is modes and out.shapes is shapes
@@ -461,7 +466,7 @@ def test_filled_samples_widen_every_interval_by_the_information_they_lack():
     the other structures' part included (an asymmetric interval stays asymmetric)."""
     from types import SimpleNamespace
 
-    from armaxmodal.modes.selection import _filled_samples_scale
+    from armaxmodal.modes.result import filled_samples_scale as _filled_samples_scale
 
     filled = am.QualityWarning("gap_filled", ("head",), "x", 700.0)
     bridged = am.QualityWarning("dropped_packet", ("head",), "y", 20.0)

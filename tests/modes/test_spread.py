@@ -7,7 +7,7 @@ import pytest
 import armaxmodal as am
 from armaxmodal.modes.diagram import stabilisation_diagram
 from armaxmodal.modes.intervals import with_intervals
-from armaxmodal.modes.selection import select_modes
+from armaxmodal.modes.pipeline import select_modes
 from armaxmodal.modes.spread import apply_segment_spread
 from armaxmodal.stats import Z95
 

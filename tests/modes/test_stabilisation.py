@@ -8,7 +8,8 @@ import armaxmodal as am
 from armaxmodal.cli import main
 from armaxmodal.exceptions import DataError, OrderError
 from armaxmodal.modes.diagram import stabilisation_diagram
-from armaxmodal.modes.selection import select_modes
+from armaxmodal.modes.pipeline import select_modes
+from armaxmodal.modes.settings import ClusterSettings
 
 # Issue targets for automatic selection with nothing told but the data.
 FREQ_RTOL, DAMPING_RTOL = 0.02, 0.10
@@ -213,7 +214,7 @@ def test_a_mode_whose_damping_crosses_zero_is_kept_where_the_frf_shows_its_peak(
     from armaxmodal.modes.clusters import _supported, cluster_poles
 
     kept = poles[poles.rejected == ""]
-    old = [c for c in cluster_poles(kept, range(2, 21, 2), 0.05, 0.5) if _supported(len(c), 10, 0.4)]
+    old = [c for c in cluster_poles(kept, range(2, 21, 2), 0.05, 0.5) if _supported(len(c), 10, ClusterSettings())]
     assert all(abs(poles.loc[c, "freq_hz"].median() / truth.freq_hz[0] - 1) > 0.02 for c in old)
 
 
@@ -238,7 +239,7 @@ def test_poles_crossing_zero_without_an_frf_peak_stay_rejected(light_diagram):
 
 def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
     from armaxmodal.modes.completeness import modes_the_record_needs
-    from armaxmodal.modes.working import WorkingSelection
+    from armaxmodal.modes.state import SelectionState
 
     s, diagram = light_diagram
     m = s.modes()
@@ -252,7 +253,7 @@ def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
         }
     )
     shapes = np.column_stack([m.modal_constants[:, 0], 0.3 * m.modal_constants[:, 0], m.modal_constants[:, 1]])
-    kept = modes_the_record_needs(diagram.recording, WorkingSelection(modes, shapes), None)
+    kept = modes_the_record_needs(diagram.recording, SelectionState(modes, shapes), None)
     assert kept.modes.freq_hz.tolist() == [m.freq_hz[0], m.freq_hz[1]]  # the better-supported one stays
     np.testing.assert_array_equal(kept.shapes, shapes[:, [0, 2]])
     (note,) = kept.warnings
@@ -261,7 +262,7 @@ def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
     assert kept.check.passed and kept.check.model_error.max() < 0.15
     # the true modes alone: nothing to merge
     true = modes.iloc[[0, 2]].reset_index(drop=True)
-    again = modes_the_record_needs(diagram.recording, WorkingSelection(true, shapes[:, [0, 2]]), None)
+    again = modes_the_record_needs(diagram.recording, SelectionState(true, shapes[:, [0, 2]]), None)
     assert len(again.modes) == 2 and again.warnings == ()
 
 
@@ -270,7 +271,7 @@ def test_a_spurious_heavily_damped_neighbour_is_left_out_and_said(light_diagram)
     1-storey model's storey mode) is not needed by the FRF once the mode's own pole is
     refitted: left out, as a split of that peak (its half-power band covers the mode)."""
     from armaxmodal.modes.completeness import modes_the_record_needs
-    from armaxmodal.modes.working import WorkingSelection
+    from armaxmodal.modes.state import SelectionState
 
     s, diagram = light_diagram
     m = s.modes()
@@ -284,7 +285,7 @@ def test_a_spurious_heavily_damped_neighbour_is_left_out_and_said(light_diagram)
         }
     )
     shapes = np.column_stack([m.modal_constants[:, 0], 0.1 * m.modal_constants[:, 0], m.modal_constants[:, 1]])
-    kept = modes_the_record_needs(diagram.recording, WorkingSelection(modes, shapes), None)
+    kept = modes_the_record_needs(diagram.recording, SelectionState(modes, shapes), None)
     assert kept.modes.freq_hz.tolist() == [m.freq_hz[0], m.freq_hz[1]]
     (note,) = kept.warnings
     assert note.code == "split_merged" and note.value == pytest.approx(1.15 * m.freq_hz[0])
@@ -369,7 +370,7 @@ def test_rescue_rules_each_decide(light_diagram):
 
     def rescued(*groups, band=None):
         rest = pd.concat(groups, ignore_index=True)
-        found = _rescued_clusters(fake, rest, nas, 0.05, 0.4, band)
+        found = _rescued_clusters(fake, rest, nas, ClusterSettings(), band)
         return [sorted(rest.loc[c, "freq_hz"].unique().tolist()) for c in found]
 
     assert rescued(group(f1, scatter, 0.01)) == [[f1]]  # the FRF peaks there

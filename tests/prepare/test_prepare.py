@@ -10,7 +10,7 @@ import scipy.stats
 import armaxmodal as am
 from armaxmodal.exceptions import DataError
 from armaxmodal.modes.diagram import stabilisation_diagram
-from armaxmodal.modes.selection import select_modes
+from armaxmodal.modes.pipeline import select_modes
 from armaxmodal.prepare.checks import check_quality
 from armaxmodal.prepare.delay import estimate_delays
 from armaxmodal.prepare.preparation import check_band, prepare

@@ -1,0 +1,379 @@
+"""Automatic mode selection from a stabilisation diagram (thesis Section 3.4), as named stages.
+
+:func:`~armaxmodal.select_modes` runs one tuple of stages over one frozen
+:class:`~armaxmodal.modes.state.SelectionState`; every stage is ``stage(state, context) -> state``
+and reads what does not change (the diagram, the band, the orders, the settings) from one
+:class:`~armaxmodal.modes.state.SelectionContext`. Which tuple runs is the only choice the
+arguments make, and each is named:
+
+* :data:`AUTOMATIC` -- the diagram's stable clusters are the candidates; the measured FRF
+  proposes and screens them; the maximum-likelihood modal model counts them;
+* :data:`FIXED_COUNT` -- ``n_modes`` given: the best-supported clusters, checked, not counted;
+* :data:`PICKED` -- ``picks`` given: the picked clusters, reported from the counted model;
+* the same three without the frequency-domain refit (``refine=False``), which also leaves the
+  count out, since the modal model is fitted under the hold the refit chose.
+
+A stage that finds nothing to select sets the state's ``result`` and the pipeline ends there.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import replace
+
+import numpy as np
+import pandas as pd
+
+from armaxmodal._threads import one_blas_thread
+from armaxmodal.exceptions import PickError
+from armaxmodal.modes.clusters import clustered_modes, merge_duplicates, why_no_mode
+from armaxmodal.modes.completeness import modes_the_check_adds, modes_the_record_needs, refit_with_added
+from armaxmodal.modes.counted import confirmed_where_incoherent, counted_modes, dropped_where_peaks_remain
+from armaxmodal.modes.diagram import StabilisationDiagram
+from armaxmodal.modes.header import oversampling_note
+from armaxmodal.modes.intervals import with_intervals
+from armaxmodal.modes.modal_check import check_modes
+from armaxmodal.modes.per_sensor import per_sensor_table
+from armaxmodal.modes.picks import check_picks, picked_modes
+from armaxmodal.modes.result import (
+    ModeSelection,
+    filled_samples_scale,
+    no_mode_selection,
+    not_separated_notes,
+    unresolved_damping_notes,
+)
+from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_and_segment_fits
+from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
+from armaxmodal.modes.spread import N_SEGMENTS, apply_segment_spread, segment_spread
+from armaxmodal.modes.state import SelectionContext, SelectionState
+
+__all__ = ["AUTOMATIC", "FIXED_COUNT", "PICKED", "Stage", "select_modes", "stages_for"]
+
+Stage = Callable[[SelectionState, SelectionContext], SelectionState]
+
+
+# -- the stages ----------------------------------------------------------------------------------
+def take_picks(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """Each pick takes its cluster of the diagram now, before any fit: a pick the diagram does not
+    offer stops the run here (:class:`~armaxmodal.exceptions.PickError`)."""
+    rows, vectors = picked_modes(ctx.diagram, ctx.picks, ctx.band, ctx.nas, ctx.settings.cluster)
+    return replace(state, picked=(_armax_intervals(rows), vectors))
+
+
+def candidates(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """The diagram's clusters that hold poles of ``min_support`` of the orders (and the rescued
+    lightly damped ones), each from its lowest-BIC fit finished to convergence. With none, the
+    picks stand alone; with no pick either, the selection ends with a ``no_modes`` note."""
+    c = ctx.settings.cluster
+    modes, vectors = clustered_modes(ctx.diagram, ctx.band, ctx.nas, c, ctx.n_jobs, ctx.bar)
+    if modes.empty and state.picked is not None:
+        modes, vectors = state.picked
+    if modes.empty:  # a result, not a stop: the diagram, its poles and why each cluster failed
+        why = why_no_mode(ctx.diagram, ctx.band, ctx.nas, c)
+        return replace(state, result=no_mode_selection(ctx.diagram, why, ctx.settings))
+    return state.with_modes(_armax_intervals(modes), np.column_stack(vectors))
+
+
+def merge(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """Two candidates closer than the half-power band whose shapes agree (``merge_mac``) are one
+    mode split by over-modelling: the weaker goes. The rest by frequency."""
+    modes = state.modes
+    keep = merge_duplicates(modes, list(state.shapes.T), ctx.settings.cluster.merge_mac, ctx.diagram.recording.duration)
+    state = state.kept(keep)
+    return state.kept(state.modes.sort_values("freq_hz").index)
+
+
+def best_n(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """The ``n_modes`` best-supported candidates (support, then orders, then residue energy), by frequency."""
+    ranked = state.modes.sort_values(["support", "count", "energy"], ascending=False).index[: ctx.n_modes]
+    state = state.kept(ranked)
+    return state.kept(state.modes.sort_values("freq_hz").index)
+
+
+def refit(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """The frequency-domain refit under the inter-sample behaviour the data choose
+    (:mod:`armaxmodal.modes.refine`), reported for a band-limited record, with the segment refits
+    of every mode's representative orders run beside it over the worker threads."""
+    fitted = refit_and_segment_fits(ctx.diagram, state.modes, ctx.band, True, ctx.segments, ctx.orders, ctx.n_jobs,
+                                    ctx.bar)  # fmt: skip
+    done = fitted.pop("refit")
+    c = ctx.settings.cluster
+    state = refined_modes(ctx.diagram, replace(state, segment_fits=fitted), done, c.freq, c.damping, c.merge_mac)
+    return state.warned(*done.notes()) if isinstance(done, RefitFailure) else state
+
+
+def segment_fits(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """The segment refits of every mode's representative orders alone (no frequency-domain refit)."""
+    fitted = refit_and_segment_fits(ctx.diagram, state.modes, ctx.band, False, ctx.segments, ctx.orders, ctx.n_jobs,
+                                    ctx.bar)  # fmt: skip
+    return replace(state, segment_fits=fitted)
+
+
+def screen_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """The measured H1 screens the candidates: a mode its LSFD check does not need goes, a left-out
+    cluster it needs comes in (:mod:`armaxmodal.modes.completeness`); after an addition the refit
+    is made again of all of them."""
+    rec, n_before, limits = ctx.diagram.recording, len(state.modes), _limits(ctx.settings)
+    state = modes_the_record_needs(rec, state, ctx.band)
+    state = modes_the_check_adds(ctx.diagram, state, ctx.band, ctx.nas, ctx.settings.cluster)
+    if len(state.modes) > n_before:
+        state = modes_the_record_needs(rec, state, ctx.band)
+    if ctx.refine and len(state.modes) > n_before:  # the refit saw fewer modes than are reported
+        state = refit_with_added(ctx.diagram, state, ctx.band, limits)
+    return state
+
+
+def count(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """The last word on the number of modes: nested tests of the maximum-likelihood modal model with
+    every pole free (:mod:`armaxmodal.modes.counted`). It needs the refit's hold and band: where the
+    refit could not be made, its ``refit_failed`` note says the modes are not counted."""
+    if state.refinement is None or not len(state.modes):
+        return state
+    hold, band_hz = state.refinement.hold, state.refinement.band_hz
+    state = counted_modes(ctx.diagram, state, band_hz, hold, ctx.nas, ctx.settings, ctx.band,
+                          n_jobs=ctx.n_jobs)  # fmt: skip
+    ctx.update_bar(state.count.trials)
+    return state
+
+
+def add_picks(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """The picks as the modes reported: a pick is the automatic mode within the clustering's reach
+    of it or of its cluster; a pick no automatic mode answers is added from its cluster. The modal
+    model is then fitted with every mode and pole of the automatic one kept as it stands, so that
+    the modes not picked do not bias the picked ones."""
+    rows, vectors = state.picked
+    modes = state.modes.assign(picked_hz=np.nan)
+    reach, forced = ctx.settings.cluster.pick_reach, []
+    for k, row in rows.iterrows():
+        distance = [np.abs(np.log(modes.freq_hz.to_numpy() / f)) for f in (row.picked_hz, row.freq_hz)]
+        best = int(np.argmin([np.min(d) for d in distance]))
+        at = int(np.argmin(distance[best]))
+        if distance[best][at] <= reach and not np.isfinite(modes.at[at, "picked_hz"]):
+            modes.at[at, "picked_hz"] = row.picked_hz
+        else:
+            forced.append(k)
+    modes = pd.concat([modes, rows.loc[forced]], ignore_index=True)
+    shapes = np.column_stack([state.shapes, *[vectors[k] for k in forced]]) if forced else state.shapes
+    state = state.with_modes(modes, shapes)
+    if state.refinement is None:  # no modal model to fit them with: the picks as the diagram has them, checked
+        return replace(state.kept(np.flatnonzero(np.isfinite(modes.picked_hz.to_numpy()))), check=None)
+    hold, band_hz = state.refinement.hold, state.refinement.band_hz
+    return counted_modes(ctx.diagram, state, band_hz, hold, ctx.nas, ctx.settings, ctx.band, picked=True,
+                         n_jobs=ctx.n_jobs)  # fmt: skip
+
+
+def separate(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """A ``modes_not_separated`` note for each neighbouring pair the record does not separate and
+    that the count did not report as one."""
+    return state.warned(*not_separated_notes(state.modes, ctx.settings.count.separation_sd))
+
+
+def check(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """The modal-model check of the modes (:mod:`armaxmodal.modes.modal_check`): the LSFD fit of every
+    output's H1 by the selected poles, or by the model's two poles where one row reports a pair."""
+    f, x = state.modes.freq_hz, state.modes.damping
+    if state.check_poles:
+        f, x = zip(*state.check_poles, strict=True)
+    return replace(state, check=check_modes(ctx.diagram.recording, np.array(f), np.array(x), ctx.band))
+
+
+def check_unless_counted(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """The check of picks: the count already checked the model the picks come from (the picks and
+    the modes not picked); without a count, the picks are checked as they stand."""
+    return state if state.check is not None else check(state, ctx)
+
+
+def confirm(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """Modes the check leaves unconfirmed (no coherent line near them) that the modal model
+    confirms decisively and alike in both halves of the record."""
+    return confirmed_where_incoherent(ctx.diagram, state, ctx.settings)
+
+
+def spread(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """Each mode's spread over disjoint segments of the record widens its intervals where it exceeds
+    them (:mod:`armaxmodal.modes.spread`), from the segment refits the refit stage ran."""
+    if ctx.segments < 2:
+        return state
+    modes, orders = state.modes, ctx.orders
+    limits = ctx.settings.intervals
+    table = segment_spread(ctx.diagram.recording, modes, lambda i: orders[int(modes.at[i, "na"])], ctx.segments,
+                           ctx.n_jobs, state.segment_fits, limits.match_freq)  # fmt: skip
+    modes, notes = apply_segment_spread(modes, table, ctx.segments, limits.spread_alpha)
+    return replace(state, modes=modes).warned(*notes)
+
+
+def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """The intervals' parts combined, once; the per-sensor tables; the notes read off the final modes."""
+    from armaxmodal.modes.frf_check import unexplained_peaks
+
+    diagram = ctx.diagram
+    scale, widened = filled_samples_scale(diagram.recording, diagram.preparation)
+    modes = with_intervals(state.modes, scale)
+    state = replace(state, modes=modes).warned(*(widened if len(modes) else ()))
+    per_sensor, weighted = per_sensor_table(diagram, modes, state.shapes, ctx.settings.cluster.freq)
+    freq, damping = modes.freq_hz.to_numpy(), modes.damping.to_numpy()
+    # a peak a mode of the model explains is explained, picked or not (the check's poles are the model's)
+    explaining = (freq, damping)
+    if "picked_hz" in modes or state.check_poles is not None:
+        poles = state.check.poles
+        explaining = (np.abs(poles) / (2 * np.pi), -poles.real / np.abs(poles))
+    peaks = unexplained_peaks(diagram.recording, *explaining, ctx.band)
+    state = state.warned(
+        *peaks,
+        *dropped_where_peaks_remain(state.count, peaks, ctx.settings.cluster.same_row_freq),
+        *oversampling_note(freq, diagram.recording.fs),
+        *unresolved_damping_notes(modes, len(ctx.nas)),
+        *state.check.warnings(),
+    )
+    result = ModeSelection(modes, state.shapes, per_sensor, weighted, diagram, state.refinement, state.warnings,
+                           state.check, state.count, ctx.settings)  # fmt: skip
+    return replace(state, result=result)
+
+
+# -- the stage lists -----------------------------------------------------------------------------
+#: the diagram's candidates, screened by the FRF and counted by the modal model
+AUTOMATIC: tuple[Stage, ...] = (candidates, merge, refit, screen_by_frf, count, separate, check, confirm, spread,
+                                finish)  # fmt: skip
+#: ``n_modes`` given: the best-supported candidates, refitted and checked; nothing dropped or added
+FIXED_COUNT: tuple[Stage, ...] = (candidates, merge, best_n, refit, check, spread, finish)
+#: ``picks`` given: the picked clusters reported from the model the automatic selection counted
+PICKED: tuple[Stage, ...] = (take_picks, candidates, merge, refit, screen_by_frf, count, add_picks, separate,
+                             check_unless_counted, confirm, spread, finish)  # fmt: skip
+
+
+def stages_for(n_modes: int | None, picks, refine: bool) -> tuple[Stage, ...]:
+    """The stage list of a call: :data:`AUTOMATIC`, :data:`FIXED_COUNT` or :data:`PICKED`; without
+    the refit (``refine=False``) the same with ``segment_fits`` for ``refit`` and no ``count``
+    (the modal model is fitted under the hold the refit chooses) nor ``confirm`` (the count's)."""
+    if picks is not None and n_modes is not None:
+        raise PickError("picks and n_modes do not mix: pick the modes, or give their number, not both.")
+    stages = PICKED if picks is not None else FIXED_COUNT if n_modes is not None else AUTOMATIC
+    if refine:
+        return stages
+    return tuple(segment_fits if s is refit else s for s in stages if s not in (count, confirm))
+
+
+# -- the entry point -----------------------------------------------------------------------------
+def select_modes(
+    diagram: StabilisationDiagram,
+    n_modes: int | None = None,
+    band: tuple[float, float] | None = None,
+    *,
+    settings: SelectionSettings | None = None,
+    refine: bool = True,
+    segments: int = N_SEGMENTS,
+    n_jobs: int | None = None,
+    progress: bool = False,
+    picks=None,
+    on_stage: Callable[[str], None] | None = None,
+) -> ModeSelection:
+    """Pick the physical modes from the shared-pole poles of a diagram.
+
+    What decides which modes are reported:
+
+    1. **candidates** -- the diagram's poles are clustered across orders (greedy, by increasing
+       ``na``: a pole joins the nearest cluster within ``settings.cluster.freq`` relative frequency
+       and ``settings.cluster.damping`` relative damping that has no pole of its order yet); a
+       cluster holding poles of ``settings.cluster.min_support`` of the orders is a candidate,
+       reported from its lowest-BIC fit. Two candidates closer than their half-power band whose
+       shapes agree (MAC at least ``settings.cluster.merge_mac``) are one mode split (**merge**).
+    2. **refit** -- the candidates are refitted to the recording's DFT under the inter-sample
+       behaviour the data choose (band-limited or held).
+    3. **screen_by_frf** -- the measured H1 proposes modes: a candidate its LSFD check does not need
+       goes, a left-out stable cluster that explains a peak comes in.
+    4. **count** -- the maximum-likelihood modal model with every pole free decides the number of
+       modes by nested tests (BIC on the effective lines; halves agree): it removes, adds or
+       splits modes, and says where the record does not decide (``count_undecided``).
+    5. **check**, **confirm**, **spread**, **finish** -- the modal-model check, the intervals
+       widened by the segments' spread and the other structures and estimators, and the verdict.
+
+    ``n_modes``, ``picks`` and ``refine=False`` run other named stage lists (:func:`stages_for`).
+
+    Parameters
+    ----------
+    diagram : StabilisationDiagram
+    n_modes : int, optional
+        Keep the ``n_modes`` best-supported modes (the modal-model check then judges them but
+        neither drops nor adds any, and they are not counted).
+    band : (lo, hi), optional
+        Frequency band in Hz (default: the diagram's band, if it was given one).
+    settings : SelectionSettings, optional
+        Every threshold of the stages (:mod:`armaxmodal.modes.settings`); the result carries it.
+    refine : bool
+        Refit the selected modes to the recording's DFT (and count them by the modal model).
+    segments : int
+        Refit each mode's representative orders on this many disjoint segments and widen
+        the intervals where their spread exceeds them (:mod:`armaxmodal.modes.spread`); 0 skips.
+    n_jobs : int, optional
+        Worker threads for the finishing and segment fits (default: all cores; 1 inside a
+        worker that has one core already, e.g. a study's).
+    progress : bool
+        Show a count of the fits the selection runs, labelled with the stage.
+    picks : sequence of float, optional
+        Frequencies (Hz) picked by hand: each takes the nearest cluster of the diagram holding
+        poles of at least ``settings.cluster.min_orders`` orders within the clustering's reach (a
+        :class:`~armaxmodal.exceptions.PickError` says when none does). The picks are refitted,
+        checked and judged as automatic modes are, but none is dropped or added: a pick the
+        record does not need is said to be (``pick_not_supported``). Not with ``n_modes``.
+    on_stage : callable, optional
+        Called with each stage's name as it is entered.
+
+    Returns
+    -------
+    ModeSelection
+        The modes with their intervals and shapes, the modal-model check, the count's
+        evidence, the settings and the verdict.
+
+    See Also
+    --------
+    armaxmodal.stabilisation_diagram : the sweep this selects from.
+    armaxmodal.modes.settings.SelectionSettings : the thresholds.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 120.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> selection = am.select_modes(am.stabilisation_diagram(ride, range(4, 13, 2)))
+    >>> selection.quality
+    'good'
+    >>> print(selection.modes.freq_hz.round(1).tolist())  # exact: 5.83, 8.31, 13.50, 16.25 Hz
+    [5.8, 8.3, 13.5, 16.2]
+    """
+    from tqdm import tqdm
+
+    settings = DEFAULTS if settings is None else settings
+    if not isinstance(settings, SelectionSettings):
+        raise TypeError(f"settings: expected a SelectionSettings, got {type(settings).__name__}.")
+    stages = stages_for(n_modes, picks, refine)
+    if band is None and diagram.preparation is not None:
+        band = diagram.preparation.band
+    checked = None if picks is None else check_picks(picks, band, diagram.recording.fs, settings.cluster)
+    with one_blas_thread(), tqdm(desc="mode selection", unit="fit", disable=not progress) as bar:
+        ctx = SelectionContext(diagram, settings, band, sorted({o.na for o in diagram.orders}), n_modes, checked,
+                               segments, refine, n_jobs, bar, on_stage)  # fmt: skip
+        return run_stages(stages, SelectionState.empty(len(diagram.recording.sensors)), ctx)
+
+
+def run_stages(stages: tuple[Stage, ...], state: SelectionState, ctx: SelectionContext) -> ModeSelection:
+    """Run ``stages`` in order until one sets the result."""
+    for stage in stages:
+        if ctx.on_stage is not None:
+            ctx.on_stage(stage.__name__)
+        if ctx.bar is not None:
+            ctx.bar.set_description(f"mode selection ({stage.__name__})", refresh=False)
+        state = stage(state, ctx)
+        if state.result is not None:
+            return state.result
+    raise RuntimeError("the stage list ends without a result: its last stage must be 'finish'")
+
+
+def _armax_intervals(modes: pd.DataFrame) -> pd.DataFrame:
+    """The ARMAX fit's standard deviations kept beside the reported ones: the segment refits are
+    ARMAX fits, and their spread is judged against these even where another estimator is reported."""
+    return modes.assign(estimator="armax", freq_sd_armax=modes.freq_sd, damping_sd_armax=modes.damping_sd)
+
+
+def _limits(settings: SelectionSettings) -> tuple[float, float, float]:
+    c = settings.cluster
+    return c.freq, c.damping, c.merge_mac

@@ -1,0 +1,291 @@
+"""The result of :func:`~armaxmodal.select_modes`: :class:`ModeSelection`, its JSON contract
+(``schemas/stabilise.schema.json``) and its verdict, and the notes read off the final modes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from armaxmodal.modal import mode_record
+from armaxmodal.modes.diagram import StabilisationDiagram
+from armaxmodal.modes.header import record_header
+from armaxmodal.modes.intervals import not_separated, with_intervals
+from armaxmodal.modes.modal_check import ModalCheck
+from armaxmodal.modes.mode_count import ModeCount
+from armaxmodal.modes.refine import ModalRefinement
+from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
+from armaxmodal.quality_warnings import UNCERTAIN_CODES, QualityWarning
+
+__all__ = ["ModeSelection", "verdict"]
+
+
+@dataclass(frozen=True)
+class ModeSelection:
+    """Physical modes picked from a stabilisation diagram.
+
+    Attributes
+    ----------
+    modes : DataFrame
+        One row per mode, by frequency: freq_hz, damping, damped_freq_hz and 95 % intervals
+        (``*_ci95_lo/hi``), the parts the intervals combine (the estimate's ``freq_sd`` and
+        ``damping_sd``, the other structures' ``*_other_lo/hi``, the segments'
+        ``*_segment_half``: :mod:`armaxmodal.modes.intervals`), na of the representative fit,
+        count and support of the cluster, its spread (standard deviation over orders) and medoid.
+    shapes : (n_sensors, n_modes) complex ndarray
+        EPFRF modal constants per sensor (Eq. 3.24) from the representative fit.
+    per_sensor : DataFrame
+        Table 3.2 form: one row per sensor and mode with the sensor's own frequency, damping
+        and residue magnitude, NaN where the sensor does not show the mode (the thesis's X).
+    weighted : DataFrame
+        Eqs. 3.35-3.36: per mode, the mean of the per-sensor values weighted by ``|M_ij|``.
+    diagram : StabilisationDiagram
+    refinement : ModalRefinement or None
+        The frequency-domain refit (:mod:`armaxmodal.modes.refine`); its ``hold`` is the
+        inter-sample behaviour the data chose. ``modes.estimator`` says which values are
+        reported: the refit for a band-limited recording, the ARMAX fit (the exact model
+        class) for a held input.
+    own_warnings : tuple of QualityWarning
+        The selection's own notes (``warnings`` adds the diagram's).
+    check : ModalCheck or None
+        The modal-model check of the modes.
+    count : ModeCount or None
+        The maximum-likelihood count, when it ran.
+    settings : SelectionSettings
+        The thresholds that made this selection (:mod:`armaxmodal.modes.settings`).
+    """
+
+    modes: pd.DataFrame
+    shapes: np.ndarray
+    per_sensor: pd.DataFrame
+    weighted: pd.DataFrame
+    diagram: StabilisationDiagram
+    refinement: ModalRefinement | None = None
+    own_warnings: tuple[QualityWarning, ...] = ()
+    check: ModalCheck | None = None
+    count: ModeCount | None = None
+    settings: SelectionSettings = field(default=DEFAULTS, repr=False)
+
+    @property
+    def picks(self) -> list[float] | None:
+        """The frequencies (Hz) the modes were picked at by hand, or None for an automatic pick."""
+        if "picked_hz" not in self.modes:
+            return None
+        return sorted(float(f) for f in self.modes.picked_hz if np.isfinite(f))
+
+    @property
+    def reconstruction_error(self) -> float:
+        """The modal-model check's relative misfit (:mod:`armaxmodal.modes.modal_check`): the
+        largest output's relative RMS difference between the measured H1 and its LSFD fit
+        by the selected poles with residual terms and a delay. Computed once, in
+        :func:`~armaxmodal.select_modes`: the CLI, the figure and the JSON report the same number."""
+        return self.check.overall_error if self.check is not None else float("nan")
+
+    @property
+    def quality(self) -> str:
+        """``"poor"`` when the modal-model check fails; ``"uncertain"`` when it passes but a
+        warning of ``armaxmodal.quality_warnings.UNCERTAIN_CODES`` stands (the record does not decide
+        the number of modes, two modes are closer than it separates, or the preparation found a
+        fault that moves modes); else ``"good"``."""
+        if self.check is None or not self.check.passed:
+            return "poor"
+        return "uncertain" if self.uncertain_because else "good"
+
+    @property
+    def verdict(self) -> str:
+        """The closing line of ``stabilise``: the quality and why (:func:`verdict`)."""
+        return verdict(self.check, len(self.modes), self.uncertain_because)
+
+    def _repr_html_(self) -> str:
+        """A notebook's view: the verdict and the modes with their intervals."""
+        import html
+
+        from armaxmodal.modes.report import modes_table
+
+        table = modes_table(self).to_html(index=False, float_format=lambda v: f"{v:.4g}", border=0)
+        return f"<p><b>{html.escape(self.verdict)}</b></p>{table}"
+
+    @property
+    def uncertain_because(self) -> list[str]:
+        """The codes of the warnings that make a passing selection uncertain, sorted."""
+        return sorted({w.code for w in self.warnings if w.code in UNCERTAIN_CODES})
+
+    @property
+    def warnings(self) -> list[QualityWarning]:
+        """The diagram's data-quality warnings and the selection's own."""
+        return self.diagram.warnings + list(self.own_warnings)
+
+    def to_dict(self, shapes: str = "shared") -> dict:
+        """The JSON contract of the ``stabilise`` command.
+
+        ``shapes="shared"`` reports the shared-pole residues (complete by construction);
+        ``"per_sensor"`` each sensor's own residue, with gaps filled by Eq. (3.34) and
+        flagged ``supplemented``.
+
+        Parameters
+        ----------
+        shapes : {"shared", "per_sensor"}
+            Which residues give the mode shapes.
+
+        Returns
+        -------
+        dict
+            Strict-JSON-ready (no NaN), as ``schemas/stabilise.schema.json`` describes.
+        """
+        if shapes not in ("shared", "per_sensor"):
+            raise ValueError(f"shapes: expected 'shared' or 'per_sensor', got {shapes!r}.")
+        rec = self.diagram.recording
+        if shapes == "shared":
+            matrix, flags = self.shapes, np.zeros(self.shapes.shape, dtype=bool)
+        else:
+            from armaxmodal.modes.per_sensor import supplement_shapes
+
+            matrix, flags = supplement_shapes(self)
+        modes = []
+        for i, row in enumerate(self.modes.itertuples(index=False)):
+            record = mode_record(row, matrix[:, i], rec.sensors, flags[:, i])
+            record.update(
+                orders_supporting=int(row.count),
+                freq_spread_hz=float(row.freq_spread),
+                damping_spread=float(row.damping_spread),
+            )
+            if "segments_found" in self.modes:
+                record["segment_spread"] = {
+                    "segments_found": int(row.segments_found),
+                    "freq_sd_hz": _finite_or_none(row.freq_segment_sd),
+                    "damping_sd": _finite_or_none(row.damping_segment_sd),
+                }
+                record["model_error_dominates"] = bool(row.model_error_dominates)
+            record["picked"] = bool(np.isfinite(getattr(row, "picked_hz", np.nan)))
+            if "structure_widened" in self.modes:  # the modal model's count (modes/counted.py)
+                record["count_undecided"] = bool(row.count_undecided)
+                record["interval_covers_other_counts"] = bool(row.structure_widened)
+            if "estimator_widened" in self.modes:  # the two estimators disagree (modes/estimators.py)
+                record["interval_covers_other_estimator"] = bool(row.estimator_widened)
+            modes.append(record)
+        per_sensor = [
+            {k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in r.items()}
+            for r in self.per_sensor.drop(columns=["own_modal_constant"]).to_dict("records")
+        ]
+        t = self.diagram.tolerances
+        prep = self.diagram.preparation
+        return {
+            **record_header(rec, prep, self.warnings),
+            "nk": self.diagram.orders[0].nk,
+            "orders_na": [o.na for o in self.diagram.orders],
+            "tolerances": {"freq": t.freq, "damping": t.damping, "shape": t.shape, "max_damping": t.max_damping},
+            "quality": self.quality,
+            "reconstruction_error": _finite_or_none(self.reconstruction_error),
+            "modal_check": None if self.check is None else self.check.to_dict(),
+            "intersample_hold": None if self.refinement is None else self.refinement.hold,
+            "estimator": sorted(set(self.modes.estimator)),
+            "picks": self.picks,
+            "settings": self.settings.to_dict(),
+            "modes": modes,
+            "per_sensor": per_sensor,
+        }
+
+
+def filled_samples_scale(recording, preparation) -> tuple[float, list[QualityWarning]]:
+    """The factor every interval is widened by for samples the reader filled in (``gap_filled``,
+    ``dropped_packet``): an interpolated sample carries no information, so a record of ``N``
+    samples with ``k`` filled holds ``N - k`` observations, and a standard deviation the fit
+    computed from ``N`` is too small by ``sqrt(N / (N - k))``. Counted in the record's own
+    samples, before any resampling. Returns ``(factor, notes)``; 1 and none without filled samples."""
+    filled = sum(w.value or 0.0 for w in recording.meta.get("read_warnings", ())
+                 if w.code in ("gap_filled", "dropped_packet"))  # fmt: skip
+    if not filled:
+        return 1.0, []
+    # gap_filled counts one channel's samples; a filled sample of any channel is lost to the fit
+    n = recording.duration * (recording.fs if preparation is None else preparation.original_fs)
+    factor = float(np.sqrt(n / max(n - filled, 1.0)))
+    note = QualityWarning(
+        "gap_filled", (),
+        f"{filled:g} filled sample(s) carry no information: every interval is widened by {factor:.6f} "
+        f"(sqrt(N / (N - filled)), N = {n:.0f})", factor,
+    )  # fmt: skip
+    return factor, [note]
+
+
+def verdict(check, n_modes: int, uncertain_because: list[str] = ()) -> str:
+    """The closing line: whether the modes explain the record, and whether the record decides them
+    (``uncertain_because``: the codes of the warnings that leave it undecided)."""
+    if n_modes == 0:
+        return "quality: POOR -- no stable mode found: the no_modes note says why each cluster was rejected"
+    if check is not None and check.passed and uncertain_because:
+        return (
+            f"quality: UNCERTAIN -- the {n_modes} selected mode(s) explain the measured FRF, but the record does not "
+            f"settle them: {', '.join(uncertain_because)} (see the notes)"
+        )
+    if check is not None and check.passed:
+        return f"quality: good -- the {n_modes} selected mode(s) explain the measured FRF of every checked output"
+    if check is not None and check.unconfirmed_hz and not check.failing:
+        where = ", ".join(f"{f:.2f}" for f in check.unconfirmed_hz)
+        return f"quality: POOR -- the record does not confirm the mode(s) at {where} Hz (no coherent H1 there)"
+    if check is None or not check.failing:
+        return "quality: POOR -- no output has coherent lines to check the modes against: treat them as unconfirmed"
+    worst = float(np.nanmax(check.model_error))
+    return (
+        f"quality: POOR -- the selected modes do not explain the measured FRF of {', '.join(check.failing)} "
+        f"(model error up to {100 * worst:.0f} %): treat them as unconfirmed (see the warning)"
+    )
+
+
+#: the columns of an empty selection (what the command line and the JSON read of a mode)
+_MODE_COLUMNS = ("freq_hz", "damping", "damped_freq_hz", "freq_ci95_lo", "freq_ci95_hi", "damping_ci95_lo",
+                 "damping_ci95_hi", "na", "count", "support", "freq_spread", "damping_spread", "estimator")  # fmt: skip
+
+
+def no_mode_selection(diagram: StabilisationDiagram, why: str, settings: SelectionSettings = DEFAULTS) -> ModeSelection:
+    """The selection of a diagram with no stable mode: no modes, quality ``poor``, and a
+    ``no_modes`` note that says why every cluster was rejected and what to do."""
+    note = QualityWarning(
+        "no_modes", (), f"{why}. Widen the band, extend the order range, or check that the input excites the structure."
+    )
+    empty = pd.DataFrame(columns=list(_MODE_COLUMNS))
+    per_sensor = pd.DataFrame(columns=["sensor", "mode", "own_modal_constant"])
+    shapes = np.zeros((len(diagram.recording.sensors), 0), dtype=complex)
+    return ModeSelection(empty, shapes, per_sensor, pd.DataFrame(columns=["mode"]), diagram, None, (note,), None,
+                         settings=settings)  # fmt: skip
+
+
+def not_separated_notes(modes: pd.DataFrame, separation_sd: float) -> list[QualityWarning]:
+    """A ``modes_not_separated`` note for each pair of neighbouring modes whose frequencies
+    differ by less than ``separation_sd`` standard deviations of the difference and that the
+    count did not report as one (picks, or modes the count left)."""
+    f = modes.freq_hz.to_numpy()
+    return [QualityWarning(
+        "modes_not_separated", (),
+        f"modes at {f[i]:.3f} and {f[j]:.3f} Hz are {gap:.1f} standard deviations of their difference apart (under "
+        f"{separation_sd:g}): the record does not separate them; they may be one mode", float(f[i]),
+    ) for i, j, gap in not_separated(with_intervals(modes), separation_sd)]  # fmt: skip
+
+
+def unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[QualityWarning]:
+    """A ``damping_unresolved`` note for every mode whose damping interval reaches zero or
+    whose damping estimate is not positive at some orders of the sweep, with the reason."""
+    notes = []
+    for m in modes.itertuples(index=False):
+        crossed = int(m.orders_damping_unresolved)
+        if crossed == 0 and m.damping_ci95_lo > 0:
+            continue
+        facts = [f"damping {m.damping:.2g}, 95 % interval [{m.damping_ci95_lo:.2g}, {m.damping_ci95_hi:.2g}]"]
+        if crossed:
+            facts.append(f"its estimate is not positive at {crossed} of {n_orders} orders")
+        if getattr(m, "model_error_dominates", False):
+            why = ("the interval is the spread of the record's thirds (model_error_dominates): the thirds disagree "
+                   "about this damping; run 'armaxmodal diagnose'")  # fmt: skip
+        else:
+            why = "the damping is below what this record resolves: a longer record, or more excitation here, narrows it"
+        notes.append(QualityWarning(
+            "damping_unresolved", (),
+            f"mode at {m.freq_hz:.3f} Hz ([{m.freq_ci95_lo:.4g}, {m.freq_ci95_hi:.4g}] Hz): {'; '.join(facts)}. {why}",
+            float(m.freq_hz),
+        ))  # fmt: skip
+    return notes
+
+
+def _finite_or_none(value) -> float | None:
+    return float(value) if np.isfinite(value) else None

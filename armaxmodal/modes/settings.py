@@ -1,0 +1,194 @@
+"""The thresholds of the mode selection, in one place: one frozen settings object per stage of
+:func:`armaxmodal.select_modes` (:mod:`armaxmodal.modes.pipeline`), each value with the
+measurement behind it. (The clustering, the count, the intervals and the line rule are here; the
+FRF check's and the DFT fitter's thresholds still sit in :mod:`armaxmodal.modes.modal_check`,
+:mod:`armaxmodal.modes.support`, :mod:`armaxmodal.modes.completeness` and
+:mod:`armaxmodal.modes.modal_model`.)
+
+``select_modes(settings=SelectionSettings(count=CountSettings(decisive_bic=6.0)))`` overrides any
+of them; the result carries the settings that made it (``ModeSelection.settings``, and
+``"settings"`` in the JSON). Values that answer the same question are derived from one another,
+never copied: a pick's reach and a counted mode's row reach are the clustering's frequency reach,
+two modes told apart by shape use the merge's MAC, and a line is a pole damped below
+:attr:`LineSettings.undamped` wherever the question is asked.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field, fields
+
+__all__ = [
+    "ClusterSettings",
+    "CountSettings",
+    "IntervalSettings",
+    "LineSettings",
+    "SelectionSettings",
+]
+
+
+@dataclass(frozen=True)
+class ClusterSettings:
+    """Which poles of the diagram are one mode (stages ``candidates`` and ``merge``)."""
+
+    #: relative frequency distance within which a pole joins a cluster (its median); also a pick's
+    #: reach and a counted mode's row reach (:attr:`pick_reach`, :attr:`same_row_freq`)
+    freq: float = 0.05
+    #: relative damping distance within which a pole joins a cluster
+    damping: float = 0.5
+    #: share of the swept orders a cluster must hold poles of to be a mode of the diagram
+    min_support: float = 0.4
+    #: shape agreement (MAC) above which two close modes are one mode split by over-modelling;
+    #: also the agreement at which two counted modes are not told apart by shape
+    merge_mac: float = 0.8
+    #: a pole is stable across the diagram when poles of at least this many orders lie near it:
+    #: a left-out cluster is a candidate for the count, and a pick takes a cluster, only then
+    min_orders: int = 3
+    #: a finished fit's pole farther than this (relative frequency) is another pole, not this one finished
+    finished_max_shift: float = 0.05
+
+    @property
+    def pick_reach(self) -> float:
+        """A pick takes a cluster whose median lies within this relative distance: the clustering's
+        own reach, so a pick never takes a column the diagram shows as another mode's."""
+        return self.freq
+
+    @property
+    def same_row_freq(self) -> float:
+        """A counted mode within this relative frequency of a selected one keeps that row's cluster
+        facts (orders, support, spread): the clustering's own reach."""
+        return self.freq
+
+
+@dataclass(frozen=True)
+class LineSettings:
+    """Is a pole a line (a periodic disturbance) or a mode, in one place for the diagram's
+    ``periodic_disturbance`` note, the count's reported poles and the diagnosis."""
+
+    #: damping below this, at a pole the input does not drive, is a line, not a structural mode: a
+    #: hum on a fixture copy's output gave 5e-5-3e-4 at every order, a line on the input alone up to
+    #: 1.7e-3; the lightest mode of the measured records is 4.8e-3 (the F-16's torsion). The damping
+    #: alone does not decide: a two-mass chain damped 0.05 % and 0.1 % is driven, and its modes are modes
+    undamped: float = 2e-3
+    #: the modal model's pole damped this little sits at its fit's floor (twice the lower damping
+    #: bound): a line or a frequency that moves, not a mode (the supine ride's 0.3 m/s^2 hum at
+    #: 12.5 Hz came out at 12.500 Hz, damping 1e-4). The count has no residue-energy test, so it
+    #: cannot take :attr:`undamped`, which would drop the driven light modes above
+    at_fit_floor: float = 2e-4
+    #: poles of one line across orders agree to this relative frequency (the hum: 3e-4)
+    freq_tol: float = 1e-3
+    #: the input carries the line too when its PSD there stands this far above the median of the
+    #: neighbouring lines (10 dB; a Welch average of seven segments exceeds it by chance with
+    #: probability ~1e-9)
+    input_ratio: float = 10.0
+
+
+@dataclass(frozen=True)
+class CountSettings:
+    """The count by nested tests of the maximum-likelihood modal model (stage ``count``): the
+    only stage that keeps or drops a mode."""
+
+    #: a change of the criterion this large is "very strong" evidence (Kass & Raftery 1995): a
+    #: mode's removal, or a candidate's addition, that moves it less leaves the count undecided
+    decisive_bic: float = 10.0
+    #: a refused addition whose likelihood ratio a chi-square of its parameters puts beyond this
+    #: probability leaves the count undecided (when its mode is the same in both halves). BIC's
+    #: penalty grows with the data, so a weakly seen mode can raise the likelihood far beyond chance
+    #: and still lose on BIC; 1e-6 keeps the largest of a handful of candidates at chance (the
+    #: battery's 46 bodies: at most the 1e-3 quantile) far below it
+    likelihood_alpha: float = 1e-6
+    #: the residual's correlation across lines is summed up to this many lines (Bartlett's window):
+    #: the widest structure of model error is a resonance's half-power band, 2 xi f = 3-10 Hz
+    #: for the bodies, i.e. hundreds of lines; the sum stops earlier at the first negative value
+    max_correlation_lag: int = 400
+    #: search steps at most (each accepted step changes the count by one)
+    max_steps: int = 6
+    #: residual evaluations of a screening fit: the candidates are compared after this many steps
+    #: from their starts, and the best of each kind is then iterated to convergence
+    screen_nfev: int = 10
+    #: residual evaluations of the chosen model's last fit, to convergence
+    final_nfev: int = 200
+    #: residual evaluations of each half's fit in the halves test
+    halves_nfev: int = 40
+    #: a new pole's frequency and damping in the record's two halves may differ by this many
+    #: standard deviations of their difference (a two-sided 1 % test would take 2.6)
+    halves_sd: float = 3.0
+    #: a candidate addition within this relative frequency of a mode is that mode
+    same_mode_freq: float = 0.03
+    #: the nested tests run on at most this many samples of a record (18 min at 60 Hz, 9 at 120 Hz:
+    #: every body's modes are counted on less); a longer record's chosen model is fitted whole
+    max_samples: int = 65_536
+    #: left-out clusters of the diagram tried as additions: the largest few (each costs a fit)
+    max_candidates: int = 3
+    #: lines either side of the residual's peak averaged to place a new pole
+    peak_width_lines: int = 9
+    #: two modes closer than this many standard deviations of their difference are not separated
+    #: by the record (a difference 3 SD from zero is the usual resolution rule)
+    separation_sd: float = 3.0
+
+
+@dataclass(frozen=True)
+class IntervalSettings:
+    """What the 95 % intervals cover beyond the estimate's own deviation (stages ``segments`` and
+    ``intervals``)."""
+
+    #: family-wise false-alarm rate of the segments' spread test over all modes and both parameters
+    spread_alpha: float = 0.01
+    #: a segment pole is the mode's when within this relative frequency of it
+    match_freq: float = 0.05
+    #: the level of the two estimators' test: the one the segments' test of model error uses
+    estimators_alpha: float = 0.01
+
+
+@dataclass(frozen=True)
+class SelectionSettings:
+    """Every threshold of :func:`armaxmodal.select_modes`, one object per stage.
+
+    Attributes
+    ----------
+    cluster : ClusterSettings
+        Which poles are one mode (``candidates``, ``merge``, picks, the count's candidates).
+    lines : LineSettings
+        Which poles are lines: the count reads ``at_fit_floor``; the diagram's
+        ``periodic_disturbance`` note and the diagnosis read the defaults (the diagram is made
+        before any selection).
+    count : CountSettings
+        The count by nested tests, and the separation of close modes.
+    intervals : IntervalSettings
+        The segments' and the two estimators' tests.
+
+    Examples
+    --------
+    >>> from armaxmodal.modes.settings import CountSettings, SelectionSettings
+    >>> strict = SelectionSettings(count=CountSettings(decisive_bic=20.0))
+    >>> strict.count.decisive_bic, SelectionSettings().count.decisive_bic
+    (20.0, 10.0)
+    >>> strict.cluster.pick_reach  # derived from the clustering's reach, never copied
+    0.05
+    """
+
+    cluster: ClusterSettings = field(default_factory=ClusterSettings)
+    lines: LineSettings = field(default_factory=LineSettings)
+    count: CountSettings = field(default_factory=CountSettings)
+    intervals: IntervalSettings = field(default_factory=IntervalSettings)
+
+    def __post_init__(self):
+        for f in fields(self):
+            value = getattr(self, f.name)
+            expected = f.default_factory  # type: ignore[misc]
+            if not isinstance(value, expected):
+                raise TypeError(f"settings.{f.name}: expected a {expected.__name__}, got {type(value).__name__}.")
+
+    def to_dict(self) -> dict:
+        """Every value by stage, JSON-ready (the ``"settings"`` of the ``stabilise`` JSON).
+
+        Returns
+        -------
+        dict
+            ``{stage: {name: value}}``; tuples as lists.
+        """
+        return {name: {k: list(v) if isinstance(v, tuple) else v for k, v in part.items()}
+                for name, part in asdict(self).items()}  # fmt: skip
+
+
+#: the defaults, shared by the functions that can also be called outside the pipeline
+DEFAULTS = SelectionSettings()

@@ -1,0 +1,155 @@
+"""The selection as named stages (armaxmodal.modes.pipeline): one recording visits each stage of
+its list once, in order; each stage runs alone on a state; the settings reach the stages and come
+back on the result and in the JSON."""
+
+from dataclasses import replace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import armaxmodal as am
+from armaxmodal.modes import pipeline
+from armaxmodal.modes.settings import ClusterSettings, CountSettings, SelectionSettings
+from armaxmodal.modes.state import SelectionContext, SelectionState
+from tests.cli.test_schemas import _validator
+
+AUTOMATIC = ["candidates", "merge", "refit", "screen_by_frf", "count", "separate", "check", "confirm", "spread",
+             "finish"]  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def diagram(fixtures_dir):
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    return am.stabilisation_diagram(rec, orders=range(4, 17, 2), n_jobs=1)
+
+
+def _traced(diagram, **kwargs):
+    entered = []
+    selection = am.select_modes(diagram, n_jobs=1, on_stage=entered.append, **kwargs)
+    return entered, selection
+
+
+def test_one_recording_visits_each_stage_once_in_order(diagram):
+    entered, selection = _traced(diagram)
+    assert entered == AUTOMATIC
+    assert [s.__name__ for s in pipeline.AUTOMATIC] == AUTOMATIC
+    assert selection.count is not None and len(selection.modes) == 4  # the count ran and kept the four modes
+
+
+def test_the_arguments_choose_a_named_stage_list(diagram):
+    fixed, selection = _traced(diagram, n_modes=2, segments=0)
+    assert fixed == ["candidates", "merge", "best_n", "refit", "check", "spread", "finish"]
+    assert len(selection.modes) == 2 and selection.count is None  # the count does not run on a fixed number
+    plain, selection = _traced(diagram, refine=False, segments=0)
+    assert plain == ["candidates", "merge", "segment_fits", "screen_by_frf", "separate", "check", "spread", "finish"]
+    assert selection.refinement is None and selection.count is None
+    picked, selection = _traced(diagram, picks=[8.3], segments=0)
+    assert picked == ["take_picks", "candidates", "merge", "refit", "screen_by_frf", "count", "add_picks",
+                      "separate", "check_unless_counted", "confirm", "spread", "finish"]  # fmt: skip
+    assert selection.picks == [8.3]
+    with pytest.raises(am.PickError, match="do not mix"):
+        pipeline.stages_for(2, [8.3], True)
+
+
+def test_a_pick_the_diagram_does_not_offer_stops_before_any_fit(diagram):
+    entered = []
+    with pytest.raises(am.PickError):
+        am.select_modes(diagram, picks=[2.0, 2.05], on_stage=entered.append)  # two picks in one cluster's reach
+    assert entered == []  # refused while the picks are checked, before the first stage
+
+
+def _state(freq, damping, support, shapes):
+    modes = pd.DataFrame({"freq_hz": freq, "damping": damping, "support": support, "count": [10] * len(freq),
+                          "energy": [1.0] * len(freq)})  # fmt: skip
+    return SelectionState(modes, np.asarray(shapes, dtype=complex))
+
+
+def test_merge_alone_drops_the_weaker_half_of_a_split_mode_and_orders_by_frequency(diagram):
+    ctx = SelectionContext(diagram, SelectionSettings(), None, [4, 6])
+    # 10.0 and 10.3 Hz lie within each other's half-power band (2 x 0.05 x 10 = 1 Hz) with one shape
+    state = _state([20.0, 10.3, 10.0], [0.02, 0.05, 0.05], [0.9, 0.5, 0.8],
+                   [[1, 1, 1], [0, 1, 1], [1, 0.5, 0.5], [0, 1, 1]])  # fmt: skip
+    out = pipeline.merge(state, ctx)
+    assert out.modes.freq_hz.tolist() == [10.0, 20.0]
+    np.testing.assert_array_equal(out.shapes, state.shapes[:, [2, 0]])
+    # shapes that differ (MAC below merge_mac) keep both
+    loose = SelectionContext(diagram, SelectionSettings(cluster=ClusterSettings(merge_mac=0.999)), None, [4, 6])
+    other = replace(state, shapes=np.array([[1, 1, 1], [0, 1, 0.2], [1, 0.5, 1], [0, 1, 0]], dtype=complex))
+    assert pipeline.merge(other, loose).modes.freq_hz.tolist() == [10.0, 10.3, 20.0]
+
+
+def test_best_n_alone_keeps_the_best_supported(diagram):
+    ctx = SelectionContext(diagram, SelectionSettings(), None, [4, 6], n_modes=2)
+    state = _state([5.0, 8.0, 13.0], [0.2, 0.3, 0.3], [0.9, 0.3, 0.6], np.eye(3))
+    assert pipeline.best_n(state, ctx).modes.freq_hz.tolist() == [5.0, 13.0]
+
+
+def test_separate_alone_uses_the_count_settings_level(diagram):
+    modes = pd.DataFrame({"freq_hz": [10.0, 10.5], "damping": [0.02, 0.02], "freq_sd": [0.1, 0.1],
+                          "damping_sd": [0.001, 0.001]})  # fmt: skip
+    state = SelectionState(modes, np.eye(2, dtype=complex))
+    at = lambda sd: SelectionContext(diagram, SelectionSettings(count=CountSettings(separation_sd=sd)), None, [4])  # noqa: E731
+    # 0.5 Hz apart with a difference's SD of 0.14 Hz: 3.5 SD
+    assert pipeline.separate(state, at(3.0)).warnings == ()
+    (note,) = pipeline.separate(state, at(4.0)).warnings
+    assert note.code == "modes_not_separated" and "under 4" in note.message
+
+
+def test_count_alone_needs_the_refit(diagram):
+    ctx = SelectionContext(diagram, SelectionSettings(), None, [4, 6])
+    state = _state([5.0], [0.2], [0.9], np.ones((4, 1)))
+    assert pipeline.count(state, ctx) is state  # no refinement: the modal model has no hold to fit under
+
+
+def test_check_alone_judges_the_modes_it_is_given(diagram):
+    ctx = SelectionContext(diagram, SelectionSettings(), None, sorted({o.na for o in diagram.orders}), segments=0)
+    exact = am.supine_human().modes()
+    modes = pd.DataFrame({"freq_hz": exact.freq_hz, "damping": exact.damping})
+    state = pipeline.check(SelectionState(modes, np.ones((4, 4), dtype=complex)), ctx)
+    assert state.check.passed and state.result is None  # the exact modes explain the ride's FRF
+    np.testing.assert_allclose(np.sort(np.abs(state.check.poles) / (2 * np.pi)), np.sort(exact.freq_hz))
+    # where one row reports a pair, the check fits the model's two poles
+    pair = replace(state, check_poles=((5.8, 0.26), (8.3, 0.35)), modes=modes.iloc[[0]], shapes=np.ones((4, 1)))
+    assert len(pipeline.check(pair, ctx).check.poles) == 2
+
+
+def test_the_stages_run_one_by_one_give_select_modes_result(diagram):
+    whole = am.select_modes(diagram, n_jobs=1, segments=0)
+    ctx = SelectionContext(diagram, SelectionSettings(), None, sorted({o.na for o in diagram.orders}), segments=0,
+                           n_jobs=1)  # fmt: skip
+    state = SelectionState.empty(len(diagram.recording.sensors))
+    for stage in pipeline.AUTOMATIC[:-1]:
+        state = stage(state, ctx)
+        assert state.result is None
+    done = pipeline.finish(state, ctx).result
+    pd.testing.assert_frame_equal(done.modes, whole.modes)
+    assert [w.message for w in done.warnings] == [w.message for w in whole.warnings]
+
+
+def test_settings_reach_the_stages_and_come_back_on_the_result(diagram):
+    default = am.select_modes(diagram, n_jobs=1, segments=0)
+    assert default.settings == SelectionSettings()
+    # a cluster must hold poles of every order: none of the ride's does, so no mode is found
+    strict = SelectionSettings(cluster=ClusterSettings(min_support=1.01))
+    none = am.select_modes(diagram, n_jobs=1, segments=0, settings=strict)
+    assert none.modes.empty and none.settings is strict
+    assert "a mode needs 8" in next(w.message for w in none.warnings if w.code == "no_modes")  # ceil(1.01 x 7)
+    with pytest.raises(TypeError, match="SelectionSettings"):
+        am.select_modes(diagram, settings={"cluster": {"freq": 0.03}})
+
+
+def test_the_json_carries_its_settings(diagram):
+    import json
+
+    selection = am.select_modes(diagram, n_jobs=1, segments=0,
+                                settings=SelectionSettings(count=CountSettings(decisive_bic=12.0)))  # fmt: skip
+    out = json.loads(json.dumps(selection.to_dict(), allow_nan=False))
+    assert out["settings"]["count"]["decisive_bic"] == 12.0
+    assert out["settings"]["cluster"]["freq"] == 0.05 and out["settings"]["lines"]["at_fit_floor"] == 2e-4
+    _validator("stabilise").validate(out)
+
+
+def test_a_wrong_settings_part_is_refused():
+    with pytest.raises(TypeError, match="settings.count: expected a CountSettings"):
+        SelectionSettings(count=ClusterSettings())
