@@ -22,7 +22,7 @@ import numpy as np
 
 import armaxmodal as am
 from armaxmodal.modes.diagram import stabilisation_diagram
-from armaxmodal.modes.selection import select_modes
+from armaxmodal.modes.pipeline import select_modes
 from armaxmodal.spectra import measured_frf
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -56,7 +56,7 @@ def run_cli(path: Path, out: Path) -> float:
 def stages(rec: am.Recording) -> None:
     from armaxmodal.estimate.fit import load_kernels
     from armaxmodal.modes import diagram as st
-    from armaxmodal.modes.selection import select_modes
+    from armaxmodal.modes.pipeline import select_modes
     from armaxmodal.prepare.preparation import prepare
 
     load_kernels()

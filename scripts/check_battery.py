@@ -21,7 +21,7 @@ from robustness import random_chain  # scripts/ is on the path when a script run
 import armaxmodal as am
 from armaxmodal.modes.diagram import stabilisation_diagram
 from armaxmodal.modes.modal_check import check_modes
-from armaxmodal.modes.selection import select_modes
+from armaxmodal.modes.pipeline import select_modes
 
 #: a found mode within this relative frequency of a true one is that mode
 MATCH = 0.05

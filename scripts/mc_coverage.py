@@ -21,7 +21,7 @@ import numpy as np
 
 import armaxmodal as am
 from armaxmodal.modes.diagram import stabilisation_diagram
-from armaxmodal.modes.selection import select_modes
+from armaxmodal.modes.pipeline import select_modes
 
 
 def one_ride(structure, truth, seed: int, hold: str, duration: float) -> np.ndarray:

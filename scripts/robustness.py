@@ -15,7 +15,7 @@ import numpy as np
 
 import armaxmodal as am
 from armaxmodal.modes.diagram import stabilisation_diagram
-from armaxmodal.modes.selection import select_modes
+from armaxmodal.modes.pipeline import select_modes
 
 
 def random_chain(rng, dampings=(0.01, 0.05, 0.15, 0.3)):
