@@ -361,7 +361,7 @@ def run_stages(stages: tuple[Stage, ...], state: SelectionState, ctx: SelectionC
         if ctx.on_stage is not None:
             ctx.on_stage(stage.__name__)
         if ctx.bar is not None:
-            ctx.bar.set_description(f"mode selection ({stage.__name__})", refresh=False)
+            ctx.bar.set_postfix_str(stage.__name__, refresh=False)
         state = stage(state, ctx)
         if state.result is not None:
             return state.result
