@@ -1,15 +1,15 @@
 """Automatic mode selection from a stabilisation diagram (thesis Section 3.4), as named stages.
 
-:func:`~armaxmodal.select_modes` runs one tuple of stages over one frozen
-:class:`~armaxmodal.modes.state.SelectionState`; every stage is ``stage(state, context) -> state``
+``select_modes`` runs one tuple of stages over one frozen
+``SelectionState`` (:mod:`armaxmodal.modes.state`); every stage is ``stage(state, context) -> state``
 and reads what does not change (the diagram, the band, the orders, the settings) from one
-:class:`~armaxmodal.modes.state.SelectionContext`. Which tuple runs is the only choice the
+``SelectionContext``. Which tuple runs is the only choice the
 arguments make, and each is named:
 
-* :data:`AUTOMATIC` -- the diagram's stable clusters are the candidates; the measured FRF
+* ``AUTOMATIC`` -- the diagram's stable clusters are the candidates; the measured FRF
   proposes and screens them; the maximum-likelihood modal model counts them;
-* :data:`FIXED_COUNT` -- ``n_modes`` given: the best-supported clusters, checked, not counted;
-* :data:`PICKED` -- ``picks`` given: the picked clusters, reported from the counted model;
+* ``FIXED_COUNT`` -- ``n_modes`` given: the best-supported clusters, checked, not counted;
+* ``PICKED`` -- ``picks`` given: the picked clusters, reported from the counted model;
 * the same three without the frequency-domain refit (``refine=False``), which also leaves the
   count out, since the modal model is fitted under the hold the refit chose.
 

@@ -1,4 +1,4 @@
-"""The result of :func:`~armaxmodal.select_modes`: :class:`ModeSelection`, its JSON contract
+"""The result of ``select_modes``: ``ModeSelection``, its JSON contract
 (``schemas/stabilise.schema.json``) and its verdict, and the notes read off the final modes.
 """
 

@@ -1,5 +1,5 @@
 """The thresholds of the mode selection, in one place: one frozen settings object per stage of
-:func:`armaxmodal.select_modes` (:mod:`armaxmodal.modes.pipeline`), each value with the
+``select_modes`` (:mod:`armaxmodal.modes.pipeline`), each value with the
 measurement behind it. (The clustering, the count, the intervals and the line rule are here; the
 FRF check's and the DFT fitter's thresholds still sit in :mod:`armaxmodal.modes.modal_check`,
 :mod:`armaxmodal.modes.support`, :mod:`armaxmodal.modes.completeness` and
@@ -9,8 +9,8 @@ FRF check's and the DFT fitter's thresholds still sit in :mod:`armaxmodal.modes.
 of them; the result carries the settings that made it (``ModeSelection.settings``, and
 ``"settings"`` in the JSON). Values that answer the same question are derived from one another,
 never copied: a pick's reach and a counted mode's row reach are the clustering's frequency reach,
-two modes told apart by shape use the merge's MAC, and a line is a pole damped below
-:attr:`LineSettings.undamped` wherever the question is asked.
+two modes told apart by shape use the merge's MAC, and what a line is stands in
+``LineSettings``.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
-"""The selection as it goes, and what every stage reads: :class:`SelectionState`, the one frozen
-object each stage of :func:`armaxmodal.select_modes` takes and returns, and
-:class:`SelectionContext`, the diagram, band, orders and settings that stay the same from stage to
+"""The selection as it goes, and what every stage reads: ``SelectionState``, the one frozen
+object each stage of ``select_modes`` takes and returns, and
+``SelectionContext``, the diagram, band, orders and settings that stay the same from stage to
 stage (:mod:`armaxmodal.modes.pipeline` names the stages)."""
 
 from __future__ import annotations
