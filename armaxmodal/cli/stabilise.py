@@ -187,11 +187,9 @@ def _picks(text: str | None, n_modes: int | None) -> list[float] | None:
 
 def print_check(check) -> None:
     """The modal-model check per output, beside the H1's own random error."""
-    from armaxmodal.modes.modal_check import MODEL_ERROR_LIMIT
-
     print(
         "modal-model check (LSFD of each H1 by the selected poles, residual terms and a delay; "
-        f"model error = misfit beyond the H1's random error, limit {100 * MODEL_ERROR_LIMIT:.0f} %):"
+        f"model error = misfit beyond the H1's random error, limit {100 * check.limit:.0f} %):"
     )
     for k, sensor in enumerate(check.sensors):
         if not np.isfinite(check.error[k]):

@@ -67,9 +67,9 @@ def _candidates(diagram, modes: pd.DataFrame, band, nas, settings: SelectionSett
 def _on_whole_record(count: ModeCount, rec, band_hz, hold: str) -> ModeCount:
     """The counted model fitted to the whole record from where the search left it."""
     whole = DftLines.from_recording(rec, band_hz)
-    start = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, max_nfev=1)
+    start = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, 1, count.dft)
     whole = whole.noise_weighted(start)
-    final = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, count.settings.final_nfev)
+    final = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, count.settings.final_nfev, count.dft)
     return replace(count, model=final)
 
 
@@ -123,7 +123,8 @@ def counted_modes(
         hidden = ~work.count.reported(band_hz)
         start_f, start_x = np.r_[start_f, model.freq_hz[hidden]], np.r_[start_x, model.damping[hidden]]
     count = count_modes(data, start_f, start_x, candidates, hold=hold, halves=halves, supported=supported,
-                        search=not picked, n_jobs=n_jobs, settings=settings.count, lines=settings.lines)  # fmt: skip
+                        search=not picked, n_jobs=n_jobs, settings=settings.count, lines=settings.lines,
+                        dft=settings.dft)  # fmt: skip
     if part is not rec:
         count = _on_whole_record(count, rec, band_hz, hold)
     keep = count.reported(data.band_hz)
@@ -172,7 +173,8 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
     data = DftLines.from_recording(rec, band_hz).noise_weighted(count.model)
     rows, shapes, notes, gone = rows.copy(), shapes.copy(), [], []
     for a, b, gap in pairs:
-        fits = [fit_modal_model(data, np.delete(m.freq_hz, k), np.delete(m.damping, k), hold, settings.count.final_nfev)
+        fits = [fit_modal_model(data, np.delete(m.freq_hz, k), np.delete(m.damping, k), hold, settings.count.final_nfev,
+                                settings.dft)
                 for k in (poles[a], poles[b])]  # fmt: skip
         one = min(fits, key=lambda fit: fit.bic())
         both = rows.loc[[a, b]]
@@ -221,7 +223,7 @@ def confirmed_where_incoherent(diagram, work: SelectionState, settings: Selectio
     part = _counted_part(rec, count.settings.max_samples)
     data = DftLines.from_recording(part, work.refinement.band_hz).noise_weighted(m)
     halves = tuple(DftLines.from_recording(half, work.refinement.band_hz) for half in split_segments(part, 2))
-    agree = agree_in_halves(data, m, halves, hold, count.settings.halves_nfev, count.settings.halves_sd)
+    agree = agree_in_halves(data, m, halves, hold, count.settings.halves_nfev, count.settings.halves_sd, count.dft)
     reach, decisive = settings.cluster.same_row_freq, count.settings.decisive_bic
     confirmed, notes = [], []
     for f in check.unconfirmed_hz:
@@ -315,7 +317,7 @@ def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hol
     if recording is not None:  # the check of the model the picks come from: the picks and the others
         f = np.r_[work.modes.freq_hz.to_numpy(), m.freq_hz[others]]
         x = np.r_[work.modes.damping.to_numpy(), m.damping[others]]
-        work = replace(work, check=check_modes(recording, f, x, band))
+        work = replace(work, check=check_modes(recording, f, x, band, settings=settings.frf))
     return work.warned(*notes)
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from armaxmodal.modes.settings import DEFAULTS, NoteSettings
 from armaxmodal.prepare.preparation import Preparation
 from armaxmodal.prepare.resample import BAND_FRACTION_OF_FS
 from armaxmodal.quality_warnings import QualityWarning
@@ -12,20 +13,15 @@ from armaxmodal.recording import Recording
 
 __all__ = ["oversampling_note", "record_header"]
 
-#: every mode found below this share of the Nyquist frequency: the record is oversampled
-#: for its structure (the measured records here: 28-66 %; the supine ride at 1 kHz: 3 %)
-OVERSAMPLED_FRACTION = 0.1
-#: ... and the band suggested ends at this multiple of the highest mode found
-SUGGESTED_BAND_FACTOR = 2.5
 
-
-def oversampling_note(mode_freqs: np.ndarray, fs: float) -> list[QualityWarning]:
+def oversampling_note(mode_freqs: np.ndarray, fs: float, settings: NoteSettings = DEFAULTS.notes
+                      ) -> list[QualityWarning]:  # fmt: skip
     """An ``oversampled`` warning when every mode found lies below
-    :data:`OVERSAMPLED_FRACTION` of the Nyquist frequency: the input excites far above the
+    ``settings.oversampled_fraction`` of the Nyquist frequency: the input excites far above the
     structure (so the rate was kept), the poles crowd ``z = 1`` and the swept orders resolve
     them poorly (the supine ride at 1 kHz under a 0.5-400 Hz ride gave one of its four modes;
     with the band suggested here, all four). The band suggested ends at
-    :data:`SUGGESTED_BAND_FACTOR` times the highest mode found.
+    ``settings.suggested_band_factor`` times the highest mode found.
 
     Parameters
     ----------
@@ -33,6 +29,8 @@ def oversampling_note(mode_freqs: np.ndarray, fs: float) -> list[QualityWarning]
         Natural frequencies of the modes found, Hz.
     fs : float
         The analysis rate, Hz.
+    settings : NoteSettings
+        The share of Nyquist that makes a record oversampled, and the band suggested.
 
     Returns
     -------
@@ -40,11 +38,14 @@ def oversampling_note(mode_freqs: np.ndarray, fs: float) -> list[QualityWarning]
         Empty, or one warning whose value is the highest mode's share of the Nyquist frequency.
     """
     mode_freqs = np.asarray(mode_freqs, dtype=float)
-    if mode_freqs.size == 0 or mode_freqs.max() >= OVERSAMPLED_FRACTION * fs / 2:
+    if mode_freqs.size == 0 or mode_freqs.max() >= settings.oversampled_fraction * fs / 2:
         return []
     top = float(mode_freqs.max())
-    hi = float(np.ceil(SUGGESTED_BAND_FACTOR * top))
-    new_fs = fs / int(np.floor(BAND_FRACTION_OF_FS * fs / hi))
+    hi = float(np.ceil(settings.suggested_band_factor * top))
+    factor = int(np.floor(BAND_FRACTION_OF_FS * fs / hi))
+    if factor < 2:  # the band suggested keeps the rate: no lower rate to suggest
+        return []
+    new_fs = fs / factor
     share = top / (fs / 2)
     return [
         QualityWarning(

@@ -11,7 +11,7 @@ the residual terms as in Peeters et al.'s PolyMAX)::
 ``r_mk`` complex residues, ``U_k`` the upper residual (modes above the band, and the direct
 term of an absolute-acceleration transmissibility, which tends to 1 below the first mode),
 ``L_k`` the lower residual (modes below the band), ``tau_k`` the output's delay against the
-input (searched over +-``MAX_DELAY_SAMPLES``). A truncated modal sum without these terms
+input (searched over +-``FrfSettings.max_delay_samples``). A truncated modal sum without these terms
 goes to 0 below the first mode where a base-excited structure's transmissibility is 1, and
 a sensor's delay adds a phase no modal sum has: without them a check fails right answers.
 
@@ -19,7 +19,7 @@ The statistic per output is the relative RMS misfit ``|H_fit - H1| / |H1|`` over
 lines, reported beside the H1's own random error in the same norm (Bendat & Piersol,
 *Random Data*, Sec. 9.2.4, from the coherence). The part of the misfit the random error
 does not account for, ``sqrt(max(e^2 - e_random^2, 0))``, is the *model error*; the modes
-explain the record when it is at most ``MODEL_ERROR_LIMIT`` on every output.
+explain the record when it is at most ``FrfSettings.model_error_limit`` on every output.
 
 ``armaxmodal.modes.support.mode_support`` gives the evidence :func:`armaxmodal.select_modes`
 keeps a mode by: how much this check worsens without it (with a neighbour inside its half-power
@@ -34,29 +34,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from armaxmodal.modes.lines import CHECK_RESOLUTION, CoherentLines, coherent_lines, resolving_nperseg
+from armaxmodal.modes.settings import DEFAULTS, FrfSettings
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.stats import H1_COHERENCE
 
-__all__ = ["ModalCheck", "check_modes", "confirmed_modes", "poles_of", "rss_at", "MODEL_ERROR_LIMIT"]
-
-#: delays searched, samples either way, in steps of :data:`DELAY_STEP_SAMPLES`: channels
-#: are aligned by whole samples before the fit, so what is left is a few samples at most
-MAX_DELAY_SAMPLES = 4.0
-DELAY_STEP_SAMPLES = 0.25
-#: the largest model error (the misfit beyond the H1's random error) of an output whose
-#: modes explain it. Measured on records whose modes are right and complete (synced
-#: shake-table runs, F-16 multisine levels 1-7, the bridge records, the fixtures; the
-#: validation page's table): 0.01-0.43, the highest on stiff3 Northridge, whose peaks the
-#: ARMAX fit carries as doublets. The same records with their strongest mode left out read
-#: 0.50-0.96 on the output that shows it. The limit sits between the two.
-MODEL_ERROR_LIMIT = 0.5
-#: a mode is confirmed by a coherent line within its half-power half-width and this many lines
-CONFIRM_LINES = 4
-#: a band is named where the misfit of a line exceeds half the H1 there and three times
-#: its random error, over at least this many neighbouring lines
-BAND_MIN_LINES = 3
-
+__all__ = ["ModalCheck", "check_modes", "confirmed_modes", "poles_of", "rss_at"]
 
 @dataclass(frozen=True)
 class ModalCheck:
@@ -85,6 +68,8 @@ class ModalCheck:
     unconfirmed_hz : tuple of float
         Modes (Hz) with no coherent line of any output near them (``confirmed_modes``):
         the record cannot confirm them, whatever the misfit.
+    limit : float
+        The largest model error of an output whose modes explain it (``FrfSettings.model_error_limit``).
     """
 
     sensors: tuple
@@ -99,20 +84,21 @@ class ModalCheck:
     residual_terms: np.ndarray
     poles: np.ndarray
     unconfirmed_hz: tuple = ()
+    limit: float = DEFAULTS.frf.model_error_limit
 
     @property
     def passed(self) -> bool:
-        """Every checked output's model error within ``MODEL_ERROR_LIMIT`` and every mode
+        """Every checked output's model error within :attr:`limit` and every mode
         confirmed (False when no output has coherent lines: nothing shows that the modes
         explain the record)."""
         checked = np.isfinite(self.model_error)
-        fits = bool(checked.any() and np.all(self.model_error[checked] <= MODEL_ERROR_LIMIT))
+        fits = bool(checked.any() and np.all(self.model_error[checked] <= self.limit))
         return fits and not self.unconfirmed_hz
 
     @property
     def failing(self) -> tuple:
-        """The checked outputs whose model error exceeds ``MODEL_ERROR_LIMIT``."""
-        return tuple(s for s, e in zip(self.sensors, self.model_error, strict=True) if e > MODEL_ERROR_LIMIT)
+        """The checked outputs whose model error exceeds :attr:`limit`."""
+        return tuple(s for s, e in zip(self.sensors, self.model_error, strict=True) if e > self.limit)
 
     @property
     def overall_error(self) -> float:
@@ -161,7 +147,7 @@ class ModalCheck:
                 float(self.unconfirmed_hz[0]),
             ))  # fmt: skip
         checked = np.isfinite(self.model_error)
-        if checked.any() and np.all(self.model_error[checked] <= MODEL_ERROR_LIMIT):
+        if checked.any() and np.all(self.model_error[checked] <= self.limit):
             return found
         if not self.failing:
             return found + [QualityWarning(
@@ -174,7 +160,7 @@ class ModalCheck:
         return found + [QualityWarning(
             "modes_do_not_explain_frf", self.failing,
             f"the selected modes do not explain the measured FRF of {', '.join(self.failing)}: model error up to "
-            f"{100 * worst:.0f} % (limit {100 * MODEL_ERROR_LIMIT:.0f} %) beyond the H1's random error, misfit "
+            f"{100 * worst:.0f} % (limit {100 * self.limit:.0f} %) beyond the H1's random error, misfit "
             f"{'at ' if self.bands else ''}{where}. Treat these modes as unconfirmed: look at the figure, widen "
             "--orders or --band, or run 'armaxmodal diagnose'",
             worst,
@@ -190,7 +176,7 @@ class ModalCheck:
             The check's misfits, verdict and warnings, strict-JSON-ready.
         """
         return {
-            "limit": MODEL_ERROR_LIMIT,
+            "limit": self.limit,
             "passed": self.passed,
             "nperseg": int(self.nperseg),
             "outputs": [
@@ -247,13 +233,14 @@ def check_nperseg(recording: Recording, freq_hz, damping) -> int:
     return resolving_nperseg(recording, freq_hz, damping, CHECK_RESOLUTION)
 
 
-def _fit_delays(lines: CoherentLines, basis: np.ndarray, fs: float, search: bool) -> tuple[float, np.ndarray, float]:
+def _fit_delays(lines: CoherentLines, basis: np.ndarray, fs: float, search: bool, settings: FrfSettings
+                ) -> tuple[float, np.ndarray, float]:  # fmt: skip
     """The delay (s) of the grid (or zero without ``search``) whose fit leaves the least
     misfit, its coefficients and residual sum of squares. All delays are solved at once
     through one QR of the basis."""
     q, r = np.linalg.qr(np.vstack([basis.real, basis.imag]))
-    top = MAX_DELAY_SAMPLES if search else 0.0
-    taus = np.arange(-top, top + DELAY_STEP_SAMPLES / 2, DELAY_STEP_SAMPLES) / fs
+    top, step = (settings.max_delay_samples if search else 0.0), settings.delay_step_samples
+    taus = np.arange(-top, top + step / 2, step) / fs
     shifted = lines.h[:, None] * np.exp(2j * np.pi * lines.freq_hz[:, None] * taus[None])
     y = np.vstack([shifted.real, shifted.imag])
     projected = q.T @ y
@@ -273,7 +260,8 @@ def rss_at(lines: CoherentLines, poles: np.ndarray, delay_s: float) -> float:
     return float(np.sum((y - a @ coef) ** 2))
 
 
-def check_modes(recording: Recording, freq_hz, damping, band=None, *, fit_delay: bool = True) -> ModalCheck:
+def check_modes(recording: Recording, freq_hz, damping, band=None, *, fit_delay: bool = True,
+                settings: FrfSettings = DEFAULTS.frf) -> ModalCheck:  # fmt: skip
     """Fit the measured FRF with the modes' poles fixed (see the module notes).
 
     Parameters
@@ -288,6 +276,8 @@ def check_modes(recording: Recording, freq_hz, damping, band=None, *, fit_delay:
         Fit each output's delay (a nuisance parameter of the check: near a lightly damped
         peak it also absorbs the H1's bias, so it is no measurement of the sensor's delay;
         the ``sensor_delay`` check is). False fits none.
+    settings : FrfSettings
+        The delays searched, the model-error limit, the lines that confirm a mode.
 
     Returns
     -------
@@ -305,43 +295,44 @@ def check_modes(recording: Recording, freq_hz, damping, band=None, *, fit_delay:
     for k, lines in enumerate(all_lines):
         if lines.freq_hz.size < n_params:
             continue  # too few coherent lines to say anything of this output
-        delay[k], coef, rss = _fit_delays(lines, _basis(lines.freq_hz, poles), recording.fs, fit_delay)
+        delay[k], coef, rss = _fit_delays(lines, _basis(lines.freq_hz, poles), recording.fs, fit_delay, settings)
         residues[k], terms[k] = _coefficients_to_terms(coef, poles.size)
         norm = float(np.sum(np.abs(lines.h) ** 2))
         error[k] = np.sqrt(rss / norm)
         rand[k] = np.sqrt(np.sum(lines.sigma**2) / norm)
     model = np.sqrt(np.clip(error**2 - rand**2, 0.0, None))
-    seen = confirmed_modes(all_lines, freq_hz, damping, recording.fs / nperseg)
+    seen = confirmed_modes(all_lines, freq_hz, damping, recording.fs / nperseg, settings.confirm_lines)
     check = ModalCheck(
         tuple(recording.sensors), error, rand, model, delay,
         np.array([ln.freq_hz.size for ln in all_lines]), nperseg, (), residues, terms, poles,
-        tuple(float(f) for f, ok in zip(freq_hz, seen, strict=True) if not ok),
+        tuple(float(f) for f, ok in zip(freq_hz, seen, strict=True) if not ok), settings.model_error_limit,
     )  # fmt: skip
     if check.passed:
         return check
-    return ModalCheck(**{**check.__dict__, "bands": _misfit_bands(check, all_lines)})
+    return ModalCheck(**{**check.__dict__, "bands": _misfit_bands(check, all_lines, settings.band_min_lines)})
 
 
-def confirmed_modes(all_lines: list[CoherentLines], freq_hz, damping, line_hz: float) -> np.ndarray:
+def confirmed_modes(all_lines: list[CoherentLines], freq_hz, damping, line_hz: float,
+                    confirm_lines: int = DEFAULTS.frf.confirm_lines) -> np.ndarray:  # fmt: skip
     """Per mode: does some output have a coherent line (:func:`~armaxmodal.modes.lines.coherent_lines`) within
-    ``|f - f_m| <= xi_m f_m +`` :data:`CONFIRM_LINES` lines? A mode where no H1 is coherent is
+    ``|f - f_m| <= xi_m f_m + confirm_lines`` lines? A mode where no H1 is coherent is
     one the record cannot confirm: the check's fit never sees it. (The lines next to a sharp
     peak lose coherence to the H1's own bias: right modes on the measured records have their
     nearest coherent line up to 3.7 lines or 4.7 ``xi f`` away; a bridge's 4.13 and 4.17 Hz
     modes inside a band of coherence below 0.8, 9 lines.)"""
     f, x = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)
     lines = np.concatenate([ln.freq_hz for ln in all_lines]) if all_lines else np.zeros(0)
-    reach = np.abs(x) * f + CONFIRM_LINES * line_hz
+    reach = np.abs(x) * f + confirm_lines * line_hz
     return np.array([bool(np.any(np.abs(lines - fm) <= r)) for fm, r in zip(f, reach, strict=True)], dtype=bool)
 
 
-def _misfit_bands(check: ModalCheck, all_lines: list[CoherentLines]) -> tuple:
-    """Runs of at least :data:`BAND_MIN_LINES` lines (gaps of up to two lines bridged) of a
+def _misfit_bands(check: ModalCheck, all_lines: list[CoherentLines], min_lines: int) -> tuple:
+    """Runs of at least ``min_lines`` lines (gaps of up to two lines bridged) of a
     failing output where the misfit exceeds half the H1 and three times its random error:
     ``(sensor, lo_hz, hi_hz)``, the three with the most misfit."""
     found = []
     for k, lines in enumerate(all_lines):
-        if not check.model_error[k] > MODEL_ERROR_LIMIT:
+        if not check.model_error[k] > check.limit:
             continue
         res = np.abs(check.frf(lines.freq_hz)[:, k] - lines.h)
         bad = np.flatnonzero((res > 0.5 * np.abs(lines.h)) & (res > 3 * lines.sigma))
@@ -349,7 +340,7 @@ def _misfit_bands(check: ModalCheck, all_lines: list[CoherentLines]) -> tuple:
             continue
         runs = np.split(bad, np.flatnonzero(np.diff(bad) > 3) + 1)
         for run in runs:
-            if run.size >= BAND_MIN_LINES:
+            if run.size >= min_lines:
                 energy = float(np.sum(res[run[0] : run[-1] + 1] ** 2))
                 found.append((energy, check.sensors[k], float(lines.freq_hz[run[0]]), float(lines.freq_hz[run[-1]])))
     return tuple(item[1:] for item in sorted(found, reverse=True)[:3])

@@ -31,24 +31,12 @@ import numpy as np
 import scipy.linalg
 import scipy.optimize
 
-from armaxmodal._threads import single_blas_thread
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.refine import _poles, _sandwich_sd, _SeparableModel
+from armaxmodal.modes.settings import DEFAULTS, DftSettings
 from armaxmodal.recording import Recording
 
 __all__ = ["DftLines", "ModalModel", "fit_modal_model"]
-
-#: the lowest and highest damping ratio a free pole may take: below, the pole is a line (a
-#: periodic disturbance, not a mode of the structure); above, no resonance is left to fit
-DAMPING_BOUNDS = (1e-4, 0.95)
-#: relative change of the cost and of the parameters at which a fit stops: a relative change
-#: of 1e-6 in the residual moves ``-2 ln L`` by about 0.03 at the 33,000 real numbers of a
-#: 120 s ride of five sensors, far below the criterion's decisive 10, and the parameters by
-#: a thousandth of their standard error (0.1-2 % of a frequency)
-FIT_TOL = 1e-6
-#: up to this many real numbers (lines x 2 x sensors) a fit's Jacobian is built for every sensor
-#: at once (2 MB a parameter at the limit); beyond, a sensor at a time
-ALL_ROWS_AT_ONCE = 250_000
 
 
 @dataclass(frozen=True)
@@ -232,13 +220,13 @@ class _GramCompressed:
     the nested tests run dozens of fits, and their Jacobians are well conditioned in
     ``(ln omega, xi)``."""
 
-    def __init__(self, model: _SeparableModel):
-        self.model = model
+    def __init__(self, model: _SeparableModel, all_rows_at_once: int):
+        self.model, self.all_rows_at_once = model, all_rows_at_once
         self._x = None
 
     def _factor(self, x):
         if self._x is None or not np.array_equal(x, self._x):
-            if self.model.b.size <= ALL_ROWS_AT_ONCE:
+            if self.model.b.size <= self.all_rows_at_once:
                 # all sensors' rows at once: the basis's derivative is built once, not per sensor
                 rows = [(self.model.jacobian(x), self.model.residual(x))]
             else:  # a long record: one sensor's rows at a time (memory), as refine's fits do
@@ -262,18 +250,18 @@ class _GramCompressed:
         return self._factor(x)[0]
 
 
-def _start_vector(data: DftLines, freq_hz, damping):
+def _start_vector(data: DftLines, freq_hz, damping, settings: DftSettings):
     w = 2 * np.pi * np.asarray(freq_hz, float)
     nyquist = np.pi / data.dt
     lo_w, n = max(np.abs(data.s[0]), 1e-6), w.size
-    lo = np.ravel(np.column_stack([np.full(n, np.log(0.5 * lo_w)), np.full(n, DAMPING_BOUNDS[0])]))
-    hi = np.ravel(np.column_stack([np.full(n, np.log(nyquist)), np.full(n, DAMPING_BOUNDS[1])]))
+    lo = np.ravel(np.column_stack([np.full(n, np.log(0.5 * lo_w)), np.full(n, settings.min_damping)]))
+    hi = np.ravel(np.column_stack([np.full(n, np.log(nyquist)), np.full(n, settings.max_damping)]))
     start = np.ravel(np.column_stack([np.log(w), np.asarray(damping, float)]))
     return np.clip(start, lo + 1e-9, hi - 1e-9), lo, hi
 
 
-@single_blas_thread
-def fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited", max_nfev: int = 40) -> ModalModel:
+def fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited", max_nfev: int = 40,
+                    settings: DftSettings = DEFAULTS.dft) -> ModalModel:  # fmt: skip
     """Fit the modal model with every pole free, from a start.
 
     Parameters
@@ -286,20 +274,22 @@ def fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited",
         Inter-sample assumption (:mod:`armaxmodal.modes.refine`).
     max_nfev : int
         Cap on residual evaluations.
+    settings : DftSettings
+        The damping bounds, the stopping tolerance and the Jacobian's block size.
 
     Returns
     -------
     ModalModel
         The fit, its modes by frequency.
     """
-    start, lo, hi = _start_vector(data, freq_hz, damping)
+    start, lo, hi = _start_vector(data, freq_hz, damping, settings)
     model = _SeparableModel(data.s, data.z_inv, data.u, data.y, data.dt, hold)
     if 2 * data.s.size < 3 * (4 * start.size // 2 + 2):
         raise OrderError(f"{data.s.size} DFT lines cannot fit {start.size // 2} modes; record longer.")
-    compressed = _GramCompressed(model)
+    compressed = _GramCompressed(model, settings.all_rows_at_once)
     res = scipy.optimize.least_squares(
         compressed.residual, start, jac=compressed.jacobian, bounds=(lo, hi), x_scale="jac", max_nfev=max_nfev,
-        ftol=FIT_TOL, xtol=FIT_TOL,
+        ftol=settings.fit_tol, xtol=settings.fit_tol,
     )
     model.residual(res.x)
     coef, resid = model.coef, model.resid

@@ -41,7 +41,7 @@ import numpy as np
 from scipy.special import chdtrc
 
 from armaxmodal.modes.modal_model import DftLines, ModalModel, fit_modal_model
-from armaxmodal.modes.settings import DEFAULTS, CountSettings, LineSettings
+from armaxmodal.modes.settings import DEFAULTS, CountSettings, DftSettings, LineSettings
 from armaxmodal.stats import MAX_DAMPING, Z95
 
 __all__ = [
@@ -149,6 +149,7 @@ class ModeCount:
     stand_ins: tuple[tuple[float, float, float], ...] = ()
     settings: CountSettings = COUNT
     lines: LineSettings = DEFAULTS.lines
+    dft: DftSettings = DEFAULTS.dft
 
     def reported(self, band_hz) -> np.ndarray:
         """Which of the model's poles are reported as modes of the band (bool per pole):
@@ -208,9 +209,10 @@ class _Search:
     few steps (``settings.screen_nfev``) and the best of each kind taken to convergence."""
 
     def __init__(self, data: DftLines, hold: str, n_effective: float, max_nfev: int, n_jobs: int | None = 1,
-                 settings: CountSettings = COUNT, lines: LineSettings = DEFAULTS.lines):  # fmt: skip
+                 settings: CountSettings = COUNT, lines: LineSettings = DEFAULTS.lines,
+                 dft: DftSettings = DEFAULTS.dft):  # fmt: skip
         self.data, self.hold, self.n_eff, self.max_nfev, self.n_jobs = data, hold, n_effective, max_nfev, n_jobs
-        self.cfg, self.lines = settings, lines
+        self.cfg, self.lines, self.dft = settings, lines, dft
         self.trials = 0
 
     def screened(self, starts: list[tuple[np.ndarray, np.ndarray]]) -> list[ModalModel | None]:
@@ -223,15 +225,16 @@ class _Search:
 
         def one(start):
             f, x = start
-            return fit_modal_model(self.data, f, x, self.hold, self.cfg.screen_nfev) if len(f) else None
+            return fit_modal_model(self.data, f, x, self.hold, self.cfg.screen_nfev, self.dft) if len(f) else None
 
         return parallel_map(one, starts, self.n_jobs, min_items=2)
 
-    def fit(self, freq_hz, damping, max_nfev: int | None = None) -> ModalModel | None:
+    def fit(self, freq_hz, damping, max_nfev: int | None = None, counted: bool = True) -> ModalModel | None:
+        """One fit to convergence (or ``max_nfev``); ``counted=False`` where the caller counts it."""
         if len(freq_hz) == 0:
             return None
-        self.trials += 1
-        return fit_modal_model(self.data, freq_hz, damping, self.hold, max_nfev or self.max_nfev)
+        self.trials += int(counted)
+        return fit_modal_model(self.data, freq_hz, damping, self.hold, max_nfev or self.max_nfev, self.dft)
 
     def bic(self, model: ModalModel | None) -> float:
         return np.inf if model is None else model.bic(self.n_eff)
@@ -249,8 +252,8 @@ class _Search:
             chosen.append(min(trials, key=lambda t: self.bic(t[2])) if trials else None)
         todo = [t for t in chosen if t is not None and t[2] is not None]
         self.trials += len(todo)
-        fits = parallel_map(lambda t: fit_modal_model(self.data, t[2].freq_hz, t[2].damping, self.hold, self.max_nfev),
-                            todo, self.n_jobs, min_items=2)  # fmt: skip
+        fits = parallel_map(lambda t: self.fit(t[2].freq_hz, t[2].damping, counted=False), todo, self.n_jobs,
+                            min_items=2)  # fmt: skip
         converged = {id(t): (t[0], t[1], fit) for t, fit in zip(todo, fits, strict=True)}
         out = []
         for trial, test in zip(chosen, (None, admissible), strict=True):
@@ -287,7 +290,7 @@ class _Search:
         same mode in both halves, while a pole that soaks up a change during the record or a
         nonlinearity (a drifting frequency, a doublet beside a real mode) lands elsewhere."""
         self.trials += 2
-        agree = agree_in_halves(self.data, trial, halves, self.hold, self.max_nfev, self.cfg.halves_sd)
+        agree = agree_in_halves(self.data, trial, halves, self.hold, self.max_nfev, self.cfg.halves_sd, self.dft)
         return all(agree[i] for i in new)
 
     def removals(self, current: ModalModel) -> list[tuple[str, float, ModalModel | None]]:
@@ -394,7 +397,7 @@ def _equally_good(search: _Search, chosen: ModalModel, rise: np.ndarray, additio
 
 
 def agree_in_halves(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: int = COUNT.halves_nfev,
-                    halves_sd: float = COUNT.halves_sd) -> np.ndarray:  # fmt: skip
+                    halves_sd: float = COUNT.halves_sd, dft: DftSettings = DEFAULTS.dft) -> np.ndarray:  # fmt: skip
     """Per pole of ``model``: the record's two halves (``halves``, lines weighted as ``data``),
     each fitted from ``model``'s poles, give the same frequency and damping within
     ``halves_sd`` standard deviations of the difference (each half's pole the one nearest
@@ -404,7 +407,8 @@ def agree_in_halves(data: DftLines, model: ModalModel, halves, hold: str, max_nf
     -------
     (n_modes,) bool ndarray
     """
-    a, b = (fit_modal_model(h.weighted(data.weights), model.freq_hz, model.damping, hold, max_nfev) for h in halves)
+    a, b = (fit_modal_model(h.weighted(data.weights), model.freq_hz, model.damping, hold, max_nfev, dft)
+            for h in halves)  # fmt: skip
     agree = np.ones(model.n_modes, dtype=bool)
     for i, f in enumerate(model.freq_hz):
         j, k = _nearest(a.freq_hz, f), _nearest(b.freq_hz, f)
@@ -517,6 +521,7 @@ def count_modes(
     n_jobs: int | None = None,
     settings: CountSettings = COUNT,
     lines: LineSettings = DEFAULTS.lines,
+    dft: DftSettings = DEFAULTS.dft,
 ) -> ModeCount:
     """Choose the number of modes by nested tests of free refits (see the module notes).
 
@@ -548,19 +553,21 @@ def count_modes(
         The count's thresholds (:mod:`armaxmodal.modes.settings`).
     lines : LineSettings
         Which poles are lines, not modes.
+    dft : DftSettings
+        The modal model's fits.
 
     Returns
     -------
     ModeCount
     """
-    start_model = fit_modal_model(data, freq_hz, damping, hold, max_nfev)
+    start_model = fit_modal_model(data, freq_hz, damping, hold, max_nfev, dft)
     # each sensor weighted by its noise level as the fitted start leaves it (the likelihood is
     # concentrated over those levels; the weights only steer the fits)
     data = data.noise_weighted(start_model)
-    start_model = fit_modal_model(data, start_model.freq_hz, start_model.damping, hold, max_nfev)
+    start_model = fit_modal_model(data, start_model.freq_hz, start_model.damping, hold, max_nfev, dft)
     fraction = effective_fraction(start_model.residual)
     searching, search = search, _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev, n_jobs,
-                                        settings, lines)  # fmt: skip
+                                        settings, lines, dft)  # fmt: skip
     # a starting mode the free fit carried away (a weak mode's pole to beyond the band) is tried
     # again as an addition
     lost = [(f, x) for f, x in zip(np.atleast_1d(freq_hz), np.atleast_1d(damping), strict=True)
@@ -615,4 +622,5 @@ def count_modes(
         if wanted and abs(wanted.rise) < settings.decisive_bic:
             alternatives += ((wanted.rise, split),)
     return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
-                     tuple(unconfirmed), alternatives, carried_away, wanted, stand_ins, settings, lines)  # fmt: skip
+                     tuple(unconfirmed), alternatives, carried_away, wanted, stand_ins, settings, lines,
+                     dft)  # fmt: skip

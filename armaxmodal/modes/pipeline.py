@@ -95,7 +95,7 @@ def refit(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     (:mod:`armaxmodal.modes.refine`), reported for a band-limited record, with the segment refits
     of every mode's representative orders run beside it over the worker threads."""
     fitted = refit_and_segment_fits(ctx.diagram, state.modes, ctx.band, True, ctx.segments, ctx.orders, ctx.n_jobs,
-                                    ctx.bar)  # fmt: skip
+                                    ctx.bar, ctx.settings.dft)  # fmt: skip
     done = fitted.pop("refit")
     c = ctx.settings.cluster
     state = refined_modes(ctx.diagram, replace(state, segment_fits=fitted), done, c.freq, c.damping, c.merge_mac)
@@ -113,13 +113,13 @@ def screen_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionStat
     """The measured H1 screens the candidates: a mode its LSFD check does not need goes, a left-out
     cluster it needs comes in (:mod:`armaxmodal.modes.completeness`); after an addition the refit
     is made again of all of them."""
-    rec, n_before, limits = ctx.diagram.recording, len(state.modes), _limits(ctx.settings)
-    state = modes_the_record_needs(rec, state, ctx.band)
-    state = modes_the_check_adds(ctx.diagram, state, ctx.band, ctx.nas, ctx.settings.cluster)
+    rec, n_before, settings = ctx.diagram.recording, len(state.modes), ctx.settings
+    state = modes_the_record_needs(rec, state, ctx.band, settings)
+    state = modes_the_check_adds(ctx.diagram, state, ctx.band, ctx.nas, settings)
     if len(state.modes) > n_before:
-        state = modes_the_record_needs(rec, state, ctx.band)
+        state = modes_the_record_needs(rec, state, ctx.band, settings)
     if ctx.refine and len(state.modes) > n_before:  # the refit saw fewer modes than are reported
-        state = refit_with_added(ctx.diagram, state, ctx.band, limits)
+        state = refit_with_added(ctx.diagram, state, ctx.band, settings)
     return state
 
 
@@ -174,7 +174,8 @@ def check(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     f, x = state.modes.freq_hz, state.modes.damping
     if state.check_poles:
         f, x = zip(*state.check_poles, strict=True)
-    return replace(state, check=check_modes(ctx.diagram.recording, np.array(f), np.array(x), ctx.band))
+    checked = check_modes(ctx.diagram.recording, np.array(f), np.array(x), ctx.band, settings=ctx.settings.frf)
+    return replace(state, check=checked)
 
 
 def check_unless_counted(state: SelectionState, ctx: SelectionContext) -> SelectionState:
@@ -221,7 +222,7 @@ def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     state = state.warned(
         *peaks,
         *dropped_where_peaks_remain(state.count, peaks, ctx.settings.cluster.same_row_freq),
-        *oversampling_note(freq, diagram.recording.fs),
+        *oversampling_note(freq, diagram.recording.fs, ctx.settings.notes),
         *unresolved_damping_notes(modes, len(ctx.nas)),
         *state.check.warnings(),
     )
@@ -372,8 +373,3 @@ def _armax_intervals(modes: pd.DataFrame) -> pd.DataFrame:
     """The ARMAX fit's standard deviations kept beside the reported ones: the segment refits are
     ARMAX fits, and their spread is judged against these even where another estimator is reported."""
     return modes.assign(estimator="armax", freq_sd_armax=modes.freq_sd, damping_sd_armax=modes.damping_sd)
-
-
-def _limits(settings: SelectionSettings) -> tuple[float, float, float]:
-    c = settings.cluster
-    return c.freq, c.damping, c.merge_mac

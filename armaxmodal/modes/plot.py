@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from armaxmodal.modes.modal_check import MODEL_ERROR_LIMIT
 from armaxmodal.spectra import excited_band, measured_frf
 from armaxmodal.stats import H1_COHERENCE as COHERENT
 
@@ -129,7 +128,7 @@ def _draw_check(ax, ax_f, f, selection) -> None:
         0.01,
         0.01,
         f"{verdict}: model error up to {100 * worst:.0f} % beyond the H1's random error "
-        f"(limit {100 * MODEL_ERROR_LIMIT:.0f} %), coherence ≥ {COHERENT:g}",
+        f"(limit {100 * check.limit:.0f} %), coherence ≥ {COHERENT:g}",
         transform=ax.transAxes,
         fontsize=8,
         va="bottom",

@@ -24,8 +24,8 @@ import numpy as np
 import scipy.linalg
 import scipy.optimize
 
-from armaxmodal._threads import single_blas_thread
 from armaxmodal.exceptions import OrderError
+from armaxmodal.modes.settings import DEFAULTS, DftSettings
 from armaxmodal.recording import Recording
 
 HOLDS = ("bandlimited", "zoh")
@@ -218,7 +218,6 @@ def _sandwich_sd(blocks, n_par: int) -> np.ndarray:
     return np.sqrt(np.clip(np.diag(bread @ meat @ bread) * scale, 0, None))
 
 
-@single_blas_thread
 def refine_modes(
     recording: Recording,
     freq_hz,
@@ -227,6 +226,7 @@ def refine_modes(
     band_hz: tuple[float, float],
     hold: str = "auto",
     max_nfev: int = 60,
+    settings: DftSettings = DEFAULTS.dft,
 ) -> ModalRefinement:
     """Refit the frequencies, damping ratios and shapes of selected modes to the DFT of a
     recording (see the module notes).
@@ -242,6 +242,12 @@ def refine_modes(
         Inter-sample assumption; "auto" fits both and keeps the lower residual.
     max_nfev : int
         Cap on residual evaluations per fit.
+    settings : DftSettings
+        The damping bounds of a free pole.
+
+    Returns
+    -------
+    ModalRefinement
     """
     if hold not in ("auto", *HOLDS):
         raise ValueError(f"hold: expected 'auto', 'bandlimited' or 'zoh', got {hold!r}.")
@@ -260,8 +266,9 @@ def refine_modes(
     w = 2 * np.pi * freq[lines]
     s, z_inv = 1j * w, np.exp(-1j * w * dt)
     start = np.ravel(np.column_stack([np.log(2 * np.pi * f0), x0]))
-    lo = np.ravel(np.column_stack([np.full(f0.size, np.log(w[0])), np.full(f0.size, 1e-4)]))
-    hi = np.ravel(np.column_stack([np.full(f0.size, np.log(np.pi * recording.fs)), np.full(f0.size, 0.95)]))
+    lo = np.ravel(np.column_stack([np.full(f0.size, np.log(w[0])), np.full(f0.size, settings.min_damping)]))
+    top = np.log(np.pi * recording.fs)
+    hi = np.ravel(np.column_stack([np.full(f0.size, top), np.full(f0.size, settings.max_damping)]))
     start = np.clip(start, lo, hi)
 
     def model(hold_, weights):

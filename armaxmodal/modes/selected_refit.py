@@ -15,6 +15,7 @@ from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.clusters import merge_duplicates
 from armaxmodal.modes.refine import refine_modes
+from armaxmodal.modes.settings import DEFAULTS, DftSettings
 from armaxmodal.modes.spread import (
     segment_jobs,
     segment_poles,
@@ -26,7 +27,8 @@ from armaxmodal.recording import Recording
 from armaxmodal.spectra import excited_band
 
 
-def refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, orders: dict, n_jobs, bar=None) -> dict:
+def refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, orders: dict, n_jobs, bar=None,
+                           dft: DftSettings = DEFAULTS.dft) -> dict:  # fmt: skip
     """The frequency-domain refit (key ``"refit"``) and the segment refits of every mode's
     representative orders (keys ``(orders, k)``), run together over the worker threads:
     the refit ran alone in this process before, while the workers waited. ``bar`` (tqdm)
@@ -35,7 +37,7 @@ def refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, or
     if segments >= 2:
         jobs += [("segment", job) for job in segment_jobs(sorted({orders[int(na)] for na in modes.na}), segments)]
     parts = split_segments(diagram.recording, segments) if segments >= 2 else []
-    task = partial(selection_job, diagram.recording, parts, modes)
+    task = partial(selection_job, diagram.recording, parts, modes, dft=dft)
     # the refit first: it is the longest job (a frequency-domain fit of every mode)
     cost = lambda job: np.inf if job[0] == "refit" else job[1][0][0]  # noqa: E731
     done = parallel_map(task, jobs, n_jobs, bar, cost=cost, min_items=2)
@@ -49,12 +51,14 @@ def refit_band(recording: Recording, band) -> tuple[float, float]:
     return (lo, hi) if band is None else (max(lo, band[0]), min(hi, band[1]))
 
 
-def selection_job(recording: Recording, parts: list, modes: pd.DataFrame, job):
+def selection_job(recording: Recording, parts: list, modes: pd.DataFrame, job, dft: DftSettings = DEFAULTS.dft):
+    """One job of :func:`refit_and_segment_fits`: a segment's refit, or the frequency-domain refit
+    (a :class:`RefitFailure` where it cannot be made)."""
     kind, what = job
     if kind == "segment":
         return segment_poles(parts, what)
     try:
-        return refine_modes(recording, modes.freq_hz, modes.damping, band_hz=what)
+        return refine_modes(recording, modes.freq_hz, modes.damping, band_hz=what, settings=dft)
     except (OrderError, np.linalg.LinAlgError) as exc:
         return RefitFailure(str(exc))  # too few lines or a degenerate basis: the ARMAX values stand, said
 

@@ -24,28 +24,11 @@ from armaxmodal.modes.frf_check import coherent_peaks, explains
 from armaxmodal.modes.lines import coherent_lines, resolving_nperseg
 from armaxmodal.modes.modal_check import ModalCheck, poles_of, rss_at
 from armaxmodal.modes.poles import SHARED
-from armaxmodal.modes.settings import ClusterSettings
+from armaxmodal.modes.settings import DEFAULTS, ClusterSettings, FrfSettings
 from armaxmodal.recording import Recording
 
-__all__ = ["MODEL_ERROR_RISE", "ModeSupport", "mode_support", "nearest_neighbour",
+__all__ = ["ModeSupport", "mode_support", "nearest_neighbour",
            "overlapping_neighbour", "peak_support", "stable_in_diagram"]  # fmt: skip
-
-#: a mode is kept when leaving it out raises the misfit of some output by at least this
-#: fraction (the relative RMS; 10 % in the residual sum of squares) and the rise is
-#: significant (:data:`SUPPORT_ALPHA`). Measured with the product's own selections: the
-#: spurious poles and halves of split peaks on the measured records (stiff 1-storey 42.9 Hz,
-#: stiff 3-storey 9.0 Hz beside 8.0, flex 3-storey 36.8 and 38.0 Hz, a bridge's 6.6 Hz)
-#: raise it by 0.5-4 %; the weakest real modes (the F-16's 3.96 and 6.61 Hz at level 1)
-#: by 6-7 %, and the others by 12 % to several times.
-MODEL_ERROR_RISE = 0.05
-SUPPORT_ALPHA = 0.01
-#: the nearest mode within this many half-power bandwidths is refitted when a mode is left out
-NEIGHBOUR_BANDWIDTHS = 3.0
-#: ... and may take over only from within this relative frequency of its own place: on the
-#: supine ride, heavily damped modes overlap, and a neighbour free to move 30 % took over
-#: 5.8 Hz, then 7.6 and 8.3 Hz in turn, leaving two of four modes
-NEIGHBOUR_MAX_SHIFT = 0.05
-
 
 @dataclass(frozen=True)
 class ModeSupport:
@@ -56,6 +39,7 @@ class ModeSupport:
     error_without: np.ndarray
     p_value: float
     refitted_neighbour: int | None
+    settings: FrfSettings = DEFAULTS.frf
 
     @property
     def rise(self) -> float:
@@ -66,8 +50,8 @@ class ModeSupport:
 
     @property
     def needed(self) -> bool:
-        """The rise is at least :data:`MODEL_ERROR_RISE` and significant at :data:`SUPPORT_ALPHA`."""
-        return bool(self.rise >= MODEL_ERROR_RISE and self.p_value <= SUPPORT_ALPHA)
+        """The rise is at least ``settings.model_error_rise`` and significant at ``settings.support_alpha``."""
+        return bool(self.rise >= self.settings.model_error_rise and self.p_value <= self.settings.support_alpha)
 
 
 def overlapping_neighbour(freq_hz, damping, m: int) -> int | None:
@@ -79,31 +63,32 @@ def overlapping_neighbour(freq_hz, damping, m: int) -> int | None:
     return min(close, key=lambda i: gap[i]) if close else None
 
 
-def nearest_neighbour(freq_hz, damping, m: int) -> int | None:
-    """The mode nearest mode ``m`` within :data:`NEIGHBOUR_BANDWIDTHS` half-power bandwidths
+def nearest_neighbour(freq_hz, damping, m: int, bandwidths: float = DEFAULTS.frf.neighbour_bandwidths) -> int | None:
+    """The mode nearest mode ``m`` within ``bandwidths`` half-power bandwidths
     (``2 xi f``, the wider of the two), or None: the mode whose pole may take over what
     ``m`` fits. A spurious pole beside a lightly damped mode corrects that mode's slightly
     biased pole at the peak; with the neighbour's pole refitted it is not needed."""
     f, x = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)
     gap = np.abs(f - f[m])
-    reach = NEIGHBOUR_BANDWIDTHS * np.maximum(2 * x * f, 2 * x[m] * f[m])
+    reach = bandwidths * np.maximum(2 * x * f, 2 * x[m] * f[m])
     close = [i for i in range(f.size) if i != m and gap[i] <= reach[i]]
     return min(close, key=lambda i: gap[i]) if close else None
 
 
 def mode_support(
-    recording: Recording, freq_hz, damping, m: int, check: ModalCheck, band=None, *, reach: str = "overlapping"
+    recording: Recording, freq_hz, damping, m: int, check: ModalCheck, band=None, *, reach: str = "overlapping",
+    settings: FrfSettings = DEFAULTS.frf,
 ) -> ModeSupport:
     """How much the check of ``check`` needs mode ``m`` (see ``ModeSupport``).
 
     The fit without the mode keeps each output's delay. A neighbour -- ``reach="overlapping"``:
     a mode whose half-power band overlaps this one's (:func:`overlapping_neighbour`);
-    ``"nearest"``: the nearest within :data:`NEIGHBOUR_BANDWIDTHS` (:func:`nearest_neighbour`),
+    ``"nearest"``: the nearest within ``settings.neighbour_bandwidths`` (:func:`nearest_neighbour`),
     the stricter test a mode the diagram supports weakly must pass to enter -- has its
     frequency and damping refitted (Nelder-Mead on the summed relative residual, residues
     projected out) so it may take over: two poles always fit one peak at least as well as
     one, so only a refitted single pole shows whether the record needs both. A neighbour
-    that moves more than :data:`NEIGHBOUR_MAX_SHIFT` to take over is not refitted. The F-test
+    that moves more than ``settings.neighbour_max_shift`` to take over is not refitted. The F-test
     compares the summed relative residual sums with ``q = 2 n_outputs`` (the residues)
     ``+ 2`` (the pole, unless the neighbour's refit spends them) over ``sum(lines) -
     parameters`` degrees of freedom (one per complex line: the Hann-windowed,
@@ -122,7 +107,10 @@ def mode_support(
 
     keep = [i for i in range(f.size) if i != m]
     with_m = relative_rss(poles_of(f, x))
-    j = (nearest_neighbour if reach == "nearest" else overlapping_neighbour)(f, x, m)
+    if reach == "nearest":
+        j = nearest_neighbour(f, x, m, settings.neighbour_bandwidths)
+    else:
+        j = overlapping_neighbour(f, x, m)
     fk, xk = f[keep], x[keep]
     if j is not None:
         at = keep.index(j)
@@ -133,7 +121,7 @@ def mode_support(
             return float(np.sum(relative_rss(poles_of(fj, xj))))
 
         best = minimize(cost, np.zeros(2), method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-9, "maxiter": 200})
-        if abs(np.exp(best.x[0]) - 1) <= NEIGHBOUR_MAX_SHIFT:
+        if abs(np.exp(best.x[0]) - 1) <= settings.neighbour_max_shift:
             fk, xk = fk.copy(), xk.copy()
             fk[at], xk[at] = f[j] * np.exp(best.x[0]), min(x[j] * np.exp(best.x[1]), 0.9)
         else:  # it took over only by leaving its own place: the two are distinct modes
@@ -145,7 +133,7 @@ def mode_support(
     s1, s0 = float(with_m.sum()), float(without.sum())
     stat = ((s0 - s1) / q) / (s1 / dof) if dof > 0 and s1 > 0 else float("nan")
     p = float(fdtrc(q, dof, stat)) if np.isfinite(stat) and stat > 0 else 1.0
-    return ModeSupport(np.sqrt(with_m), np.sqrt(without), p, j)
+    return ModeSupport(np.sqrt(with_m), np.sqrt(without), p, j, settings)
 
 
 def peak_support(recording: Recording, freq_hz: float, damping: float, band=None) -> float | None:

@@ -11,10 +11,12 @@ import pytest
 import armaxmodal as am
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.diagram import DEFAULT_ORDERS, stabilisation_diagram
-from armaxmodal.modes.modal_check import MODEL_ERROR_LIMIT, ModalCheck, check_modes
+from armaxmodal.modes.modal_check import ModalCheck, check_modes
 from armaxmodal.modes.pipeline import select_modes
-from armaxmodal.modes.settings import ClusterSettings
+from armaxmodal.modes.settings import FrfSettings, SelectionSettings
 from armaxmodal.recording import Recording
+
+MODEL_ERROR_LIMIT = FrfSettings().model_error_limit  # the check's own limit
 
 #: the exact modes of the lightly damped ride leave 10 % beyond the H1's random error: the
 #: record (240 s, 8 segments) allows 1.5 lines per half-power bandwidth of the 0.5 %-damped
@@ -102,7 +104,7 @@ def test_a_cluster_the_support_rule_left_out_enters_when_the_check_needs_it(ligh
     one = sel.modes.iloc[[0]].reset_index(drop=True)
     check = check_modes(rec, one.freq_hz, one.damping)
     start = SelectionState(one, sel.shapes[:, [0]], check=check)
-    added = modes_the_check_adds(diagram, start, None, nas, ClusterSettings())
+    added = modes_the_check_adds(diagram, start, None, nas, SelectionSettings())
     np.testing.assert_allclose(added.modes.freq_hz, truth, rtol=0.01)
     assert added.shapes.shape == (2, 2) and added.check.passed
 
@@ -171,12 +173,12 @@ def test_a_refit_may_move_a_mode_halfway_to_its_neighbour_within_twice_the_clust
 
 def test_a_mode_is_confirmed_by_a_coherent_line_within_its_half_width_and_four_lines():
     from armaxmodal.modes.lines import CoherentLines
-    from armaxmodal.modes.modal_check import CONFIRM_LINES, confirmed_modes
+    from armaxmodal.modes.modal_check import confirmed_modes
     from armaxmodal.modes.support import ModeSupport
 
     f = np.arange(1.0, 2.0001, 0.1)  # coherent lines 1.0-2.0 Hz, 0.1 Hz apart
     lines = [CoherentLines(f, np.ones(f.size, complex), np.full(f.size, 0.01))]
-    assert CONFIRM_LINES == 4
+    assert FrfSettings().confirm_lines == 4
     # 0.39 and 0.41 Hz past the last line with no damping: four lines reach 0.40 Hz; a 5 %-damped
     # mode at 2.50 Hz adds its half-power half-width, 0.125 Hz
     got = confirmed_modes(lines, [2.39, 2.41, 2.5, 1.5], [0.0, 0.0, 0.05, 0.01], 0.1)
@@ -188,6 +190,11 @@ def test_a_mode_is_confirmed_by_a_coherent_line_within_its_half_width_and_four_l
     assert not ModeSupport(rise, np.array([0.104, 0.20]), 1e-9, None).needed  # significant, but 4 %
     assert not ModeSupport(rise, flat, 0.02, None).needed  # 6 %, not significant
     assert ModeSupport(rise, flat, 1e-9, None).rise == pytest.approx(0.06)
+    # both levels are settings the support carries
+    assert not ModeSupport(rise, flat, 1e-9, None, FrfSettings(model_error_rise=0.07)).needed
+    assert ModeSupport(rise, flat, 0.02, None, FrfSettings(support_alpha=0.05)).needed
+    # the reach of a confirming line is a setting too: 0.39 Hz past the last line needs four lines
+    assert not confirmed_modes(lines, [2.39], [0.0], 0.1, confirm_lines=3)[0]
 
 
 def test_the_model_error_is_the_misfit_beyond_the_h1s_random_error(light_ride):

@@ -378,7 +378,7 @@ def test_the_search_takes_only_steps_that_lower_the_criterion(monkeypatch, supin
     import armaxmodal.modes.mode_count as mode_count
 
     table = {1: 120.0, 2: 100.0, 3: 95.0, 4: 97.0, 5: 99.0}
-    monkeypatch.setattr(mode_count, "fit_modal_model", lambda data, f, x, hold, n=40: _Scored(f, x, table))
+    monkeypatch.setattr(mode_count, "fit_modal_model", lambda data, f, x, hold, n=40, dft=None: _Scored(f, x, table))
     data, _ = supine
     f, x = np.array([5.0, 9.0, 13.0, 17.0][:start]), np.full(start, 0.3)
     count = count_modes(data, f, x, hold="zoh")
@@ -396,7 +396,7 @@ def test_a_decided_count_has_no_equally_good_model(monkeypatch, supine):
     import armaxmodal.modes.mode_count as mode_count
 
     table = {1: 150.0, 2: 130.0, 3: 95.0, 4: 120.0, 5: 140.0}
-    monkeypatch.setattr(mode_count, "fit_modal_model", lambda data, f, x, hold, n=40: _Scored(f, x, table))
+    monkeypatch.setattr(mode_count, "fit_modal_model", lambda data, f, x, hold, n=40, dft=None: _Scored(f, x, table))
     count = count_modes(supine[0], [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], hold="zoh")
     assert count.model.n_modes == 3 and count.alternatives == ()
 
@@ -421,7 +421,7 @@ def test_a_start_mode_the_free_fit_carries_away_must_be_founded(monkeypatch, sup
         moved.damping_sd = np.array([0.003, 0.003, 0.2])  # 11 Hz: interval reaches below zero
     refits = []
     monkeypatch.setattr(mode_count, "fit_modal_model",
-                        lambda d, f, x, hold, n: refits.append(list(f)) or _Scored(f, x, table))  # fmt: skip
+                        lambda d, f, x, hold, n, dft=None: refits.append(list(f)) or _Scored(f, x, table))  # fmt: skip
     search = mode_count._Search(data, "zoh", 1.0, 40)
     model, carried, kept = mode_count._without_unfounded(search, [5.0, 9.0, 13.0], moved,
                                                          lambda f, x: stable_there or abs(f - 11.0) > 0.5)  # fmt: skip
@@ -457,7 +457,7 @@ def test_with_the_halves_a_moved_pole_is_judged_by_them_not_by_the_diagram(monke
     import armaxmodal.modes.mode_count as mode_count
 
     table = {2: 100.0, 3: 100.0}  # the model does not need the moved pole
-    monkeypatch.setattr(mode_count, "fit_modal_model", lambda d, f, x, hold, n: _Scored(f, x, table))
+    monkeypatch.setattr(mode_count, "fit_modal_model", lambda d, f, x, hold, n, dft=None: _Scored(f, x, table))
     search = mode_count._Search(supine[0], "zoh", 1.0, 40)
     asked = []
     monkeypatch.setattr(search, "in_both_halves", lambda m, new, h: asked.append(list(new)) or same_in_halves)

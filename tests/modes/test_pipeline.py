@@ -10,7 +10,7 @@ import pytest
 
 import armaxmodal as am
 from armaxmodal.modes import pipeline
-from armaxmodal.modes.settings import ClusterSettings, CountSettings, SelectionSettings
+from armaxmodal.modes.settings import ClusterSettings, CountSettings, FrfSettings, NoteSettings, SelectionSettings
 from armaxmodal.modes.state import SelectionContext, SelectionState
 from tests.cli.test_schemas import _validator
 
@@ -139,6 +139,27 @@ def test_settings_reach_the_stages_and_come_back_on_the_result(diagram):
         am.select_modes(diagram, settings={"cluster": {"freq": 0.03}})
 
 
+def test_the_frf_and_note_settings_reach_the_check_and_the_notes(diagram):
+    default = am.select_modes(diagram, n_jobs=1, segments=0)
+    worst = float(default.check.model_error.max())  # 0.005 on this ride
+    # a limit below the ride's own model error: the same modes no longer explain the FRF
+    tight = SelectionSettings(frf=FrfSettings(model_error_limit=worst / 2))
+    strict = am.select_modes(diagram, n_jobs=1, segments=0, refine=False, settings=tight)
+    assert strict.check.limit == worst / 2 and not strict.check.passed and strict.quality == "poor"
+
+
+def test_the_oversampling_note_follows_its_settings():
+    from armaxmodal.modes.header import oversampling_note
+
+    (note,) = oversampling_note(np.array([5.0, 12.0]), 1000.0)  # 12 Hz of a 500 Hz Nyquist: 2.4 %
+    assert "band=(0, 30)" in note.message and note.value == pytest.approx(0.024)  # 2.5 x 12 Hz
+    (wider,) = oversampling_note(np.array([12.0]), 1000.0, NoteSettings(suggested_band_factor=5.0))
+    assert "band=(0, 60)" in wider.message
+    assert oversampling_note(np.array([12.0]), 1000.0, NoteSettings(oversampled_fraction=0.02)) == []
+    # a share so large that the band suggested keeps the rate: nothing to suggest (it divided by zero)
+    assert oversampling_note(np.array([16.2]), 60.0, NoteSettings(oversampled_fraction=0.6)) == []
+
+
 def test_the_json_carries_its_settings(diagram):
     import json
 
@@ -147,6 +168,7 @@ def test_the_json_carries_its_settings(diagram):
     out = json.loads(json.dumps(selection.to_dict(), allow_nan=False))
     assert out["settings"]["count"]["decisive_bic"] == 12.0
     assert out["settings"]["cluster"]["freq"] == 0.05 and out["settings"]["lines"]["at_fit_floor"] == 2e-4
+    assert out["settings"]["frf"]["model_error_limit"] == 0.5 and out["settings"]["dft"]["min_damping"] == 1e-4
     _validator("stabilise").validate(out)
 
 

@@ -423,7 +423,7 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     lo, hi = excited_band(rec)
     seen = []
 
-    def refit(recording, freq_hz, damping, band_hz):
+    def refit(recording, freq_hz, damping, band_hz, settings=None):
         seen.append(band_hz)
         return SimpleNamespace(hold=hold)
 
@@ -440,7 +440,7 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     # a held input: the ARMAX values are reported
     assert out.refinement is ref and out.modes is modes and out.shapes is shapes
 
-    def failing(recording, freq_hz, damping, band_hz):
+    def failing(recording, freq_hz, damping, band_hz, settings=None):
         raise OrderError("too few lines")
 
     monkeypatch.setattr(st, "refine_modes", failing)
