@@ -10,7 +10,7 @@ put as the order grows; :mod:`armaxmodal.modes.poles` classes each one.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import partial
+from functools import cached_property, partial
 
 import numpy as np
 import pandas as pd
@@ -92,11 +92,17 @@ class StabilisationDiagram:
 
     @property
     def warnings(self) -> list[QualityWarning]:
-        """Data-quality findings of the preparation and of the sweep itself."""
+        """Data-quality findings of the preparation and of the sweep itself (a copy)."""
+        return list(self._warnings)
+
+    @cached_property
+    def _warnings(self) -> tuple[QualityWarning, ...]:
+        # computed once: the disturbance lines read the record's spectrum, and every read of a
+        # selection's quality, verdict or JSON reads these (the diagram is frozen, so they hold)
         found = list(self.preparation.warnings) if self.preparation is not None else []
         found += list(self.own_warnings)
         found += _nk_edge_warning(self.orders[0].nk, self.recording)
-        return found + disturbance_lines(self.poles, self.tolerances.min_energy, self.recording, SHARED)
+        return tuple(found + disturbance_lines(self.poles, self.tolerances.min_energy, self.recording, SHARED))
 
     def to_frame(self) -> pd.DataFrame:
         """The tidy pole table without the complex columns (for CSV).

@@ -34,3 +34,18 @@ def test_prepared_once_and_each_spectrum_computed_once(monkeypatch, fixtures_dir
     assert len(preparations) == 1
     assert len(spectra) >= 2  # the checks' and the selection's segment lengths
     assert len(set(spectra)) == len(spectra), "a record's spectra computed twice"
+
+
+def test_the_diagrams_warnings_are_found_once_however_often_they_are_read(monkeypatch, fixtures_dir):
+    """A selection's quality, verdict and JSON each read the diagram's warnings; the disturbance
+    lines behind them are found once per diagram, and a reader's list is its own copy."""
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    diagram = am.stabilisation_diagram(rec, orders=range(4, 13, 2), n_jobs=1)
+    found, lines = [], diagram_module.disturbance_lines
+    monkeypatch.setattr(diagram_module, "disturbance_lines", lambda *a, **k: found.append(1) or lines(*a, **k))
+    selection = am.select_modes(diagram, n_jobs=1, segments=0)
+    codes = [w.code for w in selection.warnings]
+    selection.to_dict(), selection.quality, selection.verdict
+    assert found == [1] and [w.code for w in selection.warnings] == codes
+    diagram.warnings.clear()
+    assert [w.code for w in selection.warnings] == codes
