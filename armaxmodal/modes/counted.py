@@ -17,17 +17,13 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
+from armaxmodal.modes.count_search import count_modes
 from armaxmodal.modes.estimators import EARLIER_COLUMNS, covering_both_estimators, earlier_estimate
 from armaxmodal.modes.intervals import not_separated, with_intervals
 from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.modal_model import DftLines, fit_modal_model
-from armaxmodal.modes.mode_count import (
-    ModeCount,
-    agree_in_halves,
-    count_modes,
-    matched_poles,
-    reported,
-)
+from armaxmodal.modes.mode_count import ModeCount, agree_in_halves, matched_poles, nearest_pole
+from armaxmodal.modes.notes import count_notes, no_mode_kept_note, pick_notes
 from armaxmodal.modes.poles import mac
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
 from armaxmodal.modes.spread import split_segments
@@ -132,7 +128,7 @@ def counted_modes(
     if picked:
         return _picked_result(work, count, keep, hold, settings, rec, band)
     if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
-        return work.warned(_no_mode_kept(count, modes, data.band_hz), count=count)
+        return work.warned(no_mode_kept_note(count, modes, data.band_hz), count=count)
     rows = pd.DataFrame([_row(modes, count, i, hold, same_row) for i in np.flatnonzero(keep)])
     rows, shapes, merged = _one_where_not_separated(rows, count.model.shapes[:, keep], count, keep, rec, band_hz, hold,
                                                     settings)  # fmt: skip
@@ -140,7 +136,7 @@ def counted_modes(
     # where two poles are reported as one, the check fits the model's poles, not the row's
     poles = tuple(zip(count.model.freq_hz[keep].tolist(), count.model.damping[keep].tolist(), strict=True))
     work = work.with_modes(rows, shapes, count=count, check_poles=poles if merged else None)
-    return work.warned(*_notes(count, keep, data.band_hz, same_row), *merged, *disagree)
+    return work.warned(*count_notes(count, keep, data.band_hz, same_row), *merged, *disagree)
 
 
 def _counted_part(rec, max_samples: int):
@@ -178,7 +174,7 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
                 for k in (poles[a], poles[b])]  # fmt: skip
         one = min(fits, key=lambda fit: fit.bic())
         both = rows.loc[[a, b]]
-        k = _nearest_pole(one, float(both.freq_hz.mean()))
+        k = nearest_pole(one.freq_hz, float(both.freq_hz.mean()))
         f, x = float(one.freq_hz[k]), float(one.damping[k])
         rows.loc[a, ["freq_hz", "damping", "damped_freq_hz"]] = [f, x, f * np.sqrt(1 - x**2)]
         rows.loc[a, ["freq_sd", "damping_sd"]] = [one.freq_sd[k], one.damping_sd[k]]
@@ -203,10 +199,6 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
         ))  # fmt: skip
     kept = [i for i in range(len(rows)) if i not in gone]
     return rows.iloc[kept].reset_index(drop=True), shapes[:, kept], notes
-
-
-def _nearest_pole(model, f: float) -> int:
-    return int(np.argmin(np.abs(np.log(model.freq_hz / f))))
 
 
 def confirmed_where_incoherent(diagram, work: SelectionState, settings: SelectionSettings = DEFAULTS) -> SelectionState:
@@ -283,7 +275,7 @@ def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hol
     picked_poles = np.zeros(m.n_modes, dtype=bool)
     for j, i in pairs.items():
         picked_poles[i] = keep[i] and picked[j]
-    notes = _pick_notes(count, picked_poles)
+    notes = pick_notes(count, picked_poles)
     for j in np.flatnonzero(picked):
         i = pairs[j]
         if keep[i]:
@@ -321,19 +313,6 @@ def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hol
     return work.warned(*notes)
 
 
-def _no_mode_kept(count: ModeCount, modes: pd.DataFrame, band_hz) -> QualityWarning:
-    poles = ", ".join(
-        f"{f:.3g} Hz (damping {x:.2f})" for f, x in zip(count.model.freq_hz, count.model.damping, strict=True)
-    )
-    return QualityWarning(
-        "count_undecided",
-        (),
-        f"the maximum-likelihood modal model keeps no mode in {band_hz[0]:.3g}-{band_hz[1]:.3g} Hz (its poles: "
-        f"{poles or 'none'}); the {len(modes)} mode(s) of the diagram's selection are reported, unconfirmed by it",
-        float(len(modes)),
-    )
-
-
 def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str, same_row_freq: float) -> dict:
     """Mode ``i`` of the counted model as a selection row: the nearest selected row's cluster
     facts when it lies within ``same_row_freq``, else none (``count`` 0)."""
@@ -351,162 +330,10 @@ def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str, same_row_freq
                    medoid_damping=np.nan, orders_damping_unresolved=0, energy=np.nan,
                    freq_sd_armax=m.freq_sd[i], damping_sd_armax=m.damping_sd[i],
                    **dict.fromkeys(EARLIER_COLUMNS, np.nan))  # fmt: skip
-    other, widened = _other_structures(count, i, same_row_freq)
+    other, widened = count.other_structures(i, same_row_freq)
     row.update(
         freq_hz=f, damping=x, damped_freq_hz=f * np.sqrt(1 - x**2), freq_sd=m.freq_sd[i], damping_sd=m.damping_sd[i],
         **other, estimator=f"ml-{hold}", count_undecided=bool(count.removal_rise[i] < count.settings.decisive_bic),
         structure_widened=widened,
     )  # fmt: skip
     return row
-
-
-def _other_structures(count: ModeCount, i: int, same_row_freq: float) -> tuple[dict, bool]:
-    """The reach of mode ``i``'s counterparts' 95 % intervals in the equally good models
-    (``count.alternatives``): where the record cannot tell the number of modes, it cannot tell
-    which model's values hold either, so the reported interval covers theirs
-    (:mod:`armaxmodal.modes.intervals`). A counterpart is the alternative's pole paired with mode
-    ``i`` one to one, within ``same_row_freq``; a mode the alternative lacks, or that moved
-    farther (two merged into one), has none. Returns ``({q}_other_lo/hi: value, NaN for none;
-    widened)``, ``widened`` when a counterpart's interval reaches beyond the mode's own."""
-    m = count.model
-    own = {"freq": [m.freq_hz[i] - Z95 * m.freq_sd[i], m.freq_hz[i] + Z95 * m.freq_sd[i]],
-           "damping": [m.damping[i] - Z95 * m.damping_sd[i], m.damping[i] + Z95 * m.damping_sd[i]]}  # fmt: skip
-    reach = {"freq_other_lo": np.nan, "freq_other_hi": np.nan, "damping_other_lo": np.nan, "damping_other_hi": np.nan}
-    widened = False
-    for _, alt in count.alternatives:
-        for k, j in matched_poles(m.freq_hz, alt.freq_hz):
-            if j != i or abs(np.log(alt.freq_hz[k] / m.freq_hz[i])) > same_row_freq:
-                continue
-            for q, value, sd in (("freq", alt.freq_hz[k], alt.freq_sd[k]), ("damping", alt.damping[k],
-                                                                              alt.damping_sd[k])):  # fmt: skip
-                lo, hi, ci = value - Z95 * sd, value + Z95 * sd, own[q]
-                widened |= bool(lo < ci[0] or hi > ci[1])
-                ci[:] = [min(ci[0], lo), max(ci[1], hi)]
-                reach[f"{q}_other_lo"] = float(np.fmin(reach[f"{q}_other_lo"], lo))
-                reach[f"{q}_other_hi"] = float(np.fmax(reach[f"{q}_other_hi"], hi))
-    return reach, widened
-
-
-def _pick_notes(count: ModeCount, keep: np.ndarray) -> list[QualityWarning]:
-    """What the record says of modes picked by hand: a ``pick_not_supported`` note for each pick
-    whose removal (the rest refitted free) raises the criterion by less than the count's ``decisive_bic``
-    (``keep``: the picked poles, by pole), and a ``mode_count`` note when one mode more than the
-    model holds lowers it by more."""
-    decisive = count.settings.decisive_bic
-    notes = []
-    for i in np.flatnonzero(keep):
-        rise = float(count.removal_rise[i])
-        if rise < decisive:
-            f = float(count.model.freq_hz[i])
-            notes.append(QualityWarning(
-                "pick_not_supported", (),
-                f"the record does not support the mode picked at {f:.3f} Hz: without it (the other modes refitted "
-                f"free) the information criterion changes by {rise:+.1f}, less than the {decisive:g} a needed "
-                "mode raises it; treat it as tentative, or pick another column of the diagram", f,
-            ))  # fmt: skip
-    if count.best_addition > decisive and np.isfinite(count.best_addition_hz):
-        f = count.best_addition_hz
-        notes.append(QualityWarning(
-            "mode_count", (),
-            f"the record holds one mode more than the modal model behind the picks, near {f:.3f} Hz: adding it lowers "
-            f"the information criterion by {count.best_addition:.1f}", f,
-        ))  # fmt: skip
-    return notes
-
-
-def _why_not_reported(rise_bic: float) -> str:
-    if rise_bic > 0:
-        return f"the criterion (BIC) rises by {rise_bic:.1f}, so it is not reported"
-    return ("the search, which splits only the mode nearest the residual's peak, did not try it (with it the "
-            f"criterion falls by {-rise_bic:.1f}), so it is not reported")
-
-
-def _what_to_do(in_diagram: bool) -> str:
-    if in_diagram:
-        return "pick it (--pick) to see what the record says of it"
-    # a split's pole: the ARMAX fits merge it with its neighbour, and a pick takes a diagram's column
-    return ("the diagram holds no stable column there to pick (its ARMAX fits merge it with a neighbour); a longer "
-            "record would decide")
-
-
-def _notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: float) -> list[QualityWarning]:
-    decisive = count.settings.decisive_bic
-    notes = []
-    words = {"remove": "left out", "add": "added", "split": "split in two"}
-    for step in count.steps:
-        moved = np.isfinite(step.settled_hz) and abs(np.log(step.settled_hz / step.freq_hz)) > same_row_freq
-        where = f" (its new pole settled at {step.settled_hz:.3f} Hz)" if moved else ""
-        notes.append(QualityWarning(
-            "mode_count", (),
-            f"the maximum-likelihood modal model with every pole free: the mode at {step.freq_hz:.3f} Hz "
-            f"{words[step.action]}{where}, the information criterion (BIC) falls by {step.bic_fall:.1f}",
-            float(step.freq_hz),
-        ))  # fmt: skip
-    rise = float(count.removal_rise.min()) if count.removal_rise.size else np.inf
-    if rise < decisive:
-        notes.append(QualityWarning(
-            "count_undecided", (),
-            f"the record does not decide the number of modes: with one mode fewer (the rest refitted free) the "
-            f"criterion rises by only {rise:.1f} (under {decisive:g}, Kass & Raftery's 'very strong'); "
-            "treat the weakest mode as tentative", rise,
-        ))  # fmt: skip
-    if count.best_addition > -decisive and np.isfinite(count.best_addition_hz):
-        f = count.best_addition_hz
-        notes.append(QualityWarning(
-            "count_undecided", (),
-            f"the record does not rule out one mode more (near {f:.3f} Hz): adding it changes the criterion by "
-            f"{-count.best_addition:+.1f}, less than {decisive:g} either way", f,
-        ))  # fmt: skip
-    if count.wanted:
-        f, ratio, dof, rise_bic, in_diagram = count.wanted  # a Wanted
-        notes.append(QualityWarning(
-            "count_undecided", (),
-            f"the record may hold one mode more near {f:.3f} Hz: adding it raises the likelihood far beyond chance "
-            f"(likelihood ratio {ratio:.1f} for its {dof} parameters, p < {count.settings.likelihood_alpha:g}) and the "
-            f"mode is the same in both halves of the record, but {_why_not_reported(rise_bic)}; "
-            f"{_what_to_do(in_diagram)}", f,
-        ))  # fmt: skip
-    for start, went in count.carried_away:
-        notes.append(QualityWarning(
-            "mode_count", (),
-            f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
-            "damping unresolved, or not the same in both halves of the record); left out", went,
-        ))  # fmt: skip
-    for f in count.unconfirmed_hz:
-        notes.append(QualityWarning(
-            "mode_count", (),
-            f"one mode more near {f:.3f} Hz fits the whole record better but not each of its halves: a change "
-            "during the record (a drifting frequency, a transient, a nonlinearity), not a mode; left out", f,
-        ))  # fmt: skip
-    widened = [count.model.freq_hz[i] for i in np.flatnonzero(keep) if _other_structures(count, i, same_row_freq)[1]]
-    if widened:
-        sizes = ", ".join(f"{alt.n_modes} modes ({d:+.1f})" for d, alt in count.alternatives)
-        notes.append(QualityWarning(
-            "mode_count", (),
-            f"the 95 % intervals of the mode(s) at {', '.join(f'{f:.3f}' for f in widened)} Hz also cover their values "
-            f"in the models the record cannot tell from the chosen one ({sizes} in the criterion): the number of modes "
-            "is part of their uncertainty", float(len(widened)),
-        ))  # fmt: skip
-    for start, went, rise_without in count.stand_ins:
-        notes.append(QualityWarning(
-            "mode_count", (),
-            f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
-            "damping unresolved, or not the same in both halves of the record), but the model needs it (without it "
-            f"the criterion rises by {rise_without:.1f}): it stays in the model, as a pole for what the record does "
-            "not resolve there, and is not reported", went,
-        ))  # fmt: skip
-    outside = ~reported(count.model, band_hz)  # beyond the band, overdamped or lines (not the stand-ins)
-    hidden = int(outside.sum())
-    if hidden:
-        out = ", ".join(
-            f"{f:.3g} Hz (damping {x:.2f})"
-            for f, x in zip(count.model.freq_hz[outside], count.model.damping[outside], strict=True)
-        )
-        notes.append(QualityWarning(
-            "mode_count", (),
-            f"{hidden} pole(s) of the modal model lie outside the band {band_hz[0]:.3g}-{band_hz[1]:.3g} Hz, are "
-            f"damped beyond {MAX_DAMPING:g} or are lines (damping at the fit's floor): {out}. They stand for what lies "
-            "beyond the band or for a periodic disturbance, and are not reported as modes",
-            float(hidden),
-        ))  # fmt: skip
-    return notes

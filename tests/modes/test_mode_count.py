@@ -9,15 +9,12 @@ import pandas as pd
 import pytest
 
 import armaxmodal as am
-from armaxmodal.modes.counted import (
-    _notes,
-    _one_where_not_separated,
-    _other_structures,
-    dropped_where_peaks_remain,
-)
+from armaxmodal.modes.count_search import count_modes
+from armaxmodal.modes.counted import _one_where_not_separated, dropped_where_peaks_remain
 from armaxmodal.modes.intervals import not_separated, with_intervals
 from armaxmodal.modes.modal_model import DftLines, fit_modal_model
-from armaxmodal.modes.mode_count import ModeCount, count_modes, effective_fraction, reported
+from armaxmodal.modes.mode_count import ModeCount, Wanted, effective_fraction, reported
+from armaxmodal.modes.notes import count_notes as _notes
 from armaxmodal.modes.result import ModeSelection, not_separated_notes
 from armaxmodal.modes.settings import ClusterSettings, CountSettings, SelectionSettings
 from armaxmodal.stats import Z95
@@ -149,7 +146,7 @@ def test_undecided_counts_and_out_of_band_poles_are_said():
 
 def _structure_hull(count, i):
     """Mode ``i``'s reported intervals: its own and the other structures' part, combined on output."""
-    other, widened = _other_structures(count, i, SAME_ROW)
+    other, widened = count.other_structures(i, SAME_ROW)
     m = count.model
     row = pd.DataFrame([{"freq_hz": m.freq_hz[i], "damping": m.damping[i], "freq_sd": m.freq_sd[i],
                          "damping_sd": m.damping_sd[i], **other}])  # fmt: skip
@@ -375,10 +372,10 @@ def test_the_search_takes_only_steps_that_lower_the_criterion(monkeypatch, supin
     """Criterion 100, 95, 97 for 2, 3, 4 modes: from any start the search ends at 3, having
     taken only steps that lower the criterion; the removal and the addition from 3 are 5 and 2
     units worse, so both are undecided (under 10)."""
-    import armaxmodal.modes.mode_count as mode_count
+    import armaxmodal.modes.count_search as count_search
 
     table = {1: 120.0, 2: 100.0, 3: 95.0, 4: 97.0, 5: 99.0}
-    monkeypatch.setattr(mode_count, "fit_modal_model", lambda data, f, x, hold, n=40, dft=None: _Scored(f, x, table))
+    monkeypatch.setattr(count_search, "fit_modal_model", lambda data, f, x, hold, n=40, dft=None: _Scored(f, x, table))
     data, _ = supine
     f, x = np.array([5.0, 9.0, 13.0, 17.0][:start]), np.full(start, 0.3)
     count = count_modes(data, f, x, hold="zoh")
@@ -393,10 +390,10 @@ def test_the_search_takes_only_steps_that_lower_the_criterion(monkeypatch, supin
 def test_a_decided_count_has_no_equally_good_model(monkeypatch, supine):
     """Criterion 130, 95, 120 for 2, 3, 4 modes: every neighbour is worse by more than
     DECISIVE_BIC, so no other count enters the intervals."""
-    import armaxmodal.modes.mode_count as mode_count
+    import armaxmodal.modes.count_search as count_search
 
     table = {1: 150.0, 2: 130.0, 3: 95.0, 4: 120.0, 5: 140.0}
-    monkeypatch.setattr(mode_count, "fit_modal_model", lambda data, f, x, hold, n=40, dft=None: _Scored(f, x, table))
+    monkeypatch.setattr(count_search, "fit_modal_model", lambda data, f, x, hold, n=40, dft=None: _Scored(f, x, table))
     count = count_modes(supine[0], [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], hold="zoh")
     assert count.model.n_modes == 3 and count.alternatives == ()
 
@@ -412,7 +409,7 @@ def test_a_start_mode_the_free_fit_carries_away_must_be_founded(monkeypatch, sup
     only when its damping is resolved and the diagram holds a pole there (as an addition must).
     One that is not founded is left out, unless the model needs it (the criterion rises by
     DECISIVE_BIC or more without it): then it stays in the model, unreported."""
-    import armaxmodal.modes.mode_count as mode_count
+    import armaxmodal.modes.count_search as count_search
 
     data, _ = supine
     table = {2: 100.0 + (DECISIVE_BIC + 1 if needed else DECISIVE_BIC - 1), 3: 100.0}
@@ -420,10 +417,10 @@ def test_a_start_mode_the_free_fit_carries_away_must_be_founded(monkeypatch, sup
     if not resolved:
         moved.damping_sd = np.array([0.003, 0.003, 0.2])  # 11 Hz: interval reaches below zero
     refits = []
-    monkeypatch.setattr(mode_count, "fit_modal_model",
+    monkeypatch.setattr(count_search, "fit_modal_model",
                         lambda d, f, x, hold, n, dft=None: refits.append(list(f)) or _Scored(f, x, table))  # fmt: skip
-    search = mode_count._Search(data, "zoh", 1.0, 40)
-    model, carried, kept = mode_count._without_unfounded(search, [5.0, 9.0, 13.0], moved,
+    search = count_search._Search(data, "zoh", 1.0, 40)
+    model, carried, kept = count_search._without_unfounded(search, [5.0, 9.0, 13.0], moved,
                                                          lambda f, x: stable_there or abs(f - 11.0) > 0.5)  # fmt: skip
     if outcome == "dropped":
         assert carried == ((13.0, 11.0),) and kept == () and refits == [[5.0, 9.0]] and model.n_modes == 2
@@ -434,7 +431,7 @@ def test_a_start_mode_the_free_fit_carries_away_must_be_founded(monkeypatch, sup
         assert carried == () and kept == () and model is moved and refits == []
     # a pole that stayed near its start is not judged, however unsupported
     near = _Scored([5.0, 9.0, 12.8], [0.3, 0.3, 0.3], table)
-    assert mode_count._without_unfounded(search, [5.0, 9.0, 13.0], near, lambda f, x: False)[1:] == ((), ())
+    assert count_search._without_unfounded(search, [5.0, 9.0, 13.0], near, lambda f, x: False)[1:] == ((), ())
 
 
 def test_a_stand_in_is_in_the_model_but_not_reported_and_is_said():
@@ -454,15 +451,15 @@ def test_a_stand_in_is_in_the_model_but_not_reported_and_is_said():
 def test_with_the_halves_a_moved_pole_is_judged_by_them_not_by_the_diagram(monkeypatch, supine, same_in_halves):
     """Where the ARMAX fits are biased the diagram holds no pole where the model moves one (a stuck
     pelvis's 13.50 Hz mode sat at 14.69 Hz in every order): with the halves, they decide."""
-    import armaxmodal.modes.mode_count as mode_count
+    import armaxmodal.modes.count_search as count_search
 
     table = {2: 100.0, 3: 100.0}  # the model does not need the moved pole
-    monkeypatch.setattr(mode_count, "fit_modal_model", lambda d, f, x, hold, n, dft=None: _Scored(f, x, table))
-    search = mode_count._Search(supine[0], "zoh", 1.0, 40)
+    monkeypatch.setattr(count_search, "fit_modal_model", lambda d, f, x, hold, n, dft=None: _Scored(f, x, table))
+    search = count_search._Search(supine[0], "zoh", 1.0, 40)
     asked = []
     monkeypatch.setattr(search, "in_both_halves", lambda m, new, h: asked.append(list(new)) or same_in_halves)
     moved = _Scored([5.0, 9.0, 11.0], [0.3, 0.3, 0.3], table)
-    model, carried, _ = mode_count._without_unfounded(search, [5.0, 9.0, 13.0], moved, lambda f, x: False, ("a", "b"))
+    model, carried, _ = count_search._without_unfounded(search, [5.0, 9.0, 13.0], moved, lambda f, x: False, ("a", "b"))
     assert asked == [[2]]  # only the moved pole is put to the halves
     assert (carried == ()) is same_in_halves and model.n_modes == (3 if same_in_halves else 2)
 
@@ -592,7 +589,7 @@ def _search(bic, n_eff, halves_agree):
 )
 def test_the_likelihood_ratio_flag_needs_a_significant_ratio_a_decisive_bic_and_both_halves(ratio, halves_agree,
                                                                                               wanted):
-    from armaxmodal.modes.mode_count import _wanted
+    from armaxmodal.modes.count_search import _wanted
 
     n_eff = 1e5  # BIC's penalty for one mode of 22 parameters: 22 ln(1e5) = 253
     current = SimpleNamespace(n_params=88, freq_hz=np.array([6.6, 7.7, 11.1, 14.4]),
@@ -617,7 +614,7 @@ def test_a_split_of_a_mode_the_search_did_not_split_is_tried_for_the_likelihood(
     is, with its new pole at one of the two and the same in both halves."""
     from scipy.special import chdtrc
 
-    from armaxmodal.modes.mode_count import _Search, _split_wanted
+    from armaxmodal.modes.count_search import _Search, _split_wanted
     from armaxmodal.modes.spread import split_segments
 
     data, truth = supine
@@ -736,7 +733,7 @@ def test_a_close_pair_reported_as_one_leaves_the_count_undecided_where_the_recor
 def test_the_split_of_lowest_criterion_is_the_one_judged(best_resolved):
     """Of the reported modes' splits, the one of lowest criterion is converged and judged; one
     whose damping the record does not resolve is no mode, and no other split stands in for it."""
-    from armaxmodal.modes.mode_count import _split_wanted
+    from armaxmodal.modes.count_search import _split_wanted
 
     n_eff = 1e5
     current = SimpleNamespace(n_params=44, freq_hz=np.array([6.0, 15.0]), damping=np.array([0.2, 0.3]),
@@ -767,12 +764,12 @@ def test_a_wanted_split_as_good_as_the_chosen_model_is_one_of_the_equally_good(m
     """A wanted split whose criterion stays within the decisive 10 of the chosen model's is a model
     the record cannot tell from it: the intervals cover its modes. Beyond that, either way, it is
     not (a decisive rise is BIC's verdict; a decisive fall the search would have taken had it tried)."""
-    import armaxmodal.modes.mode_count as mode_count
+    import armaxmodal.modes.count_search as count_search
 
     data, truth = supine
     split = fit_modal_model(data, truth.freq_hz, truth.damping, "zoh", max_nfev=1)
-    wanted = mode_count.Wanted(14.0, 200.0, 22, rise, False)
-    monkeypatch.setattr(mode_count, "_split_wanted", lambda *a, **k: (wanted, split))
+    wanted = Wanted(14.0, 200.0, 22, rise, False)
+    monkeypatch.setattr(count_search, "_split_wanted", lambda *a, **k: (wanted, split))
     count = count_modes(data, truth.freq_hz, truth.damping, hold="zoh")
     assert count.wanted == (14.0, 200.0, 22, rise, False)
     assert any(m is split for _, m in count.alternatives) == joins

@@ -80,8 +80,9 @@ def test_a_pick_the_modal_model_takes_out_of_the_band_is_reported_and_said():
         freq_hz=np.array([5.1, 20.0, 12.1]), damping=np.array([0.1, 1e-4, 0.05]), freq_sd=np.full(3, 0.01),
         damping_sd=np.array([0.001, 0.0, 0.001]), shapes=np.array([[3.0, 4.0, 6.0]], dtype=complex), n_modes=3,
     )  # fmt: skip
-    count = SimpleNamespace(model=model, removal_rise=np.array([80.0, -3.0, 60.0]), alternatives=(),
-                            best_addition=-50.0, best_addition_hz=np.nan, settings=CountSettings())  # fmt: skip
+    from armaxmodal.modes.mode_count import ModeCount
+
+    count = ModeCount(model, model, (), np.array([80.0, -3.0, 60.0]), -50.0, np.nan, 1.0)
     out = _picked_result(work, count, np.array([True, False, True]), "bandlimited", SelectionSettings())
     assert out.modes.freq_hz.tolist() == [5.1, 9.0] and out.shapes.tolist() == [[3.0, 2.0]]
     assert out.modes.count_undecided.tolist() == [False, True] and out.modes.picked_hz.tolist() == [5.1, 9.0]
@@ -111,7 +112,7 @@ def test_stabilise_pick_from_the_command_line(fixtures_dir, tmp_path, capsys):
 
 def test_a_pick_the_record_does_not_need_is_said():
     """Two kept picks: without the first the criterion rises by 4 only (under 10), without the second by 80."""
-    from armaxmodal.modes.counted import _pick_notes
+    from armaxmodal.modes.notes import pick_notes as _pick_notes
 
     model = SimpleNamespace(freq_hz=np.array([5.0, 9.0]), damping=np.array([0.1, 0.05]))
     count = SimpleNamespace(model=model, removal_rise=np.array([4.0, 80.0]), best_addition=-30.0, best_addition_hz=7.0,

@@ -1,0 +1,154 @@
+"""The notes of the count, written from its verdicts (:mod:`armaxmodal.modes.mode_count`): what the
+search did, where the record does not decide the number of modes, what the picks are worth, and
+which poles stay in the model unreported. No decision is taken here: each note reads the count
+(its steps, margins, equally good models, stand-ins) and the levels it carries.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from armaxmodal.modes.mode_count import ModeCount, reported
+from armaxmodal.quality_warnings import QualityWarning
+from armaxmodal.stats import MAX_DAMPING
+
+__all__ = ["count_notes", "no_mode_kept_note", "pick_notes"]
+
+
+def no_mode_kept_note(count: ModeCount, modes: pd.DataFrame, band_hz) -> QualityWarning:
+    poles = ", ".join(
+        f"{f:.3g} Hz (damping {x:.2f})" for f, x in zip(count.model.freq_hz, count.model.damping, strict=True)
+    )
+    return QualityWarning(
+        "count_undecided",
+        (),
+        f"the maximum-likelihood modal model keeps no mode in {band_hz[0]:.3g}-{band_hz[1]:.3g} Hz (its poles: "
+        f"{poles or 'none'}); the {len(modes)} mode(s) of the diagram's selection are reported, unconfirmed by it",
+        float(len(modes)),
+    )
+
+
+def pick_notes(count: ModeCount, keep: np.ndarray) -> list[QualityWarning]:
+    """What the record says of modes picked by hand: a ``pick_not_supported`` note for each pick
+    whose removal (the rest refitted free) raises the criterion by less than the count's ``decisive_bic``
+    (``keep``: the picked poles, by pole), and a ``mode_count`` note when one mode more than the
+    model holds lowers it by more."""
+    decisive = count.settings.decisive_bic
+    notes = []
+    for i in np.flatnonzero(keep):
+        rise = float(count.removal_rise[i])
+        if rise < decisive:
+            f = float(count.model.freq_hz[i])
+            notes.append(QualityWarning(
+                "pick_not_supported", (),
+                f"the record does not support the mode picked at {f:.3f} Hz: without it (the other modes refitted "
+                f"free) the information criterion changes by {rise:+.1f}, less than the {decisive:g} a needed "
+                "mode raises it; treat it as tentative, or pick another column of the diagram", f,
+            ))  # fmt: skip
+    if count.best_addition > decisive and np.isfinite(count.best_addition_hz):
+        f = count.best_addition_hz
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"the record holds one mode more than the modal model behind the picks, near {f:.3f} Hz: adding it lowers "
+            f"the information criterion by {count.best_addition:.1f}", f,
+        ))  # fmt: skip
+    return notes
+
+
+def _why_not_reported(rise_bic: float) -> str:
+    if rise_bic > 0:
+        return f"the criterion (BIC) rises by {rise_bic:.1f}, so it is not reported"
+    return ("the search, which splits only the mode nearest the residual's peak, did not try it (with it the "
+            f"criterion falls by {-rise_bic:.1f}), so it is not reported")
+
+
+def _what_to_do(in_diagram: bool) -> str:
+    if in_diagram:
+        return "pick it (--pick) to see what the record says of it"
+    # a split's pole: the ARMAX fits merge it with its neighbour, and a pick takes a diagram's column
+    return ("the diagram holds no stable column there to pick (its ARMAX fits merge it with a neighbour); a longer "
+            "record would decide")
+
+
+def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: float) -> list[QualityWarning]:
+    decisive = count.settings.decisive_bic
+    notes = []
+    words = {"remove": "left out", "add": "added", "split": "split in two"}
+    for step in count.steps:
+        moved = np.isfinite(step.settled_hz) and abs(np.log(step.settled_hz / step.freq_hz)) > same_row_freq
+        where = f" (its new pole settled at {step.settled_hz:.3f} Hz)" if moved else ""
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"the maximum-likelihood modal model with every pole free: the mode at {step.freq_hz:.3f} Hz "
+            f"{words[step.action]}{where}, the information criterion (BIC) falls by {step.bic_fall:.1f}",
+            float(step.freq_hz),
+        ))  # fmt: skip
+    rise = float(count.removal_rise.min()) if count.removal_rise.size else np.inf
+    if rise < decisive:
+        notes.append(QualityWarning(
+            "count_undecided", (),
+            f"the record does not decide the number of modes: with one mode fewer (the rest refitted free) the "
+            f"criterion rises by only {rise:.1f} (under {decisive:g}, Kass & Raftery's 'very strong'); "
+            "treat the weakest mode as tentative", rise,
+        ))  # fmt: skip
+    if count.best_addition > -decisive and np.isfinite(count.best_addition_hz):
+        f = count.best_addition_hz
+        notes.append(QualityWarning(
+            "count_undecided", (),
+            f"the record does not rule out one mode more (near {f:.3f} Hz): adding it changes the criterion by "
+            f"{-count.best_addition:+.1f}, less than {decisive:g} either way", f,
+        ))  # fmt: skip
+    if count.wanted:
+        f, ratio, dof, rise_bic, in_diagram = count.wanted  # a Wanted
+        notes.append(QualityWarning(
+            "count_undecided", (),
+            f"the record may hold one mode more near {f:.3f} Hz: adding it raises the likelihood far beyond chance "
+            f"(likelihood ratio {ratio:.1f} for its {dof} parameters, p < {count.settings.likelihood_alpha:g}) and the "
+            f"mode is the same in both halves of the record, but {_why_not_reported(rise_bic)}; "
+            f"{_what_to_do(in_diagram)}", f,
+        ))  # fmt: skip
+    for start, went in count.carried_away:
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
+            "damping unresolved, or not the same in both halves of the record); left out", went,
+        ))  # fmt: skip
+    for f in count.unconfirmed_hz:
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"one mode more near {f:.3f} Hz fits the whole record better but not each of its halves: a change "
+            "during the record (a drifting frequency, a transient, a nonlinearity), not a mode; left out", f,
+        ))  # fmt: skip
+    widened = [count.model.freq_hz[i] for i in np.flatnonzero(keep) if count.other_structures(i, same_row_freq)[1]]
+    if widened:
+        sizes = ", ".join(f"{alt.n_modes} modes ({d:+.1f})" for d, alt in count.alternatives)
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"the 95 % intervals of the mode(s) at {', '.join(f'{f:.3f}' for f in widened)} Hz also cover their values "
+            f"in the models the record cannot tell from the chosen one ({sizes} in the criterion): the number of modes "
+            "is part of their uncertainty", float(len(widened)),
+        ))  # fmt: skip
+    for start, went, rise_without in count.stand_ins:
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
+            "damping unresolved, or not the same in both halves of the record), but the model needs it (without it "
+            f"the criterion rises by {rise_without:.1f}): it stays in the model, as a pole for what the record does "
+            "not resolve there, and is not reported", went,
+        ))  # fmt: skip
+    outside = ~reported(count.model, band_hz)  # beyond the band, overdamped or lines (not the stand-ins)
+    hidden = int(outside.sum())
+    if hidden:
+        out = ", ".join(
+            f"{f:.3g} Hz (damping {x:.2f})"
+            for f, x in zip(count.model.freq_hz[outside], count.model.damping[outside], strict=True)
+        )
+        notes.append(QualityWarning(
+            "mode_count", (),
+            f"{hidden} pole(s) of the modal model lie outside the band {band_hz[0]:.3g}-{band_hz[1]:.3g} Hz, are "
+            f"damped beyond {MAX_DAMPING:g} or are lines (damping at the fit's floor): {out}. They stand for what lies "
+            "beyond the band or for a periodic disturbance, and are not reported as modes",
+            float(hidden),
+        ))  # fmt: skip
+    return notes
