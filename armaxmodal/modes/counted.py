@@ -18,8 +18,13 @@ import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
 from armaxmodal.modes.count_search import count_modes
-from armaxmodal.modes.estimators import EARLIER_COLUMNS, covering_both_estimators, earlier_estimate
-from armaxmodal.modes.intervals import not_separated, with_intervals
+from armaxmodal.modes.intervals import (
+    EARLIER_COLUMNS,
+    covering_both_estimators,
+    earlier_estimate,
+    not_separated,
+    with_intervals,
+)
 from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.modal_model import DftLines, fit_modal_model
 from armaxmodal.modes.mode_count import ModeCount, agree_in_halves, matched_poles, nearest_pole

@@ -162,7 +162,7 @@ class ModeSelection:
             if "structure_widened" in self.modes:  # the modal model's count (modes/counted.py)
                 record["count_undecided"] = bool(row.count_undecided)
                 record["interval_covers_other_counts"] = bool(row.structure_widened)
-            if "estimator_widened" in self.modes:  # the two estimators disagree (modes/estimators.py)
+            if "estimator_widened" in self.modes:  # the two estimators disagree (modes/intervals.py)
                 record["interval_covers_other_estimator"] = bool(row.estimator_widened)
             modes.append(record)
         per_sensor = [

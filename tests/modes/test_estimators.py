@@ -1,4 +1,4 @@
-"""Two estimators that disagree (armaxmodal.modes.estimators): Hausman's statistic worked out by hand,
+"""Two estimators that disagree (armaxmodal.modes.intervals): Hausman's statistic worked out by hand,
 its level, and the intervals that then cover both estimates."""
 
 import numpy as np
@@ -6,8 +6,7 @@ import pandas as pd
 import pytest
 import scipy.stats
 
-from armaxmodal.modes.estimators import covering_both_estimators, earlier_estimate
-from armaxmodal.modes.intervals import with_intervals
+from armaxmodal.modes.intervals import covering_both_estimators, earlier_estimate, with_intervals
 from armaxmodal.stats import Z95
 
 
