@@ -588,13 +588,13 @@ MUTANTS = [
         "a mode the likelihood does not need confirmed where the H1 is incoherent (count)",
     ),
     (
-        "armaxmodal/modes/picks.py",
+        "armaxmodal/modes/clusters.py",
         'if abs(centres[k] / f - 1) > cluster.pick_reach:',
         'if abs(centres[k] / f - 1) > 10 * cluster.pick_reach:',
         "a pick takes a cluster far from it (pick)",
     ),
     (
-        "armaxmodal/modes/picks.py",
+        "armaxmodal/modes/clusters.py",
         'close = np.flatnonzero(np.diff(values) / values[:-1] <= cluster.pick_reach)',
         "close = np.flatnonzero(np.diff(values) / values[:-1] < 0)",
         "two picks on one cluster allowed (pick)",

@@ -63,8 +63,8 @@ def add_parser(sub, parents) -> None:
 
 
 def run(args) -> int:
+    from armaxmodal.modes.clusters import check_picks
     from armaxmodal.modes.diagram import stabilisation_diagram
-    from armaxmodal.modes.picks import check_picks
     from armaxmodal.modes.pipeline import select_modes
     from armaxmodal.prepare.preparation import check_band
 

@@ -9,11 +9,10 @@ neighbours, each refitted with every pole free from where the current poles stan
 * **add** a left-out stable cluster of the diagram, or a pole where the residual is largest;
 * **split** a mode in two, about its half-power band apart.
 
-The neighbour of lowest information criterion (:mod:`armaxmodal.modes.mode_count` says which)
-replaces the current model while it lowers the criterion; the search ends when no neighbour
-does. Then the chosen model is converged, starting poles carried to where no mode is founded are
-judged, the equally good models are fitted, and the additions and splits the likelihood wants but
-the criterion refuses are flagged. The parts all read and advance one ``_Search`` state.
+The neighbour of lowest criterion (:mod:`armaxmodal.modes.mode_count`) replaces the current
+model while it lowers it. Then the chosen model is converged, carried-away starts judged, the
+equally good models fitted and the refused additions the likelihood wants flagged, all on one
+``_Search`` state.
 """
 
 from __future__ import annotations

@@ -20,9 +20,10 @@ from armaxmodal.estimate.fit import fit_armax
 from armaxmodal.estimate.orders import OrderChoice, choose_orders
 from armaxmodal.estimate.result import ArmaxFit
 from armaxmodal.modal import mode_record
-from armaxmodal.modes.header import oversampling_note, record_header
 from armaxmodal.modes.modal_check import ModalCheck, check_modes, finite_or_none
+from armaxmodal.modes.notes import oversampling_note
 from armaxmodal.modes.poles import POLE_COLUMNS, SHARED, Tolerances, pole_rows, rejection_reasons
+from armaxmodal.modes.result import record_header
 from armaxmodal.prepare.preparation import Preparation, prepare
 from armaxmodal.recording import Recording
 from armaxmodal.stats import MAX_DAMPING

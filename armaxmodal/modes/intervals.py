@@ -11,7 +11,7 @@ Each quantity ``q`` (``freq`` for ``freq_hz``, ``damping``) of a selection row h
     NaN where there are none;
 ``{q}_estimator_lo``, ``{q}_estimator_hi``
     the reach of the earlier estimator's 95 % interval (the diagram's fit) where the record shows
-    the two estimators disagree (:func:`covering_both_estimators`); NaN elsewhere;
+    the two estimators disagree (``covering_both_estimators``); NaN elsewhere;
 ``{q}_segment_half``
     the half-width of the disjoint segments' interval where their spread exceeds the statistical
     one (:mod:`armaxmodal.modes.spread`); NaN where it does not.
@@ -20,7 +20,7 @@ The interval is the hull of ``value ± Z95 sd`` and the other three, scaled abou
 share of the record's samples that carry information (filled samples do not). Each stage sets its
 own part and leaves the others', so no stage has to undo or re-derive another's widening.
 
-**Two estimators that disagree** (:func:`covering_both_estimators`): the intervals cover both.
+**Two estimators that disagree** (``covering_both_estimators``): the intervals cover both.
 
 The selection estimates every mode twice before it reports it: first the diagram's ARMAX fit (or
 its band-limited refit, where the record is band-limited), then the maximum-likelihood modal model

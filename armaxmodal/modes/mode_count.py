@@ -6,7 +6,7 @@ mode fewer, one more, or one split, and keeps the neighbour of lowest criterion 
 This module holds what it returns, :class:`ModeCount`, with the verdicts derived from it (which
 poles are reported, the other structures' reach), and the tests the search applies: Bartlett's
 effective share of independent lines (:func:`effective_fraction`), the two halves' agreement
-(:func:`agree_in_halves`), the pairing of two pole sets and the residual's peak.
+(``agree_in_halves``), the pairing of two pole sets and the residual's peak.
 
 The criterion is Schwarz's BIC (``-2 ln L + p ln N``): its penalty grows with the data, unlike a
 test at a fixed level, which keeps a ghost whose ``chi^2`` gain (about 50 at 2,000 real numbers in

@@ -1,7 +1,8 @@
-"""The notes of the count, written from its verdicts (:mod:`armaxmodal.modes.mode_count`): what the
-search did, where the record does not decide the number of modes, what the picks are worth, and
-which poles stay in the model unreported. No decision is taken here: each note reads the count
-(its steps, margins, equally good models, stand-ins) and the levels it carries.
+"""The notes of the selection written from what the stages found: the count's
+(:mod:`armaxmodal.modes.mode_count`) -- what the search did, where the record does not decide the
+number of modes, what the picks are worth, which poles stay in the model unreported -- and the
+record's being sampled far above its modes. No decision is taken here: each note reads a result
+(the count's steps, margins, equally good models, stand-ins) and the levels it carries.
 """
 
 from __future__ import annotations
@@ -10,10 +11,12 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.modes.mode_count import ModeCount, reported
+from armaxmodal.modes.settings import DEFAULTS, NoteSettings
+from armaxmodal.prepare.resample import BAND_FRACTION_OF_FS
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.stats import MAX_DAMPING
 
-__all__ = ["count_notes", "no_mode_kept_note", "pick_notes"]
+__all__ = ["count_notes", "no_mode_kept_note", "oversampling_note", "pick_notes"]
 
 
 def no_mode_kept_note(count: ModeCount, modes: pd.DataFrame, band_hz) -> QualityWarning:
@@ -152,3 +155,50 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             float(hidden),
         ))  # fmt: skip
     return notes
+
+
+def oversampling_note(mode_freqs: np.ndarray, fs: float, settings: NoteSettings = DEFAULTS.notes
+                      ) -> list[QualityWarning]:  # fmt: skip
+    """An ``oversampled`` warning when every mode found lies below
+    ``settings.oversampled_fraction`` of the Nyquist frequency: the input excites far above the
+    structure (so the rate was kept), the poles crowd ``z = 1`` and the swept orders resolve
+    them poorly (the supine ride at 1 kHz under a 0.5-400 Hz ride gave one of its four modes;
+    with the band suggested here, all four). The band suggested ends at
+    ``settings.suggested_band_factor`` times the highest mode found.
+
+    Parameters
+    ----------
+    mode_freqs : (n_modes,) ndarray
+        Natural frequencies of the modes found, Hz.
+    fs : float
+        The analysis rate, Hz.
+    settings : NoteSettings
+        The share of Nyquist that makes a record oversampled, and the band suggested.
+
+    Returns
+    -------
+    list of QualityWarning
+        Empty, or one warning whose value is the highest mode's share of the Nyquist frequency.
+    """
+    mode_freqs = np.asarray(mode_freqs, dtype=float)
+    if mode_freqs.size == 0 or mode_freqs.max() >= settings.oversampled_fraction * fs / 2:
+        return []
+    top = float(mode_freqs.max())
+    hi = float(np.ceil(settings.suggested_band_factor * top))
+    factor = int(np.floor(BAND_FRACTION_OF_FS * fs / hi))
+    if factor < 2:  # the band suggested keeps the rate: no lower rate to suggest
+        return []
+    new_fs = fs / factor
+    share = top / (fs / 2)
+    return [
+        QualityWarning(
+            "oversampled",
+            (),
+            f"every mode found lies below {100 * share:.1f} % of the Nyquist frequency (the highest at "
+            f"{top:.3g} Hz of {fs / 2:g} Hz): the input excites far above the structure, so the rate was kept, "
+            "and at this rate the poles crowd z = 1 where ARMAX models resolve them poorly; modes may be "
+            f"missed or biased. Rerun with band=(0, {hi:g}) (CLI: --band 0:{hi:g}), which resamples to "
+            f"{new_fs:.4g} Hz.",
+            share,
+        )
+    ]

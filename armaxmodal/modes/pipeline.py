@@ -26,15 +26,14 @@ import pandas as pd
 
 from armaxmodal._threads import one_blas_thread
 from armaxmodal.exceptions import PickError
-from armaxmodal.modes.clusters import clustered_modes, merge_duplicates, why_no_mode
+from armaxmodal.modes.clusters import check_picks, clustered_modes, merge_duplicates, picked_modes, why_no_mode
 from armaxmodal.modes.completeness import modes_the_check_adds, modes_the_record_needs, refit_with_added
 from armaxmodal.modes.counted import confirmed_where_incoherent, counted_modes, dropped_where_peaks_remain
 from armaxmodal.modes.diagram import StabilisationDiagram
-from armaxmodal.modes.header import oversampling_note
 from armaxmodal.modes.intervals import with_intervals
 from armaxmodal.modes.modal_check import check_modes
+from armaxmodal.modes.notes import oversampling_note
 from armaxmodal.modes.per_sensor import per_sensor_table
-from armaxmodal.modes.picks import check_picks, picked_modes
 from armaxmodal.modes.result import (
     ModeSelection,
     filled_samples_scale,

@@ -11,15 +11,16 @@ import pandas as pd
 
 from armaxmodal.modal import mode_record
 from armaxmodal.modes.diagram import StabilisationDiagram
-from armaxmodal.modes.header import record_header
 from armaxmodal.modes.intervals import not_separated, with_intervals
 from armaxmodal.modes.modal_check import ModalCheck
 from armaxmodal.modes.mode_count import ModeCount
 from armaxmodal.modes.refine import ModalRefinement
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
+from armaxmodal.prepare.preparation import Preparation
 from armaxmodal.quality_warnings import UNCERTAIN_CODES, QualityWarning
+from armaxmodal.recording import Recording
 
-__all__ = ["ModeSelection", "verdict"]
+__all__ = ["ModeSelection", "record_header", "verdict"]
 
 
 @dataclass(frozen=True)
@@ -289,3 +290,22 @@ def unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[Quality
 
 def _finite_or_none(value) -> float | None:
     return float(value) if np.isfinite(value) else None
+
+
+def record_header(recording: Recording, preparation: Preparation | None, warnings) -> dict:
+    """The opening keys of every result's JSON: the rates, what the preparation did, the
+    warnings, and the channels.
+
+    Returns
+    -------
+    dict
+        ``fs`` (as recorded), ``analysis_fs``, ``preprocessing``, ``warnings``, ``input``, ``outputs``.
+    """
+    return {
+        "fs": recording.fs if preparation is None else preparation.original_fs,
+        "analysis_fs": recording.fs,
+        "preprocessing": None if preparation is None else preparation.to_dict(),
+        "warnings": [w.to_dict() for w in warnings],
+        "input": recording.input_name,
+        "outputs": list(recording.sensors),
+    }

@@ -10,8 +10,8 @@ import pytest
 
 import armaxmodal as am
 from armaxmodal.cli.main import main
+from armaxmodal.modes.clusters import check_picks
 from armaxmodal.modes.counted import _picked_result
-from armaxmodal.modes.picks import check_picks
 from armaxmodal.modes.settings import ClusterSettings, CountSettings, SelectionSettings
 from armaxmodal.modes.state import SelectionState
 

@@ -149,7 +149,7 @@ def test_the_frf_and_note_settings_reach_the_check_and_the_notes(diagram):
 
 
 def test_the_oversampling_note_follows_its_settings():
-    from armaxmodal.modes.header import oversampling_note
+    from armaxmodal.modes.notes import oversampling_note
 
     (note,) = oversampling_note(np.array([5.0, 12.0]), 1000.0)  # 12 Hz of a 500 Hz Nyquist: 2.4 %
     assert "band=(0, 30)" in note.message and note.value == pytest.approx(0.024)  # 2.5 x 12 Hz

@@ -570,7 +570,7 @@ def test_a_record_sampled_far_above_its_structure_says_so_and_its_advice_finds_t
     structure, so the rate is kept, and the sweep found one of the four modes with nothing
     said. Every mode found lies below 10 % of the Nyquist frequency: 'oversampled' names it
     and the band to use; with that band all four modes are found, within 1.5 %."""
-    from armaxmodal.modes.header import oversampling_note
+    from armaxmodal.modes.notes import oversampling_note
 
     system = am.supine_human()
     ride = am.random_vibration(1000.0, 15.0, (0.5, 400.0), seed=1)
