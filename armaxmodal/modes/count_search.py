@@ -43,8 +43,7 @@ __all__ = ["count_modes"]
 
 
 class _Search:
-    """The fits of one search: every candidate from the current model's poles, screened with a
-    few steps (``settings.screen_nfev``) and the best of each kind taken to convergence."""
+    """One search's fits: each candidate screened (``screen_nfev``), the best of a kind converged."""
 
     def __init__(self, data: DftLines, hold: str, n_effective: float, max_nfev: int, n_jobs: int | None = 1,
                  settings: CountSettings = COUNT, lines: LineSettings = DEFAULTS.lines,
@@ -160,18 +159,17 @@ def _split_start(model: ModalModel, m: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _margins(search: _Search, here: float, current: ModalModel, removed, best_removal, best_addition):
-    """``(rise, gain, new_hz)``: each removal's rise of the criterion (the screened one, or the
-    best one's converged: screening stops short, so a screened rise is at least the converged
-    one), the best addition's fall, and where its new pole settled (the one farthest from the
-    current modes)."""
+    """``(rise, gain, new_hz)``: each removal's rise of the criterion (screened, or the best one's
+    converged: a screened rise is at least the converged one), the best addition's fall, and where
+    its new pole settled (the one farthest from the current modes)."""
     rise = np.array([search.bic(t[2]) - here for t in removed])
     if best_removal is not None:
         at = int(np.argmin(rise))
         rise[at] = min(rise[at], search.bic(best_removal[2]) - here)
     gain, new_hz = -np.inf, np.nan
     if best_addition is not None and best_addition[2] is not None:
-        gain = here - search.bic(best_addition[2])
         model = best_addition[2]
+        gain = here - search.bic(model)
         dist = [np.min(np.abs(current.freq_hz / f - 1)) if current.n_modes else 1.0 for f in model.freq_hz]
         new_hz = float(model.freq_hz[int(np.argmax(dist))])
     return rise, gain, new_hz
