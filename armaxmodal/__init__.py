@@ -21,7 +21,15 @@ import importlib
 
 from armaxmodal._version import __version__
 from armaxmodal.estimate import ArmaxFit, choose_orders, fit_armax
-from armaxmodal.exceptions import ArmaxModalError, ConvergenceWarning, DataError, OrderError, PickError, StructureError
+from armaxmodal.exceptions import (
+    ArmaxModalError,
+    ConvergenceWarning,
+    DataError,
+    OrderError,
+    PickError,
+    SettingsError,
+    StructureError,
+)
 from armaxmodal.io import read_recording, read_xsens, write_recording_csv, write_recording_uff
 from armaxmodal.modes import (
     Identification,
@@ -78,6 +86,7 @@ __all__ = [
     "StabilisationDiagram",
     "Structure",
     "PickError",
+    "SettingsError",
     "StructureError",
     "__version__",
     "add_noise",

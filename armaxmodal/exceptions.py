@@ -12,6 +12,7 @@ __all__ = [
     "OrderError",
     "StructureError",
     "PickError",
+    "SettingsError",
     "ConvergenceWarning",
 ]
 
@@ -35,6 +36,11 @@ class StructureError(ArmaxModalError, ValueError):
 class PickError(ArmaxModalError, ValueError):
     """A mode picked by hand is not one the stabilisation diagram offers (outside the band, no
     stable cluster near it, two picks on one cluster)."""
+
+
+class SettingsError(ArmaxModalError, ValueError):
+    """A threshold of the mode selection's settings is outside what it can be (not a positive
+    number, a probability above 1, bounds the wrong way round)."""
 
 
 class ConvergenceWarning(UserWarning):

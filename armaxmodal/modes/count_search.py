@@ -1,18 +1,15 @@
 """The search of the count: nested tests of free refits of the maximum-likelihood modal model.
 
-From a starting set (the diagram's selection), every step compares the current model with its
-neighbours, each refitted with every pole free from where the current poles stand
-(:func:`armaxmodal.modes.modal_model.fit_modal_model`):
+From the diagram's selection, every step compares the current model with its neighbours, each
+refitted with every pole free (:func:`armaxmodal.modes.modal_model.fit_modal_model`):
 
-* **remove** each mode (the others free to take over its part: a merge of two close modes
-  is the removal of one of them);
+* **remove** each mode (the others free to take over: a merge of two close modes is a removal);
 * **add** a left-out stable cluster of the diagram, or a pole where the residual is largest;
 * **split** a mode in two, about its half-power band apart.
 
-The neighbour of lowest criterion (:mod:`armaxmodal.modes.mode_count`) replaces the current
-model while it lowers it. Then the chosen model is converged, carried-away starts judged, the
-equally good models fitted and the refused additions the likelihood wants flagged, all on one
-``_Search`` state.
+The neighbour of lowest criterion (:mod:`armaxmodal.modes.mode_count`) replaces the current model
+while it lowers it. Then the chosen model is converged, carried-away starts judged, the equally
+good models fitted and the refused additions the likelihood wants flagged, on one ``_Search``.
 """
 
 from __future__ import annotations
@@ -22,6 +19,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.special import chdtrc
 
+from armaxmodal._threads import single_blas_thread
 from armaxmodal.modes.modal_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.mode_count import (
     COUNT,
@@ -35,6 +33,7 @@ from armaxmodal.modes.mode_count import (
     new_poles,
     reported,
     residual_peak,
+    split_start,
 )
 from armaxmodal.modes.settings import DEFAULTS, CountSettings, DftSettings, LineSettings
 from armaxmodal.stats import MAX_DAMPING, Z95
@@ -145,17 +144,9 @@ class _Search:
                 continue
             trials.append(("add", float(f), np.r_[current.freq_hz, f], np.r_[current.damping, x]))
         for m in [nearest_pole(current.freq_hz, peak_hz)] if current.n_modes else []:
-            trials.append(("split", float(current.freq_hz[m]), *_split_start(current, m)))
+            trials.append(("split", float(current.freq_hz[m]), *split_start(current, m)))
         fits = self.screened([(f, x) for _, _, f, x in trials])
         return [(action, f, fit) for (action, f, _, _), fit in zip(trials, fits, strict=True)]
-
-
-def _split_start(model: ModalModel, m: int) -> tuple[np.ndarray, np.ndarray]:
-    """``model``'s poles with mode ``m`` split in two, a half-power bandwidth apart: (Hz, ratio)."""
-    f, x = model.freq_hz[m], model.damping[m]
-    half = max(x, 0.01) / 2
-    return (np.r_[np.delete(model.freq_hz, m), f * (1 - half), f * (1 + half)],
-            np.r_[np.delete(model.damping, m), x / 2, x / 2])  # fmt: skip
 
 
 def _margins(search: _Search, here: float, current: ModalModel, removed, best_removal, best_addition):
@@ -267,7 +258,7 @@ def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) 
     shown = np.flatnonzero(search.physical(current))
     if len(halves) != 2 or shown.size == 0:
         return (), None
-    screened = [fit for fit in search.screened([_split_start(current, m) for m in shown]) if fit is not None]
+    screened = [fit for fit in search.screened([split_start(current, m) for m in shown]) if fit is not None]
     if not screened:
         return (), None
     best = min(screened, key=search.bic)
@@ -281,6 +272,7 @@ def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) 
     return _likelihood_wants(search, current, model, f, gain, halves, in_diagram), model
 
 
+@single_blas_thread
 def count_modes(
     data: DftLines,
     freq_hz,
@@ -334,6 +326,14 @@ def count_modes(
     -------
     ModeCount
     """
+    return _count_modes(data, freq_hz, damping, candidates, hold=hold, max_nfev=max_nfev, halves=halves,
+                        supported=supported, search=search, n_jobs=n_jobs, settings=settings, lines=lines, dft=dft)
+
+
+def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max_nfev: int, halves: tuple,
+                 supported: Callable[[float, float], bool] | None, search: bool, n_jobs: int | None,
+                 settings: CountSettings, lines: LineSettings, dft: DftSettings) -> ModeCount:  # fmt: skip
+    """:func:`count_modes` itself, under the caller's BLAS threads (the public function holds one)."""
     start_model = fit_modal_model(data, freq_hz, damping, hold, max_nfev, dft)
     # each sensor weighted by its noise level as the fitted start leaves it (the likelihood is
     # concentrated over those levels; the weights only steer the fits)

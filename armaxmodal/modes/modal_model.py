@@ -31,6 +31,7 @@ import numpy as np
 import scipy.linalg
 import scipy.optimize
 
+from armaxmodal._threads import single_blas_thread
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.refine import _poles, _sandwich_sd, _SeparableModel
 from armaxmodal.modes.settings import DEFAULTS, DftSettings
@@ -260,6 +261,7 @@ def _start_vector(data: DftLines, freq_hz, damping, settings: DftSettings):
     return np.clip(start, lo + 1e-9, hi - 1e-9), lo, hi
 
 
+@single_blas_thread
 def fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited", max_nfev: int = 40,
                     settings: DftSettings = DEFAULTS.dft) -> ModalModel:  # fmt: skip
     """Fit the modal model with every pole free, from a start.
@@ -282,6 +284,12 @@ def fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited",
     ModalModel
         The fit, its modes by frequency.
     """
+    return _fit_modal_model(data, freq_hz, damping, hold, max_nfev, settings)
+
+
+def _fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited", max_nfev: int = 40,
+                    settings: DftSettings = DEFAULTS.dft) -> ModalModel:  # fmt: skip
+    """:func:`fit_modal_model` itself, under the caller's BLAS threads (the public function holds one)."""
     start, lo, hi = _start_vector(data, freq_hz, damping, settings)
     model = _SeparableModel(data.s, data.z_inv, data.u, data.y, data.dt, hold)
     if 2 * data.s.size < 3 * (4 * start.size // 2 + 2):

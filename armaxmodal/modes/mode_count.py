@@ -42,6 +42,7 @@ __all__ = [
     "effective_fraction",
     "matched_poles",
     "reported",
+    "split_start",
 ]
 
 #: the count's thresholds when none are given (:class:`~armaxmodal.modes.settings.CountSettings`)
@@ -293,3 +294,11 @@ def residual_peak(model: ModalModel, data: DftLines, width_lines: int = COUNT.pe
         hi += 1
     width = float(np.abs(data.s[hi]) - np.abs(data.s[lo])) / (2 * np.pi)
     return f, float(np.clip(width / (2 * f), 0.01, 0.5))
+
+
+def split_start(model: ModalModel, m: int) -> tuple[np.ndarray, np.ndarray]:
+    """``model``'s poles with mode ``m`` split in two, a half-power bandwidth apart: (Hz, ratio)."""
+    f, x = model.freq_hz[m], model.damping[m]
+    half = max(x, 0.01) / 2
+    return (np.r_[np.delete(model.freq_hz, m), f * (1 - half), f * (1 + half)],
+            np.r_[np.delete(model.damping, m), x / 2, x / 2])  # fmt: skip

@@ -24,6 +24,7 @@ import numpy as np
 import scipy.linalg
 import scipy.optimize
 
+from armaxmodal._threads import single_blas_thread
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.settings import DEFAULTS, DftSettings
 from armaxmodal.recording import Recording
@@ -218,6 +219,7 @@ def _sandwich_sd(blocks, n_par: int) -> np.ndarray:
     return np.sqrt(np.clip(np.diag(bread @ meat @ bread) * scale, 0, None))
 
 
+@single_blas_thread
 def refine_modes(
     recording: Recording,
     freq_hz,
@@ -249,6 +251,20 @@ def refine_modes(
     -------
     ModalRefinement
     """
+    return _refine_modes(recording, freq_hz, damping, band_hz=band_hz, hold=hold, max_nfev=max_nfev, settings=settings)
+
+
+def _refine_modes(
+    recording: Recording,
+    freq_hz,
+    damping,
+    *,
+    band_hz: tuple[float, float],
+    hold: str = "auto",
+    max_nfev: int = 60,
+    settings: DftSettings = DEFAULTS.dft,
+) -> ModalRefinement:
+    """:func:`refine_modes` itself, under the caller's BLAS threads (the public function holds one)."""
     if hold not in ("auto", *HOLDS):
         raise ValueError(f"hold: expected 'auto', 'bandlimited' or 'zoh', got {hold!r}.")
     f0, x0 = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)

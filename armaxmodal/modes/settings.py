@@ -12,7 +12,10 @@ two modes told apart by shape use the merge's MAC, and what a line is stands in
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field, fields
+import math
+from dataclasses import MISSING, asdict, dataclass, field, fields
+
+from armaxmodal.exceptions import SettingsError
 
 __all__ = [
     "ClusterSettings",
@@ -24,6 +27,31 @@ __all__ = [
     "NoteSettings",
     "SelectionSettings",
 ]
+
+
+#: the thresholds that are a probability, a share or a MAC: at most 1
+_AT_MOST_ONE = frozenset({"min_support", "merge_mac", "support_alpha", "likelihood_alpha", "spread_alpha",
+                          "estimators_alpha", "edge_fraction", "oversampled_fraction", "min_damping",
+                          "max_damping"})  # fmt: skip
+
+
+def _checked(settings) -> None:
+    """Refuse a value no threshold can take, naming it and its default: every threshold here is a
+    positive finite number (a whole one for counts), and a probability, share or MAC is at most 1."""
+    name = type(settings).__name__
+    for f in fields(settings):
+        value, default = getattr(settings, f.name), f.default if f.default is not MISSING else None
+        whole = isinstance(default, int) and not isinstance(default, bool)
+        if isinstance(value, bool) or not isinstance(value, int if whole else (int, float)):
+            kind = "whole number" if whole else "number"
+            raise SettingsError(f"{name}.{f.name}: expected a {kind}, got {value!r} (the default is {default!r}).")
+        if not (math.isfinite(value) and value > 0):
+            raise SettingsError(f"{name}.{f.name}: expected a positive number, got {value!r} (the default is "
+                                f"{default!r}).")  # fmt: skip
+        if f.name in _AT_MOST_ONE and value > 1:
+            raise SettingsError(f"{name}.{f.name}: a probability, share or MAC is at most 1, got {value!r} (the "
+                                f"default is {default!r}).")  # fmt: skip
+
 
 
 @dataclass(frozen=True)
@@ -58,6 +86,9 @@ class ClusterSettings:
         facts (orders, support, spread): the clustering's own reach."""
         return self.freq
 
+    def __post_init__(self):
+        _checked(self)
+
 
 @dataclass(frozen=True)
 class LineSettings:
@@ -80,6 +111,9 @@ class LineSettings:
     #: neighbouring lines (10 dB; a Welch average of seven segments exceeds it by chance with
     #: probability ~1e-9)
     input_ratio: float = 10.0
+
+    def __post_init__(self):
+        _checked(self)
 
 
 @dataclass(frozen=True)
@@ -130,6 +164,9 @@ class FrfSettings:
     #: its random error, over at least this many neighbouring lines
     band_min_lines: int = 3
 
+    def __post_init__(self):
+        _checked(self)
+
 
 @dataclass(frozen=True)
 class DftSettings:
@@ -149,6 +186,12 @@ class DftSettings:
     #: at once (2 MB a parameter at the limit); beyond, a sensor at a time
     all_rows_at_once: int = 250_000
 
+    def __post_init__(self):
+        _checked(self)
+        if self.min_damping >= self.max_damping:
+            raise SettingsError(f"DftSettings: min_damping ({self.min_damping!r}) must lie below max_damping "
+                                f"({self.max_damping!r}).")  # fmt: skip
+
 
 @dataclass(frozen=True)
 class NoteSettings:
@@ -159,6 +202,9 @@ class NoteSettings:
     oversampled_fraction: float = 0.1
     #: ... and the band suggested ends at this multiple of the highest mode found
     suggested_band_factor: float = 2.5
+
+    def __post_init__(self):
+        _checked(self)
 
 
 @dataclass(frozen=True)
@@ -204,6 +250,9 @@ class CountSettings:
     #: by the record (a difference 3 SD from zero is the usual resolution rule)
     separation_sd: float = 3.0
 
+    def __post_init__(self):
+        _checked(self)
+
 
 @dataclass(frozen=True)
 class IntervalSettings:
@@ -216,6 +265,9 @@ class IntervalSettings:
     match_freq: float = 0.05
     #: the level of the two estimators' test: the one the segments' test of model error uses
     estimators_alpha: float = 0.01
+
+    def __post_init__(self):
+        _checked(self)
 
 
 @dataclass(frozen=True)

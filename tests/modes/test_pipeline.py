@@ -10,7 +10,14 @@ import pytest
 
 import armaxmodal as am
 from armaxmodal.modes import pipeline
-from armaxmodal.modes.settings import ClusterSettings, CountSettings, FrfSettings, NoteSettings, SelectionSettings
+from armaxmodal.modes.settings import (
+    ClusterSettings,
+    CountSettings,
+    DftSettings,
+    FrfSettings,
+    NoteSettings,
+    SelectionSettings,
+)
 from armaxmodal.modes.state import SelectionContext, SelectionState
 from tests.cli.test_schemas import _validator
 
@@ -130,11 +137,11 @@ def test_the_stages_run_one_by_one_give_select_modes_result(diagram):
 def test_settings_reach_the_stages_and_come_back_on_the_result(diagram):
     default = am.select_modes(diagram, n_jobs=1, segments=0)
     assert default.settings == SelectionSettings()
-    # a cluster must hold poles of every order: none of the ride's does, so no mode is found
-    strict = SelectionSettings(cluster=ClusterSettings(min_support=1.01))
+    # a cluster must hold poles of 8 orders where the sweep has 7: no mode is found, and it says why
+    strict = SelectionSettings(cluster=ClusterSettings(min_orders=8))
     none = am.select_modes(diagram, n_jobs=1, segments=0, settings=strict)
     assert none.modes.empty and none.settings is strict
-    assert "a mode needs 8" in next(w.message for w in none.warnings if w.code == "no_modes")  # ceil(1.01 x 7)
+    assert "a mode needs 8" in next(w.message for w in none.warnings if w.code == "no_modes")
     with pytest.raises(TypeError, match="SelectionSettings"):
         am.select_modes(diagram, settings={"cluster": {"freq": 0.03}})
 
@@ -175,3 +182,24 @@ def test_the_json_carries_its_settings(diagram):
 def test_a_wrong_settings_part_is_refused():
     with pytest.raises(TypeError, match="settings.count: expected a CountSettings"):
         SelectionSettings(count=ClusterSettings())
+
+
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (lambda: CountSettings(decisive_bic=-1.0),
+         r"CountSettings.decisive_bic: expected a positive number, got -1.0 \(the default is 10.0\)"),
+        (lambda: ClusterSettings(min_support=1.2),
+         "ClusterSettings.min_support: a probability, share or MAC is at most 1"),
+        (lambda: CountSettings(max_steps=2.5), "CountSettings.max_steps: expected a whole number, got 2.5"),
+        (lambda: FrfSettings(model_error_limit=float("nan")),
+         "FrfSettings.model_error_limit: expected a positive number"),
+        (lambda: ClusterSettings(freq=True), "ClusterSettings.freq: expected a number, got True"),
+        (lambda: DftSettings(min_damping=0.5, max_damping=0.4), "min_damping .0.5. must lie below max_damping"),
+    ],
+)
+def test_a_threshold_no_setting_can_take_is_refused_by_name(make, message):
+    with pytest.raises(am.SettingsError, match=message):
+        make()
+    # at the limits, accepted
+    assert ClusterSettings(min_support=1.0).min_support == 1.0 and CountSettings(max_steps=1).max_steps == 1
