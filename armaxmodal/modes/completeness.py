@@ -76,7 +76,7 @@ def refit_with_added(diagram, work: SelectionState, band, settings: SelectionSet
     refit = selection_job(diagram.recording, [], work.modes, ("refit", refit_band(diagram.recording, band)),
                           settings.dft)  # fmt: skip
     if isinstance(refit, RefitFailure):
-        work = work.warned(*refit.notes("the modes with those the check added"))
+        work = work.warned(*refit.notes("the modes with those the check added", uncounted=False))
     else:  # the first refit's start lacked these modes: its refusals may not stand
         c = settings.cluster
         work = refined_modes(diagram, work, refit, c.freq, c.damping, c.merge_mac, relaxed=True)

@@ -69,14 +69,16 @@ class RefitFailure:
 
     reason: str
 
-    def notes(self, which: str = "the selected modes") -> list[QualityWarning]:
+    def notes(self, which: str = "the selected modes", uncounted: bool = True) -> list[QualityWarning]:
         """The note that says so (the ARMAX fit's values, or an earlier refit's, stand)."""
         return [
             QualityWarning(
                 "refit_failed",
                 (),
                 f"the frequency-domain refit of {which} could not be made ({self.reason.rstrip('.')}); "
-                "the values reported are the ARMAX fit's or an earlier refit's",
+                "the values reported are the ARMAX fit's or an earlier refit's"
+                + (", and the modes are not counted by the modal model, which is fitted under the inter-sample "
+                   "behaviour the refit chooses" if uncounted else ""),
             )
         ]
 

@@ -434,6 +434,8 @@ def test_a_refit_that_cannot_be_made_is_said_not_taken_for_refine_false(monkeypa
     plain = select_modes(diagram, refine=False, segments=0, n_jobs=1)
     notes = [w for w in failed.warnings if w.code == "refit_failed"]
     assert notes and "too few lines in the band" in notes[0].message
+    # the count needs the refit's hold: it did not run, and the note says the modes are not counted
+    assert failed.count is None and "not counted by the modal model" in notes[0].message
     assert not [w for w in plain.warnings if w.code == "refit_failed"]
     assert set(failed.modes.estimator) == {"armax"} and failed.refinement is None
     np.testing.assert_array_equal(failed.modes.freq_hz, plain.modes.freq_hz)
