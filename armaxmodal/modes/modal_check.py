@@ -88,7 +88,7 @@ class ModalCheck:
 
     @property
     def passed(self) -> bool:
-        """Every checked output's model error within :attr:`limit` and every mode
+        """Every checked output's model error within ``limit`` and every mode
         confirmed (False when no output has coherent lines: nothing shows that the modes
         explain the record)."""
         checked = np.isfinite(self.model_error)
@@ -97,7 +97,7 @@ class ModalCheck:
 
     @property
     def failing(self) -> tuple:
-        """The checked outputs whose model error exceeds :attr:`limit`."""
+        """The checked outputs whose model error exceeds ``limit``."""
         return tuple(s for s, e in zip(self.sensors, self.model_error, strict=True) if e > self.limit)
 
     @property

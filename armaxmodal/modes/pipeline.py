@@ -287,7 +287,7 @@ def select_modes(
     5. **check**, **confirm**, **spread**, **finish** -- the modal-model check, the intervals
        widened by the segments' spread and the other structures and estimators, and the verdict.
 
-    ``n_modes``, ``picks`` and ``refine=False`` run other named stage lists (:func:`stages_for`).
+    ``n_modes``, ``picks`` and ``refine=False`` run other named stage lists (``stages_for``).
 
     Parameters
     ----------
@@ -331,14 +331,16 @@ def select_modes(
 
     Examples
     --------
+    >>> import numpy as np
     >>> import armaxmodal as am
     >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 120.0, seed=1), 60.0, noise=0.03,
     ...                              seed=2)
     >>> selection = am.select_modes(am.stabilisation_diagram(ride, range(4, 13, 2)))
     >>> selection.quality
     'good'
-    >>> print(selection.modes.freq_hz.round(1).tolist())  # exact: 5.83, 8.31, 13.50, 16.25 Hz
-    [5.8, 8.3, 13.5, 16.2]
+    >>> exact = am.supine_human().modes().freq_hz  # 5.83, 8.31, 13.50, 16.25 Hz
+    >>> bool(np.allclose(selection.modes.freq_hz, exact, rtol=0.02))  # within 2 %, on any CPU
+    True
     """
     from tqdm import tqdm
 
