@@ -85,6 +85,21 @@ CODES: tuple[WarningCode, ...] = (
         "Nothing if the gaps are short against the modes' periods; the intervals are widened for the filled samples.",
     ),
     WarningCode(
+        "empty_columns_dropped", "preparation",
+        "unnamed columns at the end of a CSV's lines with no value in any row (`,,,,` after every line, as "
+        "spreadsheets export empty columns)",
+        "left out; an unnamed column that holds data is refused by its number",
+        "Nothing: informative.",
+    ),
+    WarningCode(
+        "time_rounded", "preparation",
+        "a CSV's time column whose steps are uneven only by its printed rounding (60 Hz with 4 decimals steps 0.0166 "
+        "and 0.0167 s): every stamp within a printed digit of a uniform grid",
+        "read at the rate of the column's whole span (60.000 Hz); jitter or a gap beyond the rounding is refused as "
+        "before",
+        "Nothing: informative. Print the time with more decimals to keep it exact.",
+    ),
+    WarningCode(
         "offset_removed", "preparation",
         "each channel's mean (default; `--detrend linear` for a line)",
         "removed",

@@ -15,9 +15,10 @@ from armaxmodal.io.time_axis import TO_SECONDS, bridge_dropped_rows, fs_from_tim
 
 
 # -- CSV ------------------------------------------------------------------------------
-def _check_csv_layout(path: Path) -> None:
+def _check_csv_layout(path: Path) -> int:
     """Name the usual export mistakes before pandas turns them into a tokenizer error: a
-    gzip file named .csv, another delimiter, metadata lines before the header."""
+    gzip file named .csv, another delimiter, metadata lines before the header. Returns how many
+    columns at the end of the header have no name (a spreadsheet's trailing commas)."""
     import gzip
     import zlib
 
@@ -37,11 +38,11 @@ def _check_csv_layout(path: Path) -> None:
     _check_byte_order_marks(path, text)
     lines = [ln for ln in text if ln.strip() and not ln.startswith("#")]
     if not lines:
-        return
+        return 0
     _check_separator(path, lines[:200])
     commas = [ln.count(",") for ln in lines[:200]]
     if max(commas) == 0:
-        return
+        return 0
     fields = max(set(commas), key=commas.count)
     leading = next((i for i, c in enumerate(commas) if c == fields), 0)
     if leading:
@@ -50,7 +51,7 @@ def _check_csv_layout(path: Path) -> None:
             f"{lines[0][:40]!r}): metadata lines. Put '#' before each (they are then read as comments) or "
             "delete them. Xsens DOT exports are read as they are when you pass one file per sensor."
         )
-    _check_duplicate_columns(path, lines[0])
+    return _check_duplicate_columns(path, lines[0])
 
 
 def _check_byte_order_marks(path: Path, lines: list[str]) -> None:
@@ -69,12 +70,16 @@ def _byte_order_mark_error(path: Path, where: str) -> DataError:
     )
 
 
-def _check_duplicate_columns(path: Path, header: str) -> None:
+def _check_duplicate_columns(path: Path, header: str) -> int:
     """Refuse two columns of one name, naming them: pandas would rename the second ``name.1``
-    in silence, and a channel renamed in silence is a wrong channel in the results."""
+    in silence, and a channel renamed in silence is a wrong channel in the results. The unnamed
+    columns at the header's end (``,,,,`` after every line, as spreadsheets write empty columns)
+    are not a name given twice: their number is returned, for the reader to drop them."""
     import csv
 
     names = [name.strip() for name in next(csv.reader([header]))]
+    trailing = len(names) - len("\0".join(names).rstrip("\0").split("\0")) if any(names) else 0
+    names = names[: len(names) - trailing]
     seen: dict[str, list[int]] = {}
     for k, name in enumerate(names):
         seen.setdefault(name, []).append(k + 1)
@@ -85,6 +90,33 @@ def _check_duplicate_columns(path: Path, header: str) -> None:
             f"{path.name}: the header names a column more than once: {listed}. A channel exported twice, or two "
             "sensors given one name: rename them apart, or delete the copy."
         )
+    return trailing
+
+
+def _drop_unnamed_trailing(frame: pd.DataFrame, trailing: int, path: Path) -> tuple[pd.DataFrame, list]:
+    """``frame`` without its ``trailing`` unnamed last columns, and a note, when every cell of
+    them is empty; an unnamed column that holds data is refused by its number (a channel without
+    a name cannot be used, and dropping it would lose it in silence)."""
+    from armaxmodal.quality_warnings import QualityWarning
+
+    if trailing == 0:
+        return frame, []
+    first = frame.shape[1] - trailing
+    for k in range(first, frame.shape[1]):
+        text = frame.iloc[:, k].astype(str).str.strip().str.lower()
+        held = ~text.isin(_MISSING)
+        if held.any():
+            row = int(np.argmax(held.to_numpy()))
+            raise DataError(
+                f"{path.name}: column {k + 1} has no name in the header but holds data (data row {row + 1}: "
+                f"{frame.iloc[row, k]!r}); give it a name, or delete the column."
+            )
+    note = QualityWarning(
+        "empty_columns_dropped", (),
+        f"{trailing} empty column(s) without a name at the end of every line (columns {first + 1}-{frame.shape[1]}, "
+        "a spreadsheet's trailing commas) left out", float(trailing),
+    )  # fmt: skip
+    return frame.iloc[:, :first], [note]
 
 
 def _check_separator(path: Path, lines: list[str]) -> None:
@@ -111,7 +143,7 @@ _MISSING = ("", "na", "n/a", "nan", "null", "none", "-")
 
 
 def read_csv_file(path: Path, fill_gaps_s: float | None = None):
-    _check_csv_layout(path)
+    trailing = _check_csv_layout(path)
     info = _csv_comments(path)
     try:
         # every cell a number, the common case, is parsed in C; anything else (text, empty or
@@ -119,10 +151,10 @@ def read_csv_file(path: Path, fill_gaps_s: float | None = None):
         # doubles either way: checked on the fixtures and a 20,000-row record)
         # pandas reads through a byte-order mark at the start itself
         options = {"comment": "#", "skipinitialspace": True, "keep_default_na": False}
-        frame = pd.read_csv(path, **options)
+        frame, dropped = _drop_unnamed_trailing(pd.read_csv(path, **options), trailing, path)
         numeric = all(dtype.kind in "iuf" for dtype in frame.dtypes)
         if not numeric:
-            frame = pd.read_csv(path, dtype=str, **options)
+            frame, dropped = _drop_unnamed_trailing(pd.read_csv(path, dtype=str, **options), trailing, path)
     except pd.errors.EmptyDataError as exc:
         raise DataError(f"{path.name}: the file is empty; expected a header row and data.") from exc
     except (pd.errors.ParserError, UnicodeDecodeError, OSError, EOFError) as exc:
@@ -145,9 +177,24 @@ def read_csv_file(path: Path, fill_gaps_s: float | None = None):
         if not np.all(np.isfinite(t)):
             raise DataError(f"{path.name}: the time column contains NaN or empty cells.")
         scale = TO_SECONDS.get(units.get(time_col, "").strip("()[] ").lower()) or time_scale(time_col)
-        t, channels, info["read_warnings"] = bridge_dropped_rows(t * scale, channels, path, fill_gaps_s)
-        file_fs = fs_from_time(t, path)
+        t, channels, bridged = bridge_dropped_rows(t * scale, channels, path, fill_gaps_s)
+        file_fs, rounded = fs_from_time(t, path, _printed_digit(t, scale))
+        dropped += bridged + rounded
+    if dropped:
+        info["read_warnings"] = dropped
     return channels, file_fs, info
+
+
+def _printed_digit(t: np.ndarray, scale: float) -> float | None:
+    """The last digit the time column was printed with, in seconds (``t`` in seconds, ``scale``
+    seconds per unit of the column): the largest power of ten of the column's unit of which every
+    stamp is a whole number; None below 1e-9 (a column printed in full, or not in decimals)."""
+    raw = t / scale
+    for decimals in range(10):
+        scaled = raw * 10.0**decimals
+        if np.all(np.abs(scaled - np.rint(scaled)) <= 1e-9 * np.maximum(1.0, np.abs(scaled))):
+            return scale * 10.0**-decimals
+    return None
 
 
 def _units_row(frame: pd.DataFrame) -> dict[str, str]:

@@ -41,7 +41,7 @@ def read_mat_file(path: Path):
     time_key = next((k for k in numeric if time_scale(k) is not None), None)
     if time_key is not None:
         t = numeric.pop(time_key).ravel().astype(float) * time_scale(time_key)
-        t_fs = fs_from_time(t, path)
+        t_fs, _ = fs_from_time(t, path)
         file_fs = file_fs if file_fs is not None else t_fs
     sensor_names = None
     if "sensors" in arrays and arrays["sensors"].dtype.kind in "OU":

@@ -119,7 +119,27 @@ def bridge_dropped_rows(t: np.ndarray, channels: dict, path: Path, fill_gaps_s: 
     return grid, {name: np.interp(grid, t, x) for name, x in channels.items()}, notes
 
 
-def fs_from_time(t: np.ndarray, path: Path) -> float:
+def fs_from_time(t: np.ndarray, path: Path, printed_digit: float | None = None) -> tuple[float, list]:
+    """The sampling rate of a time column ``t`` (s), from its whole span.
+
+    Parameters
+    ----------
+    t : (n,) ndarray
+        Time stamps, s.
+    path : Path
+        The file, for the messages.
+    printed_digit : float, optional
+        The last digit the column was printed with, s (1e-4 for ``0.0167``). A column whose steps
+        are uneven only by that rounding (``0.0166`` and ``0.0167`` at 60 Hz) is read at the rate
+        of its span (:func:`rounded_to_print`).
+
+    Returns
+    -------
+    fs : float
+        Hz.
+    notes : list of QualityWarning
+        A ``time_rounded`` note where the rounding made the steps uneven.
+    """
     if t.size < 2:
         raise DataError(f"{path.name}: the time column needs at least two samples.")
     if not np.all(np.isfinite(t)):
@@ -137,7 +157,10 @@ def fs_from_time(t: np.ndarray, path: Path) -> float:
             "Sort the rows, drop the repeats, or cut the record there."
         )
     worst = int(np.argmax(np.abs(steps - dt)))
+    notes = []
     if abs(steps[worst] - dt) > TIME_JITTER * dt:
+        notes = rounded_to_print(t, printed_digit)
+    if abs(steps[worst] - dt) > TIME_JITTER * dt and not notes:
         raise DataError(
             f"{path.name}: the time column is not uniformly spaced: from data row {worst + 1} to {worst + 2} it "
             f"steps {steps[worst]:.6g} s against a median of {dt:.6g} s (a dropped or "
@@ -151,7 +174,36 @@ def fs_from_time(t: np.ndarray, path: Path) -> float:
         )
     # The mean step over the whole record is far less sensitive to printed rounding; ten
     # significant digits is more than any printed time column carries.
-    return float(f"{(t.size - 1) / float(t[-1] - t[0]):.10g}")
+    return float(f"{(t.size - 1) / float(t[-1] - t[0]):.10g}"), notes
+
+
+def rounded_to_print(t: np.ndarray, printed_digit: float | None) -> list:
+    """A ``time_rounded`` note when every stamp of ``t`` (s) lies within half a printed digit of a
+    uniform grid at the rate of the column's whole span; else ``[]`` (the steps are uneven beyond
+    the rounding: jitter, a gap).
+
+    The grid's step is the span over the steps, its offset the one that centres the stamps' own
+    deviations. The first and last stamps are rounded too, which tilts the grid by up to one digit
+    over the record, so the stamps may stand up to one digit from it, never more: a 60 Hz logger
+    printing 4 decimals (steps 0.0166 and 0.0167 s) lies within 0.0001 s of its grid, while one
+    dropped row stands 0.0167 s off."""
+    from armaxmodal.quality_warnings import QualityWarning
+
+    if printed_digit is None:
+        return []
+    dt = float(t[-1] - t[0]) / (t.size - 1)
+    off = t - t[0] - dt * np.arange(t.size)
+    off -= (off.max() + off.min()) / 2
+    worst = float(np.abs(off).max())
+    if worst > printed_digit * (1 + 1e-6):
+        return []
+    steps = np.diff(t)
+    return [QualityWarning(
+        "time_rounded", (),
+        f"the time column is printed to {printed_digit:.0e} s, so its steps are uneven ({steps.min():.6g} to "
+        f"{steps.max():.6g} s); every stamp lies within {worst:.2g} s of a uniform grid: read at the rate of its whole "
+        f"span, {1 / dt:.4f} Hz", float(worst),
+    )]  # fmt: skip
 
 
 def fill_missing_samples(channels: dict, max_samples: int, source: str) -> tuple[dict, list]:

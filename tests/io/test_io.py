@@ -432,3 +432,57 @@ def test_fill_gaps_bridges_more_dropped_rows_than_the_default(tmp_path):
     assert rec.n_samples == 40 and [w.code for w in rec.meta["read_warnings"]] == ["dropped_packet"]
     with pytest.raises(DataError, match="fill_gaps: expected the longest gap"):
         am.read_recording(path, fill_gaps=-1.0)
+
+
+def test_a_spreadsheets_empty_trailing_columns_are_left_out_with_a_note(tmp_path, fixtures_dir):
+    """``,,,,`` after every line (a spreadsheet's empty columns): the file reads as without them,
+    with an ``empty_columns_dropped`` note; an unnamed column that holds a value is refused by
+    its number, and a name given twice is still refused by name."""
+    src = fixtures_dir / "supine_random.csv"
+    lines = src.read_text().splitlines()
+    padded = [ln if ln.startswith("#") else ln + ",,,," for ln in lines]
+    path = tmp_path / "padded.csv"
+    path.write_text("\n".join(padded) + "\n")
+    rec, plain = am.read_recording(path), am.read_recording(src)
+    assert rec.sensors == plain.sensors and rec.fs == plain.fs
+    np.testing.assert_array_equal(rec.response, plain.response)
+    np.testing.assert_array_equal(rec.base, plain.base)
+    (note,) = rec.meta["read_warnings"]
+    assert note.code == "empty_columns_dropped" and note.value == 4.0 and "columns 7-10" in note.message
+    k = next(i for i, ln in enumerate(padded) if not ln.startswith("#")) + 30
+    padded[k] = padded[k][:-2] + "7,"
+    path.write_text("\n".join(padded) + "\n")
+    with pytest.raises(DataError, match="column 8 has no name in the header but holds data \\(data row 30: .7.\\)"):
+        am.read_recording(path)
+    header = next(i for i, ln in enumerate(lines) if not ln.startswith("#"))
+    twice = [*lines[:header], lines[header].replace("legs", "head"), *lines[header + 1 :]]
+    path.write_text("\n".join(ln if ln.startswith("#") else ln + ",," for ln in twice) + "\n")
+    with pytest.raises(DataError, match="more than once: 'head' \\(columns 3, 6\\)"):
+        am.read_recording(path)
+
+
+@pytest.mark.parametrize("decimals", [4, 3])
+def test_a_time_column_rounded_to_its_printed_decimals_is_read_at_its_spans_rate(tmp_path, fixtures_dir, decimals):
+    """60 Hz written with 4 (3) decimals steps 0.0166 and 0.0167 s (0.016 and 0.017): not a gap.
+    Read at the rate of the whole span, with a ``time_rounded`` note; real jitter of a millisecond,
+    printed the same way, is still refused, and a dropped row still bridged and named."""
+    frame = pd.read_csv(fixtures_dir / "supine_random.csv", comment="#")
+    full = am.read_recording(fixtures_dir / "supine_random.csv")
+    rounded = frame.assign(time=frame.time.round(decimals))
+    path = tmp_path / "rounded.csv"
+    rounded.to_csv(path, index=False)
+    rec = am.read_recording(path)
+    span = rounded.time.iloc[-1] - rounded.time.iloc[0]
+    assert rec.fs == pytest.approx((len(frame) - 1) / span, rel=1e-9)
+    assert rec.fs == pytest.approx(60.0, abs=10.0 ** -decimals * 60**2 / span)  # the span's rounding, no more
+    np.testing.assert_array_equal(rec.response, full.response)
+    (note,) = rec.meta["read_warnings"]
+    assert note.code == "time_rounded" and f"printed to 1e-0{decimals} s" in note.message
+    assert note.value <= 10.0**-decimals
+    jitter = np.random.default_rng(0).uniform(-1e-3, 1e-3, len(frame))
+    frame.assign(time=(frame.time + jitter).round(decimals)).to_csv(path, index=False)
+    with pytest.raises(DataError, match="not uniformly spaced"):
+        am.read_recording(path)
+    rounded.drop(index=[3000]).to_csv(path, index=False)
+    codes = [w.code for w in am.read_recording(path).meta["read_warnings"]]
+    assert "dropped_packet" in codes
