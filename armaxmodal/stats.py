@@ -5,6 +5,7 @@
 * The coherence levels, each named by what it admits: ``H1_COHERENCE``,
   ``QUASI_STATIC_COHERENCE``, ``MISFIT_COHERENCE``, ``SECOND_INPUT_COHERENCE``.
 * ``MAX_DAMPING`` -- the damping above which a pole is no vibration mode here.
+* ``damping_interval`` -- a damping ratio's 95 % interval, taken on its logarithm.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ __all__ = [
     "QUASI_STATIC_COHERENCE",
     "SECOND_INPUT_COHERENCE",
     "Z95",
+    "damping_interval",
     "welch_nperseg",
 ]
 
@@ -43,6 +45,37 @@ SECOND_INPUT_COHERENCE = 0.5
 #: heavier damping is no vibration mode here: heavily damped biomechanical modes reach 0.4-0.5,
 #: anti-alias filter poles lie above
 MAX_DAMPING = 0.6
+
+
+def damping_interval(damping, half_width):
+    """A damping ratio's interval ``damping * exp(-+ half_width / damping)``, taken on ``log(damping)``.
+
+    A damping ratio is positive, and its estimate's distribution is skewed when its deviation is
+    not small against it: a symmetric interval ``damping +- half_width`` then reaches below zero
+    (a lightly damped mode's [-0.063, 0.083]), which no damping ratio can take. On the logarithm,
+    with the delta method's deviation ``half_width / damping``, the interval stays positive and
+    agrees with the symmetric one to first order where the deviation is small. Where the
+    symmetric interval would reach zero (``half_width >= damping``), this one spans more than a
+    factor e either side: the record does not resolve the damping. The upper end stops at 1
+    (critical damping): above it the pole pair is two real poles, not a mode.
+
+    Parameters
+    ----------
+    damping : float or array_like
+        Damping ratios (positive; others give NaN).
+    half_width : float or array_like
+        Half-widths of their symmetric intervals (``Z95 * sd`` for a 95 % interval), same shape
+        or broadcastable.
+
+    Returns
+    -------
+    (lo, hi) : float or ndarray
+        The interval's ends; NaN where ``damping`` is not positive or ``half_width`` not finite.
+    """
+    damping, half_width = np.asarray(damping, float), np.asarray(half_width, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        spread = np.exp(half_width / np.where(damping > 0, damping, np.nan))
+    return damping / spread, np.minimum(damping * spread, 1.0)
 
 
 def welch_nperseg(n_samples: int, fs: float, seconds: float = 10.0, max_fraction: int = 8) -> int:

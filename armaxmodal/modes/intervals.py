@@ -17,7 +17,10 @@ Each quantity ``q`` (``freq`` for ``freq_hz``, ``damping``) of a selection row h
     one (:mod:`armaxmodal.modes.spread`); NaN where it does not.
 
 The interval is the hull of ``value ± Z95 sd`` and the other three, scaled about the value by the
-share of the record's samples that carry information (filled samples do not). Each stage sets its
+share of the record's samples that carry information (filled samples do not). A damping ratio's
+parts are taken on its logarithm (``interval``; :func:`armaxmodal.stats.damping_interval`), so no
+damping interval reaches zero: one that spans a factor e^2 (where the symmetric interval of the
+same deviation reaches zero) or reaches critical damping is the record's ``damping_unresolved``. Each stage sets its
 own part and leaves the others', so no stage has to undo or re-derive another's widening.
 
 **Two estimators that disagree** (``covering_both_estimators``): the intervals cover both.
@@ -55,10 +58,10 @@ import scipy.stats
 
 from armaxmodal.modes.settings import DEFAULTS
 from armaxmodal.quality_warnings import QualityWarning
-from armaxmodal.stats import Z95
+from armaxmodal.stats import Z95, damping_interval
 
-__all__ = ["EARLIER_COLUMNS", "QUANTITIES", "covering_both_estimators", "earlier_estimate", "interval_columns",
-           "not_separated", "with_intervals"]
+__all__ = ["EARLIER_COLUMNS", "QUANTITIES", "covering_both_estimators", "earlier_estimate", "interval",
+           "interval_columns", "not_separated", "with_intervals"]
 
 #: ``(part prefix, value column)`` of each quantity that has an interval
 QUANTITIES = (("freq", "freq_hz"), ("damping", "damping"))
@@ -90,19 +93,30 @@ def with_intervals(modes: pd.DataFrame, scale: float = 1.0) -> pd.DataFrame:
     out = modes.copy()
     for q, value in QUANTITIES:
         v = out[value].to_numpy(float)
-        sd = out[f"{q}_sd"].to_numpy(float)
-        lo, hi = v - Z95 * sd, v + Z95 * sd
+        lo, hi = interval(q, v, Z95 * out[f"{q}_sd"].to_numpy(float))
         for reach in ("other", "estimator"):
             reach_lo, reach_hi = _part(out, f"{q}_{reach}_lo"), _part(out, f"{q}_{reach}_hi")
             lo = np.where(np.isnan(reach_lo), lo, np.minimum(lo, reach_lo))
             hi = np.where(np.isnan(reach_hi), hi, np.maximum(hi, reach_hi))
-        half = _part(out, f"{q}_segment_half")
-        lo = np.where(np.isnan(half), lo, np.fmin(v - half, lo))
-        hi = np.where(np.isnan(half), hi, np.fmax(v + half, hi))
-        if scale != 1.0:
+        seg_lo, seg_hi = interval(q, v, _part(out, f"{q}_segment_half"))
+        lo = np.where(np.isnan(seg_lo), lo, np.fmin(seg_lo, lo))
+        hi = np.where(np.isnan(seg_hi), hi, np.fmax(seg_hi, hi))
+        if scale != 1.0 and q == "damping":  # widened on the logarithm, where the interval is taken
+            lo, hi = v * (lo / v) ** scale, np.minimum(v * (hi / v) ** scale, 1.0)
+        elif scale != 1.0:
             lo, hi = v - scale * (v - lo), v + scale * (hi - v)
         out[f"{q}_ci95_lo"], out[f"{q}_ci95_hi"] = lo, hi
     return out
+
+
+def interval(q: str, value, half_width):
+    """The interval ``(lo, hi)`` of quantity ``q`` about ``value`` with a symmetric ``half_width``:
+    symmetric for a frequency, on the logarithm for a damping ratio
+    (:func:`armaxmodal.stats.damping_interval`: it never reaches zero)."""
+    if q == "damping":
+        return damping_interval(value, half_width)
+    value, half_width = np.asarray(value, float), np.asarray(half_width, float)
+    return value - half_width, value + half_width
 
 
 def _part(modes: pd.DataFrame, column: str) -> np.ndarray:
@@ -184,10 +198,10 @@ def covering_both_estimators(rows: pd.DataFrame, alpha: float = DEFAULTS.interva
     widened = np.zeros(len(out), dtype=bool)
     for q, value in QUANTITIES:
         earlier, sd = out[f"{q}_earlier"].to_numpy(float), out[f"{q}_earlier_sd"].to_numpy(float)
-        lo, hi = earlier - Z95 * sd, earlier + Z95 * sd
+        lo, hi = interval(q, earlier, Z95 * sd)
         out[f"{q}_estimator_lo"], out[f"{q}_estimator_hi"] = lo, hi
-        v, own = out[value].to_numpy(float), Z95 * out[f"{q}_sd"].to_numpy(float)
-        widened |= np.isfinite(lo) & ((lo < v - own) | (hi > v + own))
+        own_lo, own_hi = interval(q, out[value].to_numpy(float), Z95 * out[f"{q}_sd"].to_numpy(float))
+        widened |= np.isfinite(lo) & ((lo < own_lo) | (hi > own_hi))
     out["estimator_widened"] = widened
     where = ", ".join(f"{f:.3f}" for f in out.freq_hz[widened])
     note = QualityWarning(

@@ -163,7 +163,8 @@ def add_picks(state: SelectionState, ctx: SelectionContext) -> SelectionState:
 
 def separate(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     """A ``modes_not_separated`` note for each neighbouring pair the record does not separate and
-    that the count did not report as one."""
+    that the count did not report as one: after ``spread``, so that the intervals judged are the
+    reported ones, every widening included."""
     return state.warned(*not_separated_notes(state.modes, ctx.settings.count.separation_sd))
 
 
@@ -232,13 +233,13 @@ def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
 
 # -- the stage lists -----------------------------------------------------------------------------
 #: the diagram's candidates, screened by the FRF and counted by the modal model
-AUTOMATIC: tuple[Stage, ...] = (candidates, merge, refit, screen_by_frf, count, separate, check, confirm, spread,
+AUTOMATIC: tuple[Stage, ...] = (candidates, merge, refit, screen_by_frf, count, check, confirm, spread, separate,
                                 finish)  # fmt: skip
 #: ``n_modes`` given: the best-supported candidates, refitted and checked; nothing dropped or added
-FIXED_COUNT: tuple[Stage, ...] = (candidates, merge, best_n, refit, check, spread, finish)
+FIXED_COUNT: tuple[Stage, ...] = (candidates, merge, best_n, refit, check, spread, separate, finish)
 #: ``picks`` given: the picked clusters reported from the model the automatic selection counted
-PICKED: tuple[Stage, ...] = (take_picks, candidates, merge, refit, screen_by_frf, count, add_picks, separate,
-                             check_unless_counted, confirm, spread, finish)  # fmt: skip
+PICKED: tuple[Stage, ...] = (take_picks, candidates, merge, refit, screen_by_frf, count, add_picks,
+                             check_unless_counted, confirm, spread, separate, finish)  # fmt: skip
 
 
 def stages_for(n_modes: int | None, picks, refine: bool) -> tuple[Stage, ...]:
@@ -284,8 +285,10 @@ def select_modes(
     4. **count** -- the maximum-likelihood modal model with every pole free decides the number of
        modes by nested tests (BIC on the effective lines; halves agree): it removes, adds or
        splits modes, and says where the record does not decide (``count_undecided``).
-    5. **check**, **confirm**, **spread**, **finish** -- the modal-model check, the intervals
-       widened by the segments' spread and the other structures and estimators, and the verdict.
+    5. **check**, **confirm**, **spread**, **separate**, **finish** -- the modal-model check, the
+       intervals widened by the segments' spread and the other structures and estimators, a
+       ``modes_not_separated`` note (and so ``uncertain``) for neighbours the reported intervals do
+       not separate, and the verdict.
 
     ``n_modes``, ``picks`` and ``refine=False`` run other named stage lists (``stages_for``).
 

@@ -265,12 +265,14 @@ def not_separated_notes(modes: pd.DataFrame, separation_sd: float) -> list[Quali
 
 
 def unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[QualityWarning]:
-    """A ``damping_unresolved`` note for every mode whose damping interval reaches zero or
-    whose damping estimate is not positive at some orders of the sweep, with the reason."""
+    """A ``damping_unresolved`` note for every mode whose damping interval spans a factor e^2 or
+    more, or reaches critical damping, or whose damping estimate is not positive at some orders of
+    the sweep, with the reason. Taken on the logarithm, a damping interval never reaches zero; a
+    factor e either side of the value is where the symmetric interval of the same deviation would."""
     notes = []
     for m in modes.itertuples(index=False):
         crossed = int(m.orders_damping_unresolved)
-        if crossed == 0 and m.damping_ci95_lo > 0:
+        if crossed == 0 and m.damping_ci95_hi < min(1.0, np.e**2 * m.damping_ci95_lo):
             continue
         facts = [f"damping {m.damping:.2g}, 95 % interval [{m.damping_ci95_lo:.2g}, {m.damping_ci95_hi:.2g}]"]
         if crossed:

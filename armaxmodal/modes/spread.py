@@ -86,18 +86,11 @@ def segment_spread(
     for orders, k in jobs:
         poles_by_orders[orders].append(fitted[(orders, k)])
     rows = []
-    for i, mode in enumerate(modes.itertuples(index=False)):
-        orders = tuple(orders_of(i))
-        f_seg, x_seg = [], []
-        for poles in poles_by_orders[orders]:
-            if poles is None or poles.empty:
-                continue
-            ok = poles[(poles.damping > 0) & (np.abs(poles.freq_hz / mode.freq_hz - 1) <= match_freq)]
-            if ok.empty:
-                continue
-            near = ok.iloc[int(np.argmin(np.abs(ok.freq_hz - mode.freq_hz)))]
-            f_seg.append(near.freq_hz)
-            x_seg.append(near.damping)
+    freqs = modes.freq_hz.to_numpy(float)
+    for i in range(len(modes)):
+        matched = [_matched_pole(poles, freqs, i, match_freq) for poles in poles_by_orders[tuple(orders_of(i))]]
+        f_seg = [pole[0] for pole in matched if pole is not None]
+        x_seg = [pole[1] for pole in matched if pole is not None]
         found = len(f_seg)
         rows.append(
             {
@@ -107,6 +100,36 @@ def segment_spread(
             }
         )
     return pd.DataFrame(rows)
+
+
+def _matched_pole(poles: pd.DataFrame | None, freqs: np.ndarray, i: int, match_freq: float):
+    """``(freq_hz, damping)`` of the segment's pole that is mode ``i``'s, or None.
+
+    A pole is mode ``i``'s when it is the nearest to mode ``i`` (within ``match_freq``) and mode
+    ``i`` is the selected mode nearest to it; and only where the segment resolves the
+    neighbourhood, that is where every other selected mode within ``match_freq`` finds its own
+    pole in the same fit. A segment fit that finds one pole for a close pair estimates the pair's
+    blend, not either mode, and its scatter is the pair's gap, not the record's model error (two
+    modes 3 % apart were each widened to cover the other)."""
+    if poles is None or poles.empty:
+        return None
+    poles = poles[poles.damping > 0]
+    found = {j: _mutual_nearest(poles, freqs, j, match_freq)
+             for j in np.flatnonzero(np.abs(freqs / freqs[i] - 1) <= match_freq)}  # fmt: skip
+    return None if any(pole is None for pole in found.values()) else found[i]
+
+
+def _mutual_nearest(poles: pd.DataFrame, freqs: np.ndarray, i: int, match_freq: float):
+    """The pole nearest mode ``i`` within ``match_freq`` whose nearest selected mode is ``i``, as
+    ``(freq_hz, damping)``; None where there is none."""
+    f = poles.freq_hz.to_numpy(float)
+    near = np.flatnonzero(np.abs(f / freqs[i] - 1) <= match_freq)
+    if near.size == 0:
+        return None
+    k = near[int(np.argmin(np.abs(np.log(f[near] / freqs[i]))))]
+    if int(np.argmin(np.abs(np.log(freqs / f[k])))) != i:
+        return None
+    return float(f[k]), float(poles.damping.iloc[k])
 
 
 def segment_jobs(orders: list, n_segments: int = N_SEGMENTS) -> list:

@@ -50,8 +50,9 @@ def test_where_they_disagree_every_interval_covers_the_earlier_one():
     # the earlier interval reaches lower than the own (f + 0.15 - 1.96 * 0.03): it sets the low end
     np.testing.assert_allclose(ci.freq_ci95_lo, out.freq_earlier - Z95 * 0.04, rtol=1e-12)
     np.testing.assert_allclose(ci.freq_ci95_hi, out.freq_hz + Z95 * 0.03, rtol=1e-12)
-    # the damping agrees, but its earlier interval is the wider: it is covered too
-    np.testing.assert_allclose(ci.damping_ci95_lo, 0.02 - Z95 * 0.002, rtol=1e-12)
+    # the damping agrees, but its earlier interval is the wider: it is covered too (on the logarithm)
+    np.testing.assert_allclose(ci.damping_ci95_lo, 0.02 * np.exp(-Z95 * 0.002 / 0.02), rtol=1e-12)
+    np.testing.assert_allclose(out.damping_estimator_hi, 0.02 * np.exp(Z95 * 0.002 / 0.02), rtol=1e-12)
     assert out.estimator_widened.all()
 
 

@@ -1,4 +1,6 @@
-"""A mode's 95 % interval from its parts (armaxmodal.modes.intervals): each part's hull, worked out by hand."""
+"""A mode's 95 % interval from its parts (armaxmodal.modes.intervals): each part's hull, worked out by hand.
+A damping ratio's parts are taken on its logarithm: 0.05 with deviation 0.004 gives
+0.05 exp(-+ 1.96 * 0.004 / 0.05)."""
 
 import numpy as np
 import pandas as pd
@@ -13,6 +15,11 @@ def _row(**parts) -> pd.DataFrame:
     return pd.DataFrame([{"freq_hz": 10.0, "damping": 0.05, "freq_sd": 0.1, "damping_sd": 0.004, **parts}])
 
 
+def _log(value: float, half: float) -> tuple[float, float]:
+    """A damping interval by hand: ``value * exp(-+ half / value)``."""
+    return value * np.exp(-half / value), value * np.exp(half / value)
+
+
 def _ci(out: pd.DataFrame, q: str) -> tuple[float, float]:
     return float(out[f"{q}_ci95_lo"].iloc[0]), float(out[f"{q}_ci95_hi"].iloc[0])
 
@@ -20,7 +27,19 @@ def _ci(out: pd.DataFrame, q: str) -> tuple[float, float]:
 def test_the_estimate_alone_gives_its_own_interval():
     out = with_intervals(_row())
     assert _ci(out, "freq") == pytest.approx((10 - Z95 * 0.1, 10 + Z95 * 0.1), rel=1e-12)
-    assert _ci(out, "damping") == pytest.approx((0.05 - Z95 * 0.004, 0.05 + Z95 * 0.004), rel=1e-12)
+    assert _ci(out, "damping") == pytest.approx(_log(0.05, Z95 * 0.004), rel=1e-12)
+
+
+def test_a_damping_interval_never_reaches_zero_and_stops_at_critical_damping():
+    """A deviation larger than the damping itself (the symmetric interval [-0.063, 0.083] of a
+    light mode): the interval stays positive, spans more than a factor e either side, and its
+    upper end stops at 1."""
+    out = with_intervals(_row(damping=0.01, damping_sd=0.0373))
+    lo, hi = _ci(out, "damping")
+    assert lo == pytest.approx(0.01 * np.exp(-Z95 * 3.73), rel=1e-12) and 0 < lo < 0.01 / np.e
+    assert hi == 1.0
+    small = with_intervals(_row(damping=0.02, damping_sd=1e-5))  # a small deviation: the symmetric interval
+    assert _ci(small, "damping") == pytest.approx((0.02 - Z95 * 1e-5, 0.02 + Z95 * 1e-5), rel=1e-6)
 
 
 def test_another_structure_widens_only_the_side_it_reaches():
@@ -28,13 +47,15 @@ def test_another_structure_widens_only_the_side_it_reaches():
     out = with_intervals(_row(freq_other_lo=9.5, freq_other_hi=10.1, damping_other_lo=np.nan,
                               damping_other_hi=0.07))  # fmt: skip
     assert _ci(out, "freq") == pytest.approx((9.5, 10 + Z95 * 0.1), rel=1e-12)
-    assert _ci(out, "damping") == pytest.approx((0.05 - Z95 * 0.004, 0.07), rel=1e-12)
+    assert _ci(out, "damping") == pytest.approx((_log(0.05, Z95 * 0.004)[0], 0.07), rel=1e-12)
 
 
 def test_the_segments_widen_where_their_spread_dominates():
     out = with_intervals(_row(freq_segment_half=0.5, damping_segment_half=np.nan))
     assert _ci(out, "freq") == pytest.approx((9.5, 10.5), rel=1e-12)
-    assert _ci(out, "damping") == pytest.approx((0.05 - Z95 * 0.004, 0.05 + Z95 * 0.004), rel=1e-12)
+    assert _ci(out, "damping") == pytest.approx(_log(0.05, Z95 * 0.004), rel=1e-12)
+    damped = with_intervals(_row(damping_segment_half=0.02))  # wider than the statistical 0.0078: on the logarithm
+    assert _ci(damped, "damping") == pytest.approx(_log(0.05, 0.02), rel=1e-12)
     narrow = with_intervals(_row(freq_segment_half=0.01))  # within the statistical interval: no change
     assert _ci(narrow, "freq") == pytest.approx((10 - Z95 * 0.1, 10 + Z95 * 0.1), rel=1e-12)
 
@@ -42,7 +63,7 @@ def test_the_segments_widen_where_their_spread_dominates():
 def test_the_hull_of_all_parts_then_the_scale_about_the_value():
     out = with_intervals(_row(freq_other_lo=9.0, freq_other_hi=10.2, freq_segment_half=0.6), scale=2.0)
     assert _ci(out, "freq") == pytest.approx((10 - 2 * 1.0, 10 + 2 * 0.6), rel=1e-12)
-    assert _ci(out, "damping") == pytest.approx((0.05 - 2 * Z95 * 0.004, 0.05 + 2 * Z95 * 0.004), rel=1e-12)
+    assert _ci(out, "damping") == pytest.approx(_log(0.05, 2 * Z95 * 0.004), rel=1e-12)  # the scale on the logarithm
 
 
 def test_no_deviation_no_interval_from_other_structures():
@@ -76,9 +97,10 @@ def test_a_selection_reports_its_parts_and_widens_for_filled_samples():
     a, b = whole.modes, widened.modes
     np.testing.assert_allclose(a.freq_hz, b.freq_hz, rtol=1e-9)  # the same fits, to rounding
     np.testing.assert_allclose(a.freq_sd, b.freq_sd, rtol=1e-6)
-    for q, value in (("freq", "freq_hz"), ("damping", "damping")):
-        for side in ("lo", "hi"):
-            col = f"{q}_ci95_{side}"
-            np.testing.assert_allclose(b[col] - b[value], k * (a[col] - a[value]), rtol=1e-6)
+    for side in ("lo", "hi"):
+        col = f"freq_ci95_{side}"
+        np.testing.assert_allclose(b[col] - b.freq_hz, k * (a[col] - a.freq_hz), rtol=1e-6)
+        col = f"damping_ci95_{side}"  # the damping's on its logarithm
+        np.testing.assert_allclose(np.log(b[col] / b.damping), k * np.log(a[col] / a.damping), rtol=1e-6)
     own = with_intervals(a.drop(columns=[c for c in a if "other" in c or "segment_half" in c]))
     assert np.all(a.freq_ci95_lo <= own.freq_ci95_lo) and np.all(a.freq_ci95_hi >= own.freq_ci95_hi)

@@ -21,7 +21,7 @@ from armaxmodal.modes.settings import (
 from armaxmodal.modes.state import SelectionContext, SelectionState
 from tests.cli.test_schemas import _validator
 
-AUTOMATIC = ["candidates", "merge", "refit", "screen_by_frf", "count", "separate", "check", "confirm", "spread",
+AUTOMATIC = ["candidates", "merge", "refit", "screen_by_frf", "count", "check", "confirm", "spread", "separate",
              "finish"]  # fmt: skip
 
 
@@ -46,14 +46,14 @@ def test_one_recording_visits_each_stage_once_in_order(diagram):
 
 def test_the_arguments_choose_a_named_stage_list(diagram):
     fixed, selection = _traced(diagram, n_modes=2, segments=0)
-    assert fixed == ["candidates", "merge", "best_n", "refit", "check", "spread", "finish"]
+    assert fixed == ["candidates", "merge", "best_n", "refit", "check", "spread", "separate", "finish"]
     assert len(selection.modes) == 2 and selection.count is None  # the count does not run on a fixed number
     plain, selection = _traced(diagram, refine=False, segments=0)
-    assert plain == ["candidates", "merge", "segment_fits", "screen_by_frf", "separate", "check", "spread", "finish"]
+    assert plain == ["candidates", "merge", "segment_fits", "screen_by_frf", "check", "spread", "separate", "finish"]
     assert selection.refinement is None and selection.count is None
     picked, selection = _traced(diagram, picks=[8.3], segments=0)
     assert picked == ["take_picks", "candidates", "merge", "refit", "screen_by_frf", "count", "add_picks",
-                      "separate", "check_unless_counted", "confirm", "spread", "finish"]  # fmt: skip
+                      "check_unless_counted", "confirm", "spread", "separate", "finish"]  # fmt: skip
     assert selection.picks == [8.3]
     with pytest.raises(am.PickError, match="do not mix"):
         pipeline.stages_for(2, [8.3], True)

@@ -139,7 +139,7 @@ def test_refit_is_reported_unless_it_left_the_mode():
     assert out.at[0, "damped_freq_hz"] == pytest.approx(5.1 * np.sqrt(1 - 0.12**2))
     assert (out.at[0, "freq_ci95_lo"], out.at[0, "freq_ci95_hi"]) == pytest.approx((5.1 - 0.0196, 5.1 + 0.0196))
     damping_ci = (out.at[0, "damping_ci95_lo"], out.at[0, "damping_ci95_hi"])
-    assert damping_ci == pytest.approx((0.12 - 0.00392, 0.12 + 0.00392))
+    assert damping_ci == pytest.approx((0.12 * np.exp(-0.00392 / 0.12), 0.12 * np.exp(0.00392 / 0.12)), rel=1e-6)
     assert out.at[1, "freq_hz"] == 9.0
     np.testing.assert_array_equal(out_shapes[:, 0], ref.shapes[:, 0])
     np.testing.assert_array_equal(out_shapes[:, 1], shapes[:, 1])
@@ -321,7 +321,11 @@ def _notes_modes(**overrides):
 def test_unresolved_damping_notes_state_the_facts_and_the_reason():
     from armaxmodal.modes.result import unresolved_damping_notes as _unresolved_damping_notes
 
-    assert _unresolved_damping_notes(_notes_modes(), 10) == []  # a resolved damping: no note
+    assert _unresolved_damping_notes(_notes_modes(), 10) == []  # a resolved damping (a factor 7): no note
+    # a factor e^2 (7.39), where a symmetric interval of the same deviation reaches zero, or critical damping
+    assert len(_unresolved_damping_notes(_notes_modes(damping_ci95_hi=0.0005 * 7.4), 10)) == 1
+    assert _unresolved_damping_notes(_notes_modes(damping_ci95_hi=0.0005 * 7.38), 10) == []
+    assert len(_unresolved_damping_notes(_notes_modes(damping=0.5, damping_ci95_lo=0.3, damping_ci95_hi=1.0), 10)) == 1
     (note,) = _unresolved_damping_notes(_notes_modes(damping_ci95_lo=0.0), 10)  # interval reaches zero
     assert note.code == "damping_unresolved" and note.value == 4.0 and note.channels == ()
     assert note.message == (
@@ -462,8 +466,9 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
 
 
 def test_filled_samples_widen_every_interval_by_the_information_they_lack():
-    """720 of 7,200 samples filled: the intervals widen by sqrt(7200 / 6480) about each value,
-    the other structures' part included (an asymmetric interval stays asymmetric)."""
+    """720 of 7,200 samples filled: the intervals widen by sqrt(7200 / 6480) about each value (a
+    damping ratio's on its logarithm), the other structures' part included (an asymmetric interval
+    stays asymmetric)."""
     from types import SimpleNamespace
 
     from armaxmodal.modes.result import filled_samples_scale as _filled_samples_scale
@@ -478,6 +483,6 @@ def test_filled_samples_widen_every_interval_by_the_information_they_lack():
     out = with_intervals(modes, k)
     np.testing.assert_allclose(out[["freq_ci95_lo", "freq_ci95_hi"]].to_numpy(), [[5 - 0.1 * k, 5 + 0.2 * k]])
     damping_ci = out[["damping_ci95_lo", "damping_ci95_hi"]].to_numpy()
-    np.testing.assert_allclose(damping_ci, [[0.1 - 0.01 * k, 0.1 + 0.01 * k]])
+    np.testing.assert_allclose(damping_ci, [[0.1 * np.exp(-0.1 * k), 0.1 * np.exp(0.1 * k)]])
     rec.meta = {}
     assert _filled_samples_scale(rec, None) == (1.0, [])

@@ -69,3 +69,29 @@ def test_widening_follows_the_chi_square_rule():
         half = (out.freq_ci95_hi.iloc[0] - out.freq_ci95_lo.iloc[0]) / 2
         want = max(t.ppf(0.975, 2) * s / np.sqrt(3), Z95 * sigma) if flagged else Z95 * sigma
         assert half == pytest.approx(want, rel=1e-9)
+
+
+def test_a_segment_that_blends_a_close_pair_measures_neither_mode():
+    """Two modes 3 % apart fitted at one order on three segments: the middle segment finds one
+    pole between them. It is neither mode's, so each mode's spread is the two other segments', not
+    the pair's gap; a pole nearer the other mode is never this one's."""
+    import pandas as pd
+
+    from armaxmodal.modes.spread import segment_spread
+
+    modes = pd.DataFrame({"freq_hz": [10.12, 10.41], "damping": [0.01, 0.01]})
+    orders = (4, 5, 4, 0)
+
+    def poles(*freqs):
+        return pd.DataFrame({"freq_hz": freqs, "damping": [0.01] * len(freqs)})
+
+    fitted = {(orders, 0): poles(10.11, 10.42), (orders, 1): poles(10.24), (orders, 2): poles(10.13, 10.40)}
+    table = segment_spread(None, modes, lambda i: orders, 3, fitted=fitted)
+    assert table.segments_found.tolist() == [2, 2]
+    assert table.freq_segment_sd.to_numpy() == pytest.approx([np.std([10.11, 10.13], ddof=1),
+                                                              np.std([10.42, 10.40], ddof=1)], rel=1e-9)  # fmt: skip
+    # one segment holds two poles, both nearer the first mode: the second's is not taken
+    crowded = {(orders, k): poles(10.10, 10.14, 10.40) for k in range(3)}
+    crowded[(orders, 1)] = poles(10.10, 10.20)
+    table = segment_spread(None, modes, lambda i: orders, 3, fitted=crowded)
+    assert table.segments_found.tolist() == [2, 2]
