@@ -24,6 +24,7 @@ from armaxmodal.modes.modal_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.mode_count import (
     COUNT,
     ModeCount,
+    ModelTable,
     Step,
     Wanted,
     agree_in_halves,
@@ -48,13 +49,14 @@ class _Search:
                  settings: CountSettings = COUNT, lines: LineSettings = DEFAULTS.lines,
                  dft: DftSettings = DEFAULTS.dft):  # fmt: skip
         self.data, self.hold, self.n_eff, self.max_nfev, self.n_jobs = data, hold, n_effective, max_nfev, n_jobs
-        self.cfg, self.lines, self.dft = settings, lines, dft
-        self.trials = 0
+        self.cfg, self.lines, self.dft, self.trials, self.table = settings, lines, dft, 0, ModelTable(n_effective)
+        self.logged = self.table.add
 
-    def screened(self, starts: list[tuple[np.ndarray, np.ndarray]]) -> list[ModalModel | None]:
+    def screened(self, starts: list[tuple[np.ndarray, np.ndarray]], labels: list[tuple[str, float]]
+                 ) -> list[ModalModel | None]:  # fmt: skip
         """Each start ``(freq_hz, damping)`` fitted for ``settings.screen_nfev`` steps, over the worker
-        threads: the fits are independent, and numpy releases the interpreter in their large
-        array work (the count's screening is most of its time on a long record)."""
+        threads (numpy releases the interpreter in their large array work); ``labels``: each
+        start's ``(action, Hz)`` for the table."""
         from armaxmodal.estimate.pool import parallel_map
 
         self.trials += sum(len(f) > 0 for f, _ in starts)
@@ -63,23 +65,27 @@ class _Search:
             f, x = start
             return fit_modal_model(self.data, f, x, self.hold, self.cfg.screen_nfev, self.dft) if len(f) else None
 
-        return parallel_map(one, starts, self.n_jobs, min_items=2)
+        fits = parallel_map(one, starts, self.n_jobs, min_items=2)
+        return [self.logged(action, f, fit) for (action, f), fit in zip(labels, fits, strict=True)]
 
-    def fit(self, freq_hz, damping, max_nfev: int | None = None, counted: bool = True) -> ModalModel | None:
-        """One fit to convergence (or ``max_nfev``); ``counted=False`` where the caller counts it."""
+    def fit(self, freq_hz, damping, max_nfev: int | None = None, counted: bool = True,
+            label: tuple[str, float] | None = ("converge", float("nan"))) -> ModalModel | None:  # fmt: skip
+        """One fit to convergence (or ``max_nfev``); ``counted=False`` where the caller counts it;
+        ``label``: its ``(action, Hz)`` in the table (None: the caller logs it, as fits run in
+        threads do, in their order)."""
         if len(freq_hz) == 0:
             return None
         self.trials += int(counted)
-        return fit_modal_model(self.data, freq_hz, damping, self.hold, max_nfev or self.max_nfev, self.dft)
+        model = fit_modal_model(self.data, freq_hz, damping, self.hold, max_nfev or self.max_nfev, self.dft)
+        return model if label is None else self.logged(*label, model)
 
     def bic(self, model: ModalModel | None) -> float:
         return np.inf if model is None else model.bic(self.n_eff)
 
     def best_of_each(self, removed: list, added: list, admissible) -> list:
-        """``[best removal, best addition]``: of each kind the trial of lowest criterion, iterated to
-        convergence from where its screening left it; an addition must pass ``admissible`` (a test
-        of a model) before and after. The two converge at once, over the worker threads. None
-        where a kind has no trial (or no admissible one)."""
+        """``[best removal, best addition]``: of each kind the trial of lowest criterion, converged
+        from where its screening left it (both at once, over the worker threads); an addition must
+        pass ``admissible`` before and after. None where a kind has no (admissible) trial."""
         from armaxmodal.estimate.pool import parallel_map
 
         chosen = []
@@ -88,8 +94,9 @@ class _Search:
             chosen.append(min(trials, key=lambda t: self.bic(t[2])) if trials else None)
         todo = [t for t in chosen if t is not None and t[2] is not None]
         self.trials += len(todo)
-        fits = parallel_map(lambda t: self.fit(t[2].freq_hz, t[2].damping, counted=False), todo, self.n_jobs,
-                            min_items=2)  # fmt: skip
+        fits = parallel_map(lambda t: self.fit(t[2].freq_hz, t[2].damping, counted=False, label=None), todo,
+                            self.n_jobs, min_items=2)  # fmt: skip
+        fits = [self.logged(t[0], t[1], fit) for t, fit in zip(todo, fits, strict=True)]
         converged = {id(t): (t[0], t[1], fit) for t, fit in zip(todo, fits, strict=True)}
         out = []
         for trial, test in zip(chosen, (None, admissible), strict=True):
@@ -98,9 +105,8 @@ class _Search:
         return out
 
     def resolved(self, model: ModalModel | None) -> bool:
-        """Every pole of ``model`` in the band is a mode with a damping the record resolves
-        (its 95 % interval above zero). A pole pushed to the damping floor is a line, or a
-        doublet standing for a frequency that moves during the record, not a mode."""
+        """Every pole of ``model`` in the band is a mode with a damping the record resolves (its
+        symmetric 95 % interval above zero): a pole at the damping floor is a line, not a mode."""
         if model is None:
             return False
         physical = self.physical(model)
@@ -120,24 +126,23 @@ class _Search:
         return band & (model.damping <= MAX_DAMPING)
 
     def in_both_halves(self, trial: ModalModel, new: list[int], halves) -> bool:
-        """The new poles of ``trial`` (indices ``new``) have the same frequency and damping in
-        each half of the record, the model fitted there from the whole record's values, within
-        ``settings.halves_sd`` standard deviations of the difference: a mode of the structure is the
-        same mode in both halves, while a pole that soaks up a change during the record or a
-        nonlinearity (a drifting frequency, a doublet beside a real mode) lands elsewhere."""
+        """The new poles of ``trial`` (indices ``new``) have the same frequency and damping in each
+        half of the record (fitted there from the whole record's values), within ``settings.halves_sd``
+        standard deviations of the difference: a pole soaking up a drift or a nonlinearity does not.
+        The answer goes into the trial's row of the table."""
         self.trials += 2
         agree = agree_in_halves(self.data, trial, halves, self.hold, self.max_nfev, self.cfg.halves_sd, self.dft)
-        return all(agree[i] for i in new)
+        return self.table.halves(trial, all(agree[i] for i in new))
 
     def removals(self, current: ModalModel) -> list[tuple[str, float, ModalModel | None]]:
         keep = [np.arange(current.n_modes) != m for m in range(current.n_modes)]
-        fits = self.screened([(current.freq_hz[k], current.damping[k]) for k in keep])
+        fits = self.screened([(current.freq_hz[k], current.damping[k]) for k in keep],
+                             [("remove", float(f)) for f in current.freq_hz])
         return [("remove", float(f), fit) for f, fit in zip(current.freq_hz, fits, strict=True)]
 
     def additions(self, current: ModalModel, candidates, peak_hz: float) -> list[tuple[str, float, ModalModel]]:
-        """Each candidate added, and the mode nearest the residual's peak (``peak_hz``) split:
-        a mode that hides two leaves its largest residual inside its own band. (Splitting every
-        mode cost twice the fits and found nothing more on the bodies' battery.)"""
+        """Each candidate added, and the mode nearest the residual's peak (``peak_hz``) split (one
+        that hides two leaves its largest residual in its band; splitting all found no more)."""
         trials = []
         for f, x in candidates:
             if current.n_modes and np.min(np.abs(current.freq_hz / f - 1)) <= self.cfg.same_mode_freq:
@@ -145,14 +150,13 @@ class _Search:
             trials.append(("add", float(f), np.r_[current.freq_hz, f], np.r_[current.damping, x]))
         for m in [nearest_pole(current.freq_hz, peak_hz)] if current.n_modes else []:
             trials.append(("split", float(current.freq_hz[m]), *split_start(current, m)))
-        fits = self.screened([(f, x) for _, _, f, x in trials])
+        fits = self.screened([(f, x) for _, _, f, x in trials], [(action, f) for action, f, _, _ in trials])
         return [(action, f, fit) for (action, f, _, _), fit in zip(trials, fits, strict=True)]
 
 
 def _margins(search: _Search, here: float, current: ModalModel, removed, best_removal, best_addition):
-    """``(rise, gain, new_hz)``: each removal's rise of the criterion (screened, or the best one's
-    converged: a screened rise is at least the converged one), the best addition's fall, and where
-    its new pole settled (the one farthest from the current modes)."""
+    """``(rise, gain, new_hz)``: each removal's rise of the criterion (the best one's converged), the
+    best addition's fall, and where its new pole settled (the one farthest from the current modes)."""
     rise = np.array([search.bic(t[2]) - here for t in removed])
     if best_removal is not None:
         at = int(np.argmin(rise))
@@ -168,20 +172,17 @@ def _margins(search: _Search, here: float, current: ModalModel, removed, best_re
 
 def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, halves=()):
     """The chosen model without the starting poles the search carried beyond ``settings.same_mode_freq``
-    of every start to where no mode is founded, refitted to convergence. A pole reported there is
-    a new pole and must show what a mode has: a damping the record resolves, and the same
-    frequency and damping in both halves of the record (``_Search.in_both_halves``; without
-    ``halves``, stability across the diagram's orders, ``supported``).
+    of every start to where no mode is founded, refitted. A pole reported there is a new pole and
+    must show what a mode has: a resolved damping, and the same values in both halves of the record
+    (``_Search.in_both_halves``; without ``halves``, stability across the diagram's orders).
 
-    Not the diagram's support where the halves can judge: the modal model moves a pole exactly
-    where the ARMAX fits are biased (a copy of the supine ride with the pelvis stuck for 53 samples
-    had its 13.50 Hz mode at 14.69 Hz in every order; the model takes it to 13.62 Hz, the same
-    in both halves). A bridge's heavily damped 5.83 Hz start ended at 4.40 Hz with damping 0.007,
-    which the halves do not share. Judged on the converged model only: on the way, a moved pole
-    may stand in for a mode not yet added (a body's 15.78 Hz start stood at 19.99 Hz until the
-    mode above the band was added, then came back). Such poles the model needs (the criterion rises
-    by ``settings.decisive_bic`` or more without them) stay in it, unreported. Returns ``(model, left
-    out: ((start Hz, Hz), ...), kept unreported: ((start Hz, Hz, rise), ...))``."""
+    Not the diagram's support where the halves can judge: the model moves a pole where the ARMAX
+    fits are biased (a supine ride with the pelvis stuck for 53 samples: 13.50 Hz at 14.69 Hz in
+    every order, 13.62 Hz in the model, alike in both halves). A bridge's 5.83 Hz start ended at
+    4.40 Hz, damping 0.007, which the halves do not share. Judged on the converged model only (on the
+    way a moved pole may stand in for a mode not yet added). Poles the model needs (the criterion
+    rises by ``settings.decisive_bic`` or more without them) stay in it, unreported. Returns
+    ``(model, left out: ((start Hz, Hz), ...), kept unreported: ((start Hz, Hz, rise), ...))``."""
     start_hz = np.atleast_1d(np.asarray(start_hz, float))
     shown = reported(model, search.data.band_hz, search.lines)
     moved = [(i, j) for i, j in matched_poles(start_hz, model.freq_hz)
@@ -198,7 +199,8 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     keep = np.setdiff1d(np.arange(model.n_modes), [i for i, _ in unfounded])
     if not unfounded or keep.size == 0:  # nothing else to stand on: the search's model stays
         return model, (), ()
-    without = search.fit(model.freq_hz[keep], model.damping[keep], search.cfg.final_nfev)
+    without = search.fit(model.freq_hz[keep], model.damping[keep], search.cfg.final_nfev,
+                         label=("leave out", unfounded[0][1][1]))
     rise = search.bic(without) - search.bic(model)
     if rise >= search.cfg.decisive_bic:  # the model needs them: they stay in it, unreported (a body's mode at
         # 23.93 Hz, near the band's top, came out at 24.74 Hz with its damping unresolved; without
@@ -208,16 +210,14 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
 
 
 def _equally_good(search: _Search, chosen: ModalModel, rise: np.ndarray, addition: ModalModel | None):
-    """The models with one mode fewer (each mode whose removal the criterion barely resists) or
-    one more (the best addition, when it barely loses), converged on the chosen model's weights
-    and kept when their criterion stays within ``settings.decisive_bic`` of the chosen one's:
-    ``[(difference, model), ...]``. Only an undecided count costs these fits."""
+    """The models with one mode fewer or one more (the best addition) converged and kept where their
+    criterion is within ``settings.decisive_bic`` of the chosen one's: ``[(difference, model), ...]``."""
     here, out, decisive = search.bic(chosen), [], search.cfg.decisive_bic
     starts = [(np.delete(chosen.freq_hz, m), np.delete(chosen.damping, m)) for m in np.flatnonzero(rise < decisive)]
     if addition is not None:
         starts.append((addition.freq_hz, addition.damping))
     for freq_hz, damping in starts:
-        model = search.fit(freq_hz, damping, search.cfg.final_nfev)
+        model = search.fit(freq_hz, damping, search.cfg.final_nfev, label=("alternative", float("nan")))
         if model is not None and abs(search.bic(model) - here) < decisive:
             out.append((float(search.bic(model) - here), model))
     return tuple(out)
@@ -247,22 +247,22 @@ def _likelihood_wants(search: _Search, current: ModalModel, model: ModalModel, n
 
 def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) -> tuple[tuple, ModalModel | None]:
     """A split the likelihood wants (:attr:`ModeCount.wanted`; ``()`` if none) and its converged
-    model (None if no split converged with its damping resolved): every reported mode split
-    in two, the split of lowest criterion converged and judged as :func:`_wanted` judges an
-    addition, with its damping resolved. The search splits only the mode nearest the residual's
-    peak, and a split is not asked to be stable across the diagram's orders: two modes closer than
-    the ARMAX fits resolve stand as one column there (a body's 14.28 and 15.40 Hz modes came out as
-    one at 15.45 Hz; split, the likelihood ratio was 187 for 22 parameters, the new pole the same in
-    both halves, while BIC rose by 40, and the merged pair had pulled the 26.05 Hz mode above to
-    24.77 Hz, damping 0.31 for 0.25, with quality good)."""
+    model (None if no split converged with its damping resolved): every reported mode split in two,
+    the best converged and judged as :func:`_wanted` judges an addition. The search splits only the
+    mode nearest the residual's peak, and a split need not be stable across the diagram's orders:
+    two modes closer than the ARMAX fits resolve stand as one column there (a body's 14.28 and
+    15.40 Hz came out as one at 15.45 Hz; split, likelihood ratio 187 for 22 parameters, alike in
+    both halves, BIC +40)."""
     shown = np.flatnonzero(search.physical(current))
     if len(halves) != 2 or shown.size == 0:
         return (), None
-    screened = [fit for fit in search.screened([split_start(current, m) for m in shown]) if fit is not None]
-    if not screened:
+    screened = search.screened([split_start(current, m) for m in shown],
+                               [("split", float(current.freq_hz[m])) for m in shown])  # fmt: skip
+    tried = [(m, fit) for m, fit in zip(shown, screened, strict=True) if fit is not None]
+    if not tried:
         return (), None
-    best = min(screened, key=search.bic)
-    model = search.fit(best.freq_hz, best.damping, search.cfg.final_nfev)
+    m, best = min(tried, key=lambda t: search.bic(t[1]))
+    model = search.fit(best.freq_hz, best.damping, search.cfg.final_nfev, label=("split", float(current.freq_hz[m])))
     new = new_poles(current.freq_hz, model.freq_hz) if model is not None else []
     if not search.resolved(model) or not new:
         return (), None
@@ -304,15 +304,14 @@ def count_modes(
     max_nfev : int
         Cap on residual evaluations per fit.
     halves : tuple of DftLines
-        The lines of the record's two halves: the new poles of an addition the whole record
-        accepts must be the same in each (``_Search.in_both_halves``). Empty: not asked.
+        The lines of the record's two halves: an accepted addition's new poles must be the same
+        in each (``_Search.in_both_halves``). Empty: not asked.
     supported : callable, optional
-        ``supported(freq_hz, damping)``: is a pole there stable across the model orders of the
-        diagram? An addition's new poles must be (a ghost that soaks up a nonlinearity beside a
-        real mode is no stable pole of any ARMAX order). None: not asked.
+        ``supported(freq_hz, damping)``: is a pole there stable across the diagram's orders? An
+        addition's new poles must be (a ghost soaking up a nonlinearity is not). None: not asked.
     search : bool
-        False: the starting set is the model (modes picked by hand); it is fitted and its margins
-        measured (each mode's removal, the best addition), but no step is taken and no mode left out.
+        False: the starting set is the model (picks); it is fitted and its margins measured, but
+        no step is taken and no mode left out.
     n_jobs : int, optional
         Worker threads for the screening fits (default: all cores).
     settings : CountSettings
@@ -342,6 +341,7 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max
     fraction = effective_fraction(start_model.residual)
     searching, search = search, _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev, n_jobs,
                                         settings, lines, dft)  # fmt: skip
+    search.logged("start", float("nan"), start_model)
     # a starting mode the free fit carried away (a weak mode's pole to beyond the band) is tried
     # again as an addition
     lost = [(f, x) for f, x in zip(np.atleast_1d(freq_hz), np.atleast_1d(damping), strict=True)
@@ -397,4 +397,4 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max
             alternatives += ((wanted.rise, split),)
     return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
                      tuple(unconfirmed), alternatives, carried_away, wanted, stand_ins, settings, lines,
-                     dft)  # fmt: skip
+                     dft, tuple(search.table.rows))  # fmt: skip

@@ -146,6 +146,9 @@ class ModalModel:
         Inter-sample assumption ("bandlimited" or "zoh").
     residual : (n_lines, n_sensors) complex ndarray
         The weighted residual of every line: where a missing mode or a model error sits.
+    converged : bool
+        The fit met its tolerance (False: it stopped at its cap of evaluations, as a screening
+        fit is meant to).
     """
 
     freq_hz: np.ndarray
@@ -157,6 +160,7 @@ class ModalModel:
     n_real: int
     hold: str
     residual: np.ndarray
+    converged: bool = True
 
     @property
     def n_modes(self) -> int:
@@ -322,4 +326,5 @@ def _fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited"
         n_real=data.n_real,
         hold=hold,
         residual=resid[: data.s.size] + 1j * resid[data.s.size :],
+        converged=bool(res.status > 0),  # 0: stopped at max_nfev
     )

@@ -25,17 +25,21 @@ simulated record with white noise it is 1 and the criterion is plain BIC.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
 
+from armaxmodal.modes.intervals import interval
 from armaxmodal.modes.modal_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.settings import DEFAULTS, CountSettings, DftSettings, LineSettings
 from armaxmodal.stats import MAX_DAMPING, Z95
 
 __all__ = [
+    "FittedModel",
     "ModeCount",
+    "ModelTable",
     "Wanted",
     "Step",
     "agree_in_halves",
@@ -67,6 +71,44 @@ class Step:
     freq_hz: float
     bic_fall: float
     settled_hz: float = float("nan")
+
+
+class FittedModel(NamedTuple):
+    """One model the count fitted (a row of :meth:`ModeCount.models_table`), as statsmodels'
+    ``ar_select_order`` keeps every candidate's criterion: the search's choices can be read off."""
+
+    action: str  #: what the fit tried: "start", "remove", "add", "split", "converge", "leave out", "alternative"
+    freq_hz: float  #: the mode it removed, added (its start) or split (Hz); NaN for the model as it stands
+    n_modes: int  #: poles in the model
+    neg2_loglik: float  #: ``-2 ln L`` on the effective lines
+    n_params: int  #: the parameters that depend on the number of modes
+    bic: float  #: the criterion on the effective lines (smaller is better)
+    converged: bool  #: the fit met its tolerance (a screening fit stops at its cap)
+    halves_agree: bool | None  #: its new poles the same in both halves (None: not asked)
+
+
+class ModelTable:
+    """The count's table as the search fills it: one :class:`FittedModel` per fit, in order, with
+    ``-2 ln L`` and BIC on ``n_effective`` real numbers (:func:`effective_fraction`)."""
+
+    def __init__(self, n_effective: float):
+        self.n_eff, self.rows = n_effective, []
+        self._live: dict[int, tuple[weakref.ref, int]] = {}  # a fitted model still alive: its row
+
+    def add(self, action: str, freq_hz: float, model: ModalModel | None) -> ModalModel | None:
+        """``model`` (None: nothing fitted, no row), with its row added."""
+        if model is not None:
+            self._live[id(model)] = (weakref.ref(model), len(self.rows))
+            fit = float(model.neg2_loglik_on(self.n_eff)), model.n_params, float(model.bic(self.n_eff))
+            self.rows.append(FittedModel(action, float(freq_hz), model.n_modes, *fit, model.converged, None))
+        return model
+
+    def halves(self, model: ModalModel, agree: bool) -> bool:
+        """``agree`` (the halves' test of ``model``'s new poles), written into ``model``'s row."""
+        ref, row = self._live.get(id(model), (lambda: None, -1))
+        if ref() is model:
+            self.rows[row] = self.rows[row]._replace(halves_agree=agree)
+        return agree
 
 
 class Wanted(NamedTuple):
@@ -122,6 +164,8 @@ class ModeCount:
         Starting modes the search carried to where no mode is founded but which the model needs
         (the criterion rises decisively without them): kept in the model, not reported, as
         out-of-band poles are. (start Hz, where it went Hz, the criterion's rise without them).
+    models : tuple of FittedModel
+        Every model the count fitted, in the order fitted (:meth:`models_table`).
     """
 
     model: ModalModel
@@ -140,6 +184,38 @@ class ModeCount:
     settings: CountSettings = COUNT
     lines: LineSettings = DEFAULTS.lines
     dft: DftSettings = DEFAULTS.dft
+    models: tuple[FittedModel, ...] = ()
+
+    def models_table(self):
+        """Every model the count fitted, one row each (:class:`FittedModel`'s columns), in the order
+        fitted: the removals, additions and splits tried at each step, their convergence, the halves'
+        test, the equally good models.
+
+        Returns
+        -------
+        DataFrame
+            ``action``, ``freq_hz``, ``n_modes``, ``neg2_loglik``, ``n_params``, ``bic``,
+            ``converged``, ``halves_agree``.
+        """
+        import pandas as pd
+
+        return pd.DataFrame(list(self.models), columns=list(FittedModel._fields))
+
+    def to_dict(self) -> dict:
+        """The count's evidence for the JSON: the effective fraction of the lines, the fits run, the
+        accepted steps and every model fitted (:meth:`models_table`); no NaN (None instead)."""
+
+        def finite(value):
+            return float(value) if value is not None and np.isfinite(value) else None
+
+        return {
+            "effective_fraction": finite(self.effective_fraction),
+            "trials": int(self.trials),
+            "steps": [{"action": st.action, "freq_hz": finite(st.freq_hz), "bic_fall": finite(st.bic_fall),
+                       "settled_hz": finite(st.settled_hz)} for st in self.steps],  # fmt: skip
+            "models": [{**row._asdict(), "freq_hz": finite(row.freq_hz), "neg2_loglik": finite(row.neg2_loglik),
+                        "bic": finite(row.bic)} for row in self.models],  # fmt: skip
+        }
 
     def reported(self, band_hz) -> np.ndarray:
         """Which of the model's poles are reported as modes of the band (bool per pole):
@@ -183,8 +259,8 @@ class ModeCount:
             A counterpart's interval reaches beyond the mode's own.
         """
         m = self.model
-        own = {"freq": [m.freq_hz[i] - Z95 * m.freq_sd[i], m.freq_hz[i] + Z95 * m.freq_sd[i]],
-               "damping": [m.damping[i] - Z95 * m.damping_sd[i], m.damping[i] + Z95 * m.damping_sd[i]]}  # fmt: skip
+        own = {"freq": list(interval("freq", m.freq_hz[i], Z95 * m.freq_sd[i])),
+               "damping": list(interval("damping", m.damping[i], Z95 * m.damping_sd[i]))}  # fmt: skip
         reach = dict.fromkeys(("freq_other_lo", "freq_other_hi", "damping_other_lo", "damping_other_hi"), np.nan)
         widened = False
         for _, alt in self.alternatives:
@@ -193,7 +269,7 @@ class ModeCount:
                     continue
                 for q, value, sd in (("freq", alt.freq_hz[k], alt.freq_sd[k]), ("damping", alt.damping[k],
                                                                                   alt.damping_sd[k])):  # fmt: skip
-                    lo, hi, ci = value - Z95 * sd, value + Z95 * sd, own[q]
+                    (lo, hi), ci = interval(q, value, Z95 * sd), own[q]
                     widened |= bool(lo < ci[0] or hi > ci[1])
                     ci[:] = [min(ci[0], lo), max(ci[1], hi)]
                     reach[f"{q}_other_lo"] = float(np.fmin(reach[f"{q}_other_lo"], lo))

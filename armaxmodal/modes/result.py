@@ -184,6 +184,7 @@ class ModeSelection:
             "estimator": sorted(set(self.modes.estimator)),
             "picks": self.picks,
             "settings": self.settings.to_dict(),
+            "count": None if self.count is None else self.count.to_dict(),
             "modes": modes,
             "per_sensor": per_sensor,
         }

@@ -99,6 +99,25 @@ def test_the_nested_tests_undo_planted_over_and_under_modelling(supine, plant):
     assert np.all(count.removal_rise > 10 * DECISIVE_BIC)
     assert count.best_addition < -DECISIVE_BIC
     assert count.effective_fraction > 0.9  # white sensor noise: the lines are independent
+    _assert_table_tells_the_search(count, data, len(f))
+
+
+def _assert_table_tells_the_search(count, data, n_start):
+    """The count's table holds every fit: it opens with the start, each row's BIC is its -2 ln L
+    plus its penalty on the effective lines, each accepted step is a converged row that lowers the
+    criterion by the step's fall, and the chosen model is one of its rows."""
+    table = count.models_table()
+    n_eff = count.effective_fraction * data.n_real * data.y.shape[1]
+    assert (table.action.iloc[0], table.n_modes.iloc[0]) == ("start", n_start)
+    np.testing.assert_allclose(table.bic, table.neg2_loglik + table.n_params * np.log(n_eff), rtol=1e-12)
+    assert set(table.action) <= {"start", "remove", "add", "split", "converge", "leave out", "alternative"}
+    assert count.trials <= len(table) <= count.trials + 2  # the start and a final fit are no trials
+    before = table.bic.iloc[0]
+    for step in count.steps:
+        rows = table[(table.action == step.action) & np.isclose(table.freq_hz, step.freq_hz) & table.converged]
+        assert np.isclose(before - rows.bic, step.bic_fall, rtol=1e-9).any(), (step, rows)
+        before -= step.bic_fall
+    assert np.isclose(table.bic, count.model.bic(n_eff), rtol=1e-12).any()
 
 
 def test_the_penalty_grows_with_the_data(supine):
@@ -162,9 +181,10 @@ def test_intervals_cover_the_equally_good_models():
     freq, damping, widened = _structure_hull(count, 1)
     assert widened
     assert freq == pytest.approx((10.0 - Z95 * 0.1, 10.4 + Z95 * 0.104))
-    assert damping == pytest.approx((0.05 - Z95 * 0.0005, 0.06 + Z95 * 0.0006))
+    assert damping == pytest.approx((0.05 * np.exp(-Z95 * 0.01), 0.06 * np.exp(Z95 * 0.01)))  # on the logarithm
     assert _structure_hull(count, 0) == (pytest.approx((5 - Z95 * 0.05, 5 + Z95 * 0.05)),
-                                         pytest.approx((0.2 - Z95 * 0.002, 0.2 + Z95 * 0.002)), False)  # fmt: skip
+                                         pytest.approx((0.2 * np.exp(-Z95 * 0.01), 0.2 * np.exp(Z95 * 0.01))),
+                                         False)  # fmt: skip
     # two equally good models reach to both sides: the interval covers both (the lower one first)
     lower = _model([9.7], [0.05])
     both = _count([DECISIVE_BIC - 2, 80.0], -40.0, freq=(5.0, 10.0), damping=(0.2, 0.05),
@@ -282,6 +302,11 @@ def test_a_change_during_the_record_is_not_counted_as_modes():
     assert alone.model.n_modes > 2  # the likelihood alone over-models
     both = count_modes(data, exact.freq_hz, exact.damping, hold="zoh", halves=halves)
     assert both.model.n_modes == 2 and both.unconfirmed_hz
+    # the table says why: each addition the whole record took is a row the halves refused
+    table = both.models_table()
+    refused = table[table.halves_agree.eq(False)]
+    assert len(refused) >= len(both.unconfirmed_hz) and refused.action.isin(["add", "split"]).all()
+    assert table.halves_agree.isna().any()  # a fit the halves were not asked about says so
     # the two modes lie between the two halves' exact values
     late = chain(1.04).modes()
     assert np.all((both.model.freq_hz > 0.99 * exact.freq_hz) & (both.model.freq_hz < 1.01 * late.freq_hz))
@@ -359,12 +384,21 @@ class _Scored:
         self.n_real, self.rss, self.table = 100, np.ones(4), table  # the supine ride: 4 sensors
         self.residual = np.random.default_rng(0).standard_normal((50, 2)) + 0j
 
+    converged = True
+
     @property
     def n_modes(self):
         return self.freq_hz.size
 
+    @property
+    def n_params(self):
+        return self.n_modes * (2 + 4 * self.rss.size)
+
     def bic(self, n_effective=None):
         return self.table[self.n_modes]
+
+    def neg2_loglik_on(self, n_effective=None):
+        return self.bic(n_effective) - self.n_params * np.log(n_effective)
 
 
 @pytest.mark.parametrize("start", [2, 3, 4])
@@ -748,7 +782,7 @@ def test_the_split_of_lowest_criterion_is_the_one_judged(best_resolved):
     bic = {id(m): m.neg2_loglik_on(n_eff) + m.n_params * np.log(n_eff) for m in (current, low, high)}
     search = SimpleNamespace(
         n_eff=n_eff, bic=lambda m: bic[id(m)], physical=lambda m: np.ones(m.freq_hz.size, dtype=bool),
-        screened=lambda starts: [high, low], fit=lambda f, x, nfev: low if f[1] == 14.0 else high,
+        screened=lambda starts, labels: [high, low], fit=lambda f, x, nfev, label=None: low if f[1] == 14.0 else high,
         resolved=lambda m: best_resolved or m is not low, in_both_halves=lambda m, new, halves: True,
         cfg=CountSettings(),
     )  # fmt: skip
