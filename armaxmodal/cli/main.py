@@ -52,6 +52,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     os.environ.setdefault("MPLBACKEND", "Agg")
     parser = build_parser()
     args = parser.parse_args(argv)
+    args.command_line = ["armaxmodal", *(sys.argv[1:] if argv is None else argv)]  # as run, for the reports
     try:
         check_output_paths(args)
         return args.func(args)

@@ -128,8 +128,8 @@ def run(args) -> int:
     if args.report:
         from armaxmodal.modes.report import render_selection_report
 
-        settings = {"band (Hz)": args.band, "detrend": args.detrend, "command": "armaxmodal stabilise"}
-        page = render_selection_report(selection, selection.verdict, args.data, settings)
+        used = {"band (Hz)": args.band, "detrend": args.detrend}
+        page = render_selection_report(selection, selection.verdict, args.data, used, _provenance(args))
         outputs.append((args.report, lambda tmp: Path(tmp).write_text(page, encoding="utf-8")))
     if args.json:
         report = selection.to_dict(args.shapes.replace("-", "_"))
@@ -200,6 +200,17 @@ def print_check(check) -> None:
             f"model error {100 * check.model_error[k]:.1f} %, delay {1e3 * check.delay_s[k]:+.1f} ms, "
             f"{check.n_lines[k]} lines"
         )
+
+
+def _provenance(args) -> dict:
+    """The full command line and the input's SHA-256, for the report."""
+    import shlex
+
+    from armaxmodal.study.manifest import content_hash
+
+    files = [Path(p) for p in (args.data if isinstance(args.data, list) else [args.data])]
+    checksum = ", ".join(f"{content_hash(p)} ({p.name})" for p in files if p.is_file())
+    return {"command": shlex.join(args.command_line), "checksum": checksum}
 
 
 def _diagram_outputs(args, diagram, selection, plot_format) -> list:

@@ -12,7 +12,8 @@ import pandas as pd
 __all__ = ["STYLE", "SCRIPT", "figure_uri", "page", "table"]
 
 STYLE = """
-body{font-family:system-ui,sans-serif;margin:2em auto;max-width:1200px;color:#222}
+body{font-family:system-ui,sans-serif;margin:2em auto;max-width:1200px;padding:0 1em;color:#222}
+h1{overflow-wrap:anywhere}nav{margin:1em 0}details{margin:.3em 0}details p{margin:.3em 1.2em}
 table{border-collapse:collapse;margin:0.5em 0 1.5em;font-size:0.9em}
 th,td{border:1px solid #ccc;padding:3px 8px;text-align:right}th{background:#f0f0f0}
 td.gap{color:#b00;text-align:center}.thumbs{display:flex;flex-wrap:wrap;gap:10px}

@@ -1,9 +1,11 @@
 """One recording's result as one self-contained HTML page (``stabilise --report``), with the
 study report's look: what a colleague needs to judge it without the files around it.
 
-The page holds the verdict; the record (input, outputs, rates, preprocessing); every warning,
-each saying what to do; the stabilisation diagram over the FRF; the modes with their intervals;
-the modal-model check per output; the shapes; and the settings of the run.
+The page holds, under a list of its sections: the verdict; what made it (the package version, the
+date, the command and the input's checksum); the record (input, outputs, rates); the notes, one
+group per code with how it moves the verdict, what to do and every full text; the stabilisation
+diagram over the FRF; the modes with their intervals; the modal-model check per output; the shapes;
+and the settings of the run that were used. MNE-Python's ``Report`` is the model.
 """
 
 from __future__ import annotations
@@ -33,9 +35,47 @@ def modes_table(selection) -> pd.DataFrame:
     })  # fmt: skip
     if "estimator" in m:
         out["estimator"] = m.estimator.to_numpy()
-    if "picked_hz" in m:
+    if "picked_hz" in m and np.isfinite(m.picked_hz.to_numpy(float)).any():
         out["picked at (Hz)"] = m.picked_hz.to_numpy(float)
     return out
+
+
+def _notes(warnings) -> str:
+    """The notes grouped by code, in the order the stages raise them: per code how many, how it
+    moves the verdict, what to do (:data:`armaxmodal.quality_warnings.CODES`) and every full text."""
+    from armaxmodal.quality_warnings import CODES
+
+    esc, known = html.escape, {c.code: c for c in CODES}
+    order = {c.code: k for k, c in enumerate(CODES)}
+    groups: dict[str, list] = {}
+    for w in warnings:
+        groups.setdefault(w.code, []).append(w)
+    effects = ("makes the verdict uncertain", "warning", "informative")
+
+    def effect(code: str) -> int:
+        spec = known.get(code)
+        return 0 if spec is not None and spec.uncertain else 2 if spec and spec.advice.startswith("Nothing") else 1
+
+    items = []  # what moves the verdict first, then by the stage that raised it
+    for code in sorted(groups, key=lambda c: (effect(c), order.get(c, len(order)))):
+        spec, texts, level = known.get(code), groups[code], effect(code)
+        advice = f"<p>{esc(spec.advice)}</p>" if spec is not None else ""
+        full = "".join(f"<li>{esc(w.message)}</li>" for w in texts)
+        items.append(f"<details{' open' if level < 2 else ''}><summary><b>{esc(code)}</b> ({len(texts)}): "
+                     f"{effects[level]}</summary>{advice}<ul>{full}</ul></details>")  # fmt: skip
+    return "".join(items) or "<p>none</p>"
+
+
+def _made_by(provenance: dict) -> pd.DataFrame:
+    """What made the page: the version, the date, the command and the input's checksum."""
+    from datetime import UTC, datetime
+
+    from armaxmodal._version import __version__
+
+    rows = [("armaxmodal", __version__),
+            ("run at (UTC)", provenance.get("date") or datetime.now(UTC).strftime("%Y-%m-%d %H:%M:%S")),
+            ("command", provenance.get("command")), ("input SHA-256", provenance.get("checksum"))]  # fmt: skip
+    return pd.DataFrame([(k, v) for k, v in rows if v], columns=["", "value"])
 
 
 def _check_table(check) -> pd.DataFrame:
@@ -62,11 +102,12 @@ def _settings_table(selection, settings: dict) -> pd.DataFrame:
             ("stability tolerances", f"f {100 * t.freq:g} %, damping {100 * t.damping:g} %, shape 1-MAC {t.shape:g}"),
             ("inter-sample behaviour", None if selection.refinement is None else selection.refinement.hold),
             ("picks (Hz)", selection.picks)]  # fmt: skip
-    rows += list(settings.items())
-    return pd.DataFrame([(k, "" if v is None else str(v)) for k, v in rows], columns=["setting", "value"])
+    rows += list(settings.items())  # a setting the run did not use is left out, not shown empty
+    return pd.DataFrame([(k, str(v)) for k, v in rows if v is not None and v != ""], columns=["setting", "value"])
 
 
-def render_selection_report(selection, verdict: str, source: str, settings: dict | None = None) -> str:
+def render_selection_report(selection, verdict: str, source: str, settings: dict | None = None,
+                            provenance: dict | None = None) -> str:  # fmt: skip
     """The HTML text of one recording's report.
 
     Parameters
@@ -77,7 +118,10 @@ def render_selection_report(selection, verdict: str, source: str, settings: dict
     source : str
         What was read (file names), for the title.
     settings : dict, optional
-        More settings of the run to list (name -> value).
+        More settings of the run to list (name -> value; None: not used, left out).
+    provenance : dict, optional
+        ``command`` (the full command line), ``checksum`` (the input's SHA-256) and ``date``
+        (default: now, UTC); the package version is always given.
 
     Returns
     -------
@@ -86,22 +130,23 @@ def render_selection_report(selection, verdict: str, source: str, settings: dict
     from armaxmodal.modes.shape_plot import plot_shapes
 
     esc = html.escape
-    warnings = "".join(f"<li><b>{esc(w.code)}</b>: {esc(w.message)}</li>" for w in selection.warnings)
     ax, _ = selection.diagram.plot(selection)
     diagram = figure_uri(ax.figure, dpi=110)
     shapes = figure_uri(plot_shapes(selection), dpi=110) if len(selection.modes) else ""
-    check = "" if selection.check is None else "<h2>The modal-model check per output</h2>" + table(
-        _check_table(selection.check), 3
-    )
-    body = f"""
-<h1>armaxmodal stabilise: {esc(source)}</h1>
-<p class="verdict {esc(selection.quality)}">{esc(verdict)}</p>
-<h2>The record</h2>{table(_record_table(selection, source))}
-<h2>Warnings ({len(selection.warnings)})</h2>{"<ul>" + warnings + "</ul>" if warnings else "<p>none</p>"}
-<h2>Stabilisation diagram over the measured FRF</h2><img alt='stabilisation diagram' src='{diagram}'>
-<h2>Modes ({len(selection.modes)})</h2>{table(modes_table(selection), 5) if len(selection.modes) else "<p>none</p>"}
-{check}
-{"<h2>Mode shapes</h2><img alt='mode shapes' src='" + shapes + "'>" if shapes else ""}
-<h2>Settings</h2>{table(_settings_table(selection, settings or {}))}
-"""
+    n_modes = len(selection.modes)
+    sections = [
+        ("record", "The record", table(_record_table(selection, source))),
+        ("notes", f"Notes ({len(selection.warnings)})", _notes(selection.warnings)),
+        ("diagram", "Stabilisation diagram over the measured FRF", f"<img alt='diagram' src='{diagram}'>"),
+        ("modes", f"Modes ({n_modes})", table(modes_table(selection), 5) if n_modes else "<p>none</p>"),
+        ("check", "The modal-model check per output", None if selection.check is None
+         else table(_check_table(selection.check), 3)),
+        ("shapes", "Mode shapes", f"<img alt='mode shapes' src='{shapes}'>" if shapes else None),
+        ("settings", "Settings", table(_settings_table(selection, settings or {}))),
+    ]  # fmt: skip
+    sections = [(key, title, content) for key, title, content in sections if content is not None]
+    nav = " · ".join(f"<a href='#{key}'>{esc(title)}</a>" for key, title, _ in sections)
+    body = (f"<h1>armaxmodal stabilise: {esc(source)}</h1><p class=\"verdict {esc(selection.quality)}\">{esc(verdict)}"
+            f"</p>{table(_made_by(provenance or {}))}<nav>{nav}</nav>"
+            + "".join(f"<h2 id={key}>{esc(title)}</h2>{content}" for key, title, content in sections))  # fmt: skip
     return page(f"armaxmodal stabilise: {source}", body)

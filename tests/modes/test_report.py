@@ -16,9 +16,18 @@ def test_stabilise_writes_a_self_contained_report_a_browser_shows(fixtures_dir, 
     html = page.read_text()
     assert "http://" not in html and "https://" not in html  # nothing fetched
     assert html.count("src='data:image/png;base64,") == 2  # the diagram and the shapes
-    for heading in ("The record", "Warnings", "Stabilisation diagram", "Modes (4)", "modal-model check", "Settings"):
-        assert heading in html
+    for key, heading in (("record", "The record"), ("notes", "Notes"), ("diagram", "Stabilisation diagram"),
+                         ("modes", "Modes (4)"), ("check", "The modal-model check"), ("settings", "Settings")):
+        assert f"<h2 id={key}>{heading}" in html and f"<a href='#{key}'>{heading}" in html  # navigated to
     assert 'class="verdict good"' in html and "quality: good" in html
+    # what made it: the version, the command as run, the input's checksum
+    from armaxmodal.study.manifest import content_hash
+
+    assert f"<td>{am.__version__}</td>" in html and f"{content_hash(fixtures_dir / 'supine_random.csv')}" in html
+    assert f"armaxmodal --quiet stabilise {data} --orders 2:20 --report {page}" in html
+    # a setting the run did not use is left out, not shown empty; no picks, no picks column
+    assert "band (Hz)" not in html and "picked at" not in html and "picks (Hz)" not in html
+    assert "<td>detrend</td>" in html
     # the modes table holds the JSON's numbers
     record = __import__("json").loads((tmp_path / "m.json").read_text())
     for mode in record["modes"]:
@@ -43,3 +52,21 @@ def test_a_notebook_shows_the_verdict_and_the_modes(fixtures_dir):
     shown = sel._repr_html_()
     assert sel.verdict.startswith("quality: good") and sel.verdict in shown
     assert len(re.findall(r"<tr[ >]", shown)) == 1 + len(sel.modes)  # header and one row per mode
+
+
+def test_the_report_groups_the_notes_by_code_what_moves_the_verdict_first(tmp_path):
+    """Three notes of two codes: one group per code with its count, the code that makes the verdict
+    uncertain first and open, its advice, and every full text."""
+    from armaxmodal.modes.report import _notes
+
+    notes = [am.QualityWarning("resampled", (), "resampled by 1/9"),
+             am.QualityWarning("count_undecided", (), "first text"), am.QualityWarning("count_undecided", (), "second")]
+    html = _notes(notes)
+    assert html.index("count_undecided") < html.index("resampled")
+    assert "<details open><summary><b>count_undecided</b> (2): makes the verdict uncertain" in html
+    assert "<details><summary><b>resampled</b> (1): informative" in html
+    assert "<li>first text</li><li>second</li>" in html and "<li>resampled by 1/9</li>" in html
+    from armaxmodal.quality_warnings import CODES
+
+    advice = next(c.advice for c in CODES if c.code == "count_undecided")
+    assert f"<p>{__import__('html').escape(advice)}</p>" in html
