@@ -346,6 +346,22 @@ CODES: tuple[WarningCode, ...] = (
 )
 WARNING_CODES = tuple(c.code for c in CODES)
 UNCERTAIN_CODES = tuple(c.code for c in CODES if c.uncertain)
+#: the codes that make the verdict poor: the modes do not explain the record, or there are none
+PROBLEM_CODES = ("no_modes", "modes_do_not_explain_frf")
+#: besides the uncertain ones, the findings a user must act on: a fault of the data the product
+#: reports but cannot set right, or a result it could not complete
+ACT_ON_CODES = ("duplicate_channel", "inverted_sensor", "sensor_delay", "narrowband_input", "clipping", "offset_step",
+                "model_error_dominates", "nk_at_search_edge", "unexplained_peak", "damping_unresolved",
+                "incoherent_output", "unit_mismatch", "oversampled", "refit_failed")  # fmt: skip
+
+
+def severity(code: str) -> str:
+    """How a note moves the verdict, as the command line labels it: ``"problem"`` (the verdict is
+    poor), ``"warning"`` (the verdict is uncertain, or the user must act on it) or ``"info"``
+    (said, and dealt with: a bridged rounding, a resampling, how the count went)."""
+    if code in PROBLEM_CODES:
+        return "problem"
+    return "warning" if code in UNCERTAIN_CODES or code in ACT_ON_CODES else "info"
 
 
 @dataclass(frozen=True)

@@ -15,26 +15,29 @@ sys.path.insert(0, str(ROOT))
 os.environ.setdefault("MPLBACKEND", "Agg")  # the gallery draws without a display
 
 from armaxmodal import __version__  # noqa: E402
-from armaxmodal.quality_warnings import CODES  # noqa: E402
+from armaxmodal.quality_warnings import CODES, severity  # noqa: E402
 
 
 def _warning_page() -> str:
     """The warning codes' page, written from their own definitions
     (:data:`armaxmodal.quality_warnings.CODES`) so that it cannot go stale."""
     lines = [
-        "# Warning codes",
+        "# Notes and warning codes",
         "",
-        "Every warning the product raises, as `armaxmodal.quality_warnings.CODES` defines it (this page is",
-        "generated from those definitions when the docs build). A warning travels with its result: the JSON's",
-        "`warnings` list (code, channels, message, value) and a `warning [code]:` line on stderr, even with",
-        "`--quiet`. Codes marked **uncertain** make a selection that passes its check say",
-        '`"quality": "uncertain"`: the record does not settle the modes.',
+        "Every note the product raises, as `armaxmodal.quality_warnings.CODES` defines it (this page is",
+        "generated from those definitions when the docs build). A note travels with its result: the JSON's",
+        "`warnings` list (code, channels, message, value), the report's notes and, on stderr even with",
+        "`--quiet`, one line per code after the verdict (every full text with `--verbose`). Each code has a",
+        "severity that says how it moves the verdict: **problem** (the verdict is poor), **warning** (the",
+        "verdict is uncertain, or the data hold a fault to act on) or **info** (said, and dealt with). Codes",
+        'marked **uncertain** make a selection that passes its check say `"quality": "uncertain"`.',
         "",
     ]
     for c in CODES:
         flag = " (**uncertain**)" if c.uncertain else ""
-        lines += [f"## `{c.code}`", "", f"*Raised by:* {c.stage}{flag}", "", f"**Measured:** {c.measured}", "",
-                  f"**What is done:** {c.done}", "", f"**What to do:** {c.advice}", ""]
+        lines += [f"## `{c.code}`", "", f"*Raised by:* {c.stage}{flag}; *severity:* {severity(c.code)}", "",
+                  f"**Measured:** {c.measured}", "", f"**What is done:** {c.done}", "", f"**What to do:** {c.advice}",
+                  ""]  # fmt: skip
     return "\n".join(lines)
 
 

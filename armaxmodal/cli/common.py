@@ -134,10 +134,46 @@ def order_range(text: str) -> range:
     return range(lo, hi + 1, 2)
 
 
-def print_warnings(warnings) -> None:
-    """Data-quality warnings go to stderr, one line each, even with --quiet."""
+#: a note's line on the terminal, and how many code lines fit one screen with the header
+NOTE_WIDTH, NOTE_LINES = 100, 23
+
+
+def print_notes(warnings, verbose: bool = False) -> None:
+    """The notes on stderr (even with --quiet), one line per code within ``NOTE_WIDTH`` characters:
+    its severity (:func:`armaxmodal.quality_warnings.severity`), how many, the channels, what to
+    do; problems first, then warnings, then information. ``verbose``: every full text under its
+    code. The JSON and ``--report`` always hold the full texts."""
+    import textwrap
+
+    from armaxmodal.quality_warnings import CODES, UNCERTAIN_CODES, severity
+
+    if not warnings:
+        return
+    advice, order = {c.code: c.advice for c in CODES}, {c.code: k for k, c in enumerate(CODES)}
+    levels = ("problem", "warning", "info")
+    groups: dict[str, list] = {}
     for w in warnings:
-        print(f"warning [{w.code}]: {w.message}", file=sys.stderr)
+        groups.setdefault(w.code, []).append(w)
+    # problems, then what makes the verdict uncertain, then the other warnings, then information
+    codes = sorted(groups, key=lambda c: (levels.index(severity(c)), c not in UNCERTAIN_CODES, order.get(c, 99)))
+    counts = [f"{n} {level}{'s' if n > 1 and level != 'info' else ''}"  # notes, of each severity
+              for level in levels if (n := sum(severity(w.code) == level for w in warnings))]  # fmt: skip
+    more = "" if verbose else " (full texts: --verbose, --json, --report)"
+    print(f"notes: {', '.join(counts)}{more}", file=sys.stderr)
+    shown = codes if verbose else codes[:NOTE_LINES]
+    for code in shown:
+        notes = groups[code]
+        channels = sorted({c for w in notes for c in w.channels})
+        where = f", {', '.join(channels)}" if channels and len(", ".join(channels)) <= 30 else ""
+        head, text = f"  {severity(code):<8}{code} ({len(notes)}{where}): ", advice.get(code, "")
+        if len(head) + len(text) > NOTE_WIDTH and not verbose:  # cut at a word, marked
+            text = text[: NOTE_WIDTH - len(head) - 4].rsplit(" ", 1)[0] + " ..."
+        print(head + text, file=sys.stderr)
+        for w in notes if verbose else ():
+            print(textwrap.fill(w.message, NOTE_WIDTH, initial_indent="      - ", subsequent_indent="        "),
+                  file=sys.stderr)  # fmt: skip
+    if len(shown) < len(codes):
+        print(f"  ... {len(codes) - len(shown)} more codes (--verbose)", file=sys.stderr)
 
 
 def write_outputs(outputs) -> None:

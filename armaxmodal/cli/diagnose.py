@@ -11,7 +11,7 @@ from armaxmodal.cli.common import (
     load_recording,
     output_format,
     parse_pair,
-    print_warnings,
+    print_notes,
     write_outputs,
 )
 from armaxmodal.diagnosis.report import short_parameters
@@ -42,7 +42,7 @@ def run(args) -> int:
         check_report_path(args.report)
     rec = load_recording(args)
     result = diagnose(rec, band=band, max_rounds=args.max_rounds, progress=not args.quiet)
-    print_warnings(result.warnings)
+    print_notes(result.warnings, args.verbose)
     report = result.to_dict()
     print(_diagnosis_text(args.data, report))
     outputs = []
@@ -66,7 +66,8 @@ def _diagnosis_text(name: str, report: dict) -> str:
     """The diagnosis as a person reads it: fits before and after, each effect with its numbers."""
     sensors = report["outputs"]
     base, final = report["baseline"], report["final"]
-    lines = [f"{name}: {len(sensors)} sensors at {report['analysis_fs']:g} Hz; baseline orders {report['orders']}"]
+    lines = [f"{name}: {len(sensors)} sensors at {report['analysis_fs']:g} Hz; baseline orders {report['orders']}",
+             "verdict: " + report["verdict"]]  # what was found first; the numbers and the side tests after
     lines.append(f"{'sensor':>12} {'fit before %':>13} {'fit after %':>12} {'resid RMS':>10} {'H1 floor':>12}")
     for k, s in enumerate(sensors):
         if final["fit_val_pct"][k] is None:
@@ -88,8 +89,7 @@ def _diagnosis_text(name: str, report: dict) -> str:
         if e.get("note"):
             lines.append(f"  note: {e['note']}")
     for u in report["unconfirmed"]:
-        lines.append(f"unconfirmed {u['effect']} on {', '.join(u['channels'])}: {u['reason']}")
-    lines.append("verdict: " + report["verdict"])
+        lines.append(f"note: unconfirmed {u['effect']} on {', '.join(u['channels'])}: {u['reason']}")
     return "\n".join(lines)
 
 

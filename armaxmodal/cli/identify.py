@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from armaxmodal.cli.common import DETREND_HELP, add_data_args, load_recording, parse_pair, print_warnings
+from armaxmodal.cli.common import DETREND_HELP, add_data_args, load_recording, parse_pair, print_notes
 from armaxmodal.cli.stabilise import print_check
 from armaxmodal.exceptions import OrderError
 from armaxmodal.io.write import write_all, write_json
@@ -39,7 +39,7 @@ def run(args) -> int:
             raise OrderError(f"--model: expected four integers na,nb,nc,nk, got {args.model!r}.")
     band = parse_pair(args.band, "--band") if args.band else None
     result = identify(rec, orders, band=band, progress=not args.quiet, detrend=args.detrend)
-    print_warnings(result.warnings)
+    print_notes(result.warnings, args.verbose)
     na, nb, nc, nk = result.fit.orders
     print(
         f"{args.data}: shared-pole ARMAX na={na} nb={nb} nc={nc} nk={nk}, "

@@ -38,8 +38,11 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--quiet", action="store_true", help="no progress or chatter")
     # --quiet is accepted after the command too; SUPPRESS keeps a subcommand's unset default
     # from overwriting the top-level flag
+    parser.add_argument("--verbose", action="store_true", help="every note's full text, not one line per code")
     quiet = argparse.ArgumentParser(add_help=False)
     quiet.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS, help="no progress or chatter")
+    quiet.add_argument("--verbose", action="store_true", default=argparse.SUPPRESS,
+                       help="every note's full text, not one line per code")  # fmt: skip
     sub = parser.add_subparsers(dest="command", required=True)
     for command in COMMANDS:
         command.add_parser(sub, [quiet])

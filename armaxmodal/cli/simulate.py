@@ -10,13 +10,17 @@ from armaxmodal.io.write import write_recording_csv
 def add_parser(sub, parents) -> None:
     """Register the ``simulate`` command."""
     p = sub.add_parser("simulate", parents=parents, help="simulate a base-excitation ride of a reference structure")
-    p.add_argument("--system", choices=sorted(SYSTEMS), default="supine")
-    p.add_argument("--excitation", choices=["random", "sweep"], default="random")
-    p.add_argument("--fs", type=POSITIVE, default=60.0)
+    p.add_argument("--system", choices=sorted(SYSTEMS), default="supine",
+                   help="the structure: the thesis's supine body (Table 4.3) or Chapter 2's chain; default supine")
+    p.add_argument("--excitation", choices=["random", "sweep"], default="random",
+                   help="the base acceleration: band-limited random vibration or a sine sweep; default random")
+    p.add_argument("--fs", type=POSITIVE, default=60.0, help="sampling rate, Hz; default 60")
     p.add_argument("--duration", type=POSITIVE, default=120.0, help="seconds; default 120")
-    p.add_argument("--noise", type=NONNEG, default=0.05, help="sensor noise, fraction of RMS")
-    p.add_argument("--hold", choices=["zoh", "bandlimited"], default="bandlimited")
-    p.add_argument("--seed", type=NONNEG_INT, default=0)
+    p.add_argument("--noise", type=NONNEG, default=0.05, help="sensor noise, fraction of each output's RMS")
+    p.add_argument("--hold", choices=["zoh", "bandlimited"], default="bandlimited",
+                   help="the input between samples: held (zoh) or band-limited, as an anti-aliased logger records "
+                        "it; default bandlimited")
+    p.add_argument("--seed", type=NONNEG_INT, default=0, help="seed of the excitation and the noise; default 0")
     p.add_argument(
         "--effect",
         action="append",

@@ -15,7 +15,7 @@ from armaxmodal.cli.common import (
     order_range,
     output_format,
     parse_pair,
-    print_warnings,
+    print_notes,
     write_outputs,
 )
 from armaxmodal.exceptions import DataError, OrderError, PickError
@@ -92,7 +92,7 @@ def run(args) -> int:
         selection = select_modes(diagram, args.modes, band, progress=not args.quiet, picks=picks)
     except OrderError:
         # no mode: the diagram and the pole table still show the user why
-        print_warnings(diagram.warnings)
+        print_notes(diagram.warnings, args.verbose)
         write_outputs(_diagram_outputs(args, diagram, None, plot_format))
         raise
     if not args.quiet:
@@ -116,7 +116,6 @@ def run(args) -> int:
         )
         if selection.check is not None:
             print_check(selection.check)
-    print_warnings(selection.warnings)
     outputs = _diagram_outputs(args, diagram, selection, plot_format)
     if args.shapes_plot:
         from armaxmodal.modes.shape_plot import plot_shapes
@@ -135,7 +134,8 @@ def run(args) -> int:
         report = selection.to_dict(args.shapes.replace("-", "_"))
         outputs.append((args.json, lambda tmp: write_json(report, tmp)))
     write_outputs(outputs)
-    print(selection.verdict)
+    print(selection.verdict, flush=True)
+    print_notes(selection.warnings, args.verbose)  # after the verdict: what it rests on, one line per code
     return 0
 
 

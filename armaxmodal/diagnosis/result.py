@@ -166,16 +166,25 @@ def _per_output(summary: dict, sensors, outputs) -> dict:
 
 
 def _verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float = 0.01) -> str:
-    """One sentence a person can act on, unsure where the data leave doubt."""
+    """One sentence a person can act on: what was found and confirmed first (each effect, where,
+    and its held-out error before and after), then what is left; "unsure" only where nothing was
+    confirmed and a test fired (a dry friction confirmed as a damping nonlinearity read "unsure",
+    for two side tests whose fixes did not help)."""
     coloured = [s for s, p in zip(diagnosis.sensors, whiteness, strict=True) if p is not None and p < alpha]
-    if coloured:
-        return (
-            f"unsure: the residual of {', '.join(coloured)} is still not white after the fixes; an effect the "
-            "fixes do not capture (a non-smooth nonlinearity such as friction or a clearance, a time change, a "
-            "missing mode) may remain. Look at the figure."
-        )
+    left = (f"the residual of {', '.join(coloured)} is still not white after the fixes; an effect the fixes do not "
+            "capture (a non-smooth nonlinearity such as friction or a clearance, a time change, a missing mode) may "
+            "remain. Look at the figure.") if coloured else ""  # fmt: skip
+    if diagnosis.effects:
+        found = "; ".join(f"{e.finding.effect} on {', '.join(e.finding.channels)} (held-out error {e.error_before:.3g}"
+                          f" -> {e.error_after:.3g})" for e in diagnosis.effects)  # fmt: skip
+        if left:
+            return f"found and confirmed: {found}. But {left}"
+        if diagnosis.unconfirmed:
+            return (f"found and confirmed: {found}; the effects listed explain the residual (white after the fixes). "
+                    "Other tests fired whose fixes did not lower the held-out error (see 'unconfirmed').")  # fmt: skip
+        return f"found and confirmed: {found}; the effects listed explain the residual (white after the fixes)."
+    if left:
+        return f"unsure: {left}"
     if diagnosis.unconfirmed:
         return "unsure: some tests fired but their fixes did not lower the held-out error (see 'unconfirmed')."
-    if diagnosis.effects:
-        return "the effects listed explain the residual: it is white after the fixes."
     return "no effect: the residual is consistent with the model."

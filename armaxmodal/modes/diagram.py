@@ -179,11 +179,8 @@ def choose_nk(recording: Recording, nk_values=NK_SEARCH, na_values=DELAY_CHOICE_
 def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=True, bar=None):
     """``(nk, {(SHARED, orders): checkpoint})``: the chosen delay and where its fits stopped,
     which the sweep continues instead of fitting those orders again. ``bar`` (tqdm) counts
-    the fits."""
+    the fits; the extension counts its own on a bar of its own, so that no total grows."""
     jobs = [(SHARED, (na, default_nb(na, nk), default_nc(na), nk)) for na in na_values for nk in nk_values]
-    if bar is not None and not extend:  # the first search's fits are in the bar's total
-        bar.total += len(jobs)
-        bar.refresh()
     # 8 iterations settle the choice where delays differ by tens of BIC units or more (checked
     # on every fixture, a lightly damped structure and the real recordings against 20 and 50);
     # where BIC is flatter the cap decides between delays the record does not tell apart
@@ -200,8 +197,12 @@ def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=Tr
     nk = int(jobs[int(np.argmin(scores))][1][3])
     if extend and nk == min(nk_values):
         # the best delay is the most non-causal one searched: look NK_EXTENSION further, once
+        from tqdm import tqdm
+
         further = range(nk, nk - NK_EXTENSION - 1, -1)
-        return _choose_nk(recording, further, na_values, n_jobs, tol, extend=False, bar=bar)
+        with tqdm(total=len(further) * len(na_values), desc=f"input delay choice beyond nk = {nk}", unit="fit",
+                  disable=bar is None or bar.disable) as more:  # fmt: skip
+            return _choose_nk(recording, further, na_values, n_jobs, tol, extend=False, bar=more)
     return nk, {job: ck for job, (_, ck) in zip(jobs, fits, strict=True) if job[1][3] == nk and ck is not None}
 
 

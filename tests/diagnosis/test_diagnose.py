@@ -63,7 +63,8 @@ def test_periodic_disturbance_is_named_measured_and_removed(clean):
 def test_a_notebook_shows_the_diagnosis_verdict_and_effects(clean):
     d = _run(inject(clean, "periodic_disturbance", ["head"], freq_hz=11.7, amp=0.1))
     shown = d._repr_html_()
-    assert d.to_dict()["verdict"] in shown and "periodic_disturbance" in shown and "multitaper_F" in shown
+    verdict = __import__("html").escape(d.to_dict()["verdict"])  # "held-out error 0.1 -> 0.08", escaped
+    assert verdict in shown and "periodic_disturbance" in shown and "multitaper_F" in shown
 
 
 def test_a_line_where_the_random_input_reads_a_chance_p_of_1e_3_is_still_named(clean):
@@ -185,7 +186,7 @@ def test_cli_writes_strict_json_with_the_contract(tmp_path, clean):
     html = page.read_text()
     assert "https://" not in html and html.count("src='data:image/png;base64,") == 1
     assert "offset_drift" in html and f"{first['error_before']:.4g}" in html and f"{first['error_after']:.4g}" in html
-    assert js["verdict"] in html
+    assert __import__("html").escape(js["verdict"]) in html and js["verdict"].startswith("found and confirmed: offset")
     dom, console_errors = open_in_headless_chromium(page, tmp_path / "profile")
     assert 'data-figures="1/1"' in dom and not console_errors
 
@@ -305,7 +306,9 @@ def test_two_effects_are_named_in_turn_without_undoing_each_other(clean):
     named = [(e.finding.effect, e.finding.channels) for e in d.effects]
     assert named == [("input_delay", ("legs",)), ("periodic_disturbance", ("head",))]
     assert d.effects[0].parameters["delay_samples"] == pytest.approx(2.0, abs=0.2)
-    assert d.to_dict()["verdict"].startswith("the effects listed explain")
+    verdict = d.to_dict()["verdict"]
+    assert verdict.startswith("found and confirmed: input_delay on legs (held-out error ")
+    assert "; periodic_disturbance on head (held-out error " in verdict and "the effects listed explain" in verdict
 
 
 def test_simulate_cli_plants_effects_and_refuses_bad_ones(tmp_path, capsys):

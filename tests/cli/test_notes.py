@@ -1,0 +1,60 @@
+"""The notes on the terminal: one line per code within 100 characters, labelled by how the code
+moves the verdict, the whole block on one screen; every full text under --verbose."""
+
+import numpy as np
+
+import armaxmodal as am
+from armaxmodal.cli.common import print_notes
+from armaxmodal.cli.main import main
+from armaxmodal.quality_warnings import CODES, PROBLEM_CODES, UNCERTAIN_CODES, severity
+
+
+def _one_of_each() -> list:
+    """A note of every code (two of the first), each with a long text."""
+    notes = [am.QualityWarning(c.code, ("head",), f"{c.code}: " + "a long measured sentence " * 12) for c in CODES]
+    return [notes[0], *notes]
+
+
+def test_one_line_per_code_on_one_screen_what_moves_the_verdict_first(capsys):
+    print_notes(_one_of_each())
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) <= 25 and all(len(line) <= 100 for line in lines), max(map(len, lines))
+    n_warnings = sum(severity(c.code) == "warning" for c in CODES) + (severity(CODES[0].code) == "warning")
+    assert lines[0].startswith(f"notes: {len(PROBLEM_CODES)} problems, {n_warnings} warnings, ")
+    assert lines[-1] == f"  ... {len(CODES) - 23} more codes (--verbose)"
+    shown = [line.split()[1] for line in lines[1:-1]]
+    labels = [line.split()[0] for line in lines[1:-1]]
+    assert labels == [severity(code) for code in shown]
+    assert labels == sorted(labels, key=["problem", "warning", "info"].index)  # problems, then warnings
+    n_problems, n_uncertain = len(PROBLEM_CODES), len(UNCERTAIN_CODES)
+    assert set(shown[n_problems : n_problems + n_uncertain]) == set(UNCERTAIN_CODES)  # then what makes it uncertain
+    assert f"{CODES[0].code} (2, head): " in lines[1 + shown.index(CODES[0].code)]
+    assert "a long measured sentence" not in "\n".join(lines)  # the full texts are not on the screen
+
+
+def test_verbose_shows_every_full_text(capsys):
+    notes = _one_of_each()
+    print_notes(notes, verbose=True)
+    err = capsys.readouterr().err
+    assert err.count("      - ") == len(notes) and "more codes" not in err
+    assert all(f"  {severity(c.code):<8}{c.code} (" in err for c in CODES)
+    assert all(len(line) <= 100 for line in err.splitlines() if line.startswith("      "))
+
+
+def test_severity_follows_the_verdict():
+    assert [severity(c) for c in ("modes_do_not_explain_frf", "count_undecided", "clipping", "resampled")] == [
+        "problem", "warning", "warning", "info"]  # fmt: skip
+    assert all(severity(c.code) == "warning" for c in CODES if c.uncertain)
+
+
+def test_stabilise_prints_the_verdict_then_the_notes(fixtures_dir, tmp_path, capsys):
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    drift = np.linspace(0.0, 2.0, rec.n_samples)[:, None]  # a drifting pelvis: uncertain
+    drifted = am.Recording(rec.fs, rec.base, rec.response + drift * (np.arange(4) == 2), rec.sensors)
+    path = am.write_recording_csv(drifted, tmp_path / "drift.csv")
+    assert main(["--quiet", "stabilise", str(path), "--orders", "2:16"]) == 0
+    out, err = capsys.readouterr()
+    assert out.strip().splitlines()[-1].startswith("quality: UNCERTAIN") and "drift" in out
+    assert err.startswith("notes: ") and "\n  warning drift (1, pelvis): Rerun with `--detrend linear`" in err
+    assert main(["--quiet", "--verbose", "stabilise", str(path), "--orders", "2:16"]) == 0
+    assert "      - " in capsys.readouterr().err
