@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from armaxmodal.cli.common import POSITIVE_INT, order_range, parse_pair
+from armaxmodal.cli.common import DETREND_HELP, POSITIVE_INT, order_range, parse_pair
 from armaxmodal.exceptions import DataError
 
 __all__ = ["add_parser", "run"]
@@ -29,7 +29,7 @@ def add_parser(sub, parents) -> None:
         "--modes", type=POSITIVE_INT, default=None, help="modes per recording (default: automatic)"
     )
     p.add_argument("--band", default=None, help="frequency band LO:HI in Hz")
-    p.add_argument("--detrend", choices=["mean", "linear", "none"], default="mean")
+    p.add_argument("--detrend", choices=["mean", "linear", "none"], default="mean", help=DETREND_HELP)
     p.add_argument("--sensors", default=None, help="comma-separated sensors to analyse (default: those most share)")
     p.add_argument("--lump", default=None, help="A,B: test whether segments A and B can be lumped (e.g. legs,feet)")
     p.add_argument("--model", action="store_true", help="fit the average subject's chain and scale it to each subject")

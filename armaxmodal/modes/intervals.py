@@ -18,7 +18,7 @@ Each quantity ``q`` (``freq`` for ``freq_hz``, ``damping``) of a selection row h
 
 The interval is the hull of ``value ± Z95 sd`` and the other three, scaled about the value by the
 share of the record's samples that carry information (filled samples do not). A damping ratio's
-parts are taken on its logarithm (``interval``; :func:`armaxmodal.stats.damping_interval`), so no
+parts are taken on its logarithm (``interval``; ``armaxmodal.stats.damping_interval``), so no
 damping interval reaches zero: one that spans a factor e^2 (where the symmetric interval of the
 same deviation reaches zero) or reaches critical damping is the record's ``damping_unresolved``. Each stage sets its
 own part and leaves the others', so no stage has to undo or re-derive another's widening.

@@ -187,7 +187,7 @@ class ModeCount:
     models: tuple[FittedModel, ...] = ()
 
     def models_table(self):
-        """Every model the count fitted, one row each (:class:`FittedModel`'s columns), in the order
+        """Every model the count fitted, one row each (``FittedModel``'s columns), in the order
         fitted: the removals, additions and splits tried at each step, their convergence, the halves'
         test, the equally good models.
 

@@ -185,3 +185,19 @@ def test_a_ride_with_a_filled_gap_gives_the_modes_of_the_whole_ride(fixtures_dir
     for whole, filled in zip(runs["whole"]["modes"], runs["filled"]["modes"], strict=True):
         assert whole["freq_ci95"][0] <= filled["freq_hz"] <= whole["freq_ci95"][1]
         assert whole["damping_ci95"][0] <= filled["damping"] <= whole["damping_ci95"][1]
+
+
+def test_every_flag_of_every_command_says_what_it_does():
+    """The command-line reference (docs/user_guide/cli.md) is written from the parser: a flag
+    without help text would be a bare name there."""
+    import argparse
+
+    from armaxmodal.cli.main import build_parser
+
+    parser = build_parser()
+    (commands,) = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    bare = [f"{name} {'/'.join(action.option_strings) or action.dest}"
+            for name, sub in commands.choices.items() for action in sub._actions
+            if not action.help and not isinstance(action, argparse._HelpAction)]  # fmt: skip
+    assert not bare, bare
+    assert all(choice.help for choice in commands._choices_actions)  # every command too
