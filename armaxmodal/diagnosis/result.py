@@ -125,7 +125,10 @@ class Diagnosis:
 
         final = _per_output(self.final.summary(self.noise_floor), self.final.model.signals.sensors, self.sensors)
         final.update(modes_before=modes(self.baseline), modes_after=modes(self.final))
+        from armaxmodal._version import __version__
+
         return {
+            "armaxmodal_version": __version__,
             "verdict": _verdict(self, final["whiteness_p"]),
             "fs": self.original_fs,
             "analysis_fs": self.recording.fs,

@@ -302,9 +302,13 @@ def record_header(recording: Recording, preparation: Preparation | None, warning
     Returns
     -------
     dict
-        ``fs`` (as recorded), ``analysis_fs``, ``preprocessing``, ``warnings``, ``input``, ``outputs``.
+        ``armaxmodal_version``, ``fs`` (as recorded), ``analysis_fs``, ``preprocessing``, ``warnings``,
+        ``input``, ``outputs``.
     """
+    from armaxmodal._version import __version__
+
     return {
+        "armaxmodal_version": __version__,  # the release the notes (docs: release notes) describe
         "fs": recording.fs if preparation is None else preparation.original_fs,
         "analysis_fs": recording.fs,
         "preprocessing": None if preparation is None else preparation.to_dict(),
