@@ -22,45 +22,23 @@ from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.disturbance import disturbance_lines
 from armaxmodal.modes.poles import SHARED, Tolerances, pole_rows, rejection_reasons, stability_classes
+from armaxmodal.modes.settings import SWEEP
 from armaxmodal.prepare.preparation import Preparation, prepare
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
 __all__ = ["stabilisation_diagram", "StabilisationDiagram", "choose_nk"]
 
-# A sweep fit stops when an iteration lowers the loss by less than this fraction (a tenth of
-# its statistical resolution, 1/N, for records up to 10^4 samples): enough to place poles.
-# The fits whose estimates are reported are finished to fit_armax's default criterion.
-SWEEP_TOL = 1e-5
-
-
-#: input delays the sweep searches (non-causal taps for band-limited data)
-NK_SEARCH = range(0, -7, -1)
-
-
-#: when the best delay is the most non-causal searched, this many more are tried once
-NK_EXTENSION = 3
-
-
-#: the middle orders at which the delay is chosen (jointly with the order, see choose_nk)
-DELAY_CHOICE_ORDERS = (8, 10, 12)
-
-
-#: iteration cap of the delay choice's fits; the sweep continues those of the chosen delay
-DELAY_CHOICE_ITERATIONS = 8
-
-
-#: samples the record must hold per parameter of one sensor's model (about 3 na + 1 - nk) at
-#: the sweep's highest order: fewer, and the fits describe the noise (and take minutes each)
-SAMPLES_PER_PARAMETER = 20
-
-
-#: the orders swept when none are given, capped at what the record supports
-DEFAULT_ORDERS = range(2, 31, 2)
-
-
-#: a default sweep capped below this top order has too few orders to show stability: refused
-MIN_DEFAULT_TOP = 8
+# The sweep's numbers, each explained where it is set (:class:`~armaxmodal.modes.settings.SweepSettings`),
+# under the names the sweep's code and its tests use
+SWEEP_TOL = SWEEP.tol
+NK_SEARCH = SWEEP.nk_search
+NK_EXTENSION = SWEEP.nk_extension
+DELAY_CHOICE_ORDERS = SWEEP.delay_choice_orders
+DELAY_CHOICE_ITERATIONS = SWEEP.delay_choice_iterations
+SAMPLES_PER_PARAMETER = SWEEP.samples_per_parameter
+DEFAULT_ORDERS = SWEEP.default_orders
+MIN_DEFAULT_TOP = SWEEP.min_default_top
 
 
 @dataclass(frozen=True)

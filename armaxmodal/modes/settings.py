@@ -26,6 +26,7 @@ __all__ = [
     "LineSettings",
     "NoteSettings",
     "SelectionSettings",
+    "SweepSettings",
 ]
 
 
@@ -332,3 +333,46 @@ class SelectionSettings:
 
 #: the defaults, shared by the functions that can also be called outside the pipeline
 DEFAULTS = SelectionSettings()
+
+
+@dataclass(frozen=True)
+class SweepSettings:
+    """The numbers of the stabilisation sweep (:func:`armaxmodal.stabilisation_diagram`), which runs
+    before any selection and so stands beside :class:`SelectionSettings`, not in it; the JSON
+    reports what they made (``orders_na``, ``nk``).
+
+    Attributes
+    ----------
+    tol : float
+        A sweep fit stops when an iteration lowers the loss by less than this fraction (a tenth
+        of its statistical resolution, 1/N, for records up to 10^4 samples): enough to place
+        poles. The fits whose estimates are reported are finished to ``fit_armax``'s default.
+    nk_search : tuple of int
+        The input delays searched (non-causal taps for band-limited data).
+    nk_extension : int
+        When the best delay is the most non-causal searched, this many more are tried, once.
+    delay_choice_orders : tuple of int
+        The middle orders at which the delay is chosen (jointly with the order: ``choose_nk``).
+    delay_choice_iterations : int
+        The delay choice's fits' iteration cap; the sweep continues those of the chosen delay.
+    samples_per_parameter : int
+        Samples the record must hold per parameter of one sensor's model (about 3 na + 1 - nk)
+        at the sweep's top order: fewer, and the fits describe the noise (and take minutes each).
+    default_orders : tuple of int
+        The orders swept when none are given, capped at what the record supports.
+    min_default_top : int
+        A default sweep capped below this top order has too few orders to show stability: refused.
+    """
+
+    tol: float = 1e-5
+    nk_search: tuple[int, ...] = tuple(range(0, -7, -1))
+    nk_extension: int = 3
+    delay_choice_orders: tuple[int, ...] = (8, 10, 12)
+    delay_choice_iterations: int = 8
+    samples_per_parameter: int = 20
+    default_orders: tuple[int, ...] = tuple(range(2, 31, 2))
+    min_default_top: int = 8
+
+
+#: the sweep's numbers
+SWEEP = SweepSettings()
