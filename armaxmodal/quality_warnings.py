@@ -163,11 +163,14 @@ CODES: tuple[WarningCode, ...] = (
     ),
     WarningCode(
         "damping_unresolved", "selection",
-        "a mode whose damping interval reaches zero, or whose damping estimate is not positive at some orders of the "
-        "sweep",
-        "kept when the measured FRF has a clear coherent peak there (below); its frequency stands, its damping is "
-        "below what the record resolves",
-        "Treat the damping as an upper bound; a longer record or more excitation near the mode narrows it.",
+        "a mode whose damping interval (taken on log ξ, it never reaches zero) spans a factor e² or more, where the "
+        "symmetric interval of the same deviation would reach zero, or reaches critical damping; or whose damping "
+        "estimate is not positive at some orders of the sweep",
+        "kept when the measured FRF has a clear coherent peak there; its frequency stands, its damping is known only "
+        "to its interval, and the note says why (too light for the record, the thirds disagree, or the equally good "
+        "models or the two estimators disagree)",
+        "Quote the damping with its interval; a longer record or more excitation near the mode narrows it, and "
+        "`diagnose` looks for what the thirds or the models disagree about.",
     ),
     WarningCode(
         "split_merged", "selection",

@@ -281,6 +281,9 @@ def unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[Quality
         if getattr(m, "model_error_dominates", False):
             why = ("the interval is the spread of the record's thirds (model_error_dominates): the thirds disagree "
                    "about this damping; run 'armaxmodal diagnose'")  # fmt: skip
+        elif getattr(m, "structure_widened", False) or getattr(m, "estimator_widened", False):
+            why = ("the interval covers the other models the record finds as good (another number of modes, two poles "
+                   "reported as one) or the other estimator's value, which disagree about this damping")  # fmt: skip
         else:
             why = "the damping is below what this record resolves: a longer record, or more excitation here, narrows it"
         notes.append(QualityWarning(

@@ -338,6 +338,10 @@ def test_unresolved_damping_notes_state_the_facts_and_the_reason():
         "positive at 2 of 10 orders. the interval is the spread of the record's thirds (model_error_dominates): "
         "the thirds disagree about this damping; run 'armaxmodal diagnose'"
     )
+    (note,) = _unresolved_damping_notes(_notes_modes(damping_ci95_hi=0.05, structure_widened=True), 10)
+    assert note.message.endswith("the interval covers the other models the record finds as good (another number of "
+                                 "modes, two poles reported as one) or the other estimator's value, which disagree "
+                                 "about this damping")  # fmt: skip
     two = pd.concat([_notes_modes(damping_ci95_lo=-0.001), _notes_modes(freq_hz=9.0, damping_ci95_lo=0.0)])
     assert [n.value for n in _unresolved_damping_notes(two, 10)] == [4.0, 9.0]
 
