@@ -359,9 +359,20 @@ ACT_ON_CODES = ("duplicate_channel", "inverted_sensor", "sensor_delay", "narrowb
 
 
 def severity(code: str) -> str:
-    """How a note moves the verdict, as the command line labels it: ``"problem"`` (the verdict is
-    poor), ``"warning"`` (the verdict is uncertain, or the user must act on it) or ``"info"``
-    (said, and dealt with: a bridged rounding, a resampling, how the count went)."""
+    """How a note moves the verdict, as the command line labels it.
+
+    Parameters
+    ----------
+    code : str
+        A warning code (``WARNING_CODES``).
+
+    Returns
+    -------
+    str
+        ``"problem"`` (the verdict is poor), ``"warning"`` (the verdict is uncertain, or the user
+        must act on it) or ``"info"`` (said, and dealt with: a rounding read through, a
+        resampling, how the count went).
+    """
     if code in PROBLEM_CODES:
         return "problem"
     return "warning" if code in UNCERTAIN_CODES or code in ACT_ON_CODES else "info"

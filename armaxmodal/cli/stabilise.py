@@ -86,7 +86,8 @@ def run(args) -> int:
         check_positions(positions, list(rec.sensors))
     if not args.quiet:
         outputs = ", ".join(rec.sensors)
-        print(f"{args.data}: input {rec.input_name}; outputs {outputs}; {rec.n_samples} samples at {rec.fs:g} Hz")
+        read = f"{rec.n_samples} samples at {rec.fs:g} Hz"
+        print(_fill(f"{args.data}: input {rec.input_name}; outputs {outputs}; {read}"))
     diagram = stabilisation_diagram(rec, orders, band=band, detrend=args.detrend, progress=not args.quiet)
     try:
         selection = select_modes(diagram, args.modes, band, progress=not args.quiet, picks=picks)
@@ -99,21 +100,7 @@ def run(args) -> int:
         prep = diagram.preparation
         if prep is not None and prep.analysis_fs != prep.original_fs:
             print(f"analysis at {prep.analysis_fs:g} Hz (resampled from {prep.original_fs:g} Hz)")
-        print(
-            selection.modes[
-                [
-                    "freq_hz",
-                    "damping",
-                    "damped_freq_hz",
-                    "freq_ci95_lo",
-                    "freq_ci95_hi",
-                    "damping_ci95_lo",
-                    "damping_ci95_hi",
-                    "count",
-                    *(["picked_hz"] if "picked_hz" in selection.modes else []),
-                ]
-            ].to_string(float_format=lambda v: f"{v:.4f}")
-        )
+        print_modes(selection.modes)
         if selection.check is not None:
             print_check(selection.check)
     outputs = _diagram_outputs(args, diagram, selection, plot_format)
@@ -134,7 +121,7 @@ def run(args) -> int:
         report = selection.to_dict(args.shapes.replace("-", "_"))
         outputs.append((args.json, lambda tmp: write_json(report, tmp)))
     write_outputs(outputs)
-    print(selection.verdict, flush=True)
+    print(_fill(selection.verdict), flush=True)
     print_notes(selection.warnings, args.verbose)  # after the verdict: what it rests on, one line per code
     return 0
 
@@ -185,12 +172,33 @@ def _picks(text: str | None, n_modes: int | None) -> list[float] | None:
         ) from exc
 
 
+def _fill(text: str) -> str:
+    """``text`` wrapped to the notes' width, continuation lines indented."""
+    import textwrap
+
+    from armaxmodal.cli.common import NOTE_WIDTH
+
+    return textwrap.fill(text, NOTE_WIDTH, subsequent_indent="  ", break_on_hyphens=False)
+
+
+def print_modes(modes) -> None:
+    """The modes as a person reads them, within the notes' width: frequency and damping, each
+    with its 95 % interval, the orders that support it, and the pick it answers (the JSON and
+    ``--csv`` hold every column)."""
+    picked = "picked_hz" in modes and np.isfinite(modes.picked_hz.to_numpy(float)).any()
+    print(f"{'mode':>4} {'f (Hz)':>9}  {'95 % interval (Hz)':<22} {'damping':>7}  {'95 % interval':<16} {'orders':>6}"
+          + ("  picked (Hz)" if picked else ""))  # fmt: skip
+    for k, m in enumerate(modes.itertuples(index=False), start=1):
+        f_ci = f"[{m.freq_ci95_lo:.4f}, {m.freq_ci95_hi:.4f}]"
+        x_ci = f"[{m.damping_ci95_lo:.4f}, {m.damping_ci95_hi:.4f}]"
+        pick = f"  {m.picked_hz:11.4f}" if picked and np.isfinite(m.picked_hz) else ""
+        print(f"{k:>4} {m.freq_hz:9.4f}  {f_ci:<22} {m.damping:7.4f}  {x_ci:<16} {int(m.count):>6}{pick}")
+
+
 def print_check(check) -> None:
     """The modal-model check per output, beside the H1's own random error."""
-    print(
-        "modal-model check (LSFD of each H1 by the selected poles, residual terms and a delay; "
-        f"model error = misfit beyond the H1's random error, limit {100 * check.limit:.0f} %):"
-    )
+    print(_fill("modal-model check (LSFD of each H1 by the selected poles, residual terms and a delay; model error = "
+                f"misfit beyond the H1's random error, limit {100 * check.limit:.0f} %):"))  # fmt: skip
     for k, sensor in enumerate(check.sensors):
         if not np.isfinite(check.error[k]):
             print(f"  {sensor}: not checked (too few lines where its coherence is at least 0.8)")

@@ -241,19 +241,16 @@ def confirmed_where_incoherent(diagram, work: SelectionState, settings: Selectio
 
 
 def dropped_where_peaks_remain(count: ModeCount | None, peaks, same_row_freq: float) -> list[QualityWarning]:
-    """A ``count_undecided`` note for each starting mode the count did not report as unfounded
-    (``count.carried_away``, left out; ``count.stand_ins``, kept in the model unreported) while
-    the measured FRF keeps a coherent peak that no reported mode explains within
-    ``same_row_freq`` of where it started or went (``peaks``: the ``unexplained_peak`` notes).
-    The two kinds of evidence disagree: the halves test is weak on a transient input (an
-    earthquake's record), and the H1 still shows a resonance there. Inglewood's 5.83 Hz start went
-    to 4.40 Hz, unfounded, with coherent peaks left at 5.77 and 4.38 Hz."""
+    """A ``count_undecided`` note for each starting mode the count left out as unfounded
+    (``count.carried_away``) while the measured FRF keeps a coherent peak that no reported mode
+    explains within ``same_row_freq`` of where it started or went (``peaks``: the
+    ``unexplained_peak`` notes). The two kinds of evidence disagree: the halves test is weak on a
+    transient input (an earthquake's record), and the H1 still shows a resonance there. (A stand-in,
+    kept in the model unreported, is undecided already inside the band: ``notes.count_notes``.)"""
     if count is None:
         return []
     notes = []
-    unreported = [(start, went, "left out") for start, went in count.carried_away]
-    unreported += [(start, went, "kept in the model but not reported") for start, went, _ in count.stand_ins]
-    for start, went, fate in unreported:
+    for start, went, fate in [(start, went, "left out") for start, went in count.carried_away]:
         near = [p.value for p in peaks
                 if min(abs(np.log(p.value / start)), abs(np.log(p.value / went))) <= same_row_freq]  # fmt: skip
         if near:

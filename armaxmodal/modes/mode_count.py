@@ -203,7 +203,14 @@ class ModeCount:
 
     def to_dict(self) -> dict:
         """The count's evidence for the JSON: the effective fraction of the lines, the fits run, the
-        accepted steps and every model fitted (:meth:`models_table`); no NaN (None instead)."""
+        accepted steps and every model fitted (:meth:`models_table`).
+
+        Returns
+        -------
+        dict
+            ``effective_fraction``, ``trials``, ``steps`` and ``models``, strict-JSON-ready (None for NaN),
+            as ``schemas/stabilise.schema.json``'s ``count`` describes.
+        """
 
         def finite(value):
             return float(value) if value is not None and np.isfinite(value) else None

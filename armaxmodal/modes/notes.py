@@ -133,12 +133,17 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             "is part of their uncertainty", float(len(widened)),
         ))  # fmt: skip
     for start, went, rise_without in count.stand_ins:
+        # inside the band, a pole the likelihood needs is the record's own: it does not decide whether a mode
+        # is there (a body's 17.40 Hz mode stood there, its halves disagreeing, under 'good')
+        inside = band_hz[0] <= went <= band_hz[1]
         notes.append(QualityWarning(
-            "mode_count", (),
+            "count_undecided" if inside else "mode_count", (),
             f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
             "damping unresolved, or not the same in both halves of the record), but the model needs it (without it "
             f"the criterion rises by {rise_without:.1f}): it stays in the model, as a pole for what the record does "
-            "not resolve there, and is not reported", went,
+            "not resolve there, and is not reported"
+            + ("; whether a mode is there, the record does not decide: compare another record of the structure, or "
+               "pick it ('--pick') to see what the record says of it" if inside else ""), went,
         ))  # fmt: skip
     outside = ~reported(count.model, band_hz)  # beyond the band, overdamped or lines (not the stand-ins)
     hidden = int(outside.sum())

@@ -104,3 +104,13 @@ def test_a_selection_reports_its_parts_and_widens_for_filled_samples():
         np.testing.assert_allclose(np.log(b[col] / b.damping), k * np.log(a[col] / a.damping), rtol=1e-6)
     own = with_intervals(a.drop(columns=[c for c in a if "other" in c or "segment_half" in c]))
     assert np.all(a.freq_ci95_lo <= own.freq_ci95_lo) and np.all(a.freq_ci95_hi >= own.freq_ci95_hi)
+
+
+def test_a_damping_that_is_not_positive_has_no_interval_on_the_logarithm():
+    """A pole with zero or negative damping (a line, an unstable pole) has no log-scale interval:
+    NaN, not a mirrored or infinite one."""
+    from armaxmodal.stats import damping_interval
+
+    lo, hi = damping_interval(np.array([-0.01, 0.0, 0.02]), np.array([0.001, 0.001, Z95 * 0.001]))
+    assert np.isnan(lo[:2]).all() and np.isnan(hi[:2]).all()
+    assert (lo[2], hi[2]) == pytest.approx(_log(0.02, Z95 * 0.001), rel=1e-12)

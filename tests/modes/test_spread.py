@@ -95,3 +95,9 @@ def test_a_segment_that_blends_a_close_pair_measures_neither_mode():
     crowded[(orders, 1)] = poles(10.10, 10.20)
     table = segment_spread(None, modes, lambda i: orders, 3, fitted=crowded)
     assert table.segments_found.tolist() == [2, 2]
+    # a segment whose fit failed (None), found no pole, or found one growing (negative damping) where a
+    # mode is, gives neither mode of the pair a value
+    growing = pd.DataFrame({"freq_hz": [10.12, 10.41], "damping": [-0.01, 0.01]})
+    for failed in (None, poles(), growing):
+        table = segment_spread(None, modes, lambda i: orders, 3, fitted={**fitted, (orders, 1): failed})
+        assert table.segments_found.tolist() == [2, 2]
