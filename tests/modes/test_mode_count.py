@@ -120,6 +120,24 @@ def _assert_table_tells_the_search(count, data, n_start):
     assert np.isclose(table.bic, count.model.bic(n_eff), rtol=1e-12).any()
 
 
+def test_the_tables_rows_are_on_the_effective_lines(supine):
+    """A row's -2 ln L and BIC are the model's on the effective lines (here half of them, as a
+    correlated residual gives), and the halves' answer goes into the row of the model asked."""
+    from armaxmodal.modes.mode_count import ModelTable
+
+    data, truth = supine
+    model = fit_modal_model(data, truth.freq_hz, truth.damping, "zoh", max_nfev=1)
+    half = data.n_real * data.y.shape[1] / 2
+    table = ModelTable(half)
+    assert table.add("start", np.nan, model) is model and table.add("add", 9.0, None) is None
+    other = table.add("remove", 5.8, fit_modal_model(data, truth.freq_hz[1:], truth.damping[1:], "zoh", max_nfev=1))
+    row = table.rows[0]
+    assert row.neg2_loglik == pytest.approx(model.neg2_loglik / 2) and row.bic == pytest.approx(model.bic(half))
+    assert (row.action, row.n_modes, row.n_params, row.halves_agree) == ("start", 4, model.n_params, None)
+    assert table.halves(other, False) is False and [r.halves_agree for r in table.rows] == [None, False]
+    assert len(table.rows) == 2 and table.rows[1].freq_hz == 5.8
+
+
 def test_the_penalty_grows_with_the_data(supine):
     """BIC's ``p ln N``: the same models on half the lines are judged with a smaller penalty."""
     data, truth = supine
