@@ -70,3 +70,23 @@ def test_the_report_groups_the_notes_by_code_what_moves_the_verdict_first(tmp_pa
 
     advice = next(c.advice for c in CODES if c.code == "count_undecided")
     assert f"<p>{__import__('html').escape(advice)}</p>" in html
+
+
+def test_the_report_of_an_uncertain_run_shows_its_notes_in_a_browser(fixtures_dir, tmp_path):
+    """A drifting pelvis makes the run uncertain: the page, as headless Chromium renders it, holds
+    the verdict, the notes that make it so with their full texts, and what made it (version, date,
+    command)."""
+    import numpy as np
+
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    drift = np.linspace(0.0, 2.0, rec.n_samples)[:, None] * (np.arange(4) == 2)
+    path = am.write_recording_csv(am.Recording(rec.fs, rec.base, rec.response + drift, rec.sensors),
+                                  tmp_path / "drift.csv")  # fmt: skip
+    page = tmp_path / "run.html"
+    assert main(["--quiet", "stabilise", str(path), "--orders", "2:16", "--report", str(page)]) == 0
+    dom, console_errors = open_in_headless_chromium(page, tmp_path / "profile")
+    assert not console_errors and 'class="verdict uncertain"' in dom and "quality: UNCERTAIN" in dom
+    notes = dom[dom.index("<h2 id=\"notes\">") if "<h2 id=\"notes\">" in dom else dom.index("<h2 id=notes>"):]
+    assert "<b>drift</b> (1): makes the verdict uncertain" in notes and "pelvis" in notes
+    assert f"<td>{am.__version__}</td>" in dom and "run at (UTC)" in dom
+    assert f"armaxmodal --quiet stabilise {path} --orders 2:16 --report {page}" in dom
