@@ -486,3 +486,8 @@ def test_a_time_column_rounded_to_its_printed_decimals_is_read_at_its_spans_rate
     rounded.drop(index=[3000]).to_csv(path, index=False)
     codes = [w.code for w in am.read_recording(path).meta["read_warnings"]]
     assert "dropped_packet" in codes
+    # the same column in milliseconds, printed to 3 decimals fewer: its digit is the same in seconds
+    in_ms = frame.assign(time=(frame.time * 1000).round(decimals - 3)).rename(columns={"time": "time_ms"})
+    in_ms.to_csv(path, index=False)
+    (note,) = am.read_recording(path).meta["read_warnings"]
+    assert note.code == "time_rounded" and f"printed to 1e-0{decimals} s" in note.message
