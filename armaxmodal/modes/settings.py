@@ -338,7 +338,8 @@ DEFAULTS = SelectionSettings()
 @dataclass(frozen=True)
 class SweepSettings:
     """The numbers of the stabilisation sweep (:func:`armaxmodal.stabilisation_diagram`), which runs
-    before any selection and so stands beside :class:`SelectionSettings`, not in it; the JSON
+    before any selection and so stands beside
+    :class:`~armaxmodal.modes.settings.SelectionSettings`, not in it; the JSON
     reports what they made (``orders_na``, ``nk``).
 
     Attributes
