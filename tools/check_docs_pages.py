@@ -28,10 +28,12 @@ PAGES = {
     "validation/simulated.html": "Validation: simulated systems",
     "validation/real.html": "Validation: measured records",
     "validation/limits.html": "Validation: limits",
-    "user_guide/warnings.html": "Warning codes",
+    "user_guide/warnings.html": "Notes and warning codes",
+    "user_guide/cli.html": "Command-line reference",
     "performance.html": "Performance",
     "api.html": "API reference",
-    "changelog.html": "Changelog",
+    "release_notes.html": "Release notes",
+    "changelog.html": "Development notes",
 }
 
 
