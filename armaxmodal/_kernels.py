@@ -303,3 +303,88 @@ def max_root_radius_below(p, radius):
             b[i] = (a[i] - k * a[m - i]) / denom
         a = b
     return True
+
+
+@njit(**JIT_OPTIONS)
+def modal_basis(s, z_inv, u, lam, dt, bandlimited, basis, slopes):
+    """Fill the DFT modal model's basis and each pole's slopes, a line at a time.
+
+    Parameters
+    ----------
+    s, z_inv, u : (L,) complex128
+        Each line's ``i omega``, ``exp(-i omega dt)`` and input DFT.
+    lam : (n,) complex128
+        The upper poles (rad/s).
+    dt : float
+        Sample interval (s).
+    bandlimited : bool
+        Plant columns ``u / (s - lam)`` (True) or the held ``u / (1 - mu z^-1)`` (False).
+    basis : (2 L, 4 n + 2) float64, filled
+        Real parts of the lines over their imaginary parts; columns: a real pair per mode
+        (``h + h'`` and ``i (h - h')`` for the pole's plant ``h`` and its conjugate's ``h'``),
+        the input, a transient pair per mode (the same of ``1 / (1 - mu z^-1)``), a constant.
+    slopes : (4, n, L) complex128, filled
+        ``d/d lambda`` of the plant at the pole and at its conjugate, then of the transient.
+    """
+    n_lines, n = s.size, lam.size
+    for j in range(n):
+        for conj in range(2):
+            p = lam[j] if conj == 0 else np.conj(lam[j])
+            mu = np.exp(p * dt)
+            for line in range(n_lines):
+                held = 1.0 / (1.0 - mu * z_inv[line])
+                held_slope = dt * mu * z_inv[line] * held * held
+                if bandlimited:
+                    plant = u[line] / (s[line] - p)
+                    plant_slope = plant / (s[line] - p)
+                else:
+                    plant, plant_slope = u[line] * held, u[line] * held_slope
+                slopes[conj, j, line], slopes[2 + conj, j, line] = plant_slope, held_slope
+                _put_pair(basis, line, n_lines, 2 * j, plant, conj)
+                _put_pair(basis, line, n_lines, 2 * n + 1 + 2 * j, held, conj)
+    for line in range(n_lines):
+        basis[line, 2 * n], basis[n_lines + line, 2 * n] = u[line].real, u[line].imag
+        basis[line, 4 * n + 1], basis[n_lines + line, 4 * n + 1] = 1.0, 0.0
+
+
+@njit(**JIT_OPTIONS)
+def _put_pair(basis, line, n_lines, col, h, conj):
+    """Add ``h`` (the pole's, conj 0, or its conjugate's, conj 1) to its pair's two columns."""
+    sign = 1.0 if conj == 0 else -1.0
+    a = h  # column a: h + h'
+    b = 1j * sign * h  # column b: i (h - h')
+    if conj == 0:
+        basis[line, col], basis[n_lines + line, col] = a.real, a.imag
+        basis[line, col + 1], basis[n_lines + line, col + 1] = b.real, b.imag
+    else:
+        basis[line, col] += a.real
+        basis[n_lines + line, col] += a.imag
+        basis[line, col + 1] += b.real
+        basis[n_lines + line, col + 1] += b.imag
+
+
+@njit(**JIT_OPTIONS)
+def modal_moved(slopes, alpha, beta, d_lam, out):
+    """``-dA/dx coef`` of the modal model, every sensor and parameter at once.
+
+    Parameters
+    ----------
+    slopes : (4, n, L) complex128
+        As :func:`modal_basis` fills them.
+    alpha, beta : (n, S) complex128
+        Each mode's plant and transient coefficient per sensor (its pair's two real
+        coefficients as one complex number).
+    d_lam : (n, 2) complex128
+        ``d lambda / d x`` for x = (log omega_n, xi) per mode.
+    out : (2 L, S, 2 n) float64, filled
+        Real parts over imaginary parts, as the basis's rows.
+    """
+    n, n_lines = slopes.shape[1], slopes.shape[2]
+    for j in range(n):
+        for line in range(n_lines):
+            for k in range(alpha.shape[1]):
+                own = slopes[0, j, line] * alpha[j, k] + slopes[2, j, line] * beta[j, k]
+                partner = slopes[1, j, line] * np.conj(alpha[j, k]) + slopes[3, j, line] * np.conj(beta[j, k])
+                for i in range(2):
+                    m = -(d_lam[j, i] * own + np.conj(d_lam[j, i]) * partner)
+                    out[line, k, 2 * j + i], out[n_lines + line, k, 2 * j + i] = m.real, m.imag

@@ -86,3 +86,41 @@ def sdp_inner_cvxpy(lam, psi, allowed, mass_ratio_bounds=None):
         ]
     cp.Problem(cp.Minimize(cp.sum_squares(cp.hstack(parts))), cons).solve(solver=cp.CLARABEL)
     return np.asarray(m.value), np.asarray(c.value) * w_ref, np.asarray(k.value) * w_ref**2
+
+
+def modal_basis(s, z_inv, u, lam, dt, bandlimited):
+    """The DFT modal model's real basis and its pole slopes, a column at a time in numpy:
+    ``(basis (2 L, 4 n + 2), slopes (4, n, L))`` as ``armaxmodal._kernels.modal_basis`` fills them."""
+
+    def held(p, slope):
+        mu = np.exp(p * dt)
+        den = 1 - mu * z_inv
+        return dt * mu * z_inv / den**2 if slope else 1 / den
+
+    def plant(p, slope):
+        if bandlimited:
+            return u / (s - p) ** (slope + 1)
+        return u * held(p, slope)
+
+    def pair(h, h_conj):
+        return [h + h_conj, 1j * (h - h_conj)]
+
+    cols = [c for p in lam for c in pair(plant(p, 0), plant(np.conj(p), 0))] + [u]
+    cols += [c for p in lam for c in pair(held(p, 0), held(np.conj(p), 0))] + [np.ones_like(s)]
+    basis = np.array(cols).T
+    slopes = np.array([[f(q, 1) for q in poles] for f in (plant, held) for poles in (lam, np.conj(lam))])
+    return np.vstack([basis.real, basis.imag]), slopes
+
+
+def modal_moved(slopes, alpha, beta, d_lam):
+    """``-dA/dx coef`` per sensor and parameter, (2 L, S, 2 n), a mode and parameter at a time."""
+    n, lines = slopes.shape[1], slopes.shape[2]
+    out = np.empty((2 * lines, alpha.shape[1], 2 * n))
+    for j in range(n):
+        for i in range(2):
+            g = d_lam[j, i]
+            own = np.outer(slopes[0, j], alpha[j]) + np.outer(slopes[2, j], beta[j])
+            partner = np.outer(slopes[1, j], np.conj(alpha[j])) + np.outer(slopes[3, j], np.conj(beta[j]))
+            m = -(g * own + np.conj(g) * partner)
+            out[:lines, :, 2 * j + i], out[lines:, :, 2 * j + i] = m.real, m.imag
+    return out

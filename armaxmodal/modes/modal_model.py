@@ -220,25 +220,17 @@ class _GramCompressed:
     """The projected residual and Jacobian reduced to ``n + 1`` rows through the normal
     equations: ``[R; 0]`` and ``[R^-T J'r; sqrt(|r|^2 - |R^-T J'r|^2)]`` with ``R'R = J'J``
     have the same ``J'J``, ``J'r`` and ``|r|`` as the full rows, so a trust-region solver
-    takes the same steps. Ten times cheaper than the QR of the rows that
-    :class:`armaxmodal.modes.refine._Compressed` takes (0.07 against 0.8 ms for 6,600 x 9):
-    the nested tests run dozens of fits, and their Jacobians are well conditioned in
-    ``(ln omega, xi)``."""
+    takes the same steps. The normal equations come without the Jacobian's rows
+    (:meth:`armaxmodal.modes.refine._SeparableModel.normal_equations`): the nested tests run
+    dozens of fits, and their Jacobians are well conditioned in ``(ln omega, xi)``."""
 
-    def __init__(self, model: _SeparableModel, all_rows_at_once: int):
-        self.model, self.all_rows_at_once = model, all_rows_at_once
+    def __init__(self, model: _SeparableModel):
+        self.model = model
         self._x = None
 
     def _factor(self, x):
         if self._x is None or not np.array_equal(x, self._x):
-            if self.model.b.size <= self.all_rows_at_once:
-                # all sensors' rows at once: the basis's derivative is built once, not per sensor
-                rows = [(self.model.jacobian(x), self.model.residual(x))]
-            else:  # a long record: one sensor's rows at a time (memory), as refine's fits do
-                rows = self.model.sensor_rows(x)
-            gram, grad, power = 0.0, 0.0, 0.0
-            for jac, resid in rows:
-                gram, grad, power = gram + jac.T @ jac, grad + jac.T @ resid, power + resid @ resid
+            gram, grad, power = self.model.normal_equations(x)
             gram = gram + 1e-12 * np.trace(gram) * np.eye(x.size) / x.size  # a null direction stays solvable
             r = scipy.linalg.cholesky(gram, lower=False, check_finite=False)
             top = scipy.linalg.solve_triangular(r, grad, trans="T", check_finite=False)
@@ -281,7 +273,7 @@ def fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited",
     max_nfev : int
         Cap on residual evaluations.
     settings : DftSettings
-        The damping bounds, the stopping tolerance and the Jacobian's block size.
+        The damping bounds and the stopping tolerance.
 
     Returns
     -------
@@ -298,7 +290,7 @@ def _fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited"
     model = _SeparableModel(data.s, data.z_inv, data.u, data.y, data.dt, hold)
     if 2 * data.s.size < 3 * (4 * start.size // 2 + 2):
         raise OrderError(f"{data.s.size} DFT lines cannot fit {start.size // 2} modes; record longer.")
-    compressed = _GramCompressed(model, settings.all_rows_at_once)
+    compressed = _GramCompressed(model)
     res = scipy.optimize.least_squares(
         compressed.residual, start, jac=compressed.jacobian, bounds=(lo, hi), x_scale="jac", max_nfev=max_nfev,
         ftol=settings.fit_tol, xtol=settings.fit_tol,

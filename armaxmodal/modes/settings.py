@@ -183,9 +183,6 @@ class DftSettings:
     #: 120 s ride of five sensors, far below the criterion's decisive 10, and the parameters by
     #: a thousandth of their standard error (0.1-2 % of a frequency)
     fit_tol: float = 1e-6
-    #: up to this many real numbers (lines x 2 x sensors) a fit's Jacobian is built for every sensor
-    #: at once (2 MB a parameter at the limit); beyond, a sensor at a time
-    all_rows_at_once: int = 250_000
 
     def __post_init__(self):
         _checked(self)

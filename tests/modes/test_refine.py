@@ -154,3 +154,46 @@ def test_refit_errors_agree_with_the_armax_bound_on_held_data():
     ratio_x = ref.damping_sd / armax.damping_sd.to_numpy()
     assert np.all((ratio_f > 0.5) & (ratio_f < 2.0)), ratio_f
     assert np.all((ratio_x > 0.5) & (ratio_x < 2.0)), ratio_x
+
+
+@pytest.mark.parametrize("hold", ["bandlimited", "zoh"])
+def test_the_modal_kernels_equal_their_column_by_column_references(hold):
+    """The basis, the pole slopes and ``-dA/dx coef`` from the kernels, against numpy built a
+    column at a time (tests/naive.py), on random lines, poles and coefficients."""
+    from armaxmodal._kernels import modal_basis, modal_moved
+    from armaxmodal.modes.refine import _pole_derivatives
+    from tests import naive
+
+    rng = np.random.default_rng(7)
+    dt, lines, n, sensors = 0.01, 300, 3, 4
+    w = np.sort(rng.uniform(1, 150, lines))
+    s, z_inv, u = 1j * w, np.exp(-1j * w * dt), rng.standard_normal(lines) + 1j * rng.standard_normal(lines)
+    x = np.ravel(np.column_stack([np.log(rng.uniform(10, 120, n)), rng.uniform(0.01, 0.3, n)]))
+    lam = -x[1::2] * np.exp(x[0::2]) + 1j * np.exp(x[0::2]) * np.sqrt(1 - x[1::2] ** 2)
+    basis, slopes = np.empty((2 * lines, 4 * n + 2), order="F"), np.empty((4, n, lines), complex)
+    modal_basis(s, z_inv, u, lam, dt, hold == "bandlimited", basis, slopes)
+    want_basis, want_slopes = naive.modal_basis(s, z_inv, u, lam, dt, hold == "bandlimited")
+    np.testing.assert_allclose(basis, want_basis, rtol=1e-12, atol=1e-12 * np.abs(want_basis).max())
+    np.testing.assert_allclose(slopes, want_slopes, rtol=1e-12)
+    alpha, beta = (rng.standard_normal((n, sensors)) + 1j * rng.standard_normal((n, sensors)) for _ in range(2))
+    moved = np.empty((2 * lines, sensors, 2 * n))
+    modal_moved(slopes, alpha, beta, _pole_derivatives(x), moved)
+    want = naive.modal_moved(want_slopes, alpha, beta, _pole_derivatives(x))
+    np.testing.assert_allclose(moved, want, rtol=1e-12, atol=1e-12 * np.abs(want).max())
+
+
+@pytest.mark.parametrize("at_nyquist", [False, True])
+def test_the_normal_equations_equal_those_of_the_jacobians_rows(fixtures_dir, at_nyquist):
+    """``J'J``, ``J'r`` and ``|r|^2`` without the rows equal those of the formed Jacobian, also
+    where a fit has put an undamped pole at the Nyquist frequency (30 Hz for this 60 Hz ride, as a
+    count's fit did): its slope lies almost in the basis and the difference of squares alone kept
+    no digit of its diagonal."""
+    model = _supine_model(fixtures_dir, "bandlimited")
+    freq = np.array([5.8, 8.3, 13.5, 16.2] + ([30.0] if at_nyquist else []))
+    damping = np.array([0.26, 0.35, 0.3, 0.27] + ([1e-4] if at_nyquist else []))
+    x = np.ravel(np.column_stack([np.log(2 * np.pi * freq), damping]))
+    j, r = model.jacobian(x), model.residual(x).copy()
+    gram, grad, power = model.normal_equations(x)
+    np.testing.assert_allclose(gram, j.T @ j, rtol=1e-8, atol=1e-10 * np.abs(j.T @ j).max())
+    np.testing.assert_allclose(grad, j.T @ r, rtol=1e-6, atol=1e-9 * np.abs(j.T @ r).max())
+    assert power == pytest.approx(r @ r, rel=1e-12)
