@@ -61,7 +61,7 @@ def run(args) -> int:
             print(prediction.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
     outputs = []
     if args.plot:
-        from armaxmodal.modes.plot import plot_prediction
+        from armaxmodal.io.report.diagram_plot import plot_prediction
 
         axes = plot_prediction(rec, prediction.attrs["prediction"], prediction.fit_percent.to_numpy())
         outputs.append((args.plot, lambda tmp: axes[0].figure.savefig(tmp, dpi=150, format=plot_format)))

@@ -81,7 +81,7 @@ def run(args) -> int:
     if picks is not None:  # refused before the sweep, not after it
         check_picks(picks, band, rec.fs)
     if positions is not None:
-        from armaxmodal.modes.shape_plot import check_positions
+        from armaxmodal.io.report.shape_plot import check_positions
 
         check_positions(positions, list(rec.sensors))
     if not args.quiet:
@@ -105,14 +105,14 @@ def run(args) -> int:
             print_check(selection.check)
     outputs = _diagram_outputs(args, diagram, selection, plot_format)
     if args.shapes_plot:
-        from armaxmodal.modes.shape_plot import plot_shapes
+        from armaxmodal.io.report.shape_plot import plot_shapes
 
         shapes_fig = plot_shapes(selection, positions=positions)
         outputs.append((args.shapes_plot, lambda tmp: shapes_fig.savefig(tmp, dpi=150, format=shapes_format)))
     if args.uff:
         outputs.append((args.uff, _uff_writer(selection)))
     if args.report:
-        from armaxmodal.modes.report import render_selection_report
+        from armaxmodal.io.report.selection_report import render_selection_report
 
         used = {"band (Hz)": args.band, "detrend": args.detrend}
         page = render_selection_report(selection, selection.verdict, args.data, used, _provenance(args))

@@ -9,7 +9,7 @@ import html
 
 import pandas as pd
 
-from armaxmodal.io.html_page import figure_uri, page, table
+from armaxmodal.io.report.html_page import figure_uri, page, table
 
 __all__ = ["effects_table", "render_diagnosis_report", "short_parameters"]
 

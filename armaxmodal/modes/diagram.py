@@ -94,7 +94,7 @@ class StabilisationDiagram:
         return self.poles.drop(columns=["pole", "vector"])
 
     def plot(self, selection=None, ax=None):
-        from armaxmodal.modes.plot import plot_stabilisation
+        from armaxmodal.io.report.diagram_plot import plot_stabilisation
 
         return plot_stabilisation(self, selection, ax=ax)
 

@@ -103,7 +103,7 @@ class ModeSelection:
         """A notebook's view: the verdict and the modes with their intervals."""
         import html
 
-        from armaxmodal.modes.report import modes_table
+        from armaxmodal.io.report.selection_report import modes_table
 
         table = modes_table(self).to_html(index=False, float_format=lambda v: f"{v:.4g}", border=0)
         return f"<p><b>{html.escape(self.verdict)}</b></p>{table}"

@@ -1,4 +1,4 @@
-"""The study as one self-contained HTML page (:mod:`armaxmodal.io.html_page`, the one-record
+"""The study as one self-contained HTML page (:mod:`armaxmodal.io.report.html_page`, the one-record
 reports' look): settings, tables, figures embedded as data URIs, failures with reasons."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import html
 import numpy as np
 import pandas as pd
 
-from armaxmodal.io.html_page import figure_uri, page, table
+from armaxmodal.io.report.html_page import figure_uri, page, table
 
 __all__ = ["render_report"]
 

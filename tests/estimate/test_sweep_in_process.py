@@ -418,7 +418,7 @@ def test_the_figure_draws_the_h1_and_coherence_the_check_judged(diagram, monkeyp
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    import armaxmodal.modes.plot as plot
+    import armaxmodal.io.report.diagram_plot as plot
     from armaxmodal.spectra import measured_frf
 
     asked = []
@@ -444,7 +444,7 @@ def test_the_frf_axis_spans_the_curves_inside_the_input_band():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from armaxmodal.modes.plot import _limit_frf_axis
+    from armaxmodal.io.report.diagram_plot import _limit_frf_axis
     from armaxmodal.spectra import excited_band, measured_frf
 
     s, _ = _two_mode_ride(30.0)

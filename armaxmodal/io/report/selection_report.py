@@ -15,7 +15,7 @@ import html
 import numpy as np
 import pandas as pd
 
-from armaxmodal.io.html_page import figure_uri, page, table
+from armaxmodal.io.report.html_page import figure_uri, page, table
 
 __all__ = ["render_selection_report", "modes_table"]
 
@@ -127,7 +127,7 @@ def render_selection_report(selection, verdict: str, source: str, settings: dict
     -------
     str
     """
-    from armaxmodal.modes.shape_plot import plot_shapes
+    from armaxmodal.io.report.shape_plot import plot_shapes
 
     esc = html.escape
     ax, _ = selection.diagram.plot(selection)

@@ -7,8 +7,8 @@ import pytest
 
 import armaxmodal as am
 from armaxmodal.cli.main import main
+from armaxmodal.io.report.shape_plot import plot_shapes
 from armaxmodal.modal import normalised_shape
-from armaxmodal.modes.shape_plot import plot_shapes
 
 
 def test_normalised_shape_puts_the_largest_component_at_one():

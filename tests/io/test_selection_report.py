@@ -57,7 +57,7 @@ def test_a_notebook_shows_the_verdict_and_the_modes(fixtures_dir):
 def test_the_report_groups_the_notes_by_code_what_moves_the_verdict_first(tmp_path):
     """Three notes of two codes: one group per code with its count, the code that makes the verdict
     uncertain first and open, its advice, and every full text."""
-    from armaxmodal.modes.report import _notes
+    from armaxmodal.io.report.selection_report import _notes
 
     notes = [am.QualityWarning("resampled", (), "resampled by 1/9"),
              am.QualityWarning("count_undecided", (), "first text"), am.QualityWarning("count_undecided", (), "second")]
