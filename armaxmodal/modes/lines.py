@@ -12,32 +12,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from armaxmodal.modes.settings import CHECK_RESOLUTION, PEAK_RESOLUTION, Resolution
 from armaxmodal.recording import Recording
 from armaxmodal.spectra import coherence, excited_band, h1_relative_error
 from armaxmodal.stats import H1_COHERENCE
 
 __all__ = ["CHECK_RESOLUTION", "CoherentLines", "PEAK_RESOLUTION", "Resolution", "coherent_lines", "measured_h1",
            "resolving_nperseg"]  # fmt: skip
-
-
-@dataclass(frozen=True)
-class Resolution:
-    """How finely an H1 must resolve the narrowest mode: ``lines_per_bandwidth`` Welch lines in
-    its half-power bandwidth ``2 xi f``, from at least ``min_segments`` half-overlapping
-    segments (fewer, and the H1's random error and the coherence's bias grow)."""
-
-    lines_per_bandwidth: int
-    min_segments: int
-
-
-#: the FRF peak search: a peak must stand out over 4 lines either side (a noise bump is a line
-#: or two wide), so the narrowest mode spans 4 lines; 4 segments at least
-PEAK_RESOLUTION = Resolution(lines_per_bandwidth=4, min_segments=4)
-#: the modal-model check: 2 lines per bandwidth (the H1's bias at a peak is about
-#: -(line / bandwidth)^2 / 3 with a Hann window: -8 % at two lines) from 8 segments at least
-#: (with fewer, the coherence of an unrelated line reaches 0.8 by chance: its estimate is
-#: biased by about 1 / segments)
-CHECK_RESOLUTION = Resolution(lines_per_bandwidth=2, min_segments=8)
 
 
 def resolving_nperseg(recording: Recording, freq_hz, damping, resolution: Resolution = PEAK_RESOLUTION) -> int:

@@ -27,14 +27,10 @@ import scipy.optimize
 from armaxmodal._kernels import modal_basis, modal_moved
 from armaxmodal._threads import single_blas_thread
 from armaxmodal.exceptions import OrderError
-from armaxmodal.modes.settings import DEFAULTS, DftSettings
+from armaxmodal.modes.settings import DEFAULTS, NORMAL_EQUATIONS_MIN_RATIO, DftSettings
 from armaxmodal.recording import Recording
 
 HOLDS = ("bandlimited", "zoh")
-
-# The normal equations' difference of squares ``|M|^2 - |Q'M|^2`` keeps about 16 + log10 of this
-# many digits of ``|P_perp M|^2``; below it the Jacobian's rows are formed instead.
-_FEWEST_DIGITS_KEPT = 1e-6
 
 
 @dataclass(frozen=True)
@@ -212,7 +208,7 @@ class _SeparableModel:
         m_m = np.einsum("csi,csk->ik", np.conj(w), (slopes_gram @ w.reshape(4 * n, -1)).reshape(w.shape)).real
         off_basis = m_m - np.einsum("asi,ask->ik", on_basis, on_basis)
         power = float(np.sum(self.resid**2))
-        if np.min(np.diag(off_basis) / np.diag(m_m)) < _FEWEST_DIGITS_KEPT:
+        if np.min(np.diag(off_basis) / np.diag(m_m)) < NORMAL_EQUATIONS_MIN_RATIO:
             # a pole's slope almost in the basis (a pole far outside the band, two poles nearly
             # one): the difference of squares has lost too many digits, so the rows are formed
             gram, grad = 0.0, 0.0

@@ -25,9 +25,35 @@ __all__ = [
     "IntervalSettings",
     "LineSettings",
     "NoteSettings",
+    "Resolution",
     "SelectionSettings",
     "SweepSettings",
 ]
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """How finely an H1 must resolve the narrowest mode: ``lines_per_bandwidth`` Welch lines in its
+    half-power bandwidth ``2 xi f``, from at least ``min_segments`` half-overlapping segments."""
+
+    lines_per_bandwidth: int
+    min_segments: int
+
+
+#: the FRF peak search: a peak must stand out over 4 lines either side (a noise bump is a line
+#: or two wide), so the narrowest mode spans 4 lines; 4 segments at least
+PEAK_RESOLUTION = Resolution(lines_per_bandwidth=4, min_segments=4)
+#: the modal-model check: 2 lines per bandwidth (the H1's bias at a peak is about
+#: -(line / bandwidth)^2 / 3 with a Hann window: -8 % at two lines) from 8 segments at least
+#: (with fewer, the coherence of an unrelated line reaches 0.8 by chance: its estimate is
+#: biased by about 1 / segments)
+CHECK_RESOLUTION = Resolution(lines_per_bandwidth=2, min_segments=8)
+#: the record's parts the spread is measured over, when not given (``select_modes(segments=...)``)
+N_SEGMENTS = 3
+#: the modal model's normal equations take ``|P_perp M|^2`` as ``|M|^2 - |Q'M|^2``, which keeps
+#: about 16 + log10 of this ratio of the two digits; below it the Jacobian's rows are formed
+#: (a light pole at the Nyquist frequency kept none)
+NORMAL_EQUATIONS_MIN_RATIO = 1e-6
 
 
 #: the thresholds that are a probability, a share or a MAC: at most 1
@@ -335,9 +361,8 @@ DEFAULTS = SelectionSettings()
 @dataclass(frozen=True)
 class SweepSettings:
     """The numbers of the stabilisation sweep (:func:`armaxmodal.stabilisation_diagram`), which runs
-    before any selection and so stands beside
-    :class:`~armaxmodal.modes.settings.SelectionSettings`, not in it; the JSON
-    reports what they made (``orders_na``, ``nk``).
+    before any selection and so stands beside :class:`~armaxmodal.modes.settings.SelectionSettings`,
+    not in it; the JSON reports what they made (``orders_na``, ``nk``).
 
     Attributes
     ----------
@@ -371,6 +396,4 @@ class SweepSettings:
     default_orders: tuple[int, ...] = tuple(range(2, 31, 2))
     min_default_top: int = 8
 
-
-#: the sweep's numbers
-SWEEP = SweepSettings()
+SWEEP = SweepSettings()  #: the sweep's numbers

@@ -17,15 +17,11 @@ from functools import partial
 import numpy as np
 import pandas as pd
 
-from armaxmodal.modes.settings import DEFAULTS
+from armaxmodal.modes.settings import DEFAULTS, N_SEGMENTS
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
 __all__ = ["segment_spread", "apply_segment_spread", "segment_jobs", "segment_poles", "split_segments", "N_SEGMENTS"]
-
-#: the record's parts the spread is measured over, when not given (``select_modes(segments=...)``)
-N_SEGMENTS = 3
-
 
 def split_segments(recording: Recording, k: int = N_SEGMENTS) -> list[Recording]:
     """The record cut into ``k`` disjoint, equal parts (the remainder dropped)."""

@@ -1,0 +1,31 @@
+"""The shape the one-pipeline issue asks of ``modes/``: every threshold in ``settings.py``, and
+no module a reader cannot hold (at most 400 lines)."""
+
+import ast
+from pathlib import Path
+
+import pytest
+
+import armaxmodal.modes
+
+MODULES = sorted(Path(armaxmodal.modes.__file__).parent.glob("*.py"))
+
+
+def _numbers(node: ast.AST) -> list:
+    return [n.value for n in ast.walk(node) if isinstance(n, ast.Constant)
+            and isinstance(n.value, int | float) and not isinstance(n.value, bool)]  # fmt: skip
+
+
+@pytest.mark.parametrize("path", [p for p in MODULES if p.name != "settings.py"], ids=lambda p: p.name)
+def test_no_numeric_module_constant_outside_the_settings(path):
+    """A number bound at module level is a threshold a user cannot override: it belongs in
+    ``modes/settings.py`` with its calibration comment."""
+    tree = ast.parse(path.read_text())
+    bound = [node for node in tree.body if isinstance(node, ast.Assign | ast.AnnAssign) and node.value is not None]
+    found = [(node.lineno, _numbers(node.value)) for node in bound if _numbers(node.value)]
+    assert not found, f"{path.name}: numeric module constants at lines {found}"
+
+
+@pytest.mark.parametrize("path", MODULES, ids=lambda p: p.name)
+def test_no_module_of_modes_is_over_400_lines(path):
+    assert len(path.read_text().splitlines()) <= 400
