@@ -64,6 +64,9 @@ extensions = [
     "myst_parser",
     "sphinx_gallery.gen_gallery",
     "sphinxarg.ext",
+    "sphinx_copybutton",
+    # MathJax 3 served with the pages (no CDN): an offline reader sees the method's equations
+    "sphinx-mathjax-offline",
 ]
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 templates_path = ["_templates"]
@@ -102,5 +105,14 @@ html_theme_options = {
     "navigation_with_keys": False,
     "show_toc_level": 2,
     "use_edit_page_button": False,
+    # the reader's pages in the top bar, the API reference among them; the rest under "More"
+    "header_links_before_dropdown": 6,
 }
-html_static_path: list[str] = []
+# pages without sub-pages have no section navigation: no empty left column beside them
+html_sidebars = {page: [] for page in ("index", "install", "getting_started", "method", "architecture",
+                                       "performance", "performance_ratios", "api", "modules", "release_notes",
+                                       "changelog")}  # fmt: skip
+html_static_path = ["_static"]
+html_css_files = ["wrap.css"]  # long code lines wrap instead of running out of their box
+copybutton_prompt_text = r"\$ |>>> |\.\.\. "
+copybutton_prompt_is_regexp = True

@@ -182,8 +182,7 @@ def _relative_sd(mode: dict, value: str, interval: str, z95: float) -> float:
 
 def _print_solution(sol, total_mass: float | None) -> None:
     """The recovered chain's components and its modes, as two tables."""
-    table = sol.to_frame()
-    parts = table[table.component != "mode"].dropna(axis=1, how="all").drop(columns="method")
+    parts = sol.to_frame()
     if parts.size:
         first = sol.structure.names[0]
         scale = (

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
 import pandas as pd
 
+from armaxmodal.stats import Z95
 from armaxmodal.systems.structure import ChainComponents, ExactModes, Structure
 
 
@@ -49,23 +51,42 @@ class InverseSolution:
     std: ChainComponents | None = None
 
     def to_frame(self) -> pd.DataFrame:
-        """Chain components (or matrix diagonals) and the recovered modes, one row each.
+        """The recovered components, one row each, as a tidy table (the modes are
+        ``self.modes.to_frame()``).
 
         Returns
         -------
         pandas.DataFrame
-            One row per mass, spring and damper (with its standard error where known), then one
-            per recovered mode; ``method`` names the solver.
+            For a chain: ``component`` (mass, k, c, k_s, c_s), ``location``, ``value``, ``unit`` and,
+            where the method gives standard errors (model updating), ``std`` and ``identified``:
+            ``"yes"`` where the 95 % interval ``value +- 1.96 std`` excludes zero, ``"no"`` where it
+            reaches zero (the data do not tell the component from nothing), ``"fixed"`` for a value
+            the scale or a bound holds (std 0), ``"at zero"`` for one held at its lower bound.
+            Without a chain (PIA): the diagonals of M, K and C (``component``, ``location``,
+            ``value``).
+
+        Examples
+        --------
+        >>> import armaxmodal as am
+        >>> s = am.chapter2_system()
+        >>> m = s.modes()
+        >>> sol = am.inner_solve(m.eigenvalues, m.shapes, total_mass=s.masses.sum(), names=s.names)
+        >>> table = sol.to_frame()
+        >>> list(table.columns)
+        ['component', 'location', 'value', 'unit']
+        >>> print(f"{table.value.iloc[0]:.3f} kg")
+        6.000 kg
         """
-        if self.components is not None:
-            comp = self.components.to_frame()
-            if self.std is not None:
-                comp.insert(3, "std", self.std.to_frame()["value"].to_numpy())
-        else:
+        if self.components is None:
             s = self.structure
-            rows = [("M", n, s.M[i, i]) for i, n in enumerate(s.names)]
-            rows += [("K", n, s.K[i, i]) for i, n in enumerate(s.names)]
-            rows += [("C", n, s.C[i, i]) for i, n in enumerate(s.names)]
-            comp = pd.DataFrame(rows, columns=["component", "location", "value"])
-        modes = self.modes.to_frame().assign(component="mode")
-        return pd.concat([comp.assign(method=self.method), modes.assign(method=self.method)], ignore_index=True)
+            rows = [(kind, n, matrix[i, i]) for kind, matrix in (("M", s.M), ("K", s.K), ("C", s.C))
+                    for i, n in enumerate(s.names)]  # fmt: skip
+            return pd.DataFrame(rows, columns=["component", "location", "value"])
+        table = self.components.to_frame()
+        if self.std is None:
+            return table
+        std = self.std.to_frame()["value"].to_numpy()
+        value = table["value"].to_numpy()
+        identified = np.where(std == 0, np.where(value == 0, "at zero", "fixed"),
+                              np.where(value - Z95 * std > 0, "yes", "no"))  # fmt: skip
+        return table.assign(std=std, identified=identified)

@@ -25,7 +25,8 @@ def test_inner_solve_recovers_exact_matrices(system):
         assert _rel(got, want) < EXACT_RTOL
     np.testing.assert_allclose(sol.modes.freq_hz, m.freq_hz, rtol=EXACT_RTOL)
     assert sol.method == "inner_solve" and sol.converged and not sol.flags
-    assert set(sol.to_frame().component) >= {"mass", "k", "c", "k_s", "c_s", "mode"}
+    table = sol.to_frame()
+    assert list(table.component.unique()) == ["mass", "k", "c", "k_s", "c_s"] and table.notna().all().all()
 
 
 def test_inner_solve_scale_and_mass_bounds():
@@ -258,9 +259,12 @@ def test_model_update_standard_errors_match_its_scatter():
             sigma={"freq": 0.1 * level, "damping": 0.5 * level, "shape": level, "frf": level},
             m1=6.0,
         )
-        table = sol.to_frame().query("component != 'mode'")
+        table = sol.to_frame()
         sd = table["std"].to_numpy()
         assert sd[0] == 0 and np.all(sd[1:] > 0)  # m1 fixed; everything else estimated
+        assert table.identified.iloc[0] == "fixed" and set(table.identified.iloc[1:]) <= {"yes", "no"}
+        # "yes" exactly where the 95 % interval excludes zero
+        assert np.array_equal(table.identified.iloc[1:] == "yes", table.value.iloc[1:] > 1.96 * sd[1:])
         z.append((table["value"].to_numpy()[1:] - truth[1:]) / sd[1:])
     rms = np.sqrt(np.mean(np.concatenate(z) ** 2))
     assert 0.7 < rms < 1.4
