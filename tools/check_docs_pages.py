@@ -1,6 +1,7 @@
 """A headless look at the built documentation: every page opens in Chromium, shows its title,
-and every figure it shows exists; no example printed a traceback or an object's repr, and no
-Markdown table row was left as raw text (a blank line inside a table ends it); and no page of the
+and every figure it shows exists; no example printed a traceback, an object's repr, a pandas
+table cut short or a wall of NaN, and no Markdown table row was left as raw text (a blank line
+inside a table ends it); and no page of the
 site, API pages included, shows a cross-reference that did not resolve (the build is nitpicky too;
 this catches a page built without it). Run by .ci/run after the build.
 
@@ -10,6 +11,7 @@ Run:  python tools/check_docs_pages.py [docs/_build/html]
 from __future__ import annotations
 
 import builtins
+import html
 import re
 import shutil
 import subprocess
@@ -52,6 +54,13 @@ def rendered(browser: str, page: Path) -> str:
 OBJECT_REPR = re.compile(r"&lt;[\w.]+ object at 0x[0-9a-f]+&gt;")
 #: a paragraph that is a Markdown table row: the table ended early at a blank line
 RAW_TABLE_ROW = re.compile(r"<p>\s*\|(?:(?!</p>).)*\|\s*</p>", re.S)
+#: a pandas table printed truncated: its shape line, a column of "..." between numbers, or a row of them
+PANDAS_TRUNCATED = re.compile(
+    r"\[\d+ rows x \d+ columns\]|\d\s+\.\.\.\s+-?\d|^\s*\d*\s*\.\.\.(?:\s+\.\.\.){2,}\s*$", re.M
+)
+#: a printed table row of three or more missing values in a row: a frame mostly NaN
+NAN_WALL = re.compile(r"(?:\bNaN\b\s+){2,}\bNaN\b")
+PRE = re.compile(r"<pre[^>]*>(.*?)</pre>", re.S)
 
 
 #: the development's own bookkeeping, which a user page should not show: issue numbers and paths
@@ -70,6 +79,15 @@ def shown_as_text(dom: str) -> list[str]:
     found = [f"prints an object's repr: {r}" for r in sorted(set(OBJECT_REPR.findall(dom)))]
     for row in RAW_TABLE_ROW.findall(dom):
         found.append("a table row shown as raw text: " + " ".join(re.sub(r"<[^>]+>", "", row).split())[:80])
+    for block in PRE.findall(dom):
+        text = html.unescape(re.sub(r"<[^>]+>", "", block))
+        if text.lstrip().startswith((">>>", "$")):
+            continue  # code the reader types, where "..." is a prompt
+        for pattern, what in ((PANDAS_TRUNCATED, "a pandas table printed truncated"), (NAN_WALL, "a wall of NaN")):
+            hit = pattern.search(text)
+            if hit:
+                line = text[text.rfind("\n", 0, hit.start()) + 1 : text.find("\n", hit.end())]
+                found.append(f"{what}: {' '.join(line.split())[:80]!r}")
     return found
 
 
