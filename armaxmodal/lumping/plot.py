@@ -66,7 +66,10 @@ def _log_frequency_axis(ax, lo: float, hi: float) -> None:
 
 
 def _scalogram(ax, sc, title: str) -> None:
-    ax.pcolormesh(sc.time_s, sc.freq_hz, np.log10(sc.power + 1e-30), shading="auto", cmap="viridis")
+    # power in dB below the strongest value: the colour bar reads the same on every panel
+    db = 10 * np.log10(sc.power / sc.power.max() + 1e-30)
+    mesh = ax.pcolormesh(sc.time_s, sc.freq_hz, db, shading="auto", cmap="viridis", vmin=-40, vmax=0)
+    ax.figure.colorbar(mesh, ax=ax, label="power (dB below its peak)")
     ax.plot(sc.time_s, sc.coi_hz, "w--", lw=1)
     _log_frequency_axis(ax, sc.freq_hz.min(), sc.freq_hz.max())
     ax.set_title(f"Morlet scalogram, {title}", fontsize=9)

@@ -30,10 +30,11 @@ def plot_stabilisation(diagram, selection=None, ax=None):
     low-coherence bands shaded. Returns ``(ax_top, ax_damping)``.
     """
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     if ax is None:
         fig, (ax, ax_d) = plt.subplots(
-            2, 1, sharex=True, figsize=(9, 7.5), height_ratios=(3, 1.3), constrained_layout=True
+            2, 1, sharex=True, figsize=(8, 6.2), height_ratios=(3, 1.3), constrained_layout=True
         )
     else:
         fig = ax.figure
@@ -57,6 +58,7 @@ def plot_stabilisation(diagram, selection=None, ax=None):
         ax_d.scatter(sel.freq_hz, sel.damping, marker=marker, s=18, color=colour, alpha=0.8)
         ax.scatter(sel.freq_hz, sel.na, marker=marker, s=28, color=colour, label=f"{label} ({len(sel)})", zorder=3)
     ax.set_ylabel("model order na")
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True))  # orders are whole numbers
     ax.set_title(
         f"Stabilisation: tolerances f {100 * tol.freq:g} %, ξ {100 * tol.damping:g} %, "
         f"shape 1-MAC {tol.shape:g}; nk = {diagram.orders[0].nk}",
