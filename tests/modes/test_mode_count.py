@@ -473,9 +473,8 @@ def test_a_start_mode_the_free_fit_carries_away_must_be_founded(monkeypatch, sup
     monkeypatch.setattr(count_search, "fit_modal_model",
                         lambda d, f, x, hold, n, dft=None: refits.append(list(f)) or _Scored(f, x, table))  # fmt: skip
     search = count_search._Search(data, "zoh", 1.0, 40)
-    model, carried, kept, doubted = count_search._without_unfounded(
-        search, [5.0, 9.0, 13.0], moved, lambda f, x: stable_there or abs(f - 11.0) > 0.5)  # fmt: skip
-    assert doubted == ()  # none was doubted: a moved pole is carried away, not "not needed"
+    model, carried, kept = count_search._without_unfounded(search, [5.0, 9.0, 13.0], moved,
+                                                         lambda f, x: stable_there or abs(f - 11.0) > 0.5)  # fmt: skip
     if outcome == "dropped":
         assert carried == ((13.0, 11.0),) and kept == () and refits == [[5.0, 9.0]] and model.n_modes == 2
     elif outcome == "stand-in":
@@ -485,41 +484,7 @@ def test_a_start_mode_the_free_fit_carries_away_must_be_founded(monkeypatch, sup
         assert carried == () and kept == () and model is moved and refits == []
     # a pole that stayed near its start is not judged, however unsupported
     near = _Scored([5.0, 9.0, 12.8], [0.3, 0.3, 0.3], table)
-    assert count_search._without_unfounded(search, [5.0, 9.0, 13.0], near, lambda f, x: False)[1:] == ((), (), ())
-
-
-@pytest.mark.parametrize(
-    "stable_there, resolved, needed, outcome",
-    [(False, True, False, "dropped"), (True, False, False, "dropped"), (True, True, False, "kept"),
-     (False, True, True, "stand-in"), (True, True, True, "kept")],
-)  # fmt: skip
-def test_a_start_mode_the_frf_doubts_is_kept_only_where_the_model_founds_it(monkeypatch, supine, stable_there,
-                                                                           resolved, needed, outcome):  # fmt: skip
-    """The measured FRF's check does not need the 13 Hz start, which stayed at 12.9 Hz: the count,
-    not the check, decides. Founded as a moved pole is (damping resolved, stable where it stands),
-    it is kept; else it is left out as not needed, unless the model needs it (a stand-in). An
-    undoubted start that stayed is never judged."""
-    import armaxmodal.modes.count_search as count_search
-
-    table = {2: 100.0 + (DECISIVE_BIC + 1 if needed else DECISIVE_BIC - 1), 3: 100.0}
-    stayed = _Scored([5.0, 9.0, 12.9], [0.3, 0.3, 0.3], table)
-    if not resolved:
-        stayed.damping_sd = np.array([0.003, 0.003, 0.2])
-    refits = []
-    monkeypatch.setattr(count_search, "fit_modal_model",
-                        lambda d, f, x, hold, n, dft=None: refits.append(list(f)) or _Scored(f, x, table))  # fmt: skip
-    search = count_search._Search(supine[0], "zoh", 1.0, 40)
-    supported = lambda f, x: stable_there or abs(f - 12.9) > 0.5  # noqa: E731
-    model, carried, kept, not_needed = count_search._without_unfounded(search, [5.0, 9.0, 13.0], stayed, supported,
-                                                                       doubted=(13.0,))  # fmt: skip
-    assert carried == ()
-    if outcome == "dropped":
-        assert not_needed == ((13.0, 12.9),) and kept == () and refits == [[5.0, 9.0]] and model.n_modes == 2
-    elif outcome == "stand-in":
-        assert not_needed == () and model is stayed and kept == ((13.0, 12.9, pytest.approx(DECISIVE_BIC + 1)),)
-    else:
-        assert not_needed == () and kept == () and model is stayed and refits == []
-    assert count_search._without_unfounded(search, [5.0, 9.0, 13.0], stayed, lambda f, x: False)[1:] == ((), (), ())
+    assert count_search._without_unfounded(search, [5.0, 9.0, 13.0], near, lambda f, x: False)[1:] == ((), ())
 
 
 def test_a_stand_in_is_in_the_model_but_not_reported_and_is_said():
@@ -540,17 +505,6 @@ def test_a_stand_in_is_in_the_model_but_not_reported_and_is_said():
     assert beyond.code == "mode_count" and "does not decide" not in beyond.message
 
 
-def test_a_doubted_mode_the_count_left_out_is_said_once_and_only_then():
-    """A start the FRF doubted and the model did not found is a ``mode_not_needed`` note that names
-    it; with nothing left out, no such note: no note may say a reported mode is not needed."""
-    count = replace(_count([50.0, 60.0], -40.0, freq=(5.0, 12.0), damping=(0.2, 0.3)), not_needed=((13.0, 12.9),))
-    keep = count.reported((1.0, 26.0))
-    (said,) = [n for n in _notes(count, keep, (1.0, 26.0), SAME_ROW) if n.code == "mode_not_needed"]
-    assert said.value == 13.0 and "13.000 Hz" in said.message and "12.900 Hz" in said.message
-    plain = replace(count, not_needed=())
-    assert not [n for n in _notes(plain, keep, (1.0, 26.0), SAME_ROW) if n.code == "mode_not_needed"]
-
-
 @pytest.mark.parametrize("same_in_halves", [True, False])
 def test_with_the_halves_a_moved_pole_is_judged_by_them_not_by_the_diagram(monkeypatch, supine, same_in_halves):
     """Where the ARMAX fits are biased the diagram holds no pole where the model moves one (a stuck
@@ -563,8 +517,7 @@ def test_with_the_halves_a_moved_pole_is_judged_by_them_not_by_the_diagram(monke
     asked = []
     monkeypatch.setattr(search, "in_both_halves", lambda m, new, h: asked.append(list(new)) or same_in_halves)
     moved = _Scored([5.0, 9.0, 11.0], [0.3, 0.3, 0.3], table)
-    model, carried, _, _ = count_search._without_unfounded(search, [5.0, 9.0, 13.0], moved, lambda f, x: False,
-                                                           ("a", "b"))  # fmt: skip
+    model, carried, _ = count_search._without_unfounded(search, [5.0, 9.0, 13.0], moved, lambda f, x: False, ("a", "b"))
     assert asked == [[2]]  # only the moved pole is put to the halves
     assert (carried == ()) is same_in_halves and model.n_modes == (3 if same_in_halves else 2)
 
