@@ -1,8 +1,6 @@
-"""What the measured FRF says of the candidates: the modal-model check
-(:mod:`armaxmodal.modes.modal_check`) doubts a mode it does not need and adds a left-out cluster
-that explains a clear peak no selected mode explains. Where the modal model counts the modes, a
-doubt is the count's to settle (:func:`modes_the_record_doubts`); without a count (no refit), the
-check drops the mode (:func:`modes_the_record_needs`).
+"""Which candidates the record needs: the modal-model check (:mod:`armaxmodal.modes.modal_check`)
+drops a mode the measured FRF does not need and adds a left-out cluster that explains a clear
+peak no selected mode explains.
 """
 
 from __future__ import annotations
@@ -68,24 +66,6 @@ def modes_the_record_needs(recording: Recording, work: SelectionState, band, set
                 float(f_m),
             )  # fmt: skip
         work = work.kept(i for i in range(len(modes)) if i != m).warned(note)
-
-
-def modes_the_record_doubts(recording: Recording, work: SelectionState, band, settings: SelectionSettings = DEFAULTS
-                            ) -> SelectionState:  # fmt: skip
-    """The modes the modal-model check does not need (as :func:`modes_the_record_needs` judges each,
-    all at once), as doubts for the count, not drops: the selection keeps every mode, with its
-    check, and ``doubted_hz`` names those the count keeps only where its modal model founds them
-    (a resolved damping, the same values in both halves of the record)."""
-    from armaxmodal.modes.support import mode_support
-
-    modes, frf = work.modes, settings.frf
-    check = check_modes(recording, modes.freq_hz, modes.damping, band, settings=frf)
-    if len(modes) < 2 or not np.isfinite(check.error).any():
-        return replace(work, check=check, doubted_hz=())
-    needed = [mode_support(recording, modes.freq_hz, modes.damping, m, check, band, settings=frf).needed
-              for m in range(len(modes))]  # fmt: skip
-    doubted = tuple(float(f) for f, yes in zip(modes.freq_hz, needed, strict=True) if not yes)
-    return replace(work, check=check, doubted_hz=doubted)
 
 
 def refit_with_added(diagram, work: SelectionState, band, settings: SelectionSettings = DEFAULTS) -> SelectionState:

@@ -8,8 +8,9 @@ refitted with every pole free (:func:`armaxmodal.modes.modal_model.fit_modal_mod
 * **split** a mode in two, about its half-power band apart.
 
 The neighbour of lowest criterion (:mod:`armaxmodal.modes.mode_count`) replaces the current model
-while it lowers it. Then the chosen model is converged, its carried-away and doubted starts judged,
-its equally good models fitted and the additions the likelihood wants flagged, on one ``_Search``."""
+while it lowers it. Then the chosen model is converged, carried-away starts judged, the equally
+good models fitted and the refused additions the likelihood wants flagged, on one ``_Search``.
+"""
 
 from __future__ import annotations
 
@@ -121,8 +122,8 @@ class _Search:
 
     def physical(self, model: ModalModel) -> np.ndarray:
         """Per pole: in the band and damped as a vibration mode can be."""
-        lo, hi = self.data.band_hz
-        return (model.freq_hz >= lo) & (model.freq_hz <= hi) & (model.damping <= MAX_DAMPING)
+        band = (model.freq_hz >= self.data.band_hz[0]) & (model.freq_hz <= self.data.band_hz[1])
+        return band & (model.damping <= MAX_DAMPING)
 
     def in_both_halves(self, trial: ModalModel, new: list[int], halves) -> bool:
         """The new poles of ``trial`` (indices ``new``) have the same frequency and damping in each
@@ -169,47 +170,43 @@ def _margins(search: _Search, here: float, current: ModalModel, removed, best_re
     return rise, gain, new_hz
 
 
-def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, halves=(), doubted=()):
-    """The chosen model without the poles it cannot found, refitted: starting poles carried beyond
-    ``settings.same_mode_freq`` of every start, and starting modes the measured FRF doubted
-    (``doubted``, Hz). Such a pole must show what a mode has: a resolved damping, and the same
-    values in both halves (``_Search.in_both_halves``; without halves, stability across orders).
+def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, halves=()):
+    """The chosen model without the starting poles the search carried beyond ``settings.same_mode_freq``
+    of every start to where no mode is founded, refitted. A pole reported there is a new pole and
+    must show what a mode has: a resolved damping, and the same values in both halves of the record
+    (``_Search.in_both_halves``; without ``halves``, stability across the diagram's orders).
+
     Not the diagram's support where the halves can judge: the model moves a pole where the ARMAX
     fits are biased (a supine ride with the pelvis stuck for 53 samples: 13.50 Hz at 14.69 Hz in
-    every order, 13.62 Hz in the model, alike in both halves); a bridge's 5.83 Hz start ended at
-    4.40 Hz, damping 0.007, which the halves do not share. Judged on the converged model only.
-    Poles the model needs (the criterion rises by ``decisive_bic`` or more without them) stay in
-    it, unreported. Returns ``(model, carried away ((start Hz, Hz), ...), kept unreported
-    ((start Hz, Hz, rise), ...), doubted and left out ((start Hz, Hz), ...))``."""
+    every order, 13.62 Hz in the model, alike in both halves). A bridge's 5.83 Hz start ended at
+    4.40 Hz, damping 0.007, which the halves do not share. Judged on the converged model only (on the
+    way a moved pole may stand in for a mode not yet added). Poles the model needs (the criterion
+    rises by ``settings.decisive_bic`` or more without them) stay in it, unreported. Returns
+    ``(model, left out: ((start Hz, Hz), ...), kept unreported: ((start Hz, Hz, rise), ...))``."""
     start_hz = np.atleast_1d(np.asarray(start_hz, float))
-    shown, reach = reported(model, search.data.band_hz, search.lines), search.cfg.same_mode_freq
-    moved = [(i, float(start_hz[j]), False) for i, j in matched_poles(start_hz, model.freq_hz)
-             if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > reach]  # fmt: skip
-    doubted = np.atleast_1d(np.asarray(doubted, float))
-    taken = {i for i, _, _ in moved}
-    moved += [(i, float(doubted[j]), True) for i, j in matched_poles(doubted, model.freq_hz)
-              if shown[i] and i not in taken and abs(np.log(model.freq_hz[i] / doubted[j])) <= reach]  # fmt: skip
+    shown = reported(model, search.data.band_hz, search.lines)
+    moved = [(i, j) for i, j in matched_poles(start_hz, model.freq_hz)
+             if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > search.cfg.same_mode_freq]  # fmt: skip
     unfounded = []
-    for i, start, was_doubted in moved:
+    for i, j in moved:
         f, x = model.freq_hz[i], model.damping[i]
         if len(halves) == 2:
             founded = x - Z95 * model.damping_sd[i] > 0 and search.in_both_halves(model, [i], halves)
         else:
             founded = x - Z95 * model.damping_sd[i] > 0 and (supported is None or supported(f, x))
         if not founded:
-            unfounded.append((i, (start, float(f)), was_doubted))
-    keep = np.setdiff1d(np.arange(model.n_modes), [i for i, _, _ in unfounded])
+            unfounded.append((i, (float(start_hz[j]), float(f))))
+    keep = np.setdiff1d(np.arange(model.n_modes), [i for i, _ in unfounded])
     if not unfounded or keep.size == 0:  # nothing else to stand on: the search's model stays
-        return model, (), (), ()
+        return model, (), ()
     without = search.fit(model.freq_hz[keep], model.damping[keep], search.cfg.final_nfev,
                          label=("leave out", unfounded[0][1][1]))
     rise = search.bic(without) - search.bic(model)
     if rise >= search.cfg.decisive_bic:  # the model needs them: they stay in it, unreported (a body's mode at
         # 23.93 Hz, near the band's top, came out at 24.74 Hz with its damping unresolved; without
         # it the 13.93 and 16.43 Hz modes collapsed into one at 16.20 Hz, BIC +873)
-        return model, (), tuple((*pair, float(rise)) for _, pair, _ in unfounded), ()
-    carried = tuple(pair for _, pair, was_doubted in unfounded if not was_doubted)
-    return without, carried, (), tuple(pair for _, pair, was_doubted in unfounded if was_doubted)
+        return model, (), tuple((*moved, float(rise)) for _, moved in unfounded)
+    return without, tuple(moved for _, moved in unfounded), ()
 
 
 def _equally_good(search: _Search, chosen: ModalModel, rise: np.ndarray, addition: ModalModel | None):
@@ -227,8 +224,9 @@ def _equally_good(search: _Search, chosen: ModalModel, rise: np.ndarray, additio
 
 
 def _wanted(search: _Search, current: ModalModel, addition, gain: float, new_hz: float, halves) -> tuple:
-    """The refused addition the likelihood wants (:attr:`ModeCount.wanted`), or ``()``: ``-2 ln L`` of
-    the current model less the addition's, on the effective lines, a chi-square of its parameters."""
+    """The refused addition the likelihood wants (see :attr:`ModeCount.wanted`), or ``()``. The
+    likelihood ratio is ``-2 ln L`` of the current model less the addition's, on the effective
+    lines; it is a chi-square of the parameters one mode adds where the record holds no more."""
     if addition is None or addition[2] is None or gain > -search.cfg.decisive_bic or len(halves) != 2:
         return ()
     return _likelihood_wants(search, current, addition[2], new_hz, gain, halves, in_diagram=True)
@@ -240,19 +238,21 @@ def _likelihood_wants(search: _Search, current: ModalModel, model: ModalModel, n
     ``settings.likelihood_alpha`` and its new poles are the same in both halves, else ``()``."""
     dof = model.n_params - current.n_params
     ratio = current.neg2_loglik_on(search.n_eff) - model.neg2_loglik_on(search.n_eff)
-    if dof <= 0 or chdtrc(dof, ratio) >= search.cfg.likelihood_alpha or not search.in_both_halves(
-            model, new_poles(current.freq_hz, model.freq_hz), halves):  # fmt: skip
+    if dof <= 0 or chdtrc(dof, ratio) >= search.cfg.likelihood_alpha:
+        return ()
+    if not search.in_both_halves(model, new_poles(current.freq_hz, model.freq_hz), halves):
         return ()
     return Wanted(new_hz, float(ratio), int(dof), float(-gain), bool(in_diagram))
 
 
 def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) -> tuple[tuple, ModalModel | None]:
     """A split the likelihood wants (:attr:`ModeCount.wanted`; ``()`` if none) and its converged
-    model (None if none converged with its damping resolved): every reported mode split in two, the
-    best converged and judged as :func:`_wanted` judges an addition. The search splits only the mode
-    nearest the residual's peak, and a split need not be stable across orders: two modes closer
-    than the ARMAX fits resolve stand as one column there (a body's 14.28 and 15.40 Hz as one at
-    15.45 Hz; split, likelihood ratio 187 for 22 parameters, alike in both halves, BIC +40)."""
+    model (None if no split converged with its damping resolved): every reported mode split in two,
+    the best converged and judged as :func:`_wanted` judges an addition. The search splits only the
+    mode nearest the residual's peak, and a split need not be stable across the diagram's orders:
+    two modes closer than the ARMAX fits resolve stand as one column there (a body's 14.28 and
+    15.40 Hz came out as one at 15.45 Hz; split, likelihood ratio 187 for 22 parameters, alike in
+    both halves, BIC +40)."""
     shown = np.flatnonzero(search.physical(current))
     if len(halves) != 2 or shown.size == 0:
         return (), None
@@ -288,7 +288,6 @@ def count_modes(
     settings: CountSettings = COUNT,
     lines: LineSettings = DEFAULTS.lines,
     dft: DftSettings = DEFAULTS.dft,
-    doubted: tuple[float, ...] = (),
 ) -> ModeCount:
     """Choose the number of modes by nested tests of free refits (see the module notes).
 
@@ -305,32 +304,34 @@ def count_modes(
     max_nfev : int
         Cap on residual evaluations per fit.
     halves : tuple of DftLines
-        The record's two halves: an addition's new poles must be the same in each. Empty: not asked.
+        The lines of the record's two halves: an accepted addition's new poles must be the same
+        in each (``_Search.in_both_halves``). Empty: not asked.
     supported : callable, optional
-        ``supported(freq_hz, damping)``: is a pole there stable across the diagram's orders (a ghost
-        soaking up a nonlinearity is not)? An addition's new poles must be. None: not asked.
+        ``supported(freq_hz, damping)``: is a pole there stable across the diagram's orders? An
+        addition's new poles must be (a ghost soaking up a nonlinearity is not). None: not asked.
     search : bool
-        False: the starting set is the model (picks): fitted and its margins measured, no step taken.
+        False: the starting set is the model (picks); it is fitted and its margins measured, but
+        no step is taken and no mode left out.
     n_jobs : int, optional
         Worker threads for the screening fits (default: all cores).
-    settings, lines, dft : CountSettings, LineSettings, DftSettings
-        The count's thresholds, which poles are lines, the modal model's fits (:mod:`.settings`).
-    doubted : tuple of float
-        Starting modes (Hz) the measured FRF does not need: kept only where founded (``_without_unfounded``).
+    settings : CountSettings
+        The count's thresholds (:mod:`armaxmodal.modes.settings`).
+    lines : LineSettings
+        Which poles are lines, not modes.
+    dft : DftSettings
+        The modal model's fits.
 
     Returns
     -------
     ModeCount
     """
     return _count_modes(data, freq_hz, damping, candidates, hold=hold, max_nfev=max_nfev, halves=halves,
-                        supported=supported, search=search, n_jobs=n_jobs, settings=settings, lines=lines, dft=dft,
-                        doubted=doubted)
+                        supported=supported, search=search, n_jobs=n_jobs, settings=settings, lines=lines, dft=dft)
 
 
 def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max_nfev: int, halves: tuple,
                  supported: Callable[[float, float], bool] | None, search: bool, n_jobs: int | None,
-                 settings: CountSettings, lines: LineSettings, dft: DftSettings, doubted: tuple = ()
-                 ) -> ModeCount:  # fmt: skip
+                 settings: CountSettings, lines: LineSettings, dft: DftSettings) -> ModeCount:  # fmt: skip
     """:func:`count_modes` itself, under the caller's BLAS threads (the public function holds one)."""
     start_model = fit_modal_model(data, freq_hz, damping, hold, max_nfev, dft)
     # each sensor weighted by its noise level as the fitted start leaves it (the likelihood is
@@ -381,10 +382,9 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max
     final = search.fit(current.freq_hz, current.damping, settings.final_nfev)
     if search.bic(final) < here:
         rise, gain, current = rise + here - search.bic(final), gain - (here - search.bic(final)), final
-    current, carried_away, stand_ins, not_needed = (
-        _without_unfounded(search, freq_hz, current, supported, halves, doubted) if searching
-        else (current, (), (), ()))  # fmt: skip
-    if carried_away or not_needed:  # the model lost a pole: its neighbours are judged again, from where it stands
+    current, carried_away, stand_ins = (_without_unfounded(search, freq_hz, current, supported, halves)
+                                        if searching else (current, (), ()))  # fmt: skip
+    if carried_away:  # the model lost a pole: its neighbours are judged again, from where it stands
         here, removed, best_removal, best_addition = neighbours()
         rise, gain, new_hz = _margins(search, here, current, removed, best_removal, best_addition)
     close = best_addition[2] if best_addition is not None and gain > -settings.decisive_bic else None
@@ -397,4 +397,4 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max
             alternatives += ((wanted.rise, split),)
     return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
                      tuple(unconfirmed), alternatives, carried_away, wanted, stand_ins, settings, lines,
-                     dft, tuple(search.table.rows), not_needed)  # fmt: skip
+                     dft, tuple(search.table.rows))  # fmt: skip

@@ -76,7 +76,7 @@ def _on_whole_record(count: ModeCount, rec, band_hz, hold: str) -> ModeCount:
 
 def counted_modes(
     diagram, work: SelectionState, band_hz, hold: str, nas, settings: SelectionSettings = DEFAULTS, band=None, *,
-    picked: bool = False, n_jobs: int | None = None, doubted: tuple[float, ...] = (),
+    picked: bool = False, n_jobs: int | None = None,
 ) -> SelectionState:
     """Count the modes from the selection's and return them as the selection reports modes.
 
@@ -103,9 +103,6 @@ def counted_modes(
         says which picks the record does not need); the rest stay in the model.
     n_jobs : int, optional
         Worker threads for the count's screening fits (default: all cores).
-    doubted : tuple of float
-        Starting modes (Hz) the measured FRF's check does not need: kept only where the modal
-        model founds them (``count_modes``).
 
     Returns
     -------
@@ -128,7 +125,7 @@ def counted_modes(
         start_f, start_x = np.r_[start_f, model.freq_hz[hidden]], np.r_[start_x, model.damping[hidden]]
     count = count_modes(data, start_f, start_x, candidates, hold=hold, halves=halves, supported=supported,
                         search=not picked, n_jobs=n_jobs, settings=settings.count, lines=settings.lines,
-                        dft=settings.dft, doubted=doubted)  # fmt: skip
+                        dft=settings.dft)  # fmt: skip
     if part is not rec:
         count = _on_whole_record(count, rec, band_hz, hold)
     keep = count.reported(data.band_hz)

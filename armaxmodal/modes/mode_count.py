@@ -166,9 +166,6 @@ class ModeCount:
         out-of-band poles are. (start Hz, where it went Hz, the criterion's rise without them).
     models : tuple of FittedModel
         Every model the count fitted, in the order fitted (:meth:`models_table`).
-    not_needed : tuple of (float, float)
-        Starting modes the measured FRF doubted that the model does not found either, left out:
-        (start Hz, where the model had it Hz).
     """
 
     model: ModalModel
@@ -188,7 +185,6 @@ class ModeCount:
     lines: LineSettings = DEFAULTS.lines
     dft: DftSettings = DEFAULTS.dft
     models: tuple[FittedModel, ...] = ()
-    not_needed: tuple[tuple[float, float], ...] = ()
 
     def models_table(self):
         """Every model the count fitted, one row each (``FittedModel``'s columns), in the order

@@ -117,13 +117,6 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
             "damping unresolved, or not the same in both halves of the record); left out", went,
         ))  # fmt: skip
-    for start, f in count.not_needed:
-        notes.append(QualityWarning(
-            "mode_not_needed", (),
-            f"a stable pole at {start:.3f} Hz is left out: the measured FRF does not need it, and the modal model "
-            f"does not found it either (at {f:.3f} Hz its damping is unresolved, or the record's halves disagree on "
-            "it): a spurious pole of the ARMAX fits (noise, a nonlinearity, leakage), not a mode of the record", start,
-        ))  # fmt: skip
     for f in count.unconfirmed_hz:
         notes.append(QualityWarning(
             "mode_count", (),

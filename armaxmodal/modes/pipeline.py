@@ -27,12 +27,7 @@ import pandas as pd
 from armaxmodal._threads import one_blas_thread
 from armaxmodal.exceptions import PickError
 from armaxmodal.modes.clusters import check_picks, clustered_modes, merge_duplicates, picked_modes, why_no_mode
-from armaxmodal.modes.completeness import (
-    modes_the_check_adds,
-    modes_the_record_doubts,
-    modes_the_record_needs,
-    refit_with_added,
-)
+from armaxmodal.modes.completeness import modes_the_check_adds, modes_the_record_needs, refit_with_added
 from armaxmodal.modes.counted import confirmed_where_incoherent, counted_modes, dropped_where_peaks_remain
 from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.intervals import with_intervals
@@ -114,25 +109,17 @@ def segment_fits(state: SelectionState, ctx: SelectionContext) -> SelectionState
 
 
 def screen_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionState:
-    """Without a count: a mode the H1's LSFD check does not need goes, a left-out cluster it needs
-    comes in (:mod:`armaxmodal.modes.completeness`)."""
+    """The measured H1 screens the candidates: a mode its LSFD check does not need goes, a left-out
+    cluster it needs comes in (:mod:`armaxmodal.modes.completeness`); after an addition the refit
+    is made again of all of them."""
     rec, n_before, settings = ctx.diagram.recording, len(state.modes), ctx.settings
     state = modes_the_record_needs(rec, state, ctx.band, settings)
     state = modes_the_check_adds(ctx.diagram, state, ctx.band, ctx.nas, settings)
-    return modes_the_record_needs(rec, state, ctx.band, settings) if len(state.modes) > n_before else state
-
-
-def propose_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionState:
-    """The measured H1 proposes, the count decides: a left-out stable cluster that explains a peak
-    comes in as a start (after an addition the refit is made again of all of them), and a mode the
-    LSFD check does not need stays, doubted (``doubted_hz``): the count keeps it only where its
-    modal model founds it, as it founds a pole it moved (:mod:`armaxmodal.modes.completeness`)."""
-    n_before, settings, f, x = len(state.modes), ctx.settings, state.modes.freq_hz, state.modes.damping
-    checked = check_modes(ctx.diagram.recording, f, x, ctx.band, settings=settings.frf)
-    state = modes_the_check_adds(ctx.diagram, replace(state, check=checked), ctx.band, ctx.nas, settings)
-    if len(state.modes) > n_before:  # the refit saw fewer modes than are reported
+    if len(state.modes) > n_before:
+        state = modes_the_record_needs(rec, state, ctx.band, settings)
+    if ctx.refine and len(state.modes) > n_before:  # the refit saw fewer modes than are reported
         state = refit_with_added(ctx.diagram, state, ctx.band, settings)
-    return modes_the_record_doubts(ctx.diagram.recording, state, ctx.band, settings)
+    return state
 
 
 def count(state: SelectionState, ctx: SelectionContext) -> SelectionState:
@@ -143,7 +130,7 @@ def count(state: SelectionState, ctx: SelectionContext) -> SelectionState:
         return state
     hold, band_hz = state.refinement.hold, state.refinement.band_hz
     state = counted_modes(ctx.diagram, state, band_hz, hold, ctx.nas, ctx.settings, ctx.band,
-                          n_jobs=ctx.n_jobs, doubted=state.doubted_hz)  # fmt: skip
+                          n_jobs=ctx.n_jobs)  # fmt: skip
     ctx.update_bar(state.count.trials)
     return state
 
@@ -245,28 +232,26 @@ def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
 
 
 # -- the stage lists -----------------------------------------------------------------------------
-#: the diagram's candidates, with those the FRF proposes, counted by the modal model
-AUTOMATIC: tuple[Stage, ...] = (candidates, merge, refit, propose_by_frf, count, check, confirm, spread, separate,
+#: the diagram's candidates, screened by the FRF and counted by the modal model
+AUTOMATIC: tuple[Stage, ...] = (candidates, merge, refit, screen_by_frf, count, check, confirm, spread, separate,
                                 finish)  # fmt: skip
 #: ``n_modes`` given: the best-supported candidates, refitted and checked; nothing dropped or added
 FIXED_COUNT: tuple[Stage, ...] = (candidates, merge, best_n, refit, check, spread, separate, finish)
 #: ``picks`` given: the picked clusters reported from the model the automatic selection counted
-PICKED: tuple[Stage, ...] = (take_picks, candidates, merge, refit, propose_by_frf, count, add_picks,
+PICKED: tuple[Stage, ...] = (take_picks, candidates, merge, refit, screen_by_frf, count, add_picks,
                              check_unless_counted, confirm, spread, separate, finish)  # fmt: skip
 
 
 def stages_for(n_modes: int | None, picks, refine: bool) -> tuple[Stage, ...]:
     """The stage list of a call: :data:`AUTOMATIC`, :data:`FIXED_COUNT` or :data:`PICKED`; without
     the refit (``refine=False``) the same with ``segment_fits`` for ``refit`` and no ``count``
-    (the modal model is fitted under the hold the refit chooses) nor ``confirm`` (the count's),
-    and so the FRF's ``screen_by_frf`` drops what it doubts, for want of a count to settle it."""
+    (the modal model is fitted under the hold the refit chooses) nor ``confirm`` (the count's)."""
     if picks is not None and n_modes is not None:
         raise PickError("picks and n_modes do not mix: pick the modes, or give their number, not both.")
     stages = PICKED if picks is not None else FIXED_COUNT if n_modes is not None else AUTOMATIC
     if refine:
         return stages
-    swap = {refit: segment_fits, propose_by_frf: screen_by_frf}
-    return tuple(swap.get(s, s) for s in stages if s not in (count, confirm))
+    return tuple(segment_fits if s is refit else s for s in stages if s not in (count, confirm))
 
 
 # -- the entry point -----------------------------------------------------------------------------
@@ -295,13 +280,11 @@ def select_modes(
        shapes agree (MAC at least ``settings.cluster.merge_mac``) are one mode split (**merge**).
     2. **refit** -- the candidates are refitted to the recording's DFT under the inter-sample
        behaviour the data choose (band-limited or held).
-    3. **propose_by_frf** -- the measured H1 proposes: a left-out stable cluster that explains a
-       peak comes in, and a candidate its LSFD check does not need is doubted, not dropped.
-    4. **count** -- the one keep-or-drop: the maximum-likelihood modal model with every pole free
-       decides the number of modes by nested tests (BIC on the effective lines; halves agree): it
-       removes, adds or splits modes, keeps a doubted or moved mode only where its damping is
-       resolved and both halves of the record agree on it, and says where the record does not
-       decide (``count_undecided``).
+    3. **screen_by_frf** -- the measured H1 proposes modes: a candidate its LSFD check does not need
+       goes, a left-out stable cluster that explains a peak comes in.
+    4. **count** -- the maximum-likelihood modal model with every pole free decides the number of
+       modes by nested tests (BIC on the effective lines; halves agree): it removes, adds or
+       splits modes, and says where the record does not decide (``count_undecided``).
     5. **check**, **confirm**, **spread**, **separate**, **finish** -- the modal-model check, the
        intervals widened by the segments' spread and the other structures and estimators, a
        ``modes_not_separated`` note (and so ``uncertain``) for neighbours the reported intervals do

@@ -53,9 +53,6 @@ class SelectionState:
     segment_fits : dict
         The segment refits of the representative orders, ``(orders, k) -> poles``, run beside the
         refit and read by the segment stage.
-    doubted_hz : tuple of float
-        The modes (Hz) the measured FRF's check does not need: the count keeps them only where its
-        modal model founds them.
     result : ModeSelection or None
         The finished selection; a stage that sets it ends the pipeline (a diagram with no mode).
     """
@@ -69,7 +66,6 @@ class SelectionState:
     check_poles: tuple[tuple[float, float], ...] | None = None
     picked: tuple[pd.DataFrame, list] | None = field(default=None, repr=False)
     segment_fits: dict = field(default_factory=dict, repr=False)
-    doubted_hz: tuple[float, ...] = ()
     result: ModeSelection | None = field(default=None, repr=False)
 
     def __post_init__(self):

@@ -21,7 +21,7 @@ from armaxmodal.modes.settings import (
 from armaxmodal.modes.state import SelectionContext, SelectionState
 from tests.cli.test_schemas import _validator
 
-AUTOMATIC = ["candidates", "merge", "refit", "propose_by_frf", "count", "check", "confirm", "spread", "separate",
+AUTOMATIC = ["candidates", "merge", "refit", "screen_by_frf", "count", "check", "confirm", "spread", "separate",
              "finish"]  # fmt: skip
 
 
@@ -52,7 +52,7 @@ def test_the_arguments_choose_a_named_stage_list(diagram):
     assert plain == ["candidates", "merge", "segment_fits", "screen_by_frf", "check", "spread", "separate", "finish"]
     assert selection.refinement is None and selection.count is None
     picked, selection = _traced(diagram, picks=[8.3], segments=0)
-    assert picked == ["take_picks", "candidates", "merge", "refit", "propose_by_frf", "count", "add_picks",
+    assert picked == ["take_picks", "candidates", "merge", "refit", "screen_by_frf", "count", "add_picks",
                       "check_unless_counted", "confirm", "spread", "separate", "finish"]  # fmt: skip
     assert selection.picks == [8.3]
     with pytest.raises(am.PickError, match="do not mix"):
