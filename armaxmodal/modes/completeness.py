@@ -19,13 +19,15 @@ from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
 
-def modes_the_record_needs(recording: Recording, work: SelectionState, band, settings: SelectionSettings = DEFAULTS
-                           ) -> SelectionState:  # fmt: skip
+def modes_the_record_needs(recording: Recording, work: SelectionState, band, settings: SelectionSettings = DEFAULTS,
+                           doubts: list | None = None) -> SelectionState:  # fmt: skip
     """Selection by the data: drop, one at a time and least supported first, every mode the
     modal-model check does not need (:func:`armaxmodal.modes.support.mode_support`: leaving it
     out, a neighbour inside its half-power band refitted in its place, raises no output's
     misfit by ``settings.frf.model_error_rise`` significantly). A dropped half
-    of a split peak is a ``split_merged`` note, any other a ``mode_not_needed`` note.
+    of a split peak is a ``split_merged`` note, any other a ``mode_not_needed`` note. With
+    ``doubts`` (a list), each dropped mode goes there as ``(Hz, ratio, note)`` instead of its note
+    into the selection: the count tries it again and the note stands only if it stays out.
     Returns the selection of the modes kept, with their check."""
     from armaxmodal.modes.support import mode_support
 
@@ -65,7 +67,11 @@ def modes_the_record_needs(recording: Recording, work: SelectionState, band, set
                 f"{evidence}: a spurious pole of the model (noise, a nonlinearity, leakage), not a mode of the record",
                 float(f_m),
             )  # fmt: skip
-        work = work.kept(i for i in range(len(modes)) if i != m).warned(note)
+        work = work.kept(i for i in range(len(modes)) if i != m)
+        if doubts is None:
+            work = work.warned(note)
+        else:
+            doubts.append((float(f_m), float(x_m), note))
 
 
 def refit_with_added(diagram, work: SelectionState, band, settings: SelectionSettings = DEFAULTS) -> SelectionState:

@@ -115,7 +115,11 @@ def counted_modes(
     # fitted to the whole record, so a long ride costs one fit more, not a search more
     part = _counted_part(rec, settings.count.max_samples)
     data = DftLines.from_recording(part, band_hz)
-    candidates = _candidates(diagram, modes, band, nas, settings)
+    # the modes the FRF's check doubts are tried first, as additions the likelihood, the halves and
+    # the diagram must all accept; then the diagram's other left-out clusters
+    offered = [(f, x) for f, x, _ in work.doubts]
+    candidates = offered + [c for c in _candidates(diagram, modes, band, nas, settings)
+                            if all(abs(np.log(c[0] / f)) > settings.cluster.freq for f, _ in offered)]  # fmt: skip
     halves = tuple(DftLines.from_recording(half, band_hz) for half in split_segments(part, 2))
     supported = stable_in_diagram(diagram, band, settings.cluster)
     start_f, start_x = modes.freq_hz.to_numpy(), modes.damping.to_numpy()
@@ -131,9 +135,9 @@ def counted_modes(
     keep = count.reported(data.band_hz)
     same_row = settings.cluster.same_row_freq
     if picked:
-        return _picked_result(work, count, keep, hold, settings, rec, band)
+        return _picked_result(_doubts_said(work, ()), count, keep, hold, settings, rec, band)
     if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
-        return work.warned(no_mode_kept_note(count, modes, data.band_hz), count=count)
+        return _doubts_said(work, ()).warned(no_mode_kept_note(count, modes, data.band_hz), count=count)
     rows = pd.DataFrame([_row(modes, count, i, hold, same_row) for i in np.flatnonzero(keep)])
     rows, shapes, merged = _one_where_not_separated(rows, count.model.shapes[:, keep], count, keep, rec, band_hz, hold,
                                                     settings)  # fmt: skip
@@ -141,7 +145,16 @@ def counted_modes(
     # where two poles are reported as one, the check fits the model's poles, not the row's
     poles = tuple(zip(count.model.freq_hz[keep].tolist(), count.model.damping[keep].tolist(), strict=True))
     work = work.with_modes(rows, shapes, count=count, check_poles=poles if merged else None)
+    work = _doubts_said(work, count.model.freq_hz[keep], same_row)
     return work.warned(*count_notes(count, keep, data.band_hz, same_row), *merged, *disagree)
+
+
+def _doubts_said(work: SelectionState, reported_hz, reach: float = 0.0) -> SelectionState:
+    """The notes of the modes the FRF's check doubted that the count did not take back (no reported
+    mode within ``reach`` of it, relative): they stand; the others go unsaid."""
+    reported_hz = np.asarray(reported_hz, float)
+    left = [note for f, _, note in work.doubts if not np.any(np.abs(np.log(reported_hz / f)) <= reach)]
+    return replace(work, doubts=()).warned(*left)
 
 
 def _counted_part(rec, max_samples: int):

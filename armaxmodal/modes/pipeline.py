@@ -109,14 +109,27 @@ def segment_fits(state: SelectionState, ctx: SelectionContext) -> SelectionState
 
 
 def screen_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionState:
-    """The measured H1 screens the candidates: a mode its LSFD check does not need goes, a left-out
-    cluster it needs comes in (:mod:`armaxmodal.modes.completeness`); after an addition the refit
-    is made again of all of them."""
+    """Without a count: a mode the H1's LSFD check does not need goes, with its note; a left-out
+    cluster it needs comes in (:mod:`armaxmodal.modes.completeness`)."""
+    return _screened(state, ctx, None)
+
+
+def propose_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionState:
+    """The measured H1 proposes, the count decides: a left-out cluster the LSFD check needs comes in
+    (after an addition the refit is made again of all of them), and a mode it does not need leaves
+    the count's start but is offered to the count as a candidate (``doubts``): its
+    ``mode_not_needed`` note stands only where the count does not take it back."""
+    doubts: list = []
+    return replace(_screened(state, ctx, doubts), doubts=tuple(doubts))
+
+
+def _screened(state: SelectionState, ctx: SelectionContext, doubts: list | None) -> SelectionState:
+    """The check's drops (into ``doubts`` when given) and additions (:mod:`armaxmodal.modes.completeness`)."""
     rec, n_before, settings = ctx.diagram.recording, len(state.modes), ctx.settings
-    state = modes_the_record_needs(rec, state, ctx.band, settings)
+    state = modes_the_record_needs(rec, state, ctx.band, settings, doubts)
     state = modes_the_check_adds(ctx.diagram, state, ctx.band, ctx.nas, settings)
     if len(state.modes) > n_before:
-        state = modes_the_record_needs(rec, state, ctx.band, settings)
+        state = modes_the_record_needs(rec, state, ctx.band, settings, doubts)
     if ctx.refine and len(state.modes) > n_before:  # the refit saw fewer modes than are reported
         state = refit_with_added(ctx.diagram, state, ctx.band, settings)
     return state
@@ -126,8 +139,8 @@ def count(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     """The last word on the number of modes: nested tests of the maximum-likelihood modal model with
     every pole free (:mod:`armaxmodal.modes.counted`). It needs the refit's hold and band: where the
     refit could not be made, its ``refit_failed`` note says the modes are not counted."""
-    if state.refinement is None or not len(state.modes):
-        return state
+    if state.refinement is None or not len(state.modes):  # nothing counts the doubts: the check's word stands
+        return replace(state, doubts=()).warned(*(note for _, _, note in state.doubts)) if state.doubts else state
     hold, band_hz = state.refinement.hold, state.refinement.band_hz
     state = counted_modes(ctx.diagram, state, band_hz, hold, ctx.nas, ctx.settings, ctx.band,
                           n_jobs=ctx.n_jobs)  # fmt: skip
@@ -232,26 +245,28 @@ def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
 
 
 # -- the stage lists -----------------------------------------------------------------------------
-#: the diagram's candidates, screened by the FRF and counted by the modal model
-AUTOMATIC: tuple[Stage, ...] = (candidates, merge, refit, screen_by_frf, count, check, confirm, spread, separate,
+#: the diagram's candidates, with those the FRF proposes, counted by the modal model
+AUTOMATIC: tuple[Stage, ...] = (candidates, merge, refit, propose_by_frf, count, check, confirm, spread, separate,
                                 finish)  # fmt: skip
 #: ``n_modes`` given: the best-supported candidates, refitted and checked; nothing dropped or added
 FIXED_COUNT: tuple[Stage, ...] = (candidates, merge, best_n, refit, check, spread, separate, finish)
 #: ``picks`` given: the picked clusters reported from the model the automatic selection counted
-PICKED: tuple[Stage, ...] = (take_picks, candidates, merge, refit, screen_by_frf, count, add_picks,
+PICKED: tuple[Stage, ...] = (take_picks, candidates, merge, refit, propose_by_frf, count, add_picks,
                              check_unless_counted, confirm, spread, separate, finish)  # fmt: skip
 
 
 def stages_for(n_modes: int | None, picks, refine: bool) -> tuple[Stage, ...]:
     """The stage list of a call: :data:`AUTOMATIC`, :data:`FIXED_COUNT` or :data:`PICKED`; without
     the refit (``refine=False``) the same with ``segment_fits`` for ``refit`` and no ``count``
-    (the modal model is fitted under the hold the refit chooses) nor ``confirm`` (the count's)."""
+    (the modal model is fitted under the hold the refit chooses) nor ``confirm`` (the count's),
+    and so ``screen_by_frf``, whose drops stand, for ``propose_by_frf``, whose drops the count judges."""
     if picks is not None and n_modes is not None:
         raise PickError("picks and n_modes do not mix: pick the modes, or give their number, not both.")
     stages = PICKED if picks is not None else FIXED_COUNT if n_modes is not None else AUTOMATIC
     if refine:
         return stages
-    return tuple(segment_fits if s is refit else s for s in stages if s not in (count, confirm))
+    swap = {refit: segment_fits, propose_by_frf: screen_by_frf}
+    return tuple(swap.get(s, s) for s in stages if s not in (count, confirm))
 
 
 # -- the entry point -----------------------------------------------------------------------------
@@ -280,11 +295,13 @@ def select_modes(
        shapes agree (MAC at least ``settings.cluster.merge_mac``) are one mode split (**merge**).
     2. **refit** -- the candidates are refitted to the recording's DFT under the inter-sample
        behaviour the data choose (band-limited or held).
-    3. **screen_by_frf** -- the measured H1 proposes modes: a candidate its LSFD check does not need
-       goes, a left-out stable cluster that explains a peak comes in.
-    4. **count** -- the maximum-likelihood modal model with every pole free decides the number of
-       modes by nested tests (BIC on the effective lines; halves agree): it removes, adds or
-       splits modes, and says where the record does not decide (``count_undecided``).
+    3. **propose_by_frf** -- the measured H1 proposes: a left-out stable cluster that explains a
+       peak comes in, and a candidate its LSFD check does not need leaves the start to be offered
+       to the count as an addition.
+    4. **count** -- the one keep-or-drop: the maximum-likelihood modal model with every pole free
+       decides the number of modes by nested tests (BIC on the effective lines; an addition's new
+       poles the same in both halves and stable across orders): it removes, adds or splits modes,
+       and says where the record does not decide (``count_undecided``).
     5. **check**, **confirm**, **spread**, **separate**, **finish** -- the modal-model check, the
        intervals widened by the segments' spread and the other structures and estimators, a
        ``modes_not_separated`` note (and so ``uncertain``) for neighbours the reported intervals do

@@ -53,6 +53,9 @@ class SelectionState:
     segment_fits : dict
         The segment refits of the representative orders, ``(orders, k) -> poles``, run beside the
         refit and read by the segment stage.
+    doubts : tuple of (float, float, QualityWarning)
+        The modes the measured FRF's check does not need, ``(Hz, ratio, note)``: out of the
+        selection, offered to the count as candidates; a note stands where the count leaves it out.
     result : ModeSelection or None
         The finished selection; a stage that sets it ends the pipeline (a diagram with no mode).
     """
@@ -66,6 +69,7 @@ class SelectionState:
     check_poles: tuple[tuple[float, float], ...] | None = None
     picked: tuple[pd.DataFrame, list] | None = field(default=None, repr=False)
     segment_fits: dict = field(default_factory=dict, repr=False)
+    doubts: tuple[tuple[float, float, QualityWarning], ...] = ()
     result: ModeSelection | None = field(default=None, repr=False)
 
     def __post_init__(self):

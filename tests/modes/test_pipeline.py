@@ -19,9 +19,10 @@ from armaxmodal.modes.settings import (
     SelectionSettings,
 )
 from armaxmodal.modes.state import SelectionContext, SelectionState
+from armaxmodal.quality_warnings import QualityWarning
 from tests.cli.test_schemas import _validator
 
-AUTOMATIC = ["candidates", "merge", "refit", "screen_by_frf", "count", "check", "confirm", "spread", "separate",
+AUTOMATIC = ["candidates", "merge", "refit", "propose_by_frf", "count", "check", "confirm", "spread", "separate",
              "finish"]  # fmt: skip
 
 
@@ -52,7 +53,7 @@ def test_the_arguments_choose_a_named_stage_list(diagram):
     assert plain == ["candidates", "merge", "segment_fits", "screen_by_frf", "check", "spread", "separate", "finish"]
     assert selection.refinement is None and selection.count is None
     picked, selection = _traced(diagram, picks=[8.3], segments=0)
-    assert picked == ["take_picks", "candidates", "merge", "refit", "screen_by_frf", "count", "add_picks",
+    assert picked == ["take_picks", "candidates", "merge", "refit", "propose_by_frf", "count", "add_picks",
                       "check_unless_counted", "confirm", "spread", "separate", "finish"]  # fmt: skip
     assert selection.picks == [8.3]
     with pytest.raises(am.PickError, match="do not mix"):
@@ -107,6 +108,10 @@ def test_count_alone_needs_the_refit(diagram):
     ctx = SelectionContext(diagram, SelectionSettings(), None, [4, 6])
     state = _state([5.0], [0.2], [0.9], np.ones((4, 1)))
     assert pipeline.count(state, ctx) is state  # no refinement: the modal model has no hold to fit under
+    # a mode the FRF's check doubted is then not counted: its note stands, said once
+    note = QualityWarning("mode_not_needed", (), "a stable pole at 7.000 Hz is left out", 7.0)
+    doubted = pipeline.count(replace(state, doubts=((7.0, 0.1, note),)), ctx)
+    assert doubted.doubts == () and doubted.warnings == (note,)
 
 
 def test_check_alone_judges_the_modes_it_is_given(diagram):
