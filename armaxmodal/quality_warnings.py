@@ -264,8 +264,8 @@ CODES: tuple[WarningCode, ...] = (
     WarningCode(
         "mode_not_needed", "selection",
         "a stable cluster whose mode the modal-model check does not need (leaving it out raises no output's misfit by "
-        "5 % with p < 1 %): a spurious pole of noise, a nonlinearity or leakage (stiff 1-storey El Centro: 42.9 Hz, "
-        "+0.6 %)",
+        "5 % with p < 1 %) and that the count, offered it as an addition, leaves out: a spurious pole of noise, a "
+        "nonlinearity or leakage (stiff 1-storey El Centro: 42.9 Hz, +0.6 %)",
         "left out, with the rise and p",
         "Nothing: informative; `--pick` the frequency if you know a mode is there.",
     ),

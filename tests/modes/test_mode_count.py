@@ -829,3 +829,18 @@ def test_a_wanted_split_as_good_as_the_chosen_model_is_one_of_the_equally_good(m
     count = count_modes(data, truth.freq_hz, truth.damping, hold="zoh")
     assert count.wanted == (14.0, 200.0, 22, rise, False)
     assert any(m is split for _, m in count.alternatives) == joins
+
+
+def test_a_doubt_the_count_takes_back_goes_unsaid_and_one_it_leaves_out_is_said():
+    """The FRF's check doubted modes at 7.0 and 11.0 Hz; the count reports 7.05 Hz (within the
+    clustering's reach of 7.0: it took that one back) and nothing near 11: only 11 Hz's note stands."""
+    from armaxmodal.modes.counted import _doubts_said
+    from armaxmodal.modes.state import SelectionState
+    from armaxmodal.quality_warnings import QualityWarning
+
+    notes = [QualityWarning("mode_not_needed", (), f"a stable pole at {f:.3f} Hz is left out", f) for f in (7.0, 11.0)]
+    work = SelectionState(pd.DataFrame({"freq_hz": [5.0], "damping": [0.2]}), np.ones((4, 1), complex),
+                          doubts=((7.0, 0.1, notes[0]), (11.0, 0.1, notes[1])))  # fmt: skip
+    said = _doubts_said(work, [5.0, 7.05], SAME_ROW)
+    assert said.doubts == () and said.warnings == (notes[1],)
+    assert _doubts_said(work, [], SAME_ROW).warnings == tuple(notes)  # the count kept nothing: both stand
