@@ -120,7 +120,9 @@ def propose_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionSta
     the count's start but is offered to the count as a candidate (``doubts``): its
     ``mode_not_needed`` note stands only where the count does not take it back."""
     doubts: list = []
-    return replace(_screened(state, ctx, doubts), doubts=tuple(doubts))
+    state = _screened(state, ctx, doubts)
+    once = {f: (f, x, note) for f, x, note in reversed(doubts)}  # a mode dropped in both passes, once
+    return replace(state, doubts=tuple(sorted(once.values(), key=lambda d: d[0])))
 
 
 def _screened(state: SelectionState, ctx: SelectionContext, doubts: list | None) -> SelectionState:
