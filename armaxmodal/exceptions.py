@@ -18,30 +18,101 @@ __all__ = [
 
 
 class ArmaxModalError(Exception):
-    """Base class of every error raised on purpose by armaxmodal."""
+    """Base class of every error raised on purpose by armaxmodal.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> issubclass(am.DataError, am.ArmaxModalError), issubclass(am.OrderError, am.ArmaxModalError)
+    (True, True)
+    """
 
 
 class DataError(ArmaxModalError, ValueError):
-    """A signal, recording or file is unusable as given (NaN, wrong shape, bad column...)."""
+    """A signal, recording or file is unusable as given (NaN, wrong shape, bad column...).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> try:
+    ...     am.Recording(60.0, np.zeros(100), np.full((100, 1), np.nan), ("head",), "base")
+    ... except am.DataError as error:
+    ...     print(type(error).__name__, isinstance(error, ValueError))
+    DataError True
+    """
 
 
 class OrderError(ArmaxModalError, ValueError):
-    """Model orders are invalid or need more samples than the record has."""
+    """Model orders are invalid or need more samples than the record has.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> try:
+    ...     am.fit_armax(ride.select(["head"]), 400, 400, 400, 0)
+    ... except am.OrderError as error:
+    ...     print(type(error).__name__)
+    OrderError
+    """
 
 
 class StructureError(ArmaxModalError, ValueError):
-    """Mass, damping or stiffness matrices are not physical, or not of the asked topology."""
+    """Mass, damping or stiffness matrices are not physical, or not of the asked topology.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> try:
+    ...     am.Structure.from_chain([1.0, -2.0], [100.0, 50.0], [1.0, 1.0], [30.0], [0.1], ["a", "b"])
+    ... except am.StructureError as error:
+    ...     print(type(error).__name__)
+    StructureError
+    """
 
 
 class PickError(ArmaxModalError, ValueError):
     """A mode picked by hand is not one the stabilisation diagram offers (outside the band, no
-    stable cluster near it, two picks on one cluster)."""
+    stable cluster near it, two picks on one cluster).
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> diagram = am.stabilisation_diagram(ride, range(4, 13, 2), per_sensor=False)
+    >>> try:
+    ...     am.select_modes(diagram, picks=[25.0])
+    ... except am.PickError as error:
+    ...     print(type(error).__name__)
+    PickError
+    """
 
 
 class SettingsError(ArmaxModalError, ValueError):
     """A threshold of the mode selection's settings is outside what it can be (not a positive
-    number, a probability above 1, bounds the wrong way round)."""
+    number, a probability above 1, bounds the wrong way round).
+
+    Examples
+    --------
+    >>> from armaxmodal.exceptions import SettingsError
+    >>> from armaxmodal.modes.settings import CountSettings
+    >>> try:
+    ...     CountSettings(decisive_bic=-1.0)
+    ... except SettingsError as error:
+    ...     print(type(error).__name__)
+    SettingsError
+    """
 
 
 class ConvergenceWarning(UserWarning):
-    """An iterative estimator stopped before its convergence test was met."""
+    """An iterative estimator stopped before its convergence test was met.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> issubclass(am.ConvergenceWarning, UserWarning)
+    True
+    """

@@ -382,7 +382,15 @@ def severity(code: str) -> str:
 class QualityWarning:
     """One data-quality finding: ``code`` (see ``WARNING_CODES``), the channels it
     concerns, a sentence with the measured number, and that number (``value``, its unit in
-    the message)."""
+    the message).
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> note = am.QualityWarning("offset_removed", ("head",), "the mean of head (0.31 m/s²) was removed", 0.31)
+    >>> note.code, note.channels, note.value
+    ('offset_removed', ('head',), 0.31)
+    """
 
     code: str
     channels: tuple[str, ...]

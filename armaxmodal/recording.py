@@ -37,6 +37,18 @@ class Recording:
         Total mass of the subject, kg (used to scale physical models, Eq. 4.7).
     meta : dict
         Anything else worth keeping (source file, simulation truth, ...).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> t = np.arange(600) / 60.0
+    >>> base = np.sin(2 * np.pi * 2.0 * t)
+    >>> rec = am.Recording(60.0, base, np.column_stack([2 * base, -base]), ("head", "legs"), "base")
+    >>> rec.n_samples, rec.duration, rec.sensors
+    (600, 10.0, ('head', 'legs'))
+    >>> rec.select(["legs"]).sensors
+    ('legs',)
     """
 
     fs: float

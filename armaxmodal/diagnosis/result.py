@@ -74,7 +74,19 @@ class Effect:
 @dataclass(frozen=True)
 class Diagnosis:
     """What :func:`~armaxmodal.diagnosis.diagnose` found. ``to_dict`` is the JSON contract of
-    ``armaxmodal diagnose``."""
+    ``armaxmodal diagnose``.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> from armaxmodal.diagnosis.inject import inject
+    >>> hum = inject(ride, "periodic_disturbance", ["head"], freq_hz=11.7, amp=0.1)
+    >>> (effect,) = am.diagnose(hum, max_rounds=1).effects
+    >>> effect.finding.effect, effect.finding.channels, round(effect.parameters["freq_hz"], 1)
+    ('periodic_disturbance', ('head',), 11.7)
+    """
 
     baseline: Stage
     final: Stage

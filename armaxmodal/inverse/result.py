@@ -37,6 +37,17 @@ class InverseSolution:
         Standard errors of the chain components from the stated noise levels (Gauss-Newton
         covariance at the solution; model updating only). A component held at a bound, or
         fixed by the scale, has 0.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> system = am.chapter2_system()
+    >>> modes = system.modes()
+    >>> solution = am.inner_solve(modes.eigenvalues, modes.shapes, total_mass=system.masses.sum(), names=system.names)
+    >>> solution.method, solution.converged
+    ('inner_solve', True)
+    >>> solution.components.k.round(0).tolist()  # Table 2.1: exact modes give the exact springs
+    [74000.0, 28000.0, 120800.0, 2400.0]
     """
 
     structure: Structure

@@ -58,6 +58,18 @@ class StabilisationDiagram:
         The record the sweep fitted (after :func:`~armaxmodal.prepare.prepare`).
     preparation : Preparation or None
         What was done to the record first, with the quality warnings.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> diagram = am.stabilisation_diagram(ride, range(4, 13, 2), per_sensor=False)
+    >>> [order.na for order in diagram.orders]
+    [4, 6, 8, 10, 12]
+    >>> poles = diagram.to_frame()
+    >>> int((poles.na == 8).sum())  # the order-8 fit's poles
+    4
     """
 
     poles: pd.DataFrame

@@ -49,6 +49,15 @@ class Identification:
         The criterion table when the orders were chosen automatically.
     preparation : Preparation or None
         What was done to the record before the fit, with the data-quality warnings.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> result = am.identify(ride)
+    >>> result.quality, result.modes.freq_hz.round(1).tolist()  # exact: 5.83, 8.31, 13.50, 16.25 Hz
+    ('good', [5.8, 8.3, 13.6, 16.2])
     """
 
     fit: ArmaxFit

@@ -56,6 +56,17 @@ class ModeSelection:
         The maximum-likelihood count, when it ran.
     settings : SelectionSettings
         The thresholds that made this selection (:mod:`armaxmodal.modes.settings`).
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> selection = am.select_modes(am.stabilisation_diagram(ride, range(4, 13, 2), per_sensor=False), segments=0)
+    >>> selection.quality
+    'good'
+    >>> selection.modes.freq_hz.round(1).tolist()  # exact: 5.83, 8.31, 13.50, 16.25 Hz
+    [5.8, 8.3, 13.6, 16.2]
     """
 
     modes: pd.DataFrame

@@ -73,7 +73,15 @@ def _chain_parts(mat: np.ndarray, label: str) -> tuple[np.ndarray, np.ndarray]:
 @dataclass(frozen=True)
 class ChainComponents:
     """Springs and dampers of a chain (Fig. 4.3): element i ties mass i to the base, s_i ties
-    masses i and i+1. Units: kg, N/m, N s/m."""
+    masses i and i+1. Units: kg, N/m, N s/m.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> parts = am.chapter2_system().chain_components()  # Table 2.1 of the thesis
+    >>> parts.masses.tolist(), parts.k.tolist()
+    ([6.0, 14.0, 22.0, 9.0], [74000.0, 28000.0, 120800.0, 2400.0])
+    """
 
     masses: np.ndarray
     k: np.ndarray
@@ -123,6 +131,17 @@ class ExactModes:
     real_poles : (k,) float
         Real (over-damped) poles, rad/s; empty for an under-damped structure.
     names : tuple of str
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> modes = am.chapter2_system().modes()
+    >>> modes.to_frame().round(3)
+       mode  freq_hz  damping  damped_freq_hz
+    0     1    5.916    0.278           5.683
+    1     2    9.765    0.391           8.988
+    2     3   13.330    0.362          12.428
+    3     4   19.398    0.349          18.177
     """
 
     eigenvalues: np.ndarray
@@ -193,6 +212,15 @@ class Structure:
         Stiffness matrix, symmetric positive definite (N/m).
     names : sequence of str, optional
         One name per degree of freedom (default ``dof1..dofn``).
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> body = am.supine_human()
+    >>> body.names, body.n_dof
+    (('head', 'chest', 'pelvis', 'legs'), 4)
+    >>> body.modes().freq_hz.round(2).tolist()  # Table 4.3 of the thesis
+    [5.83, 8.31, 13.5, 16.25]
     """
 
     M: np.ndarray
