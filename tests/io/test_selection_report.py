@@ -90,3 +90,20 @@ def test_the_report_of_an_uncertain_run_shows_its_notes_in_a_browser(fixtures_di
     assert "<b>drift</b> (1): makes the verdict uncertain" in notes and "pelvis" in notes
     assert f"<td>{am.__version__}</td>" in dom and "run at (UTC)" in dom
     assert f"armaxmodal --quiet stabilise {path} --orders 2:16 --report {page}" in dom
+
+
+def test_the_report_leaves_no_figure_open(fixtures_dir):
+    """The page embeds its two figures and closes them: a notebook or a gallery calling it keeps no
+    stray figure (the gallery showed the report's diagram and shapes as figures of its own)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from armaxmodal.io.report.selection_report import render_selection_report
+
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    selection = am.select_modes(am.stabilisation_diagram(rec, range(4, 13, 2), per_sensor=False), segments=0)
+    plt.close("all")
+    page = render_selection_report(selection, "quality: good", "supine_random.csv")
+    assert page.count("data:image/png;base64,") == 2 and plt.get_fignums() == []

@@ -130,9 +130,16 @@ def render_selection_report(selection, verdict: str, source: str, settings: dict
     from armaxmodal.io.report.shape_plot import plot_shapes
 
     esc = html.escape
+    import matplotlib.pyplot as plt
+
     ax, _ = selection.diagram.plot(selection)
     diagram = figure_uri(ax.figure, dpi=110)
-    shapes = figure_uri(plot_shapes(selection), dpi=110) if len(selection.modes) else ""
+    plt.close(ax.figure)  # the page holds the picture: a caller's session keeps no open figure
+    shapes = ""
+    if len(selection.modes):
+        fig = plot_shapes(selection)
+        shapes = figure_uri(fig, dpi=110)
+        plt.close(fig)
     n_modes = len(selection.modes)
     sections = [
         ("record", "The record", table(_record_table(selection, source))),
