@@ -103,7 +103,7 @@ CODES: tuple[WarningCode, ...] = (
         "offset_removed", "preparation",
         "each channel's mean (default; `--detrend linear` for a line)",
         "removed",
-        "Nothing: informative.",
+        "Nothing: a constant (gravity on an accelerometer, a bias) is removed.",
     ),
     WarningCode(
         "offset_step", "preparation",
