@@ -62,3 +62,22 @@ def test_stabilise_prints_the_verdict_then_the_notes(fixtures_dir, tmp_path, cap
     assert len(shown) <= 25 and max(map(len, shown)) <= 100, shown
     assert main(["--quiet", "--verbose", "stabilise", str(path), "--orders", "2:16"]) == 0
     assert "      - " in capsys.readouterr().err
+
+
+#: every code's one severity, as the docs' codes page and the command line label it: a change here
+#: is a change of what a user is told to act on, made on purpose
+SEVERITIES = {
+    "problem": ["no_modes", "modes_do_not_explain_frf"],
+    "warning": ["duplicate_channel", "inverted_sensor", "sensor_delay", "narrowband_input", "clipping",
+                "dropped_packet", "offset_step", "drift", "model_error_dominates", "nk_at_search_edge",
+                "unexplained_peak", "damping_unresolved", "incoherent_output", "unit_mismatch",
+                "periodic_disturbance", "stuck_samples", "oversampled", "held_samples", "refit_failed",
+                "count_undecided", "modes_not_separated", "pick_not_supported"],
+    "info": ["gap_filled", "empty_columns_dropped", "time_rounded", "offset_removed", "trend_removed", "resampled",
+             "split_merged", "mode_not_needed", "orders_capped", "check_not_run", "mode_count", "estimators_disagree"],
+}  # fmt: skip
+
+
+def test_each_code_has_its_one_severity():
+    pinned = {code: level for level, codes in SEVERITIES.items() for code in codes}
+    assert {c.code: severity(c.code) for c in CODES} == pinned
