@@ -139,6 +139,32 @@ def test_the_stages_run_one_by_one_give_select_modes_result(diagram):
     assert [w.message for w in done.warnings] == [w.message for w in whole.warnings]
 
 
+@pytest.mark.parametrize("where_hz, taken_back", [(20.0, False), (13.5, True)])
+def test_a_doubt_is_offered_to_the_count_which_alone_keeps_or_drops_it(diagram, where_hz, taken_back):
+    """A mode the FRF's check doubted is tried by the count as an addition (its table holds the
+    trial). Where no mode is (20 Hz, damping 0.05) the count refuses it and its note is said once;
+    the ride's own 13.5 Hz mode, taken out of the start as if doubted, the count takes back, and no
+    note says it is not needed."""
+    ctx = SelectionContext(diagram, SelectionSettings(), None, sorted({o.na for o in diagram.orders}), segments=0,
+                           n_jobs=1)  # fmt: skip
+    state = SelectionState.empty(len(diagram.recording.sensors))
+    for stage in (pipeline.candidates, pipeline.merge, pipeline.refit):
+        state = stage(state, ctx)
+    rows = state.modes.freq_hz.to_numpy()
+    if taken_back:  # the 13.5 Hz mode out of the start, as the check drops one it does not need
+        state = state.kept(np.flatnonzero(np.abs(rows / where_hz - 1) > 0.05))
+    note = QualityWarning("mode_not_needed", (), f"a stable pole at {where_hz:.3f} Hz is left out", where_hz)
+    counted = pipeline.count(replace(state, doubts=((where_hz, 0.3 if taken_back else 0.05, note),)), ctx)
+    table = counted.count.models_table()
+    assert np.any((table.action == "add") & (np.abs(table.freq_hz / where_hz - 1) < 0.01))
+    said = [w for w in counted.warnings if w.code == "mode_not_needed"]
+    reported = counted.modes.freq_hz.to_numpy()
+    if taken_back:
+        assert said == [] and np.any(np.abs(reported / where_hz - 1) < 0.03)
+    else:
+        assert said == [note] and not np.any(np.abs(reported / where_hz - 1) < 0.1)
+
+
 def test_settings_reach_the_stages_and_come_back_on_the_result(diagram):
     default = am.select_modes(diagram, n_jobs=1, segments=0)
     assert default.settings == SelectionSettings()

@@ -258,6 +258,11 @@ def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
     np.testing.assert_array_equal(kept.shapes, shapes[:, [0, 2]])
     (note,) = kept.warnings
     assert note.code == "split_merged" and note.value == pytest.approx(1.01 * m.freq_hz[0])
+    # before a count: the same drop, its mode and note handed on as a doubt, not said
+    doubts = []
+    handed = modes_the_record_needs(diagram.recording, SelectionState(modes, shapes), None, doubts=doubts)
+    assert handed.modes.freq_hz.tolist() == kept.modes.freq_hz.tolist() and handed.warnings == ()
+    assert doubts == [(pytest.approx(1.01 * m.freq_hz[0]), pytest.approx(m.damping[0]), note)]
     # the check of what is kept (lightly damped: H1 bias)
     assert kept.check.passed and kept.check.model_error.max() < 0.15
     # the true modes alone: nothing to merge
