@@ -121,8 +121,13 @@ def propose_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionSta
     ``mode_not_needed`` note stands only where the count does not take it back."""
     doubts: list = []
     state = _screened(state, ctx, doubts)
-    once = {f: (f, x, note) for f, x, note in reversed(doubts)}  # a mode dropped in both passes, once
-    return replace(state, doubts=tuple(sorted(once.values(), key=lambda d: d[0])))
+    return replace(state, doubts=each_once(doubts))
+
+
+def each_once(doubts) -> tuple:
+    """The doubts by frequency, a mode the check dropped in both of its passes once (its first note)."""
+    once = {f: (f, x, note) for f, x, note in reversed(doubts)}
+    return tuple(sorted(once.values(), key=lambda d: d[0]))
 
 
 def _screened(state: SelectionState, ctx: SelectionContext, doubts: list | None) -> SelectionState:

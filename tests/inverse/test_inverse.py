@@ -319,3 +319,24 @@ def test_invert_weights_a_mode_without_an_interval_by_the_default_alone_and_says
     assert notes[1].startswith("mode(s) 3: no usable damping_ci95") and "5 %" in notes[1]
     complete, none = _modal_noise_levels({"modes": modes[:1]})
     assert none == [] and complete["freq"].shape == (1,)
+
+
+def test_a_component_is_identified_where_its_95_interval_clears_zero():
+    """k4 at 1.5 standard errors from zero is not identified, at 2.5 it is; a std of 0 is fixed,
+    or at zero where the value is 0."""
+    import dataclasses
+
+    s = am.chapter2_system()
+    m = s.modes()
+    sol = inner_solve(m.eigenvalues, m.shapes, total_mass=s.masses.sum(), names=s.names)
+    comps = sol.components
+    for ratio, expected in ((1.5, "no"), (2.5, "yes")):
+        std = dataclasses.replace(comps, masses=0 * comps.masses, k=comps.k / ratio, c=comps.c / 10,
+                                  k_s=comps.k_s / 10, c_s=0 * comps.c_s)  # fmt: skip
+        table = dataclasses.replace(sol, std=std).to_frame()
+        assert (table.component == "k").sum() == 4 and set(table[table.component == "k"].identified) == {expected}
+        assert set(table[table.component == "mass"].identified) == {"fixed"}
+        assert set(table[table.component == "c"].identified) == {"yes"}
+    zero = dataclasses.replace(sol, components=dataclasses.replace(comps, c_s=0 * comps.c_s),
+                               std=dataclasses.replace(comps, c_s=0 * comps.c_s))  # fmt: skip
+    assert set(zero.to_frame().query("component == 'c_s'").identified) == {"at zero"}

@@ -234,3 +234,9 @@ def test_a_threshold_no_setting_can_take_is_refused_by_name(make, message):
         make()
     # at the limits, accepted
     assert ClusterSettings(min_support=1.0).min_support == 1.0 and CountSettings(max_steps=1).max_steps == 1
+
+
+def test_a_mode_the_check_drops_twice_is_one_doubt_with_its_first_note():
+    first, second, other = (QualityWarning("mode_not_needed", (), text, 5.99) for text in ("first", "second", "other"))
+    doubts = [(5.99, 0.13, first), (8.57, 0.03, other), (5.99, 0.13, second)]
+    assert pipeline.each_once(doubts) == ((5.99, 0.13, first), (8.57, 0.03, other))
