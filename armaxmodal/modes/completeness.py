@@ -74,6 +74,12 @@ def modes_the_record_needs(recording: Recording, work: SelectionState, band, set
             doubts.append((float(f_m), float(x_m), note))
 
 
+def each_once(doubts) -> tuple:
+    """The doubts by frequency, a mode the check dropped in both of its passes once (its first note)."""
+    once = {f: (f, x, note) for f, x, note in reversed(doubts)}
+    return tuple(sorted(once.values(), key=lambda d: d[0]))
+
+
 def refit_with_added(diagram, work: SelectionState, band, settings: SelectionSettings = DEFAULTS) -> SelectionState:
     """The frequency-domain refit again, of every mode once the check has added some: a mode
     missing from a refit biases its neighbours (a five-segment chain's 13.5 Hz mode came out

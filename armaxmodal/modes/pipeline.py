@@ -27,7 +27,7 @@ import pandas as pd
 from armaxmodal._threads import one_blas_thread
 from armaxmodal.exceptions import PickError
 from armaxmodal.modes.clusters import check_picks, clustered_modes, merge_duplicates, picked_modes, why_no_mode
-from armaxmodal.modes.completeness import modes_the_check_adds, modes_the_record_needs, refit_with_added
+from armaxmodal.modes.completeness import each_once, modes_the_check_adds, modes_the_record_needs, refit_with_added
 from armaxmodal.modes.counted import confirmed_where_incoherent, counted_modes, dropped_where_peaks_remain
 from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.intervals import with_intervals
@@ -122,12 +122,6 @@ def propose_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionSta
     doubts: list = []
     state = _screened(state, ctx, doubts)
     return replace(state, doubts=each_once(doubts))
-
-
-def each_once(doubts) -> tuple:
-    """The doubts by frequency, a mode the check dropped in both of its passes once (its first note)."""
-    once = {f: (f, x, note) for f, x, note in reversed(doubts)}
-    return tuple(sorted(once.values(), key=lambda d: d[0]))
 
 
 def _screened(state: SelectionState, ctx: SelectionContext, doubts: list | None) -> SelectionState:
