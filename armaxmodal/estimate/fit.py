@@ -102,8 +102,8 @@ def fit_armax(
     >>> fit = am.fit_armax(ride, 8, 8, 8, 0, shared_poles=True)  # na, nb, nc, nk
     >>> fit.orders
     (8, 8, 8, 0)
-    >>> bool(np.all(fit.fit_percent > 90))  # one-step fit of each output, %
-    True
+    >>> round(float(fit.fit_percent.min()))  # the worst output's one-step fit, %
+    97
     """
     return fit_resumable(
         data, (na, nb, nc, nk), fs=fs, shared_poles=shared_poles, output_error=output_error, max_iter=max_iter,

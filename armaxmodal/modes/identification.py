@@ -179,8 +179,8 @@ def identify(
     ...                              seed=2)
     >>> result = am.identify(ride)  # orders chosen by BIC
     >>> exact = am.supine_human().modes().freq_hz  # 5.83, 8.31, 13.50, 16.25 Hz
-    >>> bool(np.allclose(result.modes.freq_hz, exact, rtol=0.02))
-    True
+    >>> round(100 * float(np.max(np.abs(result.modes.freq_hz / exact - 1))))  # the largest error, % (0.3-0.4)
+    0
     """
     preparation = None
     if not prepared:

@@ -360,8 +360,8 @@ def select_modes(
     >>> selection.quality
     'good'
     >>> exact = am.supine_human().modes().freq_hz  # 5.83, 8.31, 13.50, 16.25 Hz
-    >>> bool(np.allclose(selection.modes.freq_hz, exact, rtol=0.02))  # within 2 %, on any CPU
-    True
+    >>> round(100 * float(np.max(np.abs(selection.modes.freq_hz / exact - 1))))  # the largest error, % (0.3-0.4)
+    0
     """
     from tqdm import tqdm
 
