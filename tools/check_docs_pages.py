@@ -70,7 +70,9 @@ INTERNALS = re.compile(r"\bissues? #?\d+|\.\./shared|/work/")
 
 def internals(dom: str) -> list[str]:
     """Issue numbers and paths outside the repository in a page's text."""
-    text = re.sub(r"<[^>]+>", " ", dom)
+    # MathJax writes its font files' absolute URLs into a <style> block: code, not text a reader sees
+    text = re.sub(r"<(style|script)\b.*?</\1>", " ", dom, flags=re.S)
+    text = re.sub(r"<[^>]+>", " ", text)
     return [f"shows the project's bookkeeping: {m!r}" for m in sorted(set(INTERNALS.findall(text)))]
 
 
