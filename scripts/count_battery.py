@@ -30,7 +30,7 @@ import pandas as pd
 from scipy import signal
 
 import armaxmodal as am
-from armaxmodal.modes.modal_model import DftLines, fit_modal_model
+from armaxmodal.modes.dft_model import DftLines, fit_modal_model
 from armaxmodal.modes.selected_refit import refit_band
 
 FREQ_TOL, DAMPING_TOL, BOUNDS = 0.02, 0.10, 3.0

@@ -1,7 +1,7 @@
 """The search of the count: nested tests of free refits of the maximum-likelihood modal model.
 
 From the diagram's selection, every step compares the current model with its neighbours, each
-refitted with every pole free (:func:`armaxmodal.modes.modal_model.fit_modal_model`):
+refitted with every pole free (:func:`armaxmodal.modes.dft_model.fit_modal_model`):
 
 * **remove** each mode (the others free to take over: a merge of two close modes is a removal);
 * **add** a left-out stable cluster of the diagram, or a pole where the residual is largest;
@@ -20,7 +20,7 @@ import numpy as np
 from scipy.special import chdtrc
 
 from armaxmodal._threads import single_blas_thread
-from armaxmodal.modes.modal_model import DftLines, ModalModel, fit_modal_model
+from armaxmodal.modes.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.mode_count import (
     COUNT,
     ModeCount,

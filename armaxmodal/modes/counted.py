@@ -18,6 +18,7 @@ import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
 from armaxmodal.modes.count_search import count_modes
+from armaxmodal.modes.dft_model import DftLines, fit_modal_model
 from armaxmodal.modes.intervals import (
     EARLIER_COLUMNS,
     covering_both_estimators,
@@ -26,7 +27,6 @@ from armaxmodal.modes.intervals import (
     with_intervals,
 )
 from armaxmodal.modes.modal_check import check_modes
-from armaxmodal.modes.modal_model import DftLines, fit_modal_model
 from armaxmodal.modes.mode_count import ModeCount, agree_in_halves, matched_poles, nearest_pole
 from armaxmodal.modes.notes import count_notes, no_mode_kept_note, pick_notes
 from armaxmodal.modes.poles import mac

@@ -1,7 +1,7 @@
 """How many modes: the count's result and the tests it is built from.
 
 :func:`armaxmodal.modes.count_search.count_modes` compares free refits of the
-maximum-likelihood modal model (:func:`armaxmodal.modes.modal_model.fit_modal_model`) with one
+maximum-likelihood modal model (:func:`armaxmodal.modes.dft_model.fit_modal_model`) with one
 mode fewer, one more, or one split, and keeps the neighbour of lowest criterion while it lowers it.
 This module holds what it returns, :class:`ModeCount`, with the verdicts derived from it (which
 poles are reported, the other structures' reach), and the tests the search applies: Bartlett's
@@ -31,8 +31,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from armaxmodal.modes.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.intervals import interval
-from armaxmodal.modes.modal_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.settings import DEFAULTS, CountSettings, DftSettings, LineSettings
 from armaxmodal.stats import MAX_DAMPING, Z95
 

@@ -10,11 +10,11 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.modal import mode_record
+from armaxmodal.modes.dft_model import ModalModel
 from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.intervals import not_separated, with_intervals
 from armaxmodal.modes.modal_check import ModalCheck
 from armaxmodal.modes.mode_count import ModeCount
-from armaxmodal.modes.refine import ModalRefinement
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
 from armaxmodal.prepare.preparation import Preparation
 from armaxmodal.quality_warnings import UNCERTAIN_CODES, QualityWarning
@@ -43,8 +43,8 @@ class ModeSelection:
     weighted : DataFrame
         Eqs. 3.35-3.36: per mode, the mean of the per-sensor values weighted by ``|M_ij|``.
     diagram : StabilisationDiagram
-    refinement : ModalRefinement or None
-        The frequency-domain refit (:mod:`armaxmodal.modes.refine`); its ``hold`` is the
+    refinement : ModalModel or None
+        The frequency-domain refit (:func:`armaxmodal.modes.dft_model.refine_modes`); its ``hold`` is the
         inter-sample behaviour the data chose. ``modes.estimator`` says which values are
         reported: the refit for a band-limited recording, the ARMAX fit (the exact model
         class) for a held input.
@@ -74,7 +74,7 @@ class ModeSelection:
     per_sensor: pd.DataFrame
     weighted: pd.DataFrame
     diagram: StabilisationDiagram
-    refinement: ModalRefinement | None = None
+    refinement: ModalModel | None = None
     own_warnings: tuple[QualityWarning, ...] = ()
     check: ModalCheck | None = None
     count: ModeCount | None = None

@@ -1,5 +1,5 @@
 """The fits run for the selected modes: the frequency-domain refit
-(:mod:`armaxmodal.modes.refine`) and the segment refits (:mod:`armaxmodal.modes.spread`), run
+(:func:`armaxmodal.modes.dft_model.refine_modes`) and the segment refits (:mod:`armaxmodal.modes.spread`), run
 together over the worker threads, and the refit's values applied within their limits.
 """
 
@@ -14,7 +14,7 @@ import pandas as pd
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.clusters import merge_duplicates
-from armaxmodal.modes.refine import refine_modes
+from armaxmodal.modes.dft_model import refine_modes
 from armaxmodal.modes.settings import DEFAULTS, DftSettings
 from armaxmodal.modes.spread import (
     segment_jobs,
@@ -86,7 +86,7 @@ class RefitFailure:
 def refined_modes(
     diagram, work: SelectionState, refinement, cluster_freq, cluster_damping, merge_mac, relaxed=False
 ) -> SelectionState:
-    """The frequency-domain refit (:func:`armaxmodal.modes.refine.refine_modes`, or a
+    """The frequency-domain refit (:func:`armaxmodal.modes.dft_model.refine_modes`, or a
     :class:`RefitFailure` when it could not be made, which leaves the selection without one)
     reported for a band-limited record, and kept as the selection's ``refinement``.
     ``relaxed``: the refit may move a mode by :func:`_refit_reach`, not ``cluster_freq``.

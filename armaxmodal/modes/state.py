@@ -15,10 +15,10 @@ import pandas as pd
 from armaxmodal.quality_warnings import QualityWarning
 
 if TYPE_CHECKING:  # types only: the stages that make them import this module
+    from armaxmodal.modes.dft_model import ModalModel
     from armaxmodal.modes.diagram import StabilisationDiagram
     from armaxmodal.modes.modal_check import ModalCheck
     from armaxmodal.modes.mode_count import ModeCount
-    from armaxmodal.modes.refine import ModalRefinement
     from armaxmodal.modes.result import ModeSelection
     from armaxmodal.modes.settings import SelectionSettings
 
@@ -37,7 +37,7 @@ class SelectionState:
         (:mod:`armaxmodal.modes.intervals`).
     shapes : (n_sensors, n_modes) complex ndarray
         The modal constants, one column per row of ``modes``.
-    refinement : ModalRefinement or None
+    refinement : ModalModel or None
         The frequency-domain refit the values come from, once made.
     check : ModalCheck or None
         The modal-model check of ``modes``, once run (a stage that changes the modes runs it again).
@@ -62,7 +62,7 @@ class SelectionState:
 
     modes: pd.DataFrame
     shapes: np.ndarray
-    refinement: ModalRefinement | None = None
+    refinement: ModalModel | None = None
     check: ModalCheck | None = None
     count: ModeCount | None = None
     warnings: tuple[QualityWarning, ...] = ()

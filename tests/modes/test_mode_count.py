@@ -11,8 +11,8 @@ import pytest
 import armaxmodal as am
 from armaxmodal.modes.count_search import count_modes
 from armaxmodal.modes.counted import _one_where_not_separated, dropped_where_peaks_remain
+from armaxmodal.modes.dft_model import DftLines, fit_modal_model
 from armaxmodal.modes.intervals import not_separated, with_intervals
-from armaxmodal.modes.modal_model import DftLines, fit_modal_model
 from armaxmodal.modes.mode_count import ModeCount, Wanted, effective_fraction, reported
 from armaxmodal.modes.notes import count_notes as _notes
 from armaxmodal.modes.result import ModeSelection, not_separated_notes
