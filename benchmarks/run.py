@@ -22,7 +22,7 @@ def main() -> None:
     parser.add_argument("--skip-long", action="store_true", help="keep bench_long.py's saved result")
     args = parser.parse_args()
     steps = [
-        [sys.executable, "-m", "pytest", str(HERE / "test_peers.py"), "-q", "-p", "no:cacheprovider",
+        [sys.executable, "-m", "pytest", str(HERE / "test_peers.py"), "-q", "-n", "0", "-p", "no:cacheprovider",
          f"--benchmark-json={HERE / 'results' / 'peers.json'}"],
         [sys.executable, str(HERE / "bench_ratio.py")],
         [sys.executable, str(HERE / "bench_study.py")],

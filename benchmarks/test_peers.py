@@ -7,7 +7,7 @@ turns each group into a row of the performance page (the ratio of the medians). 
 also checks that the two solved the same problem equally well, so a ratio never compares a
 fast wrong answer with a slow right one.
 
-    python -m pytest benchmarks/test_peers.py --benchmark-json=benchmarks/results/peers.json
+    python -m pytest benchmarks/test_peers.py -n 0 --benchmark-json=benchmarks/results/peers.json
 
 Not part of the test suite (``testpaths`` is ``tests``): timings are measured, never asserted.
 """
