@@ -7,6 +7,7 @@ fetched; the gallery's figures are made when the docs build (sphinx-gallery).
 from __future__ import annotations
 
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -81,7 +82,19 @@ autodoc_default_options: dict = {}  # members only on class pages (docs/_templat
 autodoc_typehints = "none"  # numpydoc's Parameters sections say the types
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
-numpydoc_xref_param_type = False
+# the types in Parameters and Returns link to their pages: every class the API reference
+# documents, by its short name; other words (ndarray, DataFrame, shapes) stay text, since the
+# offline build has no inventory to link them to
+numpydoc_xref_param_type = True
+numpydoc_xref_ignore = "all"
+from numpydoc.xref import DEFAULT_LINKS  # noqa: E402
+
+numpydoc_xref_aliases = {word: word for word in DEFAULT_LINKS}  # numpydoc's links need inventories
+numpydoc_xref_aliases |= {
+    name.rsplit(".", 1)[-1]: name
+    for name in re.findall(r"^ {3}(armaxmodal\.[\w.]+)$", (Path(__file__).parent / "api.rst").read_text(), re.M)
+    if name.rsplit(".", 1)[-1][:1].isupper()
+}
 # every cross-reference must resolve (the build runs with -W): a renamed function breaks the build,
 # not a link
 nitpicky = True

@@ -92,6 +92,11 @@ def diagnose(
     -------
     Diagnosis
 
+    See Also
+    --------
+    armaxmodal.identify : The model whose residual is diagnosed.
+    armaxmodal.fit_armax : The ARMAX fit alone.
+
     Examples
     --------
     A hum at 11.7 Hz on the head sensor, which the model of the ride lacks:

@@ -93,6 +93,12 @@ def fit_armax(
     -------
     ArmaxFit
 
+    See Also
+    --------
+    armaxmodal.choose_orders : Choose the orders by an information criterion.
+    armaxmodal.identify : One model's modes, checked against the measured FRF.
+    armaxmodal.stabilisation_diagram : Fits over a range of orders.
+
     Examples
     --------
     >>> import numpy as np

@@ -178,6 +178,11 @@ def choose_orders(
     -------
     OrderChoice
 
+    See Also
+    --------
+    armaxmodal.fit_armax : Fit one model.
+    armaxmodal.stabilisation_diagram : Fits over a range of orders.
+
     Examples
     --------
     >>> import armaxmodal as am

@@ -98,6 +98,11 @@ def inner_solve(
     -------
     InverseSolution
 
+    See Also
+    --------
+    armaxmodal.inverse.inner_solve_sdp : The inner problem as an SDP, for any coupling pattern.
+    armaxmodal.inverse.evphc : The inverse modal problem that calls it.
+
     Examples
     --------
     The supine chain recovered from its exact modes and its total mass:

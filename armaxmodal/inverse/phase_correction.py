@@ -76,6 +76,12 @@ def evphc(
     InverseSolution
         The chain's masses, springs and dampers with their standard errors, and the cost.
 
+    See Also
+    --------
+    armaxmodal.inverse.pia : The Pilkey-Inman baseline, from all complex modes and a known mass.
+    armaxmodal.inverse.model_update : Components fitted to modal data and/or transmissibility.
+    armaxmodal.inverse.inner_solve : The inner problem alone.
+
     Examples
     --------
     >>> import numpy as np

@@ -40,6 +40,11 @@ def pia(eigenvalues, shapes, mass, *, tol: float = 1e-4, max_iter: int = 500, na
     InverseSolution
         The chain's damping and stiffness with the given masses.
 
+    See Also
+    --------
+    armaxmodal.inverse.evphc : The inverse modal problem by eigenvector phase correction.
+    armaxmodal.inverse.model_update : Components fitted to modal data and/or transmissibility.
+
     Examples
     --------
     Stiffness and damping from the exact modes and the masses (Pilkey & Inman):

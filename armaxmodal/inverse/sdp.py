@@ -91,6 +91,10 @@ def inner_solve_sdp(
     InverseSolution
         ``components`` is set when the result is a chain.
 
+    See Also
+    --------
+    armaxmodal.inverse.inner_solve : The chain's inner problem, least squares on the eigen-equations.
+
     Examples
     --------
     >>> import numpy as np

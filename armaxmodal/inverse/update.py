@@ -101,6 +101,11 @@ def model_update(
     InverseSolution
         The updated chain with its standard errors and misfits.
 
+    See Also
+    --------
+    armaxmodal.inverse.evphc : The inverse modal problem by eigenvector phase correction.
+    armaxmodal.inverse.pia : The Pilkey-Inman baseline, from all complex modes and a known mass.
+
     Examples
     --------
     >>> import numpy as np

@@ -61,6 +61,12 @@ def read_recording(
     -------
     Recording
 
+    See Also
+    --------
+    armaxmodal.read_xsens : Read an Xsens IMU export.
+    armaxmodal.write_recording_csv : Write a recording as CSV.
+    armaxmodal.stabilisation_diagram : Sweep the model order over the recording.
+
     Examples
     --------
     >>> import tempfile, pathlib

@@ -74,6 +74,11 @@ def write_recording_csv(recording: Recording, path: str | os.PathLike, float_for
     Path
         The file written.
 
+    See Also
+    --------
+    armaxmodal.write_recording_uff : Write a recording as UFF 58 records.
+    armaxmodal.read_recording : Read it back.
+
     Examples
     --------
     >>> import tempfile, pathlib
@@ -112,6 +117,11 @@ def write_recording_uff(recording: Recording, path: str | os.PathLike) -> Path:
     -------
     Path
         The file written.
+
+    See Also
+    --------
+    armaxmodal.write_recording_csv : Write a recording as CSV.
+    armaxmodal.read_recording : Read it back.
 
     Examples
     --------

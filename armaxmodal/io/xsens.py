@@ -58,6 +58,10 @@ def read_xsens(
     Recording
         ``meta["read_warnings"]`` holds a ``dropped_packet`` warning per bridged gap.
 
+    See Also
+    --------
+    armaxmodal.read_recording : Read CSV, MAT or UFF recordings.
+
     Examples
     --------
     One export per sensor (the table's and the top floor's), put on the input's time stamps:

@@ -5,7 +5,7 @@
 * :func:`~armaxmodal.select_modes` -- the physical modes picked from it by named stages
   (:mod:`.pipeline`, every threshold in :mod:`.settings`, the result in :mod:`.result`;
   :mod:`.clusters`, :mod:`.completeness`, the support tests in :mod:`.support`), refitted in the
-  frequency domain (:mod:`.refine`), counted by nested tests of the maximum-likelihood modal
+  frequency domain (:func:`.dft_model.refine_modes`), counted by nested tests of the maximum-likelihood modal
   model (:mod:`.dft_model`, :mod:`.mode_count`, :mod:`.counted`), with intervals widened by
   the segment spread (:mod:`.spread`) and judged by the modal-model check (:mod:`.modal_check`,
   on the coherent lines of :mod:`.lines`).

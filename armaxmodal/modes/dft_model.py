@@ -25,7 +25,7 @@ lines are independent complex normal variables of equal variance, so the log-lik
 concentrated over the ``sigma_k`` is ``-1/2 sum_k n_k ln(RSS_k / n_k)`` (``n_k`` real numbers
 per sensor): minimising each sensor's weighted residual is maximum likelihood. The residues,
 direct and transient terms enter linearly and are projected out (variable projection, Golub &
-Pereyra; :mod:`armaxmodal.modes._separable`), so only the frequencies and damping ratios are
+Pereyra; the private ``armaxmodal.modes._separable``), so only the frequencies and damping ratios are
 iterated, all of them free. Standard errors come from the Jacobian of the projected residual
 (the information matrix, as a sandwich).
 

@@ -255,6 +255,11 @@ def stabilisation_diagram(
         The fits of every order, their poles with stability classes, the preparation and its
         warnings.
 
+    See Also
+    --------
+    armaxmodal.select_modes : Pick the physical modes from the diagram.
+    armaxmodal.choose_orders : One order by an information criterion.
+
     Examples
     --------
     >>> import armaxmodal as am

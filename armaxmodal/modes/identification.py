@@ -171,6 +171,11 @@ def identify(
     -------
     Identification
 
+    See Also
+    --------
+    armaxmodal.fit_armax : The ARMAX fit alone.
+    armaxmodal.stabilisation_diagram : Fits over a range of orders, for select_modes.
+
     Examples
     --------
     >>> import numpy as np

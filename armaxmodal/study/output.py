@@ -52,6 +52,10 @@ def write_study(study: Study, out: str | Path, report: str | Path | None = None)
     list of Path
         The files written.
 
+    See Also
+    --------
+    armaxmodal.study.run_study : Run the study.
+
     Examples
     --------
     >>> import tempfile, pathlib

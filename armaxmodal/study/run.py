@@ -113,6 +113,11 @@ def run_study(
     -------
     Study
 
+    See Also
+    --------
+    armaxmodal.study.write_study : Write a finished study's tables, figures and report.
+    armaxmodal.select_modes : What each recording's job runs.
+
     Examples
     --------
     Two subjects' rides in one folder, analysed and tabled:

@@ -91,6 +91,10 @@ def chapter2_system() -> Structure:
     -------
     Structure
 
+    See Also
+    --------
+    armaxmodal.supine_human : The four-segment supine chain of Section 4.4.
+
     Examples
     --------
     >>> import numpy as np
@@ -125,6 +129,11 @@ def supine_human() -> Structure:
     Returns
     -------
     Structure
+
+    See Also
+    --------
+    armaxmodal.supine_with_feet : The same chain with a light feet segment.
+    armaxmodal.chapter2_system : The four-DOF system of Section 2.3.1.
 
     Examples
     --------
@@ -165,6 +174,10 @@ def supine_with_feet() -> Structure:
     Returns
     -------
     Structure
+
+    See Also
+    --------
+    armaxmodal.supine_human : The four-segment supine chain of Section 4.4.
 
     Examples
     --------

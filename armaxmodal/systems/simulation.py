@@ -107,6 +107,10 @@ def simulate(
     -------
     (n_samples, n_dof) ndarray
 
+    See Also
+    --------
+    armaxmodal.simulate_recording : A whole recording with noise.
+
     Examples
     --------
     >>> import armaxmodal as am
@@ -229,6 +233,13 @@ def simulate_recording(
     -------
     Recording
 
+    See Also
+    --------
+    armaxmodal.simulate : Every DOF's response to a sampled base acceleration.
+    armaxmodal.random_vibration : A band-limited random input.
+    armaxmodal.sine_sweep : A swept-sine input.
+    armaxmodal.add_noise : Measurement noise on a recording.
+
     Examples
     --------
     >>> import armaxmodal as am
@@ -270,6 +281,10 @@ def add_noise(x, level: float, rng: np.random.Generator) -> np.ndarray:
     -------
     ndarray
         Shaped like ``x``.
+
+    See Also
+    --------
+    armaxmodal.simulate_recording : A whole recording, noise included.
 
     Examples
     --------
@@ -319,6 +334,11 @@ def sine_sweep(
     -------
     (round(duration * fs),) ndarray, m/s^2
 
+    See Also
+    --------
+    armaxmodal.random_vibration : A band-limited random input.
+    armaxmodal.simulate_recording : Drive a structure with it.
+
     Examples
     --------
     >>> import armaxmodal as am
@@ -364,6 +384,11 @@ def random_vibration(
     -------
     (round(duration * fs),) ndarray
         m/s^2, scaled to the given RMS.
+
+    See Also
+    --------
+    armaxmodal.sine_sweep : A swept-sine input.
+    armaxmodal.simulate_recording : Drive a structure with it.
 
     Examples
     --------
