@@ -184,7 +184,13 @@ class ModalModel:
     hold_cost: dict = field(default_factory=dict)
 
     def by_frequency(self) -> ModalModel:
-        """The same model, its modes sorted by frequency."""
+        """The same model, its modes sorted by frequency.
+
+        Returns
+        -------
+        ModalModel
+            A copy whose per-mode arrays and shape columns are in ascending frequency.
+        """
         order = np.argsort(self.freq_hz)
         return replace(self, freq_hz=self.freq_hz[order], damping=self.damping[order], freq_sd=self.freq_sd[order],
                        damping_sd=self.damping_sd[order], shapes=self.shapes[:, order])  # fmt: skip
