@@ -8,7 +8,7 @@
   frequency domain (:func:`.dft_model.refine_modes`), counted by nested tests of the maximum-likelihood modal
   model (:mod:`.dft_model`, :mod:`.mode_count`, :mod:`.counted`), with intervals widened by
   the segment spread (:mod:`.spread`) and judged by the modal-model check (:mod:`.modal_check`,
-  on the coherent lines of :mod:`.lines`).
+  on the coherent lines of :mod:`.frf`).
 * :func:`~armaxmodal.identify` -- one model, its modes and the same check.
 """
 

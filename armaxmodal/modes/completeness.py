@@ -103,7 +103,7 @@ def modes_the_check_adds(diagram, work: SelectionState, band, nas, settings: Sel
     not only an overlapping one: one at a time, the largest first): the
     candidates are the cluster of poles of at least ``frf.peak_cluster_min_orders`` orders
     within ``frf.peak_cluster_freq`` of each clear, coherent H1 peak no selected mode
-    explains (:func:`armaxmodal.modes.frf_check.unexplained_peaks`), and every cluster of kept
+    explains (:func:`armaxmodal.modes.frf.unexplained_peaks`), and every cluster of kept
     poles of at least three orders away from the selected modes (heavily damped modes make
     no clear peak, and their poles scatter over the orders; these need a damping the record
     resolves, as a peak's cluster does not). A peak left unexplained is listed at the end as
@@ -140,7 +140,7 @@ def _left_out_clusters(diagram, modes: pd.DataFrame, band, nas, settings: Select
                        ) -> list[tuple[pd.DataFrame, bool]]:  # fmt: skip
     """The candidate clusters of :func:`modes_the_check_adds`, the largest first, each with
     whether it stands at an unexplained peak."""
-    from armaxmodal.modes.frf_check import unexplained_peaks
+    from armaxmodal.modes.frf import unexplained_peaks
 
     cluster, frf = settings.cluster, settings.frf
     cand = candidate_poles(diagram.poles, band)

@@ -29,13 +29,11 @@ from armaxmodal.modes.mode_count import (
     Wanted,
     agree_in_halves,
     effective_fraction,
-    matched_poles,
-    nearest_pole,
-    new_poles,
     reported,
     residual_peak,
     split_start,
 )
+from armaxmodal.modes.poles import matched_poles, nearest_pole, new_poles
 from armaxmodal.modes.settings import DEFAULTS, CountSettings, DftSettings, LineSettings
 from armaxmodal.stats import MAX_DAMPING, Z95
 
@@ -397,4 +395,4 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max
             alternatives += ((wanted.rise, split),)
     return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
                      tuple(unconfirmed), alternatives, carried_away, wanted, stand_ins, settings, lines,
-                     dft, tuple(search.table.rows))  # fmt: skip
+                     dft, tuple(search.table.rows), data.band_hz)  # fmt: skip

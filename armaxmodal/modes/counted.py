@@ -27,9 +27,9 @@ from armaxmodal.modes.intervals import (
     with_intervals,
 )
 from armaxmodal.modes.modal_check import check_modes
-from armaxmodal.modes.mode_count import ModeCount, agree_in_halves, matched_poles, nearest_pole
+from armaxmodal.modes.mode_count import ModeCount, agree_in_halves
 from armaxmodal.modes.notes import count_notes, no_mode_kept_note, pick_notes
-from armaxmodal.modes.poles import mac
+from armaxmodal.modes.poles import mac, matched_poles, nearest_pole
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
 from armaxmodal.modes.spread import split_segments
 from armaxmodal.modes.state import SelectionState
@@ -132,13 +132,14 @@ def counted_modes(
                         dft=settings.dft)  # fmt: skip
     if part is not rec:
         count = _on_whole_record(count, rec, band_hz, hold)
-    keep = count.reported(data.band_hz)
+    verdicts = count.verdicts(data.band_hz)
+    keep = np.isin(verdicts, ("needed", "undecided"))
     same_row = settings.cluster.same_row_freq
     if picked:
         return _picked_result(_doubts_said(work, ()), count, keep, hold, settings, rec, band)
     if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
         return _doubts_said(work, ()).warned(no_mode_kept_note(count, modes, data.band_hz), count=count)
-    rows = pd.DataFrame([_row(modes, count, i, hold, same_row) for i in np.flatnonzero(keep)])
+    rows = pd.DataFrame([_row(modes, count, i, hold, same_row, verdicts[i]) for i in np.flatnonzero(keep)])
     rows, shapes, merged = _one_where_not_separated(rows, count.model.shapes[:, keep], count, keep, rec, band_hz, hold,
                                                     settings)  # fmt: skip
     rows, disagree = covering_both_estimators(rows, settings.intervals.estimators_alpha)
@@ -294,7 +295,8 @@ def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hol
     for j in np.flatnonzero(picked):
         i = pairs[j]
         if keep[i]:
-            rows.append({**_row(work.modes, count, i, hold, same_row), "picked_hz": work.modes.picked_hz.iloc[j]})
+            rows.append({**_row(work.modes, count, i, hold, same_row, count.verdicts()[i]),
+                         "picked_hz": work.modes.picked_hz.iloc[j]})
             shapes.append(m.shapes[:, i])
             continue
         row = work.modes.iloc[j].to_dict()
@@ -328,9 +330,10 @@ def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hol
     return work.warned(*notes)
 
 
-def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str, same_row_freq: float) -> dict:
+def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str, same_row_freq: float, verdict: str) -> dict:
     """Mode ``i`` of the counted model as a selection row: the nearest selected row's cluster
-    facts when it lies within ``same_row_freq``, else none (``count`` 0)."""
+    facts when it lies within ``same_row_freq``, else none (``count`` 0); ``verdict`` is the
+    count's (:meth:`~armaxmodal.modes.mode_count.ModeCount.verdicts`)."""
     m = count.model
     f, x = m.freq_hz[i], m.damping[i]
     dist = np.abs(modes.freq_hz.to_numpy() / f - 1)
@@ -348,7 +351,7 @@ def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str, same_row_freq
     other, widened = count.other_structures(i, same_row_freq)
     row.update(
         freq_hz=f, damping=x, damped_freq_hz=f * np.sqrt(1 - x**2), freq_sd=m.freq_sd[i], damping_sd=m.damping_sd[i],
-        **other, estimator=f"ml-{hold}", count_undecided=bool(count.removal_rise[i] < count.settings.decisive_bic),
+        **other, estimator=f"ml-{hold}", count_undecided=verdict == "undecided",
         structure_widened=widened,
     )  # fmt: skip
     return row

@@ -20,8 +20,14 @@ from armaxmodal.estimate.fit import fit_resumable
 from armaxmodal.estimate.orders import Orders, default_nb, default_nc, information_criterion, output_mean_squares
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.exceptions import OrderError
-from armaxmodal.modes.disturbance import disturbance_lines
-from armaxmodal.modes.poles import SHARED, Tolerances, pole_rows, rejection_reasons, stability_classes
+from armaxmodal.modes.poles import (
+    SHARED,
+    Tolerances,
+    disturbance_lines,
+    pole_rows,
+    rejection_reasons,
+    stability_classes,
+)
 from armaxmodal.modes.settings import SWEEP
 from armaxmodal.prepare.preparation import Preparation, prepare
 from armaxmodal.quality_warnings import QualityWarning

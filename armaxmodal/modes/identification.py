@@ -74,7 +74,7 @@ class Identification:
         gives: a fixed or BIC-chosen order can leave a mode out); and ``oversampled`` when
         every mode lies below a tenth of the Nyquist frequency (``oversampling_note``).
         Computed once (the peak check takes spectra)."""
-        from armaxmodal.modes.frf_check import unexplained_peaks
+        from armaxmodal.modes.frf import unexplained_peaks
 
         found = () if self.preparation is None else self.preparation.warnings
         band = None if self.preparation is None else self.preparation.band

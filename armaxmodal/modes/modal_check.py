@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from armaxmodal.modes.lines import CHECK_RESOLUTION, CoherentLines, coherent_lines, resolving_nperseg
+from armaxmodal.modes.frf import CHECK_RESOLUTION, CoherentLines, coherent_lines, resolving_nperseg
 from armaxmodal.modes.settings import DEFAULTS, FrfSettings
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
@@ -229,7 +229,7 @@ def _coefficients_to_terms(coef: np.ndarray, n_modes: int) -> tuple[np.ndarray, 
 
 
 def check_nperseg(recording: Recording, freq_hz, damping) -> int:
-    """Welch segment length of the check (:data:`~armaxmodal.modes.lines.CHECK_RESOLUTION`)."""
+    """Welch segment length of the check (:data:`~armaxmodal.modes.frf.CHECK_RESOLUTION`)."""
     return resolving_nperseg(recording, freq_hz, damping, CHECK_RESOLUTION)
 
 
@@ -314,7 +314,7 @@ def check_modes(recording: Recording, freq_hz, damping, band=None, *, fit_delay:
 
 def confirmed_modes(all_lines: list[CoherentLines], freq_hz, damping, line_hz: float,
                     confirm_lines: int = DEFAULTS.frf.confirm_lines) -> np.ndarray:  # fmt: skip
-    """Per mode: does some output have a coherent line (:func:`~armaxmodal.modes.lines.coherent_lines`) within
+    """Per mode: does some output have a coherent line (:func:`~armaxmodal.modes.frf.coherent_lines`) within
     ``|f - f_m| <= xi_m f_m + confirm_lines`` lines? A mode where no H1 is coherent is
     one the record cannot confirm: the check's fit never sees it. (The lines next to a sharp
     peak lose coherence to the H1's own bias: right modes on the measured records have their

@@ -33,6 +33,7 @@ import numpy as np
 
 from armaxmodal.modes.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.intervals import interval
+from armaxmodal.modes.poles import matched_poles, nearest_pole
 from armaxmodal.modes.settings import DEFAULTS, CountSettings, DftSettings, LineSettings
 from armaxmodal.stats import MAX_DAMPING, Z95
 
@@ -44,7 +45,6 @@ __all__ = [
     "Step",
     "agree_in_halves",
     "effective_fraction",
-    "matched_poles",
     "reported",
     "split_start",
 ]
@@ -166,6 +166,8 @@ class ModeCount:
         out-of-band poles are. (start Hz, where it went Hz, the criterion's rise without them).
     models : tuple of FittedModel
         Every model the count fitted, in the order fitted (:meth:`models_table`).
+    band_hz : (float, float)
+        The band of the lines the count decided on (Hz): which poles are modes of it.
     """
 
     model: ModalModel
@@ -185,6 +187,7 @@ class ModeCount:
     lines: LineSettings = DEFAULTS.lines
     dft: DftSettings = DEFAULTS.dft
     models: tuple[FittedModel, ...] = ()
+    band_hz: tuple[float, float] = (0.0, float("inf"))
 
     def models_table(self):
         """Every model the count fitted, one row each (``FittedModel``'s columns), in the order
@@ -203,12 +206,13 @@ class ModeCount:
 
     def to_dict(self) -> dict:
         """The count's evidence for the JSON: the effective fraction of the lines, the fits run, the
-        accepted steps and every model fitted (:meth:`models_table`).
+        accepted steps, every model fitted (:meth:`models_table`) and every pole of the chosen model
+        with its :meth:`verdicts`.
 
         Returns
         -------
         dict
-            ``effective_fraction``, ``trials``, ``steps`` and ``models``, strict-JSON-ready (None for NaN),
+            ``effective_fraction``, ``trials``, ``steps``, ``models`` and ``poles``, strict-JSON-ready (None for NaN),
             as ``schemas/stabilise.schema.json``'s ``count`` describes.
         """
 
@@ -222,26 +226,56 @@ class ModeCount:
                        "settled_hz": finite(st.settled_hz)} for st in self.steps],  # fmt: skip
             "models": [{**row._asdict(), "freq_hz": finite(row.freq_hz), "neg2_loglik": finite(row.neg2_loglik),
                         "bic": finite(row.bic)} for row in self.models],  # fmt: skip
+            "poles": [{"freq_hz": finite(f), "damping": finite(x), "removal_rise": finite(rise), "verdict": verdict}
+                      for f, x, rise, verdict in zip(self.model.freq_hz, self.model.damping, self.removal_rise,
+                                                     self.verdicts(), strict=True)],  # fmt: skip
         }
 
-    def reported(self, band_hz) -> np.ndarray:
-        """Which of the model's poles are reported as modes of the band (bool per pole):
-        :func:`reported`'s, but the stand-ins (matched by frequency within ``settings.same_mode_freq``:
-        a long record's model is refitted to the whole record after the search).
+    def verdicts(self, band_hz=None) -> np.ndarray:
+        """What the count makes of each pole of the chosen model, decided here and nowhere else:
+
+        * ``"needed"``: a mode of the band whose removal (the rest refitted free) raises the
+          criterion decisively (``settings.decisive_bic``);
+        * ``"undecided"``: a mode of the band the record holds less firmly (the rise is smaller):
+          reported, and said tentative;
+        * ``"stand_in"``: a start the search carried where no mode is founded but which the
+          model needs (:attr:`stand_ins`, matched within ``settings.same_mode_freq``): kept in the
+          model, not reported;
+        * ``"not_a_mode"``: beyond the band, damped beyond
+          :data:`~armaxmodal.stats.MAX_DAMPING`, or a line (:func:`reported`).
+
+        Starts the search left out of the model (:attr:`carried_away`) are not among its poles.
 
         Parameters
         ----------
-        band_hz : (float, float)
-            The band (Hz).
+        band_hz : (float, float), optional
+            The band (Hz); default :attr:`band_hz`.
+
+        Returns
+        -------
+        (n_modes,) ndarray of str
+        """
+        band = self.band_hz if band_hz is None else band_hz
+        verdict = np.where(self.removal_rise >= self.settings.decisive_bic, "needed", "undecided").astype(object)
+        verdict[~reported(self.model, band, self.lines)] = "not_a_mode"
+        for _, went, _ in self.stand_ins:
+            verdict[np.abs(np.log(self.model.freq_hz / went)) <= self.settings.same_mode_freq] = "stand_in"
+        return verdict
+
+    def reported(self, band_hz=None) -> np.ndarray:
+        """Which of the model's poles are reported as modes of the band (bool per pole): those
+        :meth:`verdicts` calls ``needed`` or ``undecided``.
+
+        Parameters
+        ----------
+        band_hz : (float, float), optional
+            The band (Hz); default :attr:`band_hz`.
 
         Returns
         -------
         (n_modes,) bool ndarray
         """
-        keep = reported(self.model, band_hz, self.lines)
-        for _, went, _ in self.stand_ins:
-            keep &= np.abs(np.log(self.model.freq_hz / went)) > self.settings.same_mode_freq
-        return keep
+        return np.isin(self.verdicts(band_hz), ("needed", "undecided"))
 
     def other_structures(self, i: int, same_row_freq: float) -> tuple[dict, bool]:
         """The reach of mode ``i``'s counterparts' 95 % intervals in the equally good models
@@ -337,29 +371,6 @@ def agree_in_halves(data: DftLines, model: ModalModel, halves, hold: str, max_nf
                                          (a.damping, b.damping, a.damping_sd, b.damping_sd)):  # fmt: skip
             agree[i] &= bool(abs(one[j] - two[k]) <= halves_sd * np.hypot(sd_one[j], sd_two[k]))
     return agree
-
-
-def nearest_pole(freq_hz: np.ndarray, f: float) -> int:
-    return int(np.argmin(np.abs(np.log(freq_hz / f))))
-
-
-def matched_poles(old_hz: np.ndarray, new_hz: np.ndarray) -> list[tuple[int, int]]:
-    """One-to-one pairs ``(i_new, j_old)`` of two pole sets' frequencies (Hz), nearest pairs
-    first (by log ratio); the larger set's surplus poles stay unpaired."""
-    pairs = sorted((abs(np.log(n / o)), i, j) for i, n in enumerate(new_hz) for j, o in enumerate(old_hz))
-    taken_new, taken_old, out = set(), set(), []
-    for _, i, j in pairs:
-        if i not in taken_new and j not in taken_old:
-            taken_new.add(i)
-            taken_old.add(j)
-            out.append((i, j))
-    return out
-
-
-def new_poles(old_hz: np.ndarray, new_hz: np.ndarray) -> list[int]:
-    """The poles of ``new_hz`` (indices) left over when each of ``old_hz`` takes its nearest."""
-    paired = {i for i, _ in matched_poles(old_hz, new_hz)}
-    return [i for i in range(len(new_hz)) if i not in paired]
 
 
 def residual_peak(model: ModalModel, data: DftLines, width_lines: int = COUNT.peak_width_lines) -> tuple[float, float]:

@@ -219,7 +219,7 @@ def spread(state: SelectionState, ctx: SelectionContext) -> SelectionState:
 
 def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     """The intervals' parts combined, once; the per-sensor tables; the notes read off the final modes."""
-    from armaxmodal.modes.frf_check import unexplained_peaks
+    from armaxmodal.modes.frf import unexplained_peaks
 
     diagram = ctx.diagram
     scale, widened = filled_samples_scale(diagram.recording, diagram.preparation)

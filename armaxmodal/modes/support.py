@@ -20,8 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from armaxmodal.modes.frf_check import coherent_peaks, explains
-from armaxmodal.modes.lines import coherent_lines, resolving_nperseg
+from armaxmodal.modes.frf import coherent_lines, coherent_peaks, explains, resolving_nperseg
 from armaxmodal.modes.modal_check import ModalCheck, poles_of, rss_at
 from armaxmodal.modes.poles import SHARED
 from armaxmodal.modes.settings import DEFAULTS, ClusterSettings, FrfSettings

@@ -60,7 +60,7 @@ def test_a_late_output_is_explained_once_its_delay_is_fitted(fixtures_dir):
 def test_a_missing_mode_fails_the_check_and_is_named_with_its_band(light_ride):
     """The 3.5 Hz mode left out: its peak dominates both H1s. (The 11 Hz mode left out
     leaves 20 %, under the limit: its smaller peak is the unexplained_peak check's,
-    tests/test_frf_check.py.)"""
+    tests/modes/test_frf.py.)"""
     s, rec = light_ride
     m = s.modes()
     check = check_modes(rec, m.freq_hz[1:], m.damping[1:])
@@ -129,7 +129,7 @@ def test_a_mode_where_no_h1_is_coherent_is_unconfirmed_and_fails_the_verdict(lig
     """A mode at 24.8 Hz, at the edge of the ride's band where no output responds
     coherently (as the bridge's 20.7 Hz 'mode' inside a low-coherence band): the fit cannot
     see it, so the check cannot pass it."""
-    from armaxmodal.modes.lines import coherent_lines
+    from armaxmodal.modes.frf import coherent_lines
     from armaxmodal.modes.modal_check import confirmed_modes
 
     s, rec = light_ride
@@ -172,7 +172,7 @@ def test_a_refit_may_move_a_mode_halfway_to_its_neighbour_within_twice_the_clust
 
 
 def test_a_mode_is_confirmed_by_a_coherent_line_within_its_half_width_and_four_lines():
-    from armaxmodal.modes.lines import CoherentLines
+    from armaxmodal.modes.frf import CoherentLines
     from armaxmodal.modes.modal_check import confirmed_modes
     from armaxmodal.modes.support import ModeSupport
 

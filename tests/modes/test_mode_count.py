@@ -349,7 +349,7 @@ def bundled_diagram(fixtures_dir):
 
 def test_a_model_that_keeps_no_mode_leaves_the_selection_and_says_so(monkeypatch, bundled_diagram):
     before = am.select_modes(bundled_diagram, segments=0)
-    monkeypatch.setattr(ModeCount, "reported", lambda count, band: np.zeros(count.model.freq_hz.size, dtype=bool))
+    monkeypatch.setattr(ModeCount, "verdicts", lambda count, band=None: np.full(count.model.freq_hz.size, "not_a_mode"))
     sel = am.select_modes(bundled_diagram, segments=0)
     assert len(sel.modes) == len(before.modes) == 4 and sel.quality == "uncertain"
     assert "count_undecided" in sel.uncertain_because
@@ -705,6 +705,31 @@ def test_a_wanted_mode_is_said_with_why_it_is_not_reported(rise, in_diagram, sai
     assert ("--pick" in notes[0].message) == in_diagram
 
 
+def test_each_pole_has_one_verdict_from_the_count_and_the_reported_modes_follow_it():
+    """The per-pole verdicts, decided in one place: needed at a decisive rise, undecided under it,
+    a stand-in where the search carried a needed start to no mode, and not a mode beyond the band,
+    over-damped or at the fit's damping floor. ``reported`` and the JSON follow them."""
+    level = CountSettings().decisive_bic
+    freq, damping = (3.0, 5.0, 8.0, 11.0, 14.0, 40.0), (0.02, 0.03, 0.02, 0.9, 0.02, 0.02)
+    rise = [level, level - 0.1, 200.0, 80.0, 80.0, 80.0]  # the needed level exactly: needed
+    count = replace(_count(rise, -40.0, freq=freq, damping=damping), stand_ins=((13.0, 14.0 * 1.001, 30.0),),
+                    band_hz=(1.0, 25.0))  # fmt: skip
+    assert list(count.verdicts()) == ["needed", "undecided", "needed", "not_a_mode", "stand_in", "not_a_mode"]
+    assert list(count.reported()) == [True, True, True, False, False, False]
+    # another band: the 40 Hz pole is a mode of it
+    assert count.verdicts((1.0, 50.0))[-1] == "needed"
+    count = replace(count, model=replace_model(count.model, 1e-5), models=())
+    assert count.verdicts()[0] == "not_a_mode"  # at the fit's damping floor: a line
+    poles = count.to_dict()["poles"]
+    assert [p["verdict"] for p in poles] == list(count.verdicts()) and poles[2]["removal_rise"] == 200.0
+
+
+def replace_model(model, first_damping):
+    damping = model.damping.copy()
+    damping[0] = first_damping
+    return _model(model.freq_hz, damping)
+
+
 def test_a_counted_mode_no_cluster_holds_takes_none_of_its_neighbours_facts():
     """A mode the diagram's clusters did not hold gets no cluster facts and, as the ARMAX
     reference the segments' spread is judged against, its own deviation: it once took its
@@ -715,7 +740,8 @@ def test_a_counted_mode_no_cluster_holds_takes_none_of_its_neighbours_facts():
                           "freq_sd": [0.04], "damping_sd": [0.003], "freq_sd_armax": [0.04],
                           "damping_sd_armax": [0.003], "estimator": ["armax"]})  # fmt: skip
     count = _count([50.0, 60.0], -40.0, freq=(5.02, 24.8), damping=(0.2, 0.3))
-    held, new = _row(modes, count, 0, "zoh", SAME_ROW), _row(modes, count, 1, "zoh", SAME_ROW)
+    held, new = _row(modes, count, 0, "zoh", SAME_ROW, "needed"), _row(modes, count, 1, "zoh", SAME_ROW, "undecided")
+    assert (held["count_undecided"], new["count_undecided"]) == (False, True)
     assert (held["count"], held["energy"], held["freq_sd_armax"]) == (12, 0.3, 0.04)
     # the diagram's estimate of the held mode is kept for the estimators' test, the new mode has none
     assert [held[k] for k in ("freq_earlier", "freq_earlier_sd", "damping_earlier", "damping_earlier_sd")] == [

@@ -133,7 +133,8 @@ def test_the_picks_model_keeps_the_poles_the_automatic_model_hides(monkeypatch, 
     sel = am.select_modes(diagram, segments=0)
     beyond = SimpleNamespace(freq_hz=np.r_[sel.count.model.freq_hz, 40.0], damping=np.r_[sel.count.model.damping, 0.1])
     modes = sel.modes.assign(picked_hz=[5.9, 8.2, np.nan, np.nan])
-    work = SelectionState(modes, sel.shapes, sel.refinement, sel.check, replace(sel.count, model=beyond))
+    count = replace(sel.count, model=beyond, removal_rise=np.r_[sel.count.removal_rise, 50.0])  # one rise per pole
+    work = SelectionState(modes, sel.shapes, sel.refinement, sel.check, count)
     seen = []
 
     def stop(data, freq_hz, damping, *args, search=True, **kwargs):

@@ -10,8 +10,7 @@ from scipy.signal import find_peaks
 
 import armaxmodal as am
 from armaxmodal.modes.diagram import stabilisation_diagram
-from armaxmodal.modes.frf_check import peak_prominences, unexplained_peaks
-from armaxmodal.modes.lines import resolving_nperseg
+from armaxmodal.modes.frf import peak_prominences, resolving_nperseg, unexplained_peaks
 from armaxmodal.modes.pipeline import select_modes
 
 
