@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[1]
 # (file, original text, mutated text, what it models)
 MUTANTS = [
     # the modal-model check and the selection by it (issue 26); run with
-    # --match "(check)" --tests tests/modes/test_modal_check.py tests/modes/test_frf_check.py
+    # --match "(check)" --tests tests/modes/test_modal_check.py tests/modes/test_frf.py
     #   tests/modes/test_stabilisation.py::test_a_split_the_frf_does_not_need_is_merged_and_said
     #   tests/modes/test_stabilisation.py::test_a_spurious_heavily_damped_neighbour_is_left_out_and_said
     (
@@ -209,13 +209,13 @@ MUTANTS = [
     ),
     # periodic disturbances seen by the sweep
     (
-        "armaxmodal/modes/disturbance.py",
+        "armaxmodal/modes/poles.py",
         '(pooled.damping.abs() < lines.undamped) & (pooled.energy < min_energy * strongest)',
         '(pooled.damping.abs() < lines.undamped)',
         "a driven lightly damped mode called a disturbance (line)",
     ),
     (
-        "armaxmodal/modes/disturbance.py",
+        "armaxmodal/modes/poles.py",
         'if prominence >= lines.input_ratio:',
         'if prominence < lines.input_ratio:',
         "input's own line stated backwards (line)",
@@ -782,8 +782,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/intervals.py",
-        "lo = np.where(np.isnan(half), lo, np.fmin(v - half, lo))",
-        "lo = np.where(np.isnan(half), lo, v - half)",
+        "lo = np.where(np.isnan(seg_lo), lo, np.fmin(seg_lo, lo))",
+        "lo = np.where(np.isnan(seg_lo), lo, seg_lo)",
         "the segments' interval replaces a wider one (intervals)",
     ),
     (
@@ -838,13 +838,13 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/mode_count.py",
-        'keep &= np.abs(np.log(self.model.freq_hz / went)) > self.settings.same_mode_freq',
-        "keep &= True",
+        'verdict[np.abs(np.log(self.model.freq_hz / went)) <= self.settings.same_mode_freq] = "stand_in"',
+        "pass",
         "a stand-in reported (stand-in)",
     ),
     (
         "armaxmodal/modes/counted.py",
-        "keep = count.reported(data.band_hz)",
+        'keep = np.isin(verdicts, ("needed", "undecided"))',
         "keep = reported(count.model, data.band_hz)",
         "the selection reports the count's stand-ins (stand-in)",
     ),
@@ -855,10 +855,10 @@ MUTANTS = [
         "a stand-in said to lie beyond the band (stand-in)",
     ),
     (
-        "armaxmodal/modes/counted.py",
-        'unreported += [(start, went, "kept in the model but not reported") for start, went, _ in count.stand_ins]',
-        "unreported += []",
-        "a stand-in with a coherent peak left says good (stand-in)",
+        "armaxmodal/modes/notes.py",
+        '"count_undecided" if inside else "mode_count", (),',
+        '"mode_count", (),',
+        "a stand-in inside the band said informative, and the verdict good (stand-in)",
     ),
     # an output is incoherent only when low over the input's spectrum and over its own (run with
     #   --match "(coherent)" --tests tests/prepare/test_prepare.py)
@@ -904,8 +904,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "best = min(screened, key=search.bic)",
-        "best = max(screened, key=search.bic)",
+        "m, best = min(tried, key=lambda t: search.bic(t[1]))",
+        "m, best = max(tried, key=lambda t: search.bic(t[1]))",
         "the worst split judged (split-wanted)",
     ),
     (
@@ -989,7 +989,7 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/intervals.py",
-        "lo, hi = earlier - Z95 * sd, earlier + Z95 * sd",
+        "lo, hi = interval(q, earlier, Z95 * sd)",
         "lo, hi = earlier, earlier",
         "the earlier value covered, not its interval (estimators)",
     ),
@@ -1001,7 +1001,7 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/intervals.py",
-        "widened |= np.isfinite(lo) & ((lo < v - own) | (hi > v + own))",
+        "widened |= np.isfinite(lo) & ((lo < own_lo) | (hi > own_hi))",
         "widened |= np.isfinite(lo)",
         "every tested mode said widened (estimators)",
     ),
