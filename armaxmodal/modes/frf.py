@@ -3,9 +3,9 @@ the modes, and its clear, coherent peaks with those no selected mode accounts fo
 3.3.3's check, made quantitative).
 
 Two checks read the measured FRF, each at its own resolution, named here so that one does not
-borrow the other's: the search for clear FRF peaks no mode explains (:func:`unexplained_peaks`,
-at :data:`PEAK_RESOLUTION`) and the modal-model check (:mod:`armaxmodal.modes.modal_check`, at
-:data:`CHECK_RESOLUTION`).
+borrow the other's: the search for clear FRF peaks no mode explains (``unexplained_peaks``, at
+``PEAK_RESOLUTION``) and the modal-model check (:mod:`armaxmodal.modes.modal_check`, at
+``CHECK_RESOLUTION``).
 """
 
 from __future__ import annotations

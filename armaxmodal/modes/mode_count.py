@@ -55,7 +55,7 @@ COUNT = DEFAULTS.count
 
 def reported(model, band_hz, lines: LineSettings = DEFAULTS.lines) -> np.ndarray:
     """Which of a model's poles are modes of the band (bool per pole): not beyond it, not damped
-    beyond :data:`~armaxmodal.stats.MAX_DAMPING`, and not a line (damped at the fit's floor,
+    beyond ``MAX_DAMPING``, and not a line (damped at the fit's floor,
     ``lines.at_fit_floor``)."""
     f, x = model.freq_hz, model.damping
     return (f >= band_hz[0]) & (f <= band_hz[1]) & (x <= MAX_DAMPING) & (x > lines.at_fit_floor)
@@ -239,17 +239,17 @@ class ModeCount:
         * ``"undecided"``: a mode of the band the record holds less firmly (the rise is smaller):
           reported, and said tentative;
         * ``"stand_in"``: a start the search carried where no mode is founded but which the
-          model needs (:attr:`stand_ins`, matched within ``settings.same_mode_freq``): kept in the
+          model needs (``stand_ins``, matched within ``settings.same_mode_freq``): kept in the
           model, not reported;
         * ``"not_a_mode"``: beyond the band, damped beyond
-          :data:`~armaxmodal.stats.MAX_DAMPING`, or a line (:func:`reported`).
+          ``MAX_DAMPING``, or a line (:func:`reported`).
 
-        Starts the search left out of the model (:attr:`carried_away`) are not among its poles.
+        Starts the search left out of the model (``carried_away``) are not among its poles.
 
         Parameters
         ----------
         band_hz : (float, float), optional
-            The band (Hz); default :attr:`band_hz`.
+            The band (Hz); default ``band_hz``.
 
         Returns
         -------
@@ -269,7 +269,7 @@ class ModeCount:
         Parameters
         ----------
         band_hz : (float, float), optional
-            The band (Hz); default :attr:`band_hz`.
+            The band (Hz); default ``band_hz``.
 
         Returns
         -------

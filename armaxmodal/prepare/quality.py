@@ -24,7 +24,7 @@ recording:
 * ``held_samples`` -- a channel sampled at a lower rate and held to the record's
   (:mod:`armaxmodal.prepare.held`): its repeats keep to a cycle.
 
-The sweep adds ``periodic_disturbance`` (:func:`armaxmodal.modes.poles.disturbance_lines`); preparation
+The sweep adds ``periodic_disturbance`` (``disturbance_lines`` in :mod:`armaxmodal.modes.poles`); preparation
 (:mod:`armaxmodal.prepare.preparation`) adds ``offset_removed``, ``offset_step``, ``drift``,
 ``trend_removed`` and ``resampled``.
 """
