@@ -43,6 +43,12 @@ def default_nb(na: int, nk: int) -> int:
     -------
     int
         The number of B coefficients.
+
+    Examples
+    --------
+    >>> from armaxmodal.estimate import default_nb
+    >>> default_nb(8, 0), default_nb(8, -2)  # a delay of -2 samples needs two taps more
+    (9, 11)
     """
     return na + 1 - min(nk, 0)
 
@@ -59,6 +65,12 @@ def default_nc(na: int) -> int:
     -------
     int
         The order of C.
+
+    Examples
+    --------
+    >>> from armaxmodal.estimate import default_nc
+    >>> default_nc(8)
+    8
     """
     return na
 
@@ -106,6 +118,17 @@ def information_criterion(fit: ArmaxFit, kind: str = "bic", unit: np.ndarray | N
     -------
     float
         The criterion, summed over sensors; smaller is better.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> from armaxmodal.estimate import information_criterion
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> two = am.fit_armax(ride, 4, 5, 4, 0, shared_poles=True, warn=False)  # room for two modes
+    >>> four = am.fit_armax(ride, 8, 9, 8, 0, shared_poles=True, warn=False)  # for all four
+    >>> round((information_criterion(two) - information_criterion(four)) / 1000)  # BIC falls, in thousands
+    23
     """
     n = fit.n_samples
     k = len(fit.models)

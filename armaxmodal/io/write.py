@@ -200,6 +200,17 @@ def write_json(obj, path: str | os.PathLike) -> Path:
     -------
     Path
         The file written.
+
+    Examples
+    --------
+    >>> import json, tempfile, pathlib
+    >>> import numpy as np
+    >>> from armaxmodal.io import write_json
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = write_json({"freq_hz": np.float64(5.83), "damping_sd": np.nan, "orders": np.arange(2, 5)},
+    ...                       pathlib.Path(folder) / "modes.json")
+    ...     json.loads(path.read_text())  # NaN is written as null: strict JSON any reader takes
+    {'freq_hz': 5.83, 'damping_sd': None, 'orders': [2, 3, 4]}
     """
     clean = strict_json(obj)
 

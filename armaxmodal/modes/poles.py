@@ -46,7 +46,15 @@ UNRESOLVED_DAMPING = "damping not resolved"
 
 @dataclass(frozen=True)
 class Tolerances:
-    """Stability tolerances between consecutive orders and the pole-rejection rules."""
+    """Stability tolerances between consecutive orders and the pole-rejection rules.
+
+    Examples
+    --------
+    >>> from armaxmodal.modes import Tolerances
+    >>> tol = Tolerances(freq=0.02)  # a pole is stable in frequency within 2 % of the previous order's
+    >>> tol.freq, tol.damping, tol.max_damping
+    (0.02, 0.05, 0.6)
+    """
 
     freq: float = 0.01  #: relative frequency change
     damping: float = 0.05  #: relative damping change

@@ -128,6 +128,16 @@ def prepare(
     Returns
     -------
     Preparation
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> from armaxmodal.prepare import prepare
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> prep = prepare(ride)  # a clean ride: nothing dropped, shifted or resampled
+    >>> prep.analysis_fs, prep.detrend, prep.dropped, len(prep.warnings)
+    (60.0, 'mean', (), 0)
     """
     band = check_band(band, recording.fs)
     if detrend not in DETRENDS:

@@ -38,6 +38,13 @@ class StudySettings:
         The sensors analysed (None: those most recordings share, chosen by the study).
     lump : (a, b) or None
         A pair of segments to test for lumping (Chapter 5) where a recording has both.
+
+    Examples
+    --------
+    >>> from armaxmodal.study import StudySettings
+    >>> settings = StudySettings(orders=(2, 20), lump=("legs", "feet"))
+    >>> settings.orders, settings.detrend, settings.lump
+    ((2, 20), 'mean', ('legs', 'feet'))
     """
 
     input: str = "base"
