@@ -27,6 +27,15 @@ def scale_to_subject(structure: Structure, mass_kg: float) -> Structure:
     -------
     Structure
         The scaled model.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> from armaxmodal.inverse import scale_to_subject
+    >>> body = am.supine_human()  # Section 4.4's chain, 77.6 kg
+    >>> subject = scale_to_subject(body, 80.0)
+    >>> round(float(subject.masses.sum()), 1), [round(float(f), 2) for f in subject.modes().freq_hz]  # the same modes
+    (80.0, [5.83, 8.31, 13.5, 16.25])
     """
     if not (np.isfinite(mass_kg) and mass_kg > 0):
         raise DataError(f"mass_kg: expected a positive subject mass in kg, got {mass_kg!r}.")
@@ -54,6 +63,16 @@ def predict_recording(structure: Structure, recording: Recording, hold: str = "b
     -------
     pandas.DataFrame
         One row per sensor: ``fit_percent`` and ``correlation``.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> from armaxmodal.inverse import predict_recording
+    >>> body = am.supine_human()
+    >>> ride = am.simulate_recording(body, am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03, seed=2)
+    >>> table = predict_recording(body, ride, hold="zoh")  # the model that made the ride, 3 % noise on it
+    >>> [round(float(v)) for v in table.fit_percent]  # per sensor, %
+    [97, 97, 97, 97]
     """
     missing = [s for s in recording.sensors if s not in structure.names]
     if missing:

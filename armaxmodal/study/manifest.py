@@ -60,6 +60,16 @@ def read_manifest(source: str | Path) -> tuple[list[Entry], list[dict]]:
     entries : list of Entry
     failures : list of dict
         ``{"file", "reason"}`` for a missing file, a duplicate row or an unusable mass.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from armaxmodal.study import make_study, read_manifest
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     _ = make_study(folder, 2, feet_subjects=(), separate_feet=(), rides=("random",), duration=30.0)
+    ...     entries, refused = read_manifest(pathlib.Path(folder) / "manifest.csv")
+    >>> [(entry.subject, entry.ride, entry.name) for entry in entries], refused
+    ([('Sub01', 'random', 'Sub01_random.csv'), ('Sub02', 'random', 'Sub02_random.csv')], [])
     """
     source = Path(source)
     if source.is_dir():

@@ -129,6 +129,15 @@ def make_study(
     -------
     dict
         The truth written to ``truth.json``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from armaxmodal.study import make_study
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     truth = make_study(folder, 2, feet_subjects=(), separate_feet=(), rides=("random",), duration=30.0)
+    >>> len(truth["subjects"]), truth["fs"], truth["duration_s"]
+    (2, 60.0, 30.0)
     """
     out = Path(out)
     rng = np.random.default_rng(seed)
