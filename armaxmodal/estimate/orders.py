@@ -87,7 +87,17 @@ class Orders(NamedTuple):
 
 @dataclass(frozen=True)
 class OrderChoice:
-    """The chosen fit and the criterion table (one row per candidate)."""
+    """The chosen fit and the criterion table (one row per candidate).
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> choice = am.choose_orders(ride, range(4, 11, 2), range(0, -2, -1))  # 4 orders x 2 delays
+    >>> tuple(choice.fit.orders), len(choice.table)  # four modes: na = 8
+    ((8, 9, 8, 0), 8)
+    """
 
     fit: ArmaxFit
     table: pd.DataFrame

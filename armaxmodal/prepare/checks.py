@@ -32,6 +32,20 @@ def check_quality(recording: Recording) -> list[QualityWarning]:
     -------
     list of QualityWarning
         The findings, in the order the checks run.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> from armaxmodal.prepare import check_quality
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03,
+    ...                              seed=2)
+    >>> check_quality(ride)  # a clean ride
+    []
+    >>> twice = am.Recording(ride.fs, ride.base, np.column_stack([ride.response, ride.response[:, 1]]),
+    ...                      [*ride.sensors, "chest_copy"])  # the chest exported twice
+    >>> [(note.code, note.channels) for note in check_quality(twice)]
+    [('duplicate_channel', ('chest_copy', 'chest'))]
     """
     found = duplicate_channels(recording)
     found += delay_and_inversion(recording)
