@@ -116,6 +116,16 @@ def scalogram(x, fs: float, band: tuple[float, float]) -> Scalogram:
     -------
     Scalogram
         The wavelet coefficients, frequencies and cone of influence.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from armaxmodal.lumping import scalogram
+    >>> t = np.arange(0.0, 30.0, 1 / 60.0)
+    >>> s = scalogram(np.sin(2 * np.pi * 5.0 * t), 60.0, (1.0, 20.0))  # a 5 Hz tone, 30 s at 60 Hz
+    >>> power = np.mean(np.abs(s.coefficients[:, 600:1200]) ** 2, axis=1)  # its middle 10 s
+    >>> round(float(s.freq_hz[np.argmax(power)]), 1)
+    5.0
     """
     x = np.asarray(x, dtype=float)
     s0, dj, j = _scales(fs, band[0], band[1], x.size)
@@ -156,6 +166,18 @@ def wavelet_coherence(
     -------
     WaveletCoherence
         Coherence, phase, frequencies, cone of influence and significance level.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from armaxmodal.lumping import wavelet_coherence
+    >>> t = np.arange(0.0, 30.0, 1 / 60.0)
+    >>> x = np.sin(2 * np.pi * 5.0 * t)
+    >>> y = np.roll(x, 3) + 0.1 * np.random.default_rng(0).standard_normal(x.size)  # 3 samples late: 90 degrees
+    >>> wc = wavelet_coherence(x, y, 60.0, (2.0, 10.0), significance=None)
+    >>> k = np.argmin(np.abs(wc.freq_hz - 5.0))
+    >>> round(float(np.median(wc.r2[k, 300:1500])), 1), round(float(np.degrees(np.median(wc.phase_rad[k, 300:1500]))))
+    (1.0, 90)
     """
     x, y = (np.asarray(v, dtype=float) for v in (x, y))
     if x.shape != y.shape or x.ndim != 1:
