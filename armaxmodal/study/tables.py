@@ -76,6 +76,15 @@ def match_modes(freqs: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray]]:
     reference : (n_ref,) ndarray, Hz
     labels : list of int arrays
         Per recording, the 1-based reference mode of each of its modes, 0 where none fits.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from armaxmodal.study import match_modes
+    >>> reference, labels = match_modes([np.array([5.8, 8.3, 13.5]), np.array([5.9, 8.4, 13.4]),
+    ...                                  np.array([5.7, 13.6])])  # the third recording lacks the 8 Hz mode
+    >>> [round(float(f), 2) for f in reference], [mode.tolist() for mode in labels]
+    ([5.85, 8.35, 13.45], [[1, 2, 3], [1, 2, 3], [1, 3]])
     """
     counts = pd.Series([f.size for f in freqs])
     usual = int(counts.mode().max()) if len(counts) else 0
