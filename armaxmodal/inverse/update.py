@@ -308,6 +308,26 @@ def weight_sweep(eigenvalues, shapes, frf, weights=None, **kwargs):
     pandas.DataFrame
         One row per weight: weight, modal_rms (frequency, damping and shape residuals in
         noise units), frf_rms, and the model's frequencies and damping ratios.
+
+    Examples
+    --------
+    The supine body's exact modes against the FRF of the same body with the legs' spring 30 %
+    softer: weighted lightly, the FRF block gives way to the modes; weighted heavily, the modes
+    give way to it (the first mode moves from 5.83 to 5.80 Hz):
+
+    >>> import numpy as np
+    >>> import armaxmodal as am
+    >>> from armaxmodal.inverse import weight_sweep
+    >>> body = am.supine_human()
+    >>> c = body.chain_components()
+    >>> softer = am.Structure.from_chain(c.masses, c.k * [1, 1, 1, 0.7], c.c, c.k_s, c.c_s, c.names)
+    >>> f = np.linspace(1.0, 25.0, 200)
+    >>> sweep = weight_sweep(body.modes().eigenvalues, body.modes().shapes, (f, softer.transmissibility(f)),
+    ...                      weights=[0.01, 100.0], total_mass=body.masses.sum())
+    >>> sweep[["weight", "modal_rms", "frf_rms", "f1_hz"]].round(2)
+       weight  modal_rms  frf_rms  f1_hz
+    0    0.01       0.00     0.16   5.83
+    1  100.00       0.11     0.00   5.80
     """
     import pandas as pd
 

@@ -23,6 +23,18 @@ def poles(x: np.ndarray) -> np.ndarray:
     return -xi * wn + 1j * wn * np.sqrt(1.0 - xi**2)
 
 
+def start_vector(freq_hz, damping) -> np.ndarray:
+    """The parameters ``x`` (``ln omega_n, xi`` per mode) of modes in Hz and damping ratios."""
+    return np.ravel(np.column_stack([np.log(2 * np.pi * np.asarray(freq_hz, float)), np.asarray(damping, float)]))
+
+
+def x_bounds(lowest_w: float, dt: float, n_modes: int, min_damping: float, max_damping: float):
+    """Each pole's ``(ln omega_n, xi)`` limits, ``(lo, hi)``: from half the lowest line
+    (``lowest_w``, rad/s) to Nyquist, and the damping range."""
+    lo = np.tile([np.log(0.5 * max(lowest_w, 1e-6)), min_damping], n_modes)
+    return lo, np.tile([np.log(np.pi / dt), max_damping], n_modes)
+
+
 def pole_derivatives(x: np.ndarray) -> np.ndarray:
     """``d lambda / d x``: (n_modes, 2) for x = (log wn, xi) per mode."""
     wn, xi = np.exp(x[0::2]), x[1::2]
@@ -69,6 +81,12 @@ class SeparableModel:
     def residual(self, x):
         self._solve(x)
         return self.resid.ravel()
+
+    def residual_rms(self, x) -> np.ndarray:
+        """Each sensor's residual RMS per real number at ``x`` (1 where it is 0)."""
+        self._solve(x)
+        level = np.sqrt(np.mean(self.resid**2, axis=0))
+        return np.where(level > 0, level, 1.0)
 
     def sensor_rows(self, x):
         """Per sensor, its rows of the Jacobian and of the residual, ``(2 L, n)`` and ``(2 L,)``."""

@@ -1,7 +1,5 @@
-"""The search of the count: nested tests of free refits of the maximum-likelihood modal model.
-
-From the diagram's selection, every step compares the current model with its neighbours, each
-refitted with every pole free (:func:`armaxmodal.modes.dft_model.fit_modal_model`):
+"""The search of the count: from the diagram's selection, every step compares the current model
+with its neighbours, each refitted with every pole free (:func:`~armaxmodal.modes.dft_model.fit_modal_model`):
 
 * **remove** each mode (the others free to take over: a merge of two close modes is a removal);
 * **add** a left-out stable cluster of the diagram, or a pole where the residual is largest;
@@ -20,6 +18,7 @@ import numpy as np
 from scipy.special import chdtrc
 
 from armaxmodal._threads import single_blas_thread
+from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.modes.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.mode_count import (
     COUNT,
@@ -55,8 +54,6 @@ class _Search:
         """Each start ``(freq_hz, damping)`` fitted for ``settings.screen_nfev`` steps, over the worker
         threads (numpy releases the interpreter in their large array work); ``labels``: each
         start's ``(action, Hz)`` for the table."""
-        from armaxmodal.estimate.pool import parallel_map
-
         self.trials += sum(len(f) > 0 for f, _ in starts)
 
         def one(start):
@@ -84,8 +81,6 @@ class _Search:
         """``[best removal, best addition]``: of each kind the trial of lowest criterion, converged
         from where its screening left it (both at once, over the worker threads); an addition must
         pass ``admissible`` before and after. None where a kind has no (admissible) trial."""
-        from armaxmodal.estimate.pool import parallel_map
-
         chosen = []
         for trials, test in ((removed, None), (added, admissible)):
             trials = [t for t in trials if test is None or test(t[2])]
@@ -172,14 +167,11 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     """The chosen model without the starting poles the search carried beyond ``settings.same_mode_freq``
     of every start to where no mode is founded, refitted. A pole reported there is a new pole and
     must show what a mode has: a resolved damping, and the same values in both halves of the record
-    (``_Search.in_both_halves``; without ``halves``, stability across the diagram's orders).
-
-    Not the diagram's support where the halves can judge: the model moves a pole where the ARMAX
-    fits are biased (a supine ride with the pelvis stuck for 53 samples: 13.50 Hz at 14.69 Hz in
-    every order, 13.62 Hz in the model, alike in both halves). A bridge's 5.83 Hz start ended at
-    4.40 Hz, damping 0.007, which the halves do not share. Judged on the converged model only (on the
-    way a moved pole may stand in for a mode not yet added). Poles the model needs (the criterion
-    rises by ``settings.decisive_bic`` or more without them) stay in it, unreported. Returns
+    (``_Search.in_both_halves``; without ``halves``, stability across the diagram's orders), judged on
+    the converged model only (on the way a moved pole may stand in for a mode not yet added). Poles
+    the model needs (the criterion rises by ``settings.decisive_bic`` or more without them) stay in
+    it, unreported. The method page gives the cases behind both rules (a pelvis stuck for 53 samples,
+    a bridge's start carried to 4.40 Hz, a body's top mode the model needs). Returns
     ``(model, left out: ((start Hz, Hz), ...), kept unreported: ((start Hz, Hz, rise), ...))``."""
     start_hz = np.atleast_1d(np.asarray(start_hz, float))
     shown = reported(model, search.data.band_hz, search.lines)
@@ -200,9 +192,7 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     without = search.fit(model.freq_hz[keep], model.damping[keep], search.cfg.final_nfev,
                          label=("leave out", unfounded[0][1][1]))
     rise = search.bic(without) - search.bic(model)
-    if rise >= search.cfg.decisive_bic:  # the model needs them: they stay in it, unreported (a body's mode at
-        # 23.93 Hz, near the band's top, came out at 24.74 Hz with its damping unresolved; without
-        # it the 13.93 and 16.43 Hz modes collapsed into one at 16.20 Hz, BIC +873)
+    if rise >= search.cfg.decisive_bic:  # the model needs them: they stay in it, unreported
         return model, (), tuple((*moved, float(rise)) for _, moved in unfounded)
     return without, tuple(moved for _, moved in unfounded), ()
 
@@ -248,9 +238,8 @@ def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) 
     model (None if no split converged with its damping resolved): every reported mode split in two,
     the best converged and judged as :func:`_wanted` judges an addition. The search splits only the
     mode nearest the residual's peak, and a split need not be stable across the diagram's orders:
-    two modes closer than the ARMAX fits resolve stand as one column there (a body's 14.28 and
-    15.40 Hz came out as one at 15.45 Hz; split, likelihood ratio 187 for 22 parameters, alike in
-    both halves, BIC +40)."""
+    two modes closer than the ARMAX fits resolve stand as one column there (the method page's
+    14.28 and 15.40 Hz, one at 15.45 Hz)."""
     shown = np.flatnonzero(search.physical(current))
     if len(halves) != 2 or shown.size == 0:
         return (), None
@@ -314,14 +303,25 @@ def count_modes(
         Worker threads for the screening fits (default: all cores).
     settings : CountSettings
         The count's thresholds (:mod:`armaxmodal.modes.settings`).
-    lines : LineSettings
-        Which poles are lines, not modes.
-    dft : DftSettings
-        The modal model's fits.
+    lines, dft : LineSettings, DftSettings
+        Which poles are lines, not modes; the modal model's fits.
 
     Returns
     -------
     ModeCount
+
+    Examples
+    --------
+    Started one mode short, the count adds it:
+
+    >>> import armaxmodal as am
+    >>> body, exact = am.supine_human(), am.supine_human().modes()  # exact: 5.83, 8.31, 13.50, 16.25 Hz
+    >>> ride = am.simulate_recording(body, am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03, seed=2)
+    >>> from armaxmodal.modes import count_search, dft_model
+    >>> data = dft_model.DftLines.from_recording(ride, (0.5, 28.0))
+    >>> count = count_search.count_modes(data, exact.freq_hz[:3], exact.damping[:3], hold="zoh")
+    >>> [step.action for step in count.steps], [round(float(f), 1) for f in sorted(count.model.freq_hz)]
+    (['add'], [5.8, 8.3, 13.6, 16.2])
     """
     return _count_modes(data, freq_hz, damping, candidates, hold=hold, max_nfev=max_nfev, halves=halves,
                         supported=supported, search=search, n_jobs=n_jobs, settings=settings, lines=lines, dft=dft)

@@ -3,13 +3,9 @@ modes and for the maximum-likelihood count (beyond the thesis).
 
 Every sensor's DFT over the excited band is fitted as ``Y = G(Omega) U + T(z) + E``: ``G`` the
 modal sum with continuous poles, residues and a direct term, ``T`` the transient (leakage) term
-with the same poles. This is the output-error form of the modal model written on DFT lines
-(Pintelon & Schoukens, *System Identification: a Frequency Domain Approach*, 2nd ed., Ch. 6-7):
-with the transient term it is exact for a finite record, so, unlike a fit to a Welch-averaged
-H1, it has no frequency-resolution limit. That is why it is chosen over the H1 form of the
-ML-MM estimator (El-Kafafy, Guillaume & Peeters, Appl. Sci. 9 (2019) 3120): a lightly damped
-mode's half-power band (0.04 Hz at 0.3 % and 6 Hz) is narrower than any Welch line a 120 s
-ride allows, while the DFT's line is 1 / T.
+with the same poles, exact for a finite record (Pintelon & Schoukens, *System Identification: a
+Frequency Domain Approach*, 2nd ed., Ch. 6-7). The method page's "modal model by maximum
+likelihood" gives the likelihood, why this form and not a fit to the H1, and the intervals.
 
 **Inter-sample behaviour.** A discrete ARMAX model is the exact model class only when the
 input is held between samples (zero-order hold). Measured signals pass anti-aliasing filters
@@ -20,18 +16,8 @@ the 16.2 Hz mode 2.9 % low and mode 3's damping 12 % high). ``G`` is written in 
 for a band-limited input or in ``z`` for a held one; :func:`refine_modes` fits both and the
 data choose.
 
-**Likelihood.** With white output noise of variance ``sigma_k^2`` on sensor ``k``, its DFT
-lines are independent complex normal variables of equal variance, so the log-likelihood
-concentrated over the ``sigma_k`` is ``-1/2 sum_k n_k ln(RSS_k / n_k)`` (``n_k`` real numbers
-per sensor): minimising each sensor's weighted residual is maximum likelihood. The residues,
-direct and transient terms enter linearly and are projected out (variable projection, Golub &
-Pereyra; the private ``armaxmodal.modes._separable``), so only the frequencies and damping ratios are
-iterated, all of them free. Standard errors come from the Jacobian of the projected residual
-(the information matrix, as a sandwich).
-
-:class:`DftLines` holds the data once; :func:`fit_modal_model` fits one set of starting modes;
-:func:`refine_modes` refits the selected modes under the hold the data choose;
-:class:`ModalModel` carries either fit and its information criterion.
+The residues, direct and transient terms enter linearly and are projected out (the private
+``armaxmodal.modes._separable``): only the frequencies and damping ratios are iterated, all free.
 """
 
 from __future__ import annotations
@@ -44,7 +30,7 @@ import scipy.optimize
 
 from armaxmodal._threads import single_blas_thread
 from armaxmodal.exceptions import OrderError
-from armaxmodal.modes._separable import GramCompressed, SeparableModel, poles, sandwich_sd
+from armaxmodal.modes._separable import GramCompressed, SeparableModel, poles, sandwich_sd, start_vector, x_bounds
 from armaxmodal.modes.settings import DEFAULTS, DftSettings
 from armaxmodal.recording import Recording
 
@@ -72,6 +58,15 @@ class DftLines:
         Sampling interval, s.
     band_hz : (float, float)
         The band of the lines, Hz.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> from armaxmodal.modes.dft_model import DftLines
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, seed=2)
+    >>> data = DftLines.from_recording(ride, (0.5, 28.0))  # 60 s: a line every 1/60 Hz
+    >>> data.y.shape, data.n_real, data.band_hz
+    ((1651, 4), 3302, (0.5, 28.0))
     """
 
     s: np.ndarray
@@ -168,6 +163,16 @@ class ModalModel:
         From :func:`refine_modes`: each tried assumption's weighted residual sum of squares
         after the same first steps from the same start, the basis of its choice (empty for a
         plain fit).
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> body, exact = am.supine_human(), am.supine_human().modes()  # exact: 5.83, 8.31, 13.50, 16.25 Hz
+    >>> ride = am.simulate_recording(body, am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03, seed=2)
+    >>> from armaxmodal.modes.dft_model import DftLines, fit_modal_model
+    >>> model = fit_modal_model(DftLines.from_recording(ride, (0.5, 28.0)), exact.freq_hz, exact.damping, hold="zoh")
+    >>> model.n_modes, model.n_params, [round(float(x), 2) for x in model.damping]  # exact: 0.26, 0.35, 0.30, 0.27
+    (4, 72, [0.26, 0.35, 0.3, 0.27])
     """
 
     freq_hz: np.ndarray
@@ -250,16 +255,7 @@ class ModalModel:
 
 
 def _bounds(data: DftLines, n_modes: int, settings: DftSettings) -> tuple[np.ndarray, np.ndarray]:
-    """Each pole's ``(ln omega_n, xi)`` limits: from half the lowest line to Nyquist, and the
-    settings' damping range."""
-    lo_w, nyquist = max(np.abs(data.s[0]), 1e-6), np.pi / data.dt
-    lo = np.tile([np.log(0.5 * lo_w), settings.min_damping], n_modes)
-    hi = np.tile([np.log(nyquist), settings.max_damping], n_modes)
-    return lo, hi
-
-
-def _start_vector(freq_hz, damping) -> np.ndarray:
-    return np.ravel(np.column_stack([np.log(2 * np.pi * np.asarray(freq_hz, float)), np.asarray(damping, float)]))
+    return x_bounds(np.abs(data.s[0]), data.dt, n_modes, settings.min_damping, settings.max_damping)
 
 
 @single_blas_thread
@@ -296,7 +292,7 @@ def fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited",
     >>> [round(float(f), 1) for f in model.freq_hz]  # exact: 5.83, 8.31, 13.50, 16.25 Hz
     [5.8, 8.3, 13.6, 16.2]
     """
-    return _fit(data, _start_vector(freq_hz, damping), hold, max_nfev, settings).by_frequency()
+    return _fit(data, start_vector(freq_hz, damping), hold, max_nfev, settings).by_frequency()
 
 
 def _fit(data: DftLines, start: np.ndarray, hold: str, max_nfev: int, settings: DftSettings) -> ModalModel:
@@ -341,14 +337,6 @@ def _fit(data: DftLines, start: np.ndarray, hold: str, max_nfev: int, settings: 
     )
 
 
-def _noise_level(data: DftLines, start: np.ndarray, settings: DftSettings) -> np.ndarray:
-    """Each sensor's residual RMS per real number at the start, under a held input."""
-    lo, hi = _bounds(data, start.size // 2, settings)
-    model = SeparableModel(data.s, data.z_inv, data.u, data.y, data.dt, "zoh")
-    level = np.sqrt(np.mean(model.residual(np.clip(start, lo, hi)).reshape(-1, data.y.shape[1]) ** 2, axis=0))
-    return np.where(level > 0, level, 1.0)
-
-
 @single_blas_thread
 def refine_modes(recording: Recording, freq_hz, damping, *, band_hz: tuple[float, float], hold: str = "auto",
                  max_nfev: int = 60, settings: DftSettings = DEFAULTS.dft) -> ModalModel:  # fmt: skip
@@ -378,18 +366,29 @@ def refine_modes(recording: Recording, freq_hz, damping, *, band_hz: tuple[float
     ModalModel
         The refit, its modes in the order of ``freq_hz``; ``hold_cost`` holds each tried
         assumption's weighted residual sum of squares after its first steps.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> body, exact = am.supine_human(), am.supine_human().modes()  # exact: 5.83, 8.31, 13.50, 16.25 Hz
+    >>> ride = am.simulate_recording(body, am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03, seed=2)
+    >>> from armaxmodal.modes.dft_model import refine_modes
+    >>> model = refine_modes(ride, exact.freq_hz * 1.02, exact.damping, band_hz=(0.5, 28.0))  # from 2 % off
+    >>> model.hold, [round(float(f), 1) for f in model.freq_hz]  # the ride was simulated with a held input
+    ('zoh', [5.8, 8.3, 13.6, 16.2])
     """
     if hold not in ("auto", *HOLDS):
         raise ValueError(f"hold: expected 'auto', 'bandlimited' or 'zoh', got {hold!r}.")
     data = DftLines.from_recording(recording, band_hz)
-    start = _start_vector(freq_hz, damping)
-    data = data.weighted(1.0 / _noise_level(data, start, settings))
+    start = start_vector(freq_hz, damping)
+    held = SeparableModel(data.s, data.z_inv, data.u, data.y, data.dt, "zoh")  # each sensor's noise level at the start
+    data = data.weighted(1.0 / held.residual_rms(np.clip(start, *_bounds(data, start.size // 2, settings))))
     tried = HOLDS if hold == "auto" else (hold,)
     first = {h: _fit(data, start, h, 4 if hold == "auto" else max_nfev, settings) for h in tried}
     cost = {h: float(np.sum(m.rss * data.weights**2)) for h, m in first.items()}
     best = min(cost, key=cost.get)
     if hold == "auto":  # a few steps tell the assumptions apart (the wrong one stays well above)
-        chosen = _fit(data, _start_vector(first[best].freq_hz, first[best].damping), best, max_nfev, settings)
+        chosen = _fit(data, start_vector(first[best].freq_hz, first[best].damping), best, max_nfev, settings)
     else:
         chosen = first[best]
     return replace(chosen, hold_cost=cost)

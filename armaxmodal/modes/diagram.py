@@ -168,6 +168,13 @@ def choose_nk(recording: Recording, nk_values=NK_SEARCH, na_values=DELAY_CHOICE_
     -------
     int
         The delay, in samples.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> from armaxmodal.modes import choose_nk
+    >>> choose_nk(am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, seed=2))
+    -1
     """
     return _choose_nk(recording, nk_values, na_values, n_jobs)[0]
 

@@ -8,19 +8,9 @@ poles are reported, the other structures' reach), and the tests the search appli
 effective share of independent lines (:func:`effective_fraction`), the two halves' agreement
 (``agree_in_halves``), the pairing of two pole sets and the residual's peak.
 
-The criterion is Schwarz's BIC (``-2 ln L + p ln N``): its penalty grows with the data, unlike a
-test at a fixed level, which keeps a ghost whose ``chi^2`` gain (about 50 at 2,000 real numbers in
-a prototype on a five-segment body) a fixed-level F-test passes while it is far below the
-``p ln N`` (about 90) of the parameters it adds. A difference of 10 in BIC is "very strong"
-evidence (Kass & Raftery, JASA 90 (1995) 773, Sec. 3.2): a mode whose removal, or a candidate
-whose addition, changes the criterion by less is *undecided*, and the verdict says so.
-
-On measured records the residual is not white noise but model error (a mild nonlinearity, the
-H1's bias, leakage) that is smooth across lines. Neighbouring lines then carry the same
-information, and treating them as independent inflates every likelihood difference.
-:func:`effective_fraction` measures how many of the lines are independent from the residual's
-own correlation across lines, and both the likelihood and the penalty use that number. On a
-simulated record with white noise it is 1 and the criterion is plain BIC.
+The criterion is Schwarz's BIC on the effective lines: the method page's "how many modes" gives
+why BIC and not a test at a fixed level, why 10 is decisive, and why the lines are counted by
+their residual's correlation (:func:`effective_fraction`).
 """
 
 from __future__ import annotations
@@ -37,17 +27,8 @@ from armaxmodal.modes.poles import matched_poles, nearest_pole
 from armaxmodal.modes.settings import DEFAULTS, CountSettings, DftSettings, LineSettings
 from armaxmodal.stats import MAX_DAMPING, Z95
 
-__all__ = [
-    "FittedModel",
-    "ModeCount",
-    "ModelTable",
-    "Wanted",
-    "Step",
-    "agree_in_halves",
-    "effective_fraction",
-    "reported",
-    "split_start",
-]
+__all__ = ["FittedModel", "ModeCount", "ModelTable", "Wanted", "Step", "agree_in_halves", "effective_fraction",
+           "reported", "split_start"]
 
 #: the count's thresholds when none are given (:class:`~armaxmodal.modes.settings.CountSettings`)
 COUNT = DEFAULTS.count
@@ -168,6 +149,17 @@ class ModeCount:
         Every model the count fitted, in the order fitted (:meth:`models_table`).
     band_hz : (float, float)
         The band of the lines the count decided on (Hz): which poles are modes of it.
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> body, exact = am.supine_human(), am.supine_human().modes()  # exact: 5.83, 8.31, 13.50, 16.25 Hz
+    >>> ride = am.simulate_recording(body, am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03, seed=2)
+    >>> from armaxmodal.modes import count_search, dft_model
+    >>> data = dft_model.DftLines.from_recording(ride, (0.5, 28.0))
+    >>> count = count_search.count_modes(data, exact.freq_hz, exact.damping, hold="zoh")
+    >>> count.model.n_modes, count.verdicts(), round(count.effective_fraction, 1)
+    (4, array(['needed', 'needed', 'needed', 'needed'], dtype=object), 1.0)
     """
 
     model: ModalModel
@@ -334,6 +326,16 @@ def effective_fraction(residual: np.ndarray, max_lag: int = COUNT.max_correlatio
     -------
     float
         In (0, 1]; 1 when neighbouring lines are uncorrelated (white noise's DFT).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from armaxmodal.modes.mode_count import effective_fraction
+    >>> white = np.random.default_rng(0).standard_normal((4000, 4)) @ [[1, 0], [1j, 0], [0, 1], [0, 1j]]
+    >>> round(effective_fraction(white), 1)
+    1.0
+    >>> round(effective_fraction(white + np.roll(white, 1, axis=0)), 1)  # neighbours correlated 0.5
+    0.5
     """
     r = np.asarray(residual)
     r = r - r.mean(axis=0)

@@ -17,18 +17,8 @@ from dataclasses import MISSING, asdict, dataclass, field, fields
 
 from armaxmodal.exceptions import SettingsError
 
-__all__ = [
-    "ClusterSettings",
-    "CountSettings",
-    "DftSettings",
-    "FrfSettings",
-    "IntervalSettings",
-    "LineSettings",
-    "NoteSettings",
-    "Resolution",
-    "SelectionSettings",
-    "SweepSettings",
-]
+__all__ = ["ClusterSettings", "CountSettings", "DftSettings", "FrfSettings", "IntervalSettings", "LineSettings",
+           "NoteSettings", "Resolution", "SelectionSettings", "SweepSettings"]
 
 
 @dataclass(frozen=True)
@@ -385,6 +375,12 @@ class SweepSettings:
         The orders swept when none are given, capped at what the record supports.
     min_default_top : int
         A default sweep capped below this top order has too few orders to show stability: refused.
+
+    Examples
+    --------
+    >>> from armaxmodal.modes.settings import SWEEP
+    >>> SWEEP.nk_search, SWEEP.delay_choice_orders, (min(SWEEP.default_orders), max(SWEEP.default_orders))
+    ((0, -1, -2, -3, -4, -5, -6), (8, 10, 12), (2, 30))
     """
 
     tol: float = 1e-5

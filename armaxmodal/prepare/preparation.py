@@ -57,6 +57,18 @@ class Preparation:
     shifts : dict
         Channel -> samples it was moved earlier at the original rate (positive: it lagged).
     warnings : tuple of QualityWarning
+
+    Examples
+    --------
+    A ride logged at 240 Hz for a 0.5-25 Hz band is fitted at a lower rate:
+
+    >>> import armaxmodal as am
+    >>> from armaxmodal.prepare import prepare
+    >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(240.0, 60.0, seed=1), 240.0,
+    ...                              noise=0.03, seed=2)
+    >>> prep = prepare(ride, band=(0.5, 25.0))
+    >>> prep.original_fs, prep.analysis_fs, prep.recording.n_samples, prep.dropped
+    (240.0, 80.0, 4780, ())
     """
 
     recording: Recording

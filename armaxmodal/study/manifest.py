@@ -35,6 +35,17 @@ class Entry:
         Subject mass, kg (for Eq. 4.7 scaling).
     labels : dict
         The manifest's other columns.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from armaxmodal.study import make_study, read_manifest
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     _ = make_study(folder, 2, feet_subjects=(), separate_feet=(), rides=("random",), duration=30.0)
+    ...     entries, _ = read_manifest(pathlib.Path(folder) / "manifest.csv")
+    >>> entry = entries[0]
+    >>> entry.row, entry.subject, entry.ride, round(entry.mass_kg, 1), entry.file.name
+    (1, 'Sub01', 'random', 85.9, 'Sub01_random.csv')
     """
 
     row: int

@@ -40,6 +40,20 @@ class Study:
         modes, per-sensor, per-subject and summary tables, geometric-mean shapes.
     reused : int
         Recordings taken from the cache of an earlier run.
+
+    Examples
+    --------
+    Two subjects' random rides (:func:`~armaxmodal.study.make_study`) analysed:
+
+    >>> import tempfile, pathlib
+    >>> import armaxmodal as am
+    >>> from armaxmodal.study import StudySettings, make_study
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     _ = make_study(folder, 2, feet_subjects=(), separate_feet=(), rides=("random",), duration=60.0)
+    ...     study = am.run_study(pathlib.Path(folder) / "manifest.csv", pathlib.Path(folder) / "out",
+    ...                          StudySettings(orders=(2, 12)), jobs=1)
+    >>> study.sensors, len(study.recordings), study.failures, study.reused
+    (('head', 'chest', 'pelvis', 'legs'), 2, [], 0)
     """
 
     settings: StudySettings
