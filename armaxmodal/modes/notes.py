@@ -34,21 +34,18 @@ def no_mode_kept_note(count: ModeCount, modes: pd.DataFrame, band_hz) -> Quality
 
 def pick_notes(count: ModeCount, keep: np.ndarray) -> list[QualityWarning]:
     """What the record says of modes picked by hand: a ``pick_not_supported`` note for each pick
-    whose removal (the rest refitted free) raises the criterion by less than the count's ``decisive_bic``
-    (``keep``: the picked poles, by pole), and a ``mode_count`` note when one mode more than the
-    model holds lowers it by more."""
+    the count calls ``undecided`` (``keep``: the picked poles it reports, by pole), and a
+    ``mode_count`` note when one mode more than the model holds lowers the criterion decisively."""
     decisive = count.settings.decisive_bic
     notes = []
-    for i in np.flatnonzero(keep):
-        rise = float(count.removal_rise[i])
-        if rise < decisive:
-            f = float(count.model.freq_hz[i])
-            notes.append(QualityWarning(
-                "pick_not_supported", (),
-                f"the record does not support the mode picked at {f:.3f} Hz: without it (the other modes refitted "
-                f"free) the information criterion changes by {rise:+.1f}, less than the {decisive:g} a needed "
-                "mode raises it; treat it as tentative, or pick another column of the diagram", f,
-            ))  # fmt: skip
+    for i in np.flatnonzero(keep & (count.verdicts() == "undecided")):
+        rise, f = float(count.removal_rise[i]), float(count.model.freq_hz[i])
+        notes.append(QualityWarning(
+            "pick_not_supported", (),
+            f"the record does not support the mode picked at {f:.3f} Hz: without it (the other modes refitted "
+            f"free) the information criterion changes by {rise:+.1f}, less than the {decisive:g} a needed "
+            "mode raises it; treat it as tentative, or pick another column of the diagram", f,
+        ))  # fmt: skip
     if count.best_addition > decisive and np.isfinite(count.best_addition_hz):
         f = count.best_addition_hz
         notes.append(QualityWarning(
@@ -87,8 +84,9 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             f"{words[step.action]}{where}, the information criterion (BIC) falls by {step.bic_fall:.1f}",
             float(step.freq_hz),
         ))  # fmt: skip
-    rise = float(count.removal_rise.min()) if count.removal_rise.size else np.inf
-    if rise < decisive:
+    undecided = keep & (count.verdicts(band_hz) == "undecided")  # of the reported modes only
+    if undecided.any():
+        rise = float(count.removal_rise[undecided].min())
         notes.append(QualityWarning(
             "count_undecided", (),
             f"the record does not decide the number of modes: with one mode fewer (the rest refitted free) the "
