@@ -235,11 +235,11 @@ def confirmed_where_incoherent(diagram, work: SelectionState, settings: Selectio
     data = DftLines.from_recording(part, work.refinement.band_hz).noise_weighted(m)
     halves = tuple(DftLines.from_recording(half, work.refinement.band_hz) for half in split_segments(part, 2))
     agree = agree_in_halves(data, m, halves, hold, count.settings.halves_nfev, count.settings.halves_sd, count.dft)
-    reach, decisive = settings.cluster.same_row_freq, count.settings.decisive_bic
+    reach, needed = settings.cluster.same_row_freq, count.verdicts() == "needed"
     confirmed, notes = [], []
     for f in check.unconfirmed_hz:
         i = int(np.argmin(np.abs(m.freq_hz - f)))
-        if abs(m.freq_hz[i] / f - 1) <= reach and count.removal_rise[i] >= decisive and agree[i]:
+        if abs(m.freq_hz[i] / f - 1) <= reach and needed[i] and agree[i]:
             confirmed.append(f)
             notes.append(QualityWarning(
                 "mode_count", (),
