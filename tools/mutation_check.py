@@ -799,7 +799,7 @@ MUTANTS = [
         'filled samples not counted in the reported intervals (intervals)',
     ),
     (
-        "armaxmodal/modes/spread.py",
+        "armaxmodal/modes/intervals.py",
         "halves[q][i] = t_k * s / np.sqrt(n_segments)",
         "halves[q][i] = t_k * s",
         "the segments' interval of one segment, not their mean (intervals)",

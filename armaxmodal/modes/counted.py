@@ -24,6 +24,7 @@ from armaxmodal.modes.intervals import (
     covering_both_estimators,
     earlier_estimate,
     not_separated,
+    split_segments,
     with_intervals,
 )
 from armaxmodal.modes.modal_check import check_modes
@@ -31,7 +32,6 @@ from armaxmodal.modes.mode_count import ModeCount, agree_in_halves
 from armaxmodal.modes.notes import count_notes, no_mode_kept_note, pick_notes
 from armaxmodal.modes.poles import mac, matched_poles, nearest_pole
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
-from armaxmodal.modes.spread import split_segments
 from armaxmodal.modes.state import SelectionState
 from armaxmodal.modes.support import stable_in_diagram
 from armaxmodal.quality_warnings import QualityWarning

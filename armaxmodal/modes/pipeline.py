@@ -30,7 +30,7 @@ from armaxmodal.modes.clusters import check_picks, clustered_modes, merge_duplic
 from armaxmodal.modes.completeness import each_once, modes_the_check_adds, modes_the_record_needs, refit_with_added
 from armaxmodal.modes.counted import confirmed_where_incoherent, counted_modes, dropped_where_peaks_remain
 from armaxmodal.modes.diagram import StabilisationDiagram
-from armaxmodal.modes.intervals import with_intervals
+from armaxmodal.modes.intervals import N_SEGMENTS, apply_segment_spread, segment_spread, with_intervals
 from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.notes import oversampling_note
 from armaxmodal.modes.per_sensor import per_sensor_table
@@ -43,7 +43,6 @@ from armaxmodal.modes.result import (
 )
 from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_and_segment_fits
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
-from armaxmodal.modes.spread import N_SEGMENTS, apply_segment_spread, segment_spread
 from armaxmodal.modes.state import SelectionContext, SelectionState
 
 __all__ = ["AUTOMATIC", "FIXED_COUNT", "PICKED", "Stage", "select_modes", "stages_for"]
@@ -206,7 +205,7 @@ def confirm(state: SelectionState, ctx: SelectionContext) -> SelectionState:
 
 def spread(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     """Each mode's spread over disjoint segments of the record widens its intervals where it exceeds
-    them (:mod:`armaxmodal.modes.spread`), from the segment refits the refit stage ran."""
+    them (:func:`armaxmodal.modes.intervals.segment_spread`), from the segment refits the refit stage ran."""
     if ctx.segments < 2:
         return state
     modes, orders = state.modes, ctx.orders
@@ -324,7 +323,7 @@ def select_modes(
         Refit the selected modes to the recording's DFT (and count them by the modal model).
     segments : int
         Refit each mode's representative orders on this many disjoint segments and widen
-        the intervals where their spread exceeds them (:mod:`armaxmodal.modes.spread`); 0 skips.
+        the intervals where their spread exceeds them (:func:`armaxmodal.modes.intervals.segment_spread`); 0 skips.
     n_jobs : int, optional
         Worker threads for the finishing and segment fits (default: all cores; 1 inside a
         worker that has one core already, e.g. a study's).

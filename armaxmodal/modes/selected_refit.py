@@ -1,6 +1,7 @@
 """The fits run for the selected modes: the frequency-domain refit
-(:func:`armaxmodal.modes.dft_model.refine_modes`) and the segment refits (:mod:`armaxmodal.modes.spread`), run
-together over the worker threads, and the refit's values applied within their limits.
+(:func:`armaxmodal.modes.dft_model.refine_modes`) and the segment refits
+(:func:`armaxmodal.modes.intervals.segment_spread`), run together over the worker threads, and the
+refit's values applied within their limits.
 """
 
 from __future__ import annotations
@@ -15,12 +16,8 @@ from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.clusters import merge_duplicates
 from armaxmodal.modes.dft_model import refine_modes
+from armaxmodal.modes.intervals import segment_jobs, segment_poles, split_segments
 from armaxmodal.modes.settings import DEFAULTS, DftSettings
-from armaxmodal.modes.spread import (
-    segment_jobs,
-    segment_poles,
-    split_segments,
-)
 from armaxmodal.modes.state import SelectionState
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording

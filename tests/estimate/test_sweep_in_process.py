@@ -23,9 +23,9 @@ from armaxmodal.modes.diagram import (
     stabilisation_diagram,
     sweep_fit,
 )
+from armaxmodal.modes.intervals import N_SEGMENTS
 from armaxmodal.modes.pipeline import select_modes
 from armaxmodal.modes.poles import SHARED
-from armaxmodal.modes.spread import N_SEGMENTS
 from armaxmodal.recording import Recording
 
 ORDERS = range(2, 11, 2)

@@ -303,7 +303,7 @@ def test_a_change_during_the_record_is_not_counted_as_modes():
     """A two-mass chain that stiffens 4 % halfway (a set-up that settles, a joint that warms):
     the whole record is fitted better by a cascade of lightly damped doublets near the first
     mode, which the likelihood alone accepts; each half needs none of them."""
-    from armaxmodal.modes.spread import split_segments
+    from armaxmodal.modes.intervals import split_segments
     from armaxmodal.recording import Recording
 
     def chain(scale):
@@ -671,7 +671,7 @@ def test_a_split_of_a_mode_the_search_did_not_split_is_tried_for_the_likelihood(
     from scipy.special import chdtrc
 
     from armaxmodal.modes.count_search import _Search, _split_wanted
-    from armaxmodal.modes.spread import split_segments
+    from armaxmodal.modes.intervals import split_segments
 
     data, truth = supine
     f, x = truth.freq_hz.copy(), truth.damping.copy()

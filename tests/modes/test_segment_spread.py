@@ -6,9 +6,8 @@ import pytest
 
 import armaxmodal as am
 from armaxmodal.modes.diagram import stabilisation_diagram
-from armaxmodal.modes.intervals import with_intervals
+from armaxmodal.modes.intervals import apply_segment_spread, with_intervals
 from armaxmodal.modes.pipeline import select_modes
-from armaxmodal.modes.spread import apply_segment_spread
 from armaxmodal.stats import Z95
 
 FS = 60.0
@@ -77,7 +76,7 @@ def test_a_segment_that_blends_a_close_pair_measures_neither_mode():
     the pair's gap; a pole nearer the other mode is never this one's."""
     import pandas as pd
 
-    from armaxmodal.modes.spread import segment_spread
+    from armaxmodal.modes.intervals import segment_spread
 
     modes = pd.DataFrame({"freq_hz": [10.12, 10.41], "damping": [0.01, 0.01]})
     orders = (4, 5, 4, 0)
