@@ -583,9 +583,15 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/counted.py",
-        'and count.removal_rise[i] >= decisive and agree[i]:',
+        'and needed[i] and agree[i]:',
         "and agree[i]:",
         "a mode the likelihood does not need confirmed where the H1 is incoherent (count)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        'reach, needed = settings.cluster.same_row_freq, count.verdicts() == "needed"',
+        "reach, needed = settings.cluster.same_row_freq, count.removal_rise >= count.settings.decisive_bic",
+        "a pole the model needs but calls no mode confirms the H1's untested mode (count)",
     ),
     (
         "armaxmodal/modes/clusters.py",
@@ -601,9 +607,15 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/notes.py",
-        'if rise < decisive:\n            f = float(count.model.freq_hz[i])',
-        'if rise < -decisive:\n            f = float(count.model.freq_hz[i])',
+        'for i in np.flatnonzero(keep & (count.verdicts() == "undecided")):',
+        "for i in np.flatnonzero(keep & False):",
         "an unsupported pick not said (pick)",
+    ),
+    (
+        "armaxmodal/modes/notes.py",
+        'for i in np.flatnonzero(keep & (count.verdicts() == "undecided")):',
+        "for i in np.flatnonzero(keep):",
+        "every pick said unsupported, needed or not (pick)",
     ),
     (
         "armaxmodal/modes/counted.py",
@@ -637,9 +649,15 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/notes.py",
-        '    if rise < decisive:\n        notes.append(',
-        '    if rise < -decisive:\n        notes.append(',
+        '    if undecided.any():',
+        '    if False:',
         "an undecided removal not said (count)",
+    ),
+    (
+        "armaxmodal/modes/notes.py",
+        'undecided = keep & (count.verdicts(band_hz) == "undecided")',
+        "undecided = count.removal_rise < decisive",
+        "a weak pole kept unreported makes the reported modes undecided (count)",
     ),
     (
         "armaxmodal/modes/mode_count.py",

@@ -177,6 +177,10 @@ def test_undecided_counts_and_out_of_band_poles_are_said():
     assert [n.code for n in decided] == ["mode_count"]  # only the out-of-band pole
     removal = _notes(_count([DECISIVE_BIC - 1, 60.0], -40.0), np.array([True, False]), (1.0, 25.0), SAME_ROW)
     assert "count_undecided" in [n.code for n in removal]
+    # only the reported modes' removals decide: a weak pole kept unreported (above the band) does not
+    # make them tentative
+    unreported = _notes(_count([60.0, DECISIVE_BIC - 1], -40.0), np.array([True, False]), (1.0, 25.0), SAME_ROW)
+    assert "count_undecided" not in [n.code for n in unreported]
     addition = _notes(_count([50.0, 60.0], -DECISIVE_BIC + 1), np.array([True, False]), (1.0, 25.0), SAME_ROW)
     assert [n.value for n in addition if n.code == "count_undecided"] == [12.0]
 
@@ -523,19 +527,22 @@ def test_with_the_halves_a_moved_pole_is_judged_by_them_not_by_the_diagram(monke
 
 
 @pytest.mark.parametrize(
-    "rise, halves_agree, confirmed", [(500.0, True, True), (5.0, True, False), (500.0, False, False)]
+    "rise, halves_agree, stand_in, confirmed",
+    [(500.0, True, False, True), (5.0, True, False, False), (500.0, False, False, False), (500.0, True, True, False)],
 )
 def test_the_modal_model_confirms_a_mode_where_the_h1_is_not_coherent(monkeypatch, bundled_diagram, rise, halves_agree,
-                                                                      confirmed):  # fmt: skip
+                                                                      stand_in, confirmed):  # fmt: skip
     """A mode the FRF check cannot test (no coherent H1 line near it) is confirmed when the
-    likelihood needs it decisively and the record's halves agree on it; else it stays unconfirmed."""
+    likelihood needs it decisively and the record's halves agree on it; else it stays unconfirmed.
+    A pole the model needs that the count calls no mode (a stand-in) confirms nothing."""
 
     import armaxmodal.modes.counted as counted
     from armaxmodal.modes.state import SelectionState
 
     sel = am.select_modes(bundled_diagram, segments=0)
     f0 = float(sel.modes.freq_hz[0])
-    count = replace(sel.count, removal_rise=np.full(sel.count.model.n_modes, rise))
+    count = replace(sel.count, removal_rise=np.full(sel.count.model.n_modes, rise),
+                    stand_ins=((f0, f0, rise),) if stand_in else ())  # fmt: skip
     check = replace(sel.check, unconfirmed_hz=(f0,))
     assert not check.passed
     monkeypatch.setattr(counted, "agree_in_halves", lambda d, m, h, hold, *limits: np.full(m.n_modes, halves_agree))

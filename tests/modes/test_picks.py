@@ -12,6 +12,7 @@ import armaxmodal as am
 from armaxmodal.cli.main import main
 from armaxmodal.modes.clusters import check_picks
 from armaxmodal.modes.counted import _picked_result
+from armaxmodal.modes.mode_count import ModeCount
 from armaxmodal.modes.settings import ClusterSettings, CountSettings, SelectionSettings
 from armaxmodal.modes.state import SelectionState
 
@@ -80,7 +81,6 @@ def test_a_pick_the_modal_model_takes_out_of_the_band_is_reported_and_said():
         freq_hz=np.array([5.1, 20.0, 12.1]), damping=np.array([0.1, 1e-4, 0.05]), freq_sd=np.full(3, 0.01),
         damping_sd=np.array([0.001, 0.0, 0.001]), shapes=np.array([[3.0, 4.0, 6.0]], dtype=complex), n_modes=3,
     )  # fmt: skip
-    from armaxmodal.modes.mode_count import ModeCount
 
     count = ModeCount(model, model, (), np.array([80.0, -3.0, 60.0]), -50.0, np.nan, 1.0)
     out = _picked_result(work, count, np.array([True, False, True]), "bandlimited", SelectionSettings())
@@ -115,8 +115,7 @@ def test_a_pick_the_record_does_not_need_is_said():
     from armaxmodal.modes.notes import pick_notes as _pick_notes
 
     model = SimpleNamespace(freq_hz=np.array([5.0, 9.0]), damping=np.array([0.1, 0.05]))
-    count = SimpleNamespace(model=model, removal_rise=np.array([4.0, 80.0]), best_addition=-30.0, best_addition_hz=7.0,
-                            settings=CountSettings())  # fmt: skip
+    count = ModeCount(model, model, (), np.array([4.0, 80.0]), -30.0, 7.0, 1.0, settings=CountSettings())
     (note,) = _pick_notes(count, np.array([True, True]))
     assert note.code == "pick_not_supported" and note.value == 5.0 and "+4.0" in note.message
     assert _pick_notes(count, np.array([False, True])) == []  # only the picked poles are judged
