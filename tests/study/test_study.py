@@ -133,7 +133,7 @@ def test_an_interrupted_study_resumes_from_its_cache(study_dir, tmp_path):
     assert again.reused == 1
     pd.testing.assert_frame_equal(first.tables.modes, again.tables.modes)
     # other settings are other results: nothing reused
-    other = run_study(manifest, tmp_path / "out", StudySettings(orders=(2, 20)), jobs=1)
+    other = run_study(manifest, tmp_path / "out", StudySettings(orders=(2, 8)), jobs=1)
     assert other.reused == 0
 
 
@@ -269,7 +269,7 @@ def test_a_folder_study_takes_subjects_from_the_files_and_notes_a_mixed_rate(stu
     faster = am.Recording(100.0, resample_poly(r.base, 5, 3), resample_poly(r.response, 5, 3, axis=0), r.sensors,
                           subject=r.subject, mass_kg=r.mass_kg)  # fmt: skip
     write_recording_csv(faster, rides / "b.csv")
-    study = run_study(rides, tmp_path / "out", StudySettings(), jobs=2)
+    study = run_study(rides, tmp_path / "out", PLUMBING, jobs=2)
     assert [r["subject"] for r in study.recordings] == ["Sub01", "Sub02"]
     assert any("mixed sample rates" in n and "b.csv (100 Hz)" in n for n in study.notes)
     assert not study.failures and study.recordings[1]["fs"] == 100.0
