@@ -660,7 +660,7 @@ MUTANTS = [
         "a weak pole kept unreported makes the reported modes undecided (count)",
     ),
     (
-        "armaxmodal/modes/mode_count.py",
+        "armaxmodal/modes/poles.py",
         "return (f >= band_hz[0]) & (f <= band_hz[1]) & (x <= MAX_DAMPING)",
         "return (f >= band_hz[0]) & (x <= MAX_DAMPING)",
         "poles above the band reported (count)",
@@ -727,8 +727,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        'if dof <= 0 or chdtrc(dof, ratio) >= search.cfg.likelihood_alpha:',
-        'if dof <= 0 or chdtrc(2 * dof, ratio) >= search.cfg.likelihood_alpha:',
+        'if dof <= 0 or not chdtrc(dof, ratio) < search.cfg.likelihood_alpha:',
+        'if dof <= 0 or not chdtrc(2 * dof, ratio) < search.cfg.likelihood_alpha:',
         "the likelihood ratio's degrees of freedom doubled (count)",
     ),
     (
@@ -928,9 +928,27 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "if not search.resolved(model) or not new:",
-        "if not new:",
+        "if not resolved(model, search.data.band_hz) or not new:\n        return (), None",
+        "if not new:\n        return (), None",
         "a split with its damping unresolved (split-wanted)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "if dof <= 0 or not chdtrc(dof, ratio) < search.cfg.likelihood_alpha:",
+        "if dof <= 0 or chdtrc(dof, ratio) >= search.cfg.likelihood_alpha:",
+        "a likelihood ratio below zero (chdtrc's NaN) taken as beyond chance (split-wanted)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "        wanted = _unsupported_wanted(search, current, halves)",
+        "        wanted = ()",
+        "an addition the diagram has no column for never named (split-wanted)",
+    ),
+    (
+        "armaxmodal/notes.py".replace("armaxmodal/", "armaxmodal/modes/"),
+        "    if unsupported:\n        return (f\"the diagram holds no stable column there",
+        "    if False:\n        return (f\"the diagram holds no stable column there",
+        "an unsupported addition explained as one the search did not try (split-wanted)",
     ),
     (
         'armaxmodal/modes/count_search.py',

@@ -1,13 +1,10 @@
-"""The search of the count: from the diagram's selection, every step compares the current model
-with its neighbours, each refitted with every pole free (:func:`~armaxmodal.modes.dft_model.fit_modal_model`):
-
-* **remove** each mode (the others free to take over: a merge of two close modes is a removal);
-* **add** a left-out stable cluster of the diagram, or a pole where the residual is largest;
-* **split** a mode in two, about its half-power band apart.
-
-The neighbour of lowest criterion (:mod:`armaxmodal.modes.mode_count`) replaces the current model
-while it lowers it. Then the chosen model is converged, carried-away starts judged, the equally
-good models fitted and the refused additions the likelihood wants flagged, on one ``_Search``.
+"""The search of the count (the method page's "how many modes" gives its rules): from the diagram's
+selection, every step compares the current model with its neighbours, each refitted with every pole
+free (:func:`~armaxmodal.modes.dft_model.fit_modal_model`) -- a mode removed (a merge of two close
+modes is a removal), a left-out stable cluster or the residual's peak added, a mode split in two --
+and the neighbour of lowest criterion (:mod:`armaxmodal.modes.mode_count`) replaces the current
+model while it lowers it. Then the chosen model is converged, carried-away starts judged, the
+equally good models fitted and the refused additions the likelihood wants flagged.
 """
 
 from __future__ import annotations
@@ -28,13 +25,12 @@ from armaxmodal.modes.mode_count import (
     Wanted,
     agree_in_halves,
     effective_fraction,
-    reported,
     residual_peak,
     split_start,
 )
-from armaxmodal.modes.poles import matched_poles, nearest_pole, new_poles
+from armaxmodal.modes.poles import matched_poles, nearest_pole, new_poles, physical, reported, resolved
 from armaxmodal.modes.settings import DEFAULTS, CountSettings, DftSettings, LineSettings
-from armaxmodal.stats import MAX_DAMPING, Z95
+from armaxmodal.stats import Z95
 
 __all__ = ["count_modes"]
 
@@ -47,7 +43,7 @@ class _Search:
                  dft: DftSettings = DEFAULTS.dft):  # fmt: skip
         self.data, self.hold, self.n_eff, self.max_nfev, self.n_jobs = data, hold, n_effective, max_nfev, n_jobs
         self.cfg, self.lines, self.dft, self.trials, self.table = settings, lines, dft, 0, ModelTable(n_effective)
-        self.logged = self.table.add
+        self.logged, self.unsupported = self.table.add, None
 
     def screened(self, starts: list[tuple[np.ndarray, np.ndarray]], labels: list[tuple[str, float]]
                  ) -> list[ModalModel | None]:  # fmt: skip
@@ -97,26 +93,13 @@ class _Search:
             out.append(done if done is None or test is None or test(done[2]) else None)
         return out
 
-    def resolved(self, model: ModalModel | None) -> bool:
-        """Every pole of ``model`` in the band is a mode with a damping the record resolves (its
-        symmetric 95 % interval above zero): a pole at the damping floor is a line, not a mode."""
-        if model is None:
-            return False
-        physical = self.physical(model)
-        return bool(np.all(model.damping[physical] - Z95 * model.damping_sd[physical] > 0))
-
     def admissible(self, model: ModalModel | None, current: ModalModel, supported) -> bool:
         """A larger model's new poles are modes: damping resolved, and stable across the diagram's
         orders where the caller says what is (``supported``)."""
-        if not self.resolved(model):
+        if not resolved(model, self.data.band_hz):
             return False
-        new = [i for i in new_poles(current.freq_hz, model.freq_hz) if self.physical(model)[i]]
+        new = [i for i in new_poles(current.freq_hz, model.freq_hz) if physical(model, self.data.band_hz)[i]]
         return supported is None or all(supported(model.freq_hz[i], model.damping[i]) for i in new)
-
-    def physical(self, model: ModalModel) -> np.ndarray:
-        """Per pole: in the band and damped as a vibration mode can be."""
-        band = (model.freq_hz >= self.data.band_hz[0]) & (model.freq_hz <= self.data.band_hz[1])
-        return band & (model.damping <= MAX_DAMPING)
 
     def in_both_halves(self, trial: ModalModel, new: list[int], halves) -> bool:
         """The new poles of ``trial`` (indices ``new``) have the same frequency and damping in each
@@ -226,21 +209,34 @@ def _likelihood_wants(search: _Search, current: ModalModel, model: ModalModel, n
     ``settings.likelihood_alpha`` and its new poles are the same in both halves, else ``()``."""
     dof = model.n_params - current.n_params
     ratio = current.neg2_loglik_on(search.n_eff) - model.neg2_loglik_on(search.n_eff)
-    if dof <= 0 or chdtrc(dof, ratio) >= search.cfg.likelihood_alpha:
+    if dof <= 0 or not chdtrc(dof, ratio) < search.cfg.likelihood_alpha:  # NaN below 0
         return ()
     if not search.in_both_halves(model, new_poles(current.freq_hz, model.freq_hz), halves):
         return ()
     return Wanted(new_hz, float(ratio), int(dof), float(-gain), bool(in_diagram))
 
 
+def _unsupported_wanted(search: _Search, current: ModalModel, halves) -> tuple:
+    """The best addition refused only for want of a stable diagram column, converged and judged as
+    :func:`_wanted` judges one: the ARMAX fits may miss a mode the record holds (a six-mass chain at
+    400 Hz: no order resolved its three top modes; the first lowers the criterion by 61,000)."""
+    trial = search.unsupported
+    if trial is None or len(halves) != 2:
+        return ()
+    model = search.fit(trial[2].freq_hz, trial[2].damping, search.cfg.final_nfev, label=("add", trial[1]))
+    new = new_poles(current.freq_hz, model.freq_hz) if model is not None else []
+    if not resolved(model, search.data.band_hz) or not new:
+        return ()
+    gain, f = search.bic(current) - search.bic(model), float(model.freq_hz[new[0]])
+    wanted = _likelihood_wants(search, current, model, f, gain, halves, in_diagram=False)
+    return wanted._replace(unsupported=True) if wanted else ()
+
+
 def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) -> tuple[tuple, ModalModel | None]:
-    """A split the likelihood wants (:attr:`ModeCount.wanted`; ``()`` if none) and its converged
-    model (None if no split converged with its damping resolved): every reported mode split in two,
-    the best converged and judged as :func:`_wanted` judges an addition. The search splits only the
-    mode nearest the residual's peak, and a split need not be stable across the diagram's orders:
-    two modes closer than the ARMAX fits resolve stand as one column there (the method page's
-    14.28 and 15.40 Hz, one at 15.45 Hz)."""
-    shown = np.flatnonzero(search.physical(current))
+    """A split the likelihood wants (``()`` if none) and its converged model (None if no split
+    converged resolved): every reported mode split, the best converged and judged as :func:`_wanted`
+    judges an addition; it needs no diagram column (two close modes stand as one column there)."""
+    shown = np.flatnonzero(physical(current, search.data.band_hz))
     if len(halves) != 2 or shown.size == 0:
         return (), None
     screened = search.screened([split_start(current, m) for m in shown],
@@ -251,7 +247,7 @@ def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) 
     m, best = min(tried, key=lambda t: search.bic(t[1]))
     model = search.fit(best.freq_hz, best.damping, search.cfg.final_nfev, label=("split", float(current.freq_hz[m])))
     new = new_poles(current.freq_hz, model.freq_hz) if model is not None else []
-    if not search.resolved(model) or not new:
+    if not resolved(model, search.data.band_hz) or not new:
         return (), None
     gain = search.bic(current) - search.bic(model)
     f, x = float(model.freq_hz[new[0]]), float(model.damping[new[0]])
@@ -356,6 +352,8 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max
         best_removal, best_addition = search.best_of_each(
             removed, added, lambda model: search.admissible(model, current, supported)
         )
+        lacking = [t for t in added if resolved(t[2], data.band_hz) and not search.admissible(t[2], current, supported)]
+        search.unsupported = min(lacking, key=lambda t: search.bic(t[2]), default=None)  # no diagram column
         if best_addition is not None and search.bic(best_addition[2]) < here and len(halves) == 2:
             new = new_poles(current.freq_hz, best_addition[2].freq_hz)
             if not search.in_both_halves(best_addition[2], new, halves):
@@ -389,6 +387,8 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max
     alternatives = _equally_good(search, current, rise, close)
     wanted = _wanted(search, current, best_addition, gain, new_hz, halves) if searching else ()
     if searching and not wanted and close is None:  # one mode more is already undecided: said once
+        wanted = _unsupported_wanted(search, current, halves)
+    if searching and not wanted and close is None:
         wanted, split = _split_wanted(search, current, halves, supported)
         # as good as the chosen model: its modes are the record's too
         if wanted and abs(wanted.rise) < settings.decisive_bic:

@@ -23,23 +23,15 @@ import numpy as np
 
 from armaxmodal.modes.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.intervals import interval
-from armaxmodal.modes.poles import matched_poles, nearest_pole
+from armaxmodal.modes.poles import matched_poles, nearest_pole, reported
 from armaxmodal.modes.settings import DEFAULTS, CountSettings, DftSettings, LineSettings
-from armaxmodal.stats import MAX_DAMPING, Z95
+from armaxmodal.stats import Z95
 
 __all__ = ["FittedModel", "ModeCount", "ModelTable", "Wanted", "Step", "agree_in_halves", "effective_fraction",
-           "reported", "split_start"]
+           "split_start"]
 
 #: the count's thresholds when none are given (:class:`~armaxmodal.modes.settings.CountSettings`)
 COUNT = DEFAULTS.count
-
-
-def reported(model, band_hz, lines: LineSettings = DEFAULTS.lines) -> np.ndarray:
-    """Which of a model's poles are modes of the band (bool per pole): not beyond it, not damped
-    beyond ``MAX_DAMPING``, and not a line (damped at the fit's floor,
-    ``lines.at_fit_floor``)."""
-    f, x = model.freq_hz, model.damping
-    return (f >= band_hz[0]) & (f <= band_hz[1]) & (x <= MAX_DAMPING) & (x > lines.at_fit_floor)
 
 
 @dataclass(frozen=True)
@@ -100,6 +92,7 @@ class Wanted(NamedTuple):
     dof: int  #: the parameters one mode adds
     rise: float  #: the criterion's rise with it (negative: a fall)
     in_diagram: bool  #: the diagram holds a stable column there to pick
+    unsupported: bool = False  #: an addition refused only for want of a stable diagram column
 
 
 @dataclass(frozen=True)

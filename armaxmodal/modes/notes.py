@@ -56,14 +56,20 @@ def pick_notes(count: ModeCount, keep: np.ndarray) -> list[QualityWarning]:
     return notes
 
 
-def _why_not_reported(rise_bic: float) -> str:
+def _why_not_reported(rise_bic: float, unsupported: bool = False) -> str:
+    if unsupported:
+        return (f"the diagram holds no stable column there, which a mode the search adds must have (with it the "
+                f"criterion falls by {-rise_bic:.1f}), so it is not reported")
     if rise_bic > 0:
         return f"the criterion (BIC) rises by {rise_bic:.1f}, so it is not reported"
     return ("the search, which splits only the mode nearest the residual's peak, did not try it (with it the "
             f"criterion falls by {-rise_bic:.1f}), so it is not reported")
 
 
-def _what_to_do(in_diagram: bool) -> str:
+def _what_to_do(in_diagram: bool, unsupported: bool = False) -> str:
+    if unsupported:  # the ARMAX fits miss it: at a lower rate their poles crowd z = 1 less
+        return ("fit a narrower band that holds it (--band), so the record is fitted at a lower rate, or use higher "
+                "orders, and look for its column; the modes reported may be too few")
     if in_diagram:
         return "pick it (--pick) to see what the record says of it"
     # a split's pole: the ARMAX fits merge it with its neighbour, and a pick takes a diagram's column
@@ -101,13 +107,13 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             f"{-count.best_addition:+.1f}, less than {decisive:g} either way", f,
         ))  # fmt: skip
     if count.wanted:
-        f, ratio, dof, rise_bic, in_diagram = count.wanted  # a Wanted
+        f, ratio, dof, rise_bic, in_diagram, unsupported = count.wanted  # a Wanted
         notes.append(QualityWarning(
             "count_undecided", (),
             f"the record may hold one mode more near {f:.3f} Hz: adding it raises the likelihood far beyond chance "
             f"(likelihood ratio {ratio:.1f} for its {dof} parameters, p < {count.settings.likelihood_alpha:g}) and the "
-            f"mode is the same in both halves of the record, but {_why_not_reported(rise_bic)}; "
-            f"{_what_to_do(in_diagram)}", f,
+            f"mode is the same in both halves of the record, but {_why_not_reported(rise_bic, unsupported)}; "
+            f"{_what_to_do(in_diagram, unsupported)}", f,
         ))  # fmt: skip
     for start, went in count.carried_away:
         notes.append(QualityWarning(

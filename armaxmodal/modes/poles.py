@@ -30,7 +30,7 @@ from armaxmodal.spectra import excited_band
 from armaxmodal.stats import MAX_DAMPING, Z95
 
 __all__ = ["Tolerances", "pole_rows", "stability_classes", "rejection_reasons", "mac", "POLE_COLUMNS",
-           "disturbance_lines", "matched_poles", "nearest_pole", "new_poles"]
+           "disturbance_lines", "matched_poles", "nearest_pole", "new_poles", "physical", "reported", "resolved"]
 
 SHARED = "shared"
 
@@ -286,3 +286,25 @@ def new_poles(old_hz: np.ndarray, new_hz: np.ndarray) -> list[int]:
     """The poles of ``new_hz`` (indices) left over when each of ``old_hz`` takes its nearest."""
     paired = {i for i, _ in matched_poles(old_hz, new_hz)}
     return [i for i in range(len(new_hz)) if i not in paired]
+
+
+def reported(model, band_hz, lines: LineSettings = DEFAULTS.lines) -> np.ndarray:
+    """Which of a model's poles are modes of the band (bool per pole): not beyond it, not damped
+    beyond ``MAX_DAMPING``, and not a line (damped at the fit's floor,
+    ``lines.at_fit_floor``)."""
+    f, x = model.freq_hz, model.damping
+    return (f >= band_hz[0]) & (f <= band_hz[1]) & (x <= MAX_DAMPING) & (x > lines.at_fit_floor)
+
+
+def physical(model, band_hz) -> np.ndarray:
+    """Per pole of a modal model: in the band (Hz) and damped as a vibration mode can be."""
+    return (model.freq_hz >= band_hz[0]) & (model.freq_hz <= band_hz[1]) & (model.damping <= MAX_DAMPING)
+
+
+def resolved(model, band_hz) -> bool:
+    """Every pole of ``model`` in the band is a mode with a damping the record resolves (its
+    symmetric 95 % interval above zero): a pole at the damping floor is a line, not a mode."""
+    if model is None:
+        return False
+    shown = physical(model, band_hz)
+    return bool(np.all(model.damping[shown] - Z95 * model.damping_sd[shown] > 0))

@@ -13,8 +13,9 @@ from armaxmodal.modes.count_search import count_modes
 from armaxmodal.modes.counted import _one_where_not_separated, dropped_where_peaks_remain
 from armaxmodal.modes.dft_model import DftLines, fit_modal_model
 from armaxmodal.modes.intervals import not_separated, with_intervals
-from armaxmodal.modes.mode_count import ModeCount, Wanted, effective_fraction, reported
+from armaxmodal.modes.mode_count import ModeCount, Wanted, effective_fraction
 from armaxmodal.modes.notes import count_notes as _notes
+from armaxmodal.modes.poles import reported
 from armaxmodal.modes.result import ModeSelection, not_separated_notes
 from armaxmodal.modes.settings import ClusterSettings, CountSettings, SelectionSettings
 from armaxmodal.stats import Z95
@@ -453,6 +454,29 @@ def test_a_decided_count_has_no_equally_good_model(monkeypatch, supine):
     monkeypatch.setattr(count_search, "fit_modal_model", lambda data, f, x, hold, n=40, dft=None: _Scored(f, x, table))
     count = count_modes(supine[0], [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], hold="zoh")
     assert count.model.n_modes == 3 and count.alternatives == ()
+
+
+@pytest.mark.parametrize("column", [False, True])
+def test_an_addition_the_diagram_has_no_column_for_is_named_when_the_record_wants_it(monkeypatch, supine, column):
+    """Criterion 95 for 3 modes, 50 for 4, and the new pole the same in both halves: with a stable
+    column in the diagram the fourth mode is added; without one (ARMAX fits that do not resolve it:
+    a six-mass chain at 400 Hz) it is not, but the count names it and says the modes may be too
+    few, so the verdict cannot be good."""
+    import armaxmodal.modes.count_search as count_search
+
+    table = {2: 130.0, 3: 95.0, 4: 50.0, 5: 250.0}
+    monkeypatch.setattr(count_search, "fit_modal_model", lambda data, f, x, hold, n=40, dft=None: _Scored(f, x, table))
+    monkeypatch.setattr(count_search._Search, "in_both_halves", lambda self, trial, new, halves: True)
+    data = supine[0]
+    count = count_modes(data, [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], hold="zoh", halves=(data, data),
+                        supported=lambda f, x: column)  # fmt: skip
+    assert count.model.n_modes == (4 if column else 3)
+    if column:
+        assert count.wanted == ()
+        return
+    assert count.wanted.unsupported and not count.wanted.in_diagram and count.wanted.rise == pytest.approx(-45.0)
+    notes = [n for n in _notes(count, np.ones(3, bool), data.band_hz, SAME_ROW) if n.code == "count_undecided"]
+    assert len(notes) == 1 and "no stable column" in notes[0].message and "--band" in notes[0].message
 
 
 @pytest.mark.parametrize(
