@@ -217,9 +217,9 @@ def _likelihood_wants(search: _Search, current: ModalModel, model: ModalModel, n
 
 
 def _unsupported_wanted(search: _Search, current: ModalModel, halves) -> tuple:
-    """The best addition refused only for want of a stable diagram column, converged and judged as
-    :func:`_wanted` judges one: the ARMAX fits may miss a mode the record holds (a six-mass chain at
-    400 Hz: no order resolved its three top modes; the first lowers the criterion by 61,000)."""
+    """The best addition that lowers the criterion but was refused for want of a stable diagram
+    column, converged and judged as :func:`_wanted` judges one: the ARMAX fits may miss a mode the
+    record holds (a six-mass chain at 400 Hz: no order resolved its three top modes)."""
     trial = search.unsupported
     if trial is None or len(halves) != 2:
         return ()
@@ -352,8 +352,9 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max
         best_removal, best_addition = search.best_of_each(
             removed, added, lambda model: search.admissible(model, current, supported)
         )
-        lacking = [t for t in added if resolved(t[2], data.band_hz) and not search.admissible(t[2], current, supported)]
-        search.unsupported = min(lacking, key=lambda t: search.bic(t[2]), default=None)  # no diagram column
+        lacking = [t for t in added if search.bic(t[2]) < here and resolved(t[2], data.band_hz)
+                   and not search.admissible(t[2], current, supported)]  # better, but no diagram column
+        search.unsupported = min(lacking, key=lambda t: search.bic(t[2]), default=None)
         if best_addition is not None and search.bic(best_addition[2]) < here and len(halves) == 2:
             new = new_poles(current.freq_hz, best_addition[2].freq_hz)
             if not search.in_both_halves(best_addition[2], new, halves):
