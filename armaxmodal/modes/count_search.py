@@ -388,12 +388,12 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max
     alternatives = _equally_good(search, current, rise, close)
     wanted = _wanted(search, current, best_addition, gain, new_hz, halves) if searching else ()
     if searching and not wanted and close is None:  # one mode more is already undecided: said once
-        wanted = _unsupported_wanted(search, current, halves)
-    if searching and not wanted and close is None:
         wanted, split = _split_wanted(search, current, halves, supported)
         # as good as the chosen model: its modes are the record's too
         if wanted and abs(wanted.rise) < settings.decisive_bic:
             alternatives += ((wanted.rise, split),)
+    if searching and not wanted and close is None:
+        wanted = _unsupported_wanted(search, current, halves)
     return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
                      tuple(unconfirmed), alternatives, carried_away, wanted, stand_ins, settings, lines,
                      dft, tuple(search.table.rows), data.band_hz)  # fmt: skip

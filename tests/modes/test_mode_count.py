@@ -467,6 +467,7 @@ def test_an_addition_the_diagram_has_no_column_for_is_named_when_the_record_want
     table = {2: 130.0, 3: 95.0, 4: 50.0, 5: 250.0}
     monkeypatch.setattr(count_search, "fit_modal_model", lambda data, f, x, hold, n=40, dft=None: _Scored(f, x, table))
     monkeypatch.setattr(count_search._Search, "in_both_halves", lambda self, trial, new, halves: True)
+    monkeypatch.setattr(count_search, "_split_wanted", lambda *a, **k: ((), None))  # a stand-in fit splits as it adds
     data = supine[0]
     count = count_modes(data, [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], hold="zoh", halves=(data, data),
                         supported=lambda f, x: column)  # fmt: skip
@@ -716,20 +717,24 @@ def test_a_split_of_a_mode_the_search_did_not_split_is_tried_for_the_likelihood(
     if not merged:
         assert got == ()
         return
-    new_hz, ratio, dof, _, in_diagram = got
-    assert in_diagram is False  # the diagram (here: no column anywhere) cannot be picked from
+    new_hz, ratio, dof, _, in_diagram, unsupported = got
+    assert in_diagram is False and not unsupported  # no column anywhere to pick from; a split needs none
     assert np.min(np.abs(truth.freq_hz[2:] / new_hz - 1)) < FREQ_TOL, got
     assert dof == 2 + 4 * data.y.shape[1] and chdtrc(dof, ratio) < CountSettings().likelihood_alpha
 
 
 @pytest.mark.parametrize(
-    ("rise", "in_diagram", "said"),
-    [(36.5, True, ("rises by 36.5", "--pick")), (-4.0, False, ("falls by 4.0", "no stable column there to pick"))],
-)
-def test_a_wanted_mode_is_said_with_why_it_is_not_reported(rise, in_diagram, said):
+    ("rise", "in_diagram", "unsupported", "said"),
+    [(36.5, True, False, ("rises by 36.5", "--pick")),
+     (-4.0, False, False, ("falls by 4.0", "did not try it", "no stable column there to pick")),
+     (-45.0, False, True, ("falls by 45.0", "which a mode the search adds must have", "--band"))],
+)  # fmt: skip
+def test_a_wanted_mode_is_said_with_why_it_is_not_reported(rise, in_diagram, unsupported, said):
     """A wanted split may lower the criterion (the search never tried it), and may have no column of
-    the diagram a pick could take: the note says which, and what the user can do."""
-    count = replace(_count([50.0, 60.0], -40.0), wanted=(14.5, 191.0, 22, rise, in_diagram))
+    the diagram a pick could take; a wanted addition the diagram has no column for was refused for
+    that alone: the note says which, and what the user can do."""
+    wanted = Wanted(14.5, 191.0, 22, rise, in_diagram, unsupported)
+    count = replace(_count([50.0, 60.0], -40.0), wanted=wanted)
     notes = [n for n in _notes(count, np.array([True, False]), (1.0, 25.0), SAME_ROW) if n.code == "count_undecided"]
     assert len(notes) == 1 and notes[0].value == 14.5, notes
     assert all(s in notes[0].message for s in said), notes[0].message
@@ -852,18 +857,18 @@ def test_the_split_of_lowest_criterion_is_the_one_judged(best_resolved):
     current = SimpleNamespace(n_params=44, freq_hz=np.array([6.0, 15.0]), damping=np.array([0.2, 0.3]),
                               neg2_loglik_on=lambda n: 1000.0)  # fmt: skip
 
-    def split(at, ratio):
+    def split(at, ratio, damping_sd=0.01):  # an sd of 0.2 leaves a damping of 0.25 unresolved
         f = np.sort(np.r_[current.freq_hz, at])
-        return SimpleNamespace(n_params=66, freq_hz=f, damping=np.full(3, 0.25),
+        return SimpleNamespace(n_params=66, freq_hz=f, damping=np.full(3, 0.25), damping_sd=np.full(3, damping_sd),
                                neg2_loglik_on=lambda n: 1000.0 - ratio)  # fmt: skip
 
-    low, high = split(14.0, 200.0), split(5.0, 80.0)  # both beyond the 1e-6 quantile of 22 (68.9)
+    low = split(14.0, 200.0, 0.01 if best_resolved else 0.2)  # beyond the 1e-6 quantile of 22 (68.9)
+    high = split(5.0, 80.0)  # so is this one
     bic = {id(m): m.neg2_loglik_on(n_eff) + m.n_params * np.log(n_eff) for m in (current, low, high)}
     search = SimpleNamespace(
-        n_eff=n_eff, bic=lambda m: bic[id(m)], physical=lambda m: np.ones(m.freq_hz.size, dtype=bool),
+        n_eff=n_eff, bic=lambda m: bic[id(m)], data=SimpleNamespace(band_hz=(1.0, 100.0)),
         screened=lambda starts, labels: [high, low], fit=lambda f, x, nfev, label=None: low if f[1] == 14.0 else high,
-        resolved=lambda m: best_resolved or m is not low, in_both_halves=lambda m, new, halves: True,
-        cfg=CountSettings(),
+        in_both_halves=lambda m, new, halves: True, cfg=CountSettings(),
     )  # fmt: skip
     got, model = _split_wanted(search, current, ("first half", "second half"))
     if best_resolved:
@@ -884,7 +889,7 @@ def test_a_wanted_split_as_good_as_the_chosen_model_is_one_of_the_equally_good(m
     wanted = Wanted(14.0, 200.0, 22, rise, False)
     monkeypatch.setattr(count_search, "_split_wanted", lambda *a, **k: (wanted, split))
     count = count_modes(data, truth.freq_hz, truth.damping, hold="zoh")
-    assert count.wanted == (14.0, 200.0, 22, rise, False)
+    assert count.wanted == wanted
     assert any(m is split for _, m in count.alternatives) == joins
 
 
