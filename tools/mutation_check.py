@@ -637,9 +637,15 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/mode_count.py",
-        'agree[i] &= bool(abs(one[j] - two[k]) <= halves_sd * np.hypot(sd_one[j], sd_two[k]))',
-        'agree[i] &= bool(abs(one[j] - two[k]) <= 1e9 * halves_sd * np.hypot(sd_one[j], sd_two[k]))',
+        "z[i] = max(z[i], abs(one[j] - two[k]) / max(np.hypot(sd_one[j], sd_two[k]), 1e-300))",
+        "z[i] = max(z[i], 1e-9 * abs(one[j] - two[k]) / max(np.hypot(sd_one[j], sd_two[k]), 1e-300))",
         "the halves' agreement ignored (count)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "(unsettled if search.z <= settings.halves_unsettled_sd else unconfirmed)",
+        "(unconfirmed if search.z <= settings.halves_unsettled_sd else unconfirmed)",
+        "an addition the halves nearly confirm refused as a change in time, the verdict good (count)",
     ),
     (
         "armaxmodal/modes/count_search.py",

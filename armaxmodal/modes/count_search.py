@@ -23,8 +23,8 @@ from armaxmodal.modes.mode_count import (
     ModelTable,
     Step,
     Wanted,
-    agree_in_halves,
     effective_fraction,
+    halves_z,
     residual_peak,
     split_start,
 )
@@ -102,13 +102,12 @@ class _Search:
         return supported is None or all(supported(model.freq_hz[i], model.damping[i]) for i in new)
 
     def in_both_halves(self, trial: ModalModel, new: list[int], halves) -> bool:
-        """The new poles of ``trial`` (indices ``new``) have the same frequency and damping in each
-        half of the record (fitted there from the whole record's values), within ``settings.halves_sd``
-        standard deviations of the difference: a pole soaking up a drift or a nonlinearity does not.
-        The answer goes into the trial's row of the table."""
+        """The new poles of ``trial`` (indices ``new``) agree in the record's two halves (:func:`halves_z`
+        within ``settings.halves_sd``; the largest z kept in ``self.z``); the answer goes into its row."""
         self.trials += 2
-        agree = agree_in_halves(self.data, trial, halves, self.hold, self.max_nfev, self.cfg.halves_sd, self.dft)
-        return self.table.halves(trial, all(agree[i] for i in new))
+        z = halves_z(self.data, trial, halves, self.hold, self.max_nfev, self.dft)
+        self.z = max((z[i] for i in new), default=0.0)
+        return self.table.halves(trial, self.z <= self.cfg.halves_sd)
 
     def removals(self, current: ModalModel) -> list[tuple[str, float, ModalModel | None]]:
         keep = [np.arange(current.n_modes) != m for m in range(current.n_modes)]
@@ -340,7 +339,7 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max
     # again as an addition
     lost = [(f, x) for f, x in zip(np.atleast_1d(freq_hz), np.atleast_1d(damping), strict=True)
             if np.min(np.abs(np.log(start_model.freq_hz / f))) > settings.same_mode_freq]  # fmt: skip
-    current, steps, candidates, unconfirmed = start_model, [], list(candidates) + lost, []
+    current, steps, candidates, unconfirmed, unsettled = start_model, [], list(candidates) + lost, [], []
 
     def neighbours():
         """The current model's criterion, its removals, and the best removal and addition (an
@@ -357,8 +356,8 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max
         search.unsupported = min(lacking, key=lambda t: search.bic(t[2]), default=None)
         if best_addition is not None and search.bic(best_addition[2]) < here and len(halves) == 2:
             new = new_poles(current.freq_hz, best_addition[2].freq_hz)
-            if not search.in_both_halves(best_addition[2], new, halves):
-                unconfirmed.append(best_addition[1])
+            if not search.in_both_halves(best_addition[2], new, halves):  # refused, or undecided if near
+                (unsettled if search.z <= settings.halves_unsettled_sd else unconfirmed).append(best_addition[1])
                 best_addition = None
         return here, removed, best_removal, best_addition
 
@@ -396,4 +395,4 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max
         wanted = _unsupported_wanted(search, current, halves)
     return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
                      tuple(unconfirmed), alternatives, carried_away, wanted, stand_ins, settings, lines,
-                     dft, tuple(search.table.rows), data.band_hz)  # fmt: skip
+                     dft, tuple(search.table.rows), data.band_hz, tuple(unsettled))  # fmt: skip

@@ -28,7 +28,7 @@ from armaxmodal.modes.intervals import (
     with_intervals,
 )
 from armaxmodal.modes.modal_check import check_modes
-from armaxmodal.modes.mode_count import ModeCount, agree_in_halves
+from armaxmodal.modes.mode_count import ModeCount, halves_z
 from armaxmodal.modes.notes import count_notes, no_mode_kept_note, pick_notes
 from armaxmodal.modes.poles import mac, matched_poles, nearest_pole
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
@@ -234,7 +234,7 @@ def confirmed_where_incoherent(diagram, work: SelectionState, settings: Selectio
     part = _counted_part(rec, count.settings.max_samples)
     data = DftLines.from_recording(part, work.refinement.band_hz).noise_weighted(m)
     halves = tuple(DftLines.from_recording(half, work.refinement.band_hz) for half in split_segments(part, 2))
-    agree = agree_in_halves(data, m, halves, hold, count.settings.halves_nfev, count.settings.halves_sd, count.dft)
+    agree = halves_z(data, m, halves, hold, count.settings.halves_nfev, count.dft) <= count.settings.halves_sd
     reach, needed = settings.cluster.same_row_freq, count.verdicts() == "needed"
     confirmed, notes = [], []
     for f in check.unconfirmed_hz:

@@ -6,7 +6,7 @@ mode fewer, one more, or one split, and keeps the neighbour of lowest criterion 
 This module holds what it returns, :class:`ModeCount`, with the verdicts derived from it (which
 poles are reported, the other structures' reach), and the tests the search applies: Bartlett's
 effective share of independent lines (:func:`effective_fraction`), the two halves' agreement
-(``agree_in_halves``), the pairing of two pole sets and the residual's peak.
+(``halves_z``), the pairing of two pole sets and the residual's peak.
 
 The criterion is Schwarz's BIC on the effective lines: the method page's "how many modes" gives
 why BIC and not a test at a fixed level, why 10 is decisive, and why the lines are counted by
@@ -27,7 +27,7 @@ from armaxmodal.modes.poles import matched_poles, nearest_pole, reported
 from armaxmodal.modes.settings import DEFAULTS, CountSettings, DftSettings, LineSettings
 from armaxmodal.stats import Z95
 
-__all__ = ["FittedModel", "ModeCount", "ModelTable", "Wanted", "Step", "agree_in_halves", "effective_fraction",
+__all__ = ["FittedModel", "ModeCount", "ModelTable", "Wanted", "Step", "effective_fraction", "halves_z",
            "split_start"]
 
 #: the count's thresholds when none are given (:class:`~armaxmodal.modes.settings.CountSettings`)
@@ -142,6 +142,9 @@ class ModeCount:
         Every model the count fitted, in the order fitted (:meth:`models_table`).
     band_hz : (float, float)
         The band of the lines the count decided on (Hz): which poles are modes of it.
+    unsettled_hz : tuple of float
+        Additions the criterion and the diagram take whose halves differ by more than the halves
+        test allows but at most ``settings.halves_unsettled_sd``: undecided (Hz, the start).
 
     Examples
     --------
@@ -173,6 +176,7 @@ class ModeCount:
     dft: DftSettings = DEFAULTS.dft
     models: tuple[FittedModel, ...] = ()
     band_hz: tuple[float, float] = (0.0, float("inf"))
+    unsettled_hz: tuple[float, ...] = ()
 
     def models_table(self):
         """Every model the count fitted, one row each (``FittedModel``'s columns), in the order
@@ -346,26 +350,25 @@ def effective_fraction(residual: np.ndarray, max_lag: int = COUNT.max_correlatio
     return 1.0 / (1.0 + 2.0 * total)
 
 
-def agree_in_halves(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: int = COUNT.halves_nfev,
-                    halves_sd: float = COUNT.halves_sd, dft: DftSettings = DEFAULTS.dft) -> np.ndarray:  # fmt: skip
-    """Per pole of ``model``: the record's two halves (``halves``, lines weighted as ``data``),
-    each fitted from ``model``'s poles, give the same frequency and damping within
-    ``halves_sd`` standard deviations of the difference (each half's pole the one nearest
-    the model's). Two fits.
+def halves_z(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: int = COUNT.halves_nfev,
+             dft: DftSettings = DEFAULTS.dft) -> np.ndarray:  # fmt: skip
+    """Per pole of ``model``: how far apart the record's two halves (``halves``, lines weighted as
+    ``data``), each fitted from ``model``'s poles, put it, in standard deviations of the difference,
+    the larger of frequency's and damping's (each half's pole the one nearest the model's). Two fits.
 
     Returns
     -------
-    (n_modes,) bool ndarray
+    (n_modes,) ndarray
     """
     a, b = (fit_modal_model(h.weighted(data.weights), model.freq_hz, model.damping, hold, max_nfev, dft)
             for h in halves)  # fmt: skip
-    agree = np.ones(model.n_modes, dtype=bool)
+    z = np.zeros(model.n_modes)
     for i, f in enumerate(model.freq_hz):
         j, k = nearest_pole(a.freq_hz, f), nearest_pole(b.freq_hz, f)
         for one, two, sd_one, sd_two in ((a.freq_hz, b.freq_hz, a.freq_sd, b.freq_sd),
                                          (a.damping, b.damping, a.damping_sd, b.damping_sd)):  # fmt: skip
-            agree[i] &= bool(abs(one[j] - two[k]) <= halves_sd * np.hypot(sd_one[j], sd_two[k]))
-    return agree
+            z[i] = max(z[i], abs(one[j] - two[k]) / max(np.hypot(sd_one[j], sd_two[k]), 1e-300))
+    return z
 
 
 def residual_peak(model: ModalModel, data: DftLines, width_lines: int = COUNT.peak_width_lines) -> tuple[float, float]:

@@ -121,6 +121,15 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
             "damping unresolved, or not the same in both halves of the record); left out", went,
         ))  # fmt: skip
+    for f in count.unsettled_hz:
+        notes.append(QualityWarning(
+            "count_undecided", (),
+            f"one mode more near {f:.3f} Hz lowers the criterion decisively and the diagram holds a stable column "
+            f"there, but the record's halves put it {count.settings.halves_sd:g} to "
+            f"{count.settings.halves_unsettled_sd:g} standard deviations apart: the record does not settle whether it "
+            "is a mode; compare another record of "
+            "the structure, or pick it ('--pick') to see what the record says of it", f,
+        ))  # fmt: skip
     for f in count.unconfirmed_hz:
         notes.append(QualityWarning(
             "mode_count", (),

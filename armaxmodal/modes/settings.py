@@ -251,6 +251,9 @@ class CountSettings:
     #: a new pole's frequency and damping in the record's two halves may differ by this many
     #: standard deviations of their difference (a two-sided 1 % test would take 2.6)
     halves_sd: float = 3.0
+    #: an addition the criterion and the diagram take whose halves differ by more than ``halves_sd``
+    #: but at most this many is undecided, not refused (a weak mode's damping 3.6 apart in its halves)
+    halves_unsettled_sd: float = 5.0
     #: a candidate addition within this relative frequency of a mode is that mode
     same_mode_freq: float = 0.03
     #: the nested tests run on at most this many samples of a record (18 min at 60 Hz, 9 at 120 Hz:
