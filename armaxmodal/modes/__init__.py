@@ -7,7 +7,7 @@
   :mod:`.clusters`, :mod:`.completeness`, the support tests in :mod:`.support`), refitted in the
   frequency domain (:func:`.dft_model.refine_modes`), counted by nested tests of the maximum-likelihood modal
   model (:mod:`.dft_model`, :mod:`.mode_count`, :mod:`.counted`), with intervals widened by
-  the segment spread (:mod:`.spread`) and judged by the modal-model check (:mod:`.modal_check`,
+  the segment spread (:mod:`.intervals`) and judged by the modal-model check (:mod:`.modal_check`,
   on the coherent lines of :mod:`.frf`).
 * :func:`~armaxmodal.identify` -- one model, its modes and the same check.
 """

@@ -205,7 +205,7 @@ def confirm(state: SelectionState, ctx: SelectionContext) -> SelectionState:
 
 def spread(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     """Each mode's spread over disjoint segments of the record widens its intervals where it exceeds
-    them (:func:`armaxmodal.modes.intervals.segment_spread`), from the segment refits the refit stage ran."""
+    them (``segment_spread`` in :mod:`armaxmodal.modes.intervals`), from the segment refits the refit stage ran."""
     if ctx.segments < 2:
         return state
     modes, orders = state.modes, ctx.orders
@@ -323,7 +323,7 @@ def select_modes(
         Refit the selected modes to the recording's DFT (and count them by the modal model).
     segments : int
         Refit each mode's representative orders on this many disjoint segments and widen
-        the intervals where their spread exceeds them (:func:`armaxmodal.modes.intervals.segment_spread`); 0 skips.
+        the intervals where their spread exceeds them (:mod:`armaxmodal.modes.intervals`); 0 skips.
     n_jobs : int, optional
         Worker threads for the finishing and segment fits (default: all cores; 1 inside a
         worker that has one core already, e.g. a study's).

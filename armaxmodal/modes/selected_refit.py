@@ -1,6 +1,6 @@
 """The fits run for the selected modes: the frequency-domain refit
 (:func:`armaxmodal.modes.dft_model.refine_modes`) and the segment refits
-(:func:`armaxmodal.modes.intervals.segment_spread`), run together over the worker threads, and the
+(``segment_spread`` in :mod:`armaxmodal.modes.intervals`), run together over the worker threads, and the
 refit's values applied within their limits.
 """
 
