@@ -53,13 +53,13 @@ MUTANTS = [
         "lower residual dropped (check)",
     ),
     (
-        "armaxmodal/modes/support.py",
+        "armaxmodal/modes/completeness.py",
         'return bool(self.rise >= self.settings.model_error_rise and self.p_value <= self.settings.support_alpha)',
         'return bool(self.rise >= self.settings.model_error_rise or self.p_value <= self.settings.support_alpha)',
         "a mode needed by either criterion (check)",
     ),
     (
-        'armaxmodal/modes/support.py',
+        'armaxmodal/modes/completeness.py',
         '    if reach == "nearest":\n        j = nearest_neighbour(f, x, m, settings.neighbour_bandwidths)\n'
         '    else:\n        j = overlapping_neighbour(f, x, m)\n',
         '    j = None\n',
@@ -72,7 +72,7 @@ MUTANTS = [
         "a mode confirmed by a far line (check)",
     ),
     (
-        "armaxmodal/modes/support.py",
+        "armaxmodal/modes/completeness.py",
         'if abs(np.exp(best.x[0]) - 1) <= settings.neighbour_max_shift:',
         "if True:",
         "a neighbour takes over from anywhere (check)",

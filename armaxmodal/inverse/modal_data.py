@@ -22,7 +22,7 @@ def check_modes(eigenvalues, shapes, n_dof: int | None = None) -> tuple[np.ndarr
     if not (np.all(np.isfinite(lam)) and np.all(np.isfinite(psi))):
         raise StructureError(
             "modal data contain NaN or inf (a missing shape component?); fill gaps first "
-            "(armaxmodal.modes.per_sensor.supplement_shapes) or drop that sensor."
+            "(armaxmodal.modes.result.supplement_shapes) or drop that sensor."
         )
     if np.any(lam.imag <= 1e-9 * np.abs(lam)):
         raise StructureError(

@@ -23,9 +23,9 @@ from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.estimate.result import ArmaxFit
 from armaxmodal.exceptions import PickError
 from armaxmodal.modes.diagram import StabilisationDiagram
+from armaxmodal.modes.frf import peak_support
 from armaxmodal.modes.poles import SHARED, UNRESOLVED_DAMPING, mac, pole_rows
 from armaxmodal.modes.settings import DEFAULTS, ClusterSettings
-from armaxmodal.modes.support import peak_support
 from armaxmodal.recording import Recording
 from armaxmodal.stats import Z95
 
@@ -354,3 +354,21 @@ def picked_modes(diagram, picks: np.ndarray, band, nas, cluster: ClusterSettings
         raise PickError(f"picks {twice} Hz take the same cluster of the diagram; give one of them.")
     order = modes.sort_values("freq_hz").index
     return modes.loc[order].reset_index(drop=True), [vectors[i] for i in order]
+
+
+def stable_in_diagram(diagram, band, cluster: ClusterSettings):
+    """``supported(f, x)``: poles of at least ``cluster.min_orders`` orders of the diagram
+    lie within the clustering's reach of frequency ``f`` (Hz) and damping ``x``. Poles rejected
+    for their residue count: stability across orders is the pole's, and a weakly driven mode (a
+    light chain's 9.32 Hz, rejected as a negligible residue at every order) is still a mode."""
+    poles = diagram.poles[diagram.poles.source == SHARED]
+    if band is not None:
+        poles = poles[(poles.freq_hz >= band[0]) & (poles.freq_hz <= band[1])]
+    kept = poles[poles.damping > 0]
+    f, x, na = kept.freq_hz.to_numpy(), kept.damping.to_numpy(), kept.na.to_numpy()
+
+    def supported(freq_hz: float, damping: float) -> bool:
+        near = (np.abs(f / freq_hz - 1) <= cluster.freq) & (np.abs(x / damping - 1) <= cluster.damping)
+        return len(set(na[near].tolist())) >= cluster.min_orders
+
+    return supported

@@ -1,36 +1,144 @@
 """Which candidates the record needs: the modal-model check (:mod:`armaxmodal.modes.modal_check`)
 drops a mode the measured FRF does not need and adds a left-out cluster that explains a clear
 peak no selected mode explains.
+
+``mode_support`` is the test both use: the check's misfit with and without a mode, a neighbour
+refitted in its place (``ModeSupport``: needed when the rise is large and significant).
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, order_criteria, representative_pole
-from armaxmodal.modes.modal_check import check_modes
+from armaxmodal.modes.frf import coherent_lines
+from armaxmodal.modes.modal_check import ModalCheck, check_modes, poles_of, rss_at
 from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_band, selection_job
-from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
+from armaxmodal.modes.settings import DEFAULTS, FrfSettings, SelectionSettings
 from armaxmodal.modes.state import SelectionState
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
 
+@dataclass(frozen=True)
+class ModeSupport:
+    """How much the check needs one mode: each output's relative misfit with and without it
+    (a neighbour within its half-power band refitted in its place), and the F-test's p."""
+
+    error_with: np.ndarray
+    error_without: np.ndarray
+    p_value: float
+    refitted_neighbour: int | None
+    settings: FrfSettings = DEFAULTS.frf
+
+    @property
+    def rise(self) -> float:
+        """The largest relative rise of an output's misfit without the mode."""
+        ratio = self.error_without / np.maximum(self.error_with, 1e-300)
+        finite = ratio[np.isfinite(ratio)]
+        return float(finite.max() - 1) if finite.size else float("nan")
+
+    @property
+    def needed(self) -> bool:
+        """The rise is at least ``settings.model_error_rise`` and significant at ``settings.support_alpha``."""
+        return bool(self.rise >= self.settings.model_error_rise and self.p_value <= self.settings.support_alpha)
+
+
+def overlapping_neighbour(freq_hz, damping, m: int) -> int | None:
+    """The nearest mode whose half-power band overlaps mode ``m``'s
+    (``|f_i - f_m| < xi_i f_i + xi_m f_m``), or None."""
+    f, x = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)
+    gap = np.abs(f - f[m])
+    close = [i for i in range(f.size) if i != m and gap[i] < x[i] * f[i] + x[m] * f[m]]
+    return min(close, key=lambda i: gap[i]) if close else None
+
+
+def nearest_neighbour(freq_hz, damping, m: int, bandwidths: float = DEFAULTS.frf.neighbour_bandwidths) -> int | None:
+    """The mode nearest mode ``m`` within ``bandwidths`` half-power bandwidths
+    (``2 xi f``, the wider of the two), or None: the mode whose pole may take over what
+    ``m`` fits. A spurious pole beside a lightly damped mode corrects that mode's slightly
+    biased pole at the peak; with the neighbour's pole refitted it is not needed."""
+    f, x = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)
+    gap = np.abs(f - f[m])
+    reach = bandwidths * np.maximum(2 * x * f, 2 * x[m] * f[m])
+    close = [i for i in range(f.size) if i != m and gap[i] <= reach[i]]
+    return min(close, key=lambda i: gap[i]) if close else None
+
+
+def mode_support(
+    recording: Recording, freq_hz, damping, m: int, check: ModalCheck, band=None, *, reach: str = "overlapping",
+    settings: FrfSettings = DEFAULTS.frf,
+) -> ModeSupport:
+    """How much the check of ``check`` needs mode ``m`` (see ``ModeSupport``).
+
+    The fit without the mode keeps each output's delay. A neighbour -- ``reach="overlapping"``:
+    a mode whose half-power band overlaps this one's (:func:`overlapping_neighbour`);
+    ``"nearest"``: the nearest within ``settings.neighbour_bandwidths`` (:func:`nearest_neighbour`),
+    the stricter test a mode the diagram supports weakly must pass to enter -- has its
+    frequency and damping refitted (Nelder-Mead on the summed relative residual, residues
+    projected out) so it may take over: two poles always fit one peak at least as well as
+    one, so only a refitted single pole shows whether the record needs both. A neighbour
+    that moves more than ``settings.neighbour_max_shift`` to take over is not refitted. The F-test
+    compares the summed relative residual sums with ``q = 2 n_outputs`` (the residues)
+    ``+ 2`` (the pole, unless the neighbour's refit spends them) over ``sum(lines) -
+    parameters`` degrees of freedom (one per complex line: the Hann-windowed,
+    half-overlapped lines are correlated in pairs).
+    """
+    from scipy.optimize import minimize
+    from scipy.special import fdtrc  # F survival function without scipy.stats' import
+
+    f, x = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)
+    all_lines = coherent_lines(recording, check.nperseg, band)
+    used = [k for k, lines in enumerate(all_lines) if np.isfinite(check.error[k])]
+    norms = {k: float(np.sum(np.abs(all_lines[k].h) ** 2)) for k in used}
+
+    def relative_rss(poles) -> np.ndarray:
+        return np.array([rss_at(all_lines[k], poles, check.delay_s[k]) / norms[k] for k in used])
+
+    keep = [i for i in range(f.size) if i != m]
+    with_m = relative_rss(poles_of(f, x))
+    if reach == "nearest":
+        j = nearest_neighbour(f, x, m, settings.neighbour_bandwidths)
+    else:
+        j = overlapping_neighbour(f, x, m)
+    fk, xk = f[keep], x[keep]
+    if j is not None:
+        at = keep.index(j)
+
+        def cost(p):
+            fj, xj = fk.copy(), xk.copy()
+            fj[at], xj[at] = f[j] * np.exp(p[0]), min(x[j] * np.exp(p[1]), 0.9)
+            return float(np.sum(relative_rss(poles_of(fj, xj))))
+
+        best = minimize(cost, np.zeros(2), method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-9, "maxiter": 200})
+        if abs(np.exp(best.x[0]) - 1) <= settings.neighbour_max_shift:
+            fk, xk = fk.copy(), xk.copy()
+            fk[at], xk[at] = f[j] * np.exp(best.x[0]), min(x[j] * np.exp(best.x[1]), 0.9)
+        else:  # it took over only by leaving its own place: the two are distinct modes
+            j = None
+    without = relative_rss(poles_of(fk, xk))
+    n_obs = sum(all_lines[k].freq_hz.size for k in used)
+    q = 2 * len(used) + (0 if j is not None else 2)
+    dof = n_obs - len(used) * (2 * f.size + 5) - 2 * f.size
+    s1, s0 = float(with_m.sum()), float(without.sum())
+    stat = ((s0 - s1) / q) / (s1 / dof) if dof > 0 and s1 > 0 else float("nan")
+    p = float(fdtrc(q, dof, stat)) if np.isfinite(stat) and stat > 0 else 1.0
+    return ModeSupport(np.sqrt(with_m), np.sqrt(without), p, j, settings)
+
+
 def modes_the_record_needs(recording: Recording, work: SelectionState, band, settings: SelectionSettings = DEFAULTS,
                            doubts: list | None = None) -> SelectionState:  # fmt: skip
     """Selection by the data: drop, one at a time and least supported first, every mode the
-    modal-model check does not need (:func:`armaxmodal.modes.support.mode_support`: leaving it
+    modal-model check does not need (``mode_support``: leaving it
     out, a neighbour inside its half-power band refitted in its place, raises no output's
     misfit by ``settings.frf.model_error_rise`` significantly). A dropped half
     of a split peak is a ``split_merged`` note, any other a ``mode_not_needed`` note. With
     ``doubts`` (a list), each dropped mode goes there as ``(Hz, ratio, note)`` instead of its note
     into the selection: the count tries it again and the note stands only if it stays out.
     Returns the selection of the modes kept, with their check."""
-    from armaxmodal.modes.support import mode_support
-
     frf = settings.frf
     while True:
         modes = work.modes
@@ -108,8 +216,6 @@ def modes_the_check_adds(diagram, work: SelectionState, band, nas, settings: Sel
     no clear peak, and their poles scatter over the orders; these need a damping the record
     resolves, as a peak's cluster does not). A peak left unexplained is listed at the end as
     before. Returns the selection with those added, by frequency, and its check."""
-    from armaxmodal.modes.support import mode_support
-
     bic, frf = order_criteria(diagram), settings.frf
     modes, shapes, check = work.modes, work.shapes, work.check
     for sub, at_peak in _left_out_clusters(diagram, modes, band, nas, settings):

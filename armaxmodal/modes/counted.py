@@ -16,7 +16,7 @@ from dataclasses import replace
 import numpy as np
 import pandas as pd
 
-from armaxmodal.modes.clusters import candidate_poles, cluster_poles
+from armaxmodal.modes.clusters import candidate_poles, cluster_poles, stable_in_diagram
 from armaxmodal.modes.count_search import count_modes
 from armaxmodal.modes.dft_model import DftLines, fit_modal_model
 from armaxmodal.modes.intervals import (
@@ -33,7 +33,6 @@ from armaxmodal.modes.notes import count_notes, no_mode_kept_note, pick_notes
 from armaxmodal.modes.poles import mac, matched_poles, nearest_pole
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
 from armaxmodal.modes.state import SelectionState
-from armaxmodal.modes.support import stable_in_diagram
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.stats import MAX_DAMPING, Z95
 

@@ -21,7 +21,7 @@ from armaxmodal.spectra import coherence, excited_band, h1_relative_error
 from armaxmodal.stats import H1_COHERENCE
 
 __all__ = ["CHECK_RESOLUTION", "CoherentLines", "PEAK_RESOLUTION", "Resolution", "coherent_lines", "coherent_peaks",
-           "explains", "measured_h1", "resolving_nperseg", "unexplained_peaks"]  # fmt: skip
+           "explains", "measured_h1", "peak_support", "resolving_nperseg", "unexplained_peaks"]  # fmt: skip
 
 
 
@@ -199,3 +199,13 @@ def _merged(peaks, df) -> list[QualityWarning]:
             "(run 'armaxmodal diagnose')", f0,
         ))  # fmt: skip
     return warnings
+
+
+def peak_support(recording: Recording, freq_hz: float, damping: float, band=None) -> float | None:
+    """Frequency of the clear, coherent FRF peak (:func:`coherent_peaks`) that a mode at
+    ``freq_hz`` explains, or None: the data's own evidence for a mode whose poles alone are
+    not conclusive (a lightly damped pole whose damping estimate crosses zero)."""
+    n = resolving_nperseg(recording, [freq_hz], [max(damping, 1e-6)])
+    df = recording.fs / n
+    near = [p for p in coherent_peaks(recording, n, band) if explains(p[0], df, [freq_hz], [max(damping, 0.0)])]
+    return max(near, key=lambda p: p[2])[0] if near else None

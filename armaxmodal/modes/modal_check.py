@@ -21,7 +21,7 @@ lines, reported beside the H1's own random error in the same norm (Bendat & Pier
 does not account for, ``sqrt(max(e^2 - e_random^2, 0))``, is the *model error*; the modes
 explain the record when it is at most ``FrfSettings.model_error_limit`` on every output.
 
-``armaxmodal.modes.support.mode_support`` gives the evidence :func:`armaxmodal.select_modes`
+``mode_support`` in :mod:`armaxmodal.modes.completeness` gives the evidence :func:`armaxmodal.select_modes`
 keeps a mode by: how much this check worsens without it (with a neighbour inside its half-power
 band refitted in its place, so that one half of a split peak is not needed when the other
 can take the whole peak).

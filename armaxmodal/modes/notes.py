@@ -1,7 +1,8 @@
 """The notes of the selection written from what the stages found: the count's
 (:mod:`armaxmodal.modes.mode_count`) -- what the search did, where the record does not decide the
-number of modes, what the picks are worth, which poles stay in the model unreported -- and the
-record's being sampled far above its modes. No decision is taken here: each note reads a result
+number of modes, what the picks are worth, which poles stay in the model unreported -- the
+record's being sampled far above its modes, and the final modes' (two the record does not separate, a
+damping it does not resolve). No decision is taken here: each note reads a result
 (the count's steps, margins, equally good models, stand-ins) and the levels it carries.
 """
 
@@ -10,13 +11,15 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from armaxmodal.modes.intervals import not_separated, with_intervals
 from armaxmodal.modes.mode_count import ModeCount, reported
 from armaxmodal.modes.settings import DEFAULTS, NoteSettings
 from armaxmodal.prepare.resample import BAND_FRACTION_OF_FS
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.stats import MAX_DAMPING
 
-__all__ = ["count_notes", "no_mode_kept_note", "oversampling_note", "pick_notes"]
+__all__ = ["count_notes", "no_mode_kept_note", "not_separated_notes", "oversampling_note", "pick_notes",
+           "unresolved_damping_notes"]
 
 
 def no_mode_kept_note(count: ModeCount, modes: pd.DataFrame, band_hz) -> QualityWarning:
@@ -220,3 +223,44 @@ def oversampling_note(mode_freqs: np.ndarray, fs: float, settings: NoteSettings 
             share,
         )
     ]
+
+
+def not_separated_notes(modes: pd.DataFrame, separation_sd: float) -> list[QualityWarning]:
+    """A ``modes_not_separated`` note for each pair of neighbouring modes whose frequencies
+    differ by less than ``separation_sd`` standard deviations of the difference and that the
+    count did not report as one (picks, or modes the count left)."""
+    f = modes.freq_hz.to_numpy()
+    return [QualityWarning(
+        "modes_not_separated", (),
+        f"modes at {f[i]:.3f} and {f[j]:.3f} Hz are {gap:.1f} standard deviations of their difference apart (under "
+        f"{separation_sd:g}): the record does not separate them; they may be one mode", float(f[i]),
+    ) for i, j, gap in not_separated(with_intervals(modes), separation_sd)]  # fmt: skip
+
+
+def unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[QualityWarning]:
+    """A ``damping_unresolved`` note for every mode whose damping interval spans a factor e^2 or
+    more, or reaches critical damping, or whose damping estimate is not positive at some orders of
+    the sweep, with the reason. Taken on the logarithm, a damping interval never reaches zero; a
+    factor e either side of the value is where the symmetric interval of the same deviation would."""
+    notes = []
+    for m in modes.itertuples(index=False):
+        crossed = int(m.orders_damping_unresolved)
+        if crossed == 0 and m.damping_ci95_hi < min(1.0, np.e**2 * m.damping_ci95_lo):
+            continue
+        facts = [f"damping {m.damping:.2g}, 95 % interval [{m.damping_ci95_lo:.2g}, {m.damping_ci95_hi:.2g}]"]
+        if crossed:
+            facts.append(f"its estimate is not positive at {crossed} of {n_orders} orders")
+        if getattr(m, "model_error_dominates", False):
+            why = ("the interval is the spread of the record's thirds (model_error_dominates): the thirds disagree "
+                   "about this damping; run 'armaxmodal diagnose'")  # fmt: skip
+        elif getattr(m, "structure_widened", False) or getattr(m, "estimator_widened", False):
+            why = ("the interval covers the other models the record finds as good (another number of modes, two poles "
+                   "reported as one) or the other estimator's value, which disagree about this damping")  # fmt: skip
+        else:
+            why = "the damping is below what this record resolves: a longer record, or more excitation here, narrows it"
+        notes.append(QualityWarning(
+            "damping_unresolved", (),
+            f"mode at {m.freq_hz:.3f} Hz ([{m.freq_ci95_lo:.4g}, {m.freq_ci95_hi:.4g}] Hz): {'; '.join(facts)}. {why}",
+            float(m.freq_hz),
+        ))  # fmt: skip
+    return notes

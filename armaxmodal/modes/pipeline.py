@@ -32,15 +32,8 @@ from armaxmodal.modes.counted import confirmed_where_incoherent, counted_modes, 
 from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.intervals import N_SEGMENTS, apply_segment_spread, segment_spread, with_intervals
 from armaxmodal.modes.modal_check import check_modes
-from armaxmodal.modes.notes import oversampling_note
-from armaxmodal.modes.per_sensor import per_sensor_table
-from armaxmodal.modes.result import (
-    ModeSelection,
-    filled_samples_scale,
-    no_mode_selection,
-    not_separated_notes,
-    unresolved_damping_notes,
-)
+from armaxmodal.modes.notes import not_separated_notes, oversampling_note, unresolved_damping_notes
+from armaxmodal.modes.result import ModeSelection, filled_samples_scale, no_mode_selection, per_sensor_table
 from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_and_segment_fits
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
 from armaxmodal.modes.state import SelectionContext, SelectionState

@@ -49,8 +49,8 @@ def test_a_missing_lightly_damped_mode_is_named_at_its_frequency(light):
 
 
 def test_mode_support_merges_a_fake_split_and_keeps_real_close_modes(light, fixtures_dir):
+    from armaxmodal.modes.completeness import mode_support, overlapping_neighbour
     from armaxmodal.modes.modal_check import check_modes
-    from armaxmodal.modes.support import mode_support, overlapping_neighbour
 
     def support(rec, f, x, m):
         return mode_support(rec, f, x, m, check_modes(rec, f, x))

@@ -172,9 +172,9 @@ def test_a_refit_may_move_a_mode_halfway_to_its_neighbour_within_twice_the_clust
 
 
 def test_a_mode_is_confirmed_by_a_coherent_line_within_its_half_width_and_four_lines():
+    from armaxmodal.modes.completeness import ModeSupport
     from armaxmodal.modes.frf import CoherentLines
     from armaxmodal.modes.modal_check import confirmed_modes
-    from armaxmodal.modes.support import ModeSupport
 
     f = np.arange(1.0, 2.0001, 0.1)  # coherent lines 1.0-2.0 Hz, 0.1 Hz apart
     lines = [CoherentLines(f, np.ones(f.size, complex), np.full(f.size, 0.01))]

@@ -15,8 +15,9 @@ from armaxmodal.modes.dft_model import DftLines, fit_modal_model
 from armaxmodal.modes.intervals import not_separated, with_intervals
 from armaxmodal.modes.mode_count import ModeCount, Wanted, effective_fraction
 from armaxmodal.modes.notes import count_notes as _notes
+from armaxmodal.modes.notes import not_separated_notes
 from armaxmodal.modes.poles import reported
-from armaxmodal.modes.result import ModeSelection, not_separated_notes
+from armaxmodal.modes.result import ModeSelection
 from armaxmodal.modes.settings import ClusterSettings, CountSettings, SelectionSettings
 from armaxmodal.stats import Z95
 

@@ -6,8 +6,8 @@ import pytest
 import armaxmodal as am
 from armaxmodal.exceptions import DataError
 from armaxmodal.modes.diagram import stabilisation_diagram
-from armaxmodal.modes.per_sensor import supplement_shapes
 from armaxmodal.modes.pipeline import select_modes
+from armaxmodal.modes.result import supplement_shapes
 from armaxmodal.study.tables import summarise_subjects
 from armaxmodal.systems import datasets
 

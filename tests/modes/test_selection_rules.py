@@ -319,7 +319,7 @@ def _notes_modes(**overrides):
 
 
 def test_unresolved_damping_notes_state_the_facts_and_the_reason():
-    from armaxmodal.modes.result import unresolved_damping_notes as _unresolved_damping_notes
+    from armaxmodal.modes.notes import unresolved_damping_notes as _unresolved_damping_notes
 
     assert _unresolved_damping_notes(_notes_modes(), 10) == []  # a resolved damping (a factor 7): no note
     # a factor e^2 (7.39), where a symmetric interval of the same deviation reaches zero, or critical damping
@@ -352,7 +352,7 @@ def test_per_sensor_table_and_its_weighted_averages():
     the mode at fewer than half the orders from the mode's own up), and the |M|-weighted means."""
     from types import SimpleNamespace
 
-    from armaxmodal.modes.per_sensor import per_sensor_table
+    from armaxmodal.modes.result import per_sensor_table
 
     def replace(ns, **kw):
         return SimpleNamespace(**{**vars(ns), **kw})
