@@ -31,7 +31,7 @@ from scipy import signal
 
 import armaxmodal as am
 from armaxmodal.modes.dft_model import DftLines, fit_modal_model
-from armaxmodal.modes.selected_refit import refit_band
+from armaxmodal.modes.state import refit_band
 
 FREQ_TOL, DAMPING_TOL, BOUNDS = 0.02, 0.10, 3.0
 #: exact modes above this fraction of the ride's band may be missed

@@ -16,9 +16,8 @@ import pandas as pd
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, order_criteria, representative_pole
 from armaxmodal.modes.frf import coherent_lines
 from armaxmodal.modes.modal_check import ModalCheck, check_modes, poles_of, rss_at
-from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_band, selection_job
 from armaxmodal.modes.settings import DEFAULTS, FrfSettings, SelectionSettings
-from armaxmodal.modes.state import SelectionState
+from armaxmodal.modes.state import RefitFailure, SelectionState, refined_modes, refit_band, selection_job
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 

@@ -34,9 +34,8 @@ from armaxmodal.modes.intervals import N_SEGMENTS, apply_segment_spread, segment
 from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.notes import not_separated_notes, oversampling_note, unresolved_damping_notes
 from armaxmodal.modes.result import ModeSelection, filled_samples_scale, no_mode_selection, per_sensor_table
-from armaxmodal.modes.selected_refit import RefitFailure, refined_modes, refit_and_segment_fits
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
-from armaxmodal.modes.state import SelectionContext, SelectionState
+from armaxmodal.modes.state import RefitFailure, SelectionContext, SelectionState, refined_modes, refit_and_segment_fits
 
 __all__ = ["AUTOMATIC", "FIXED_COUNT", "PICKED", "Stage", "select_modes", "stages_for"]
 

@@ -160,7 +160,7 @@ def test_the_five_segment_chain_with_feet_gives_its_five_modes():
 
 
 def test_a_refit_may_move_a_mode_halfway_to_its_neighbour_within_twice_the_cluster_rule():
-    from armaxmodal.modes.selected_refit import _refit_reach
+    from armaxmodal.modes.state import _refit_reach
 
     far = np.array([8.27, 12.49, 16.08])
     assert _refit_reach(far, 1, 0.05) == pytest.approx(0.10)  # half the gap is 14 %: capped at 10 %

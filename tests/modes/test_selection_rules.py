@@ -16,9 +16,8 @@ from armaxmodal.modes.clusters import _supported, cluster_poles, merge_duplicate
 from armaxmodal.modes.diagram import SAMPLES_PER_PARAMETER, _check_top_order, _nk_edge_warning
 from armaxmodal.modes.intervals import with_intervals
 from armaxmodal.modes.poles import Tolerances, stability_classes
-from armaxmodal.modes.selected_refit import _apply_refinement
 from armaxmodal.modes.settings import ClusterSettings
-from armaxmodal.modes.state import SelectionState
+from armaxmodal.modes.state import SelectionState, _apply_refinement
 from armaxmodal.stats import Z95
 
 SHAPE = np.array([1.0 + 0.2j, 0.5 - 0.1j, -0.3 + 0.05j])
@@ -424,7 +423,7 @@ def test_finished_pole_takes_the_nearest_finished_estimate_within_five_percent()
 def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_data(monkeypatch):
     from types import SimpleNamespace
 
-    import armaxmodal.modes.selected_refit as st
+    import armaxmodal.modes.state as st
     from armaxmodal.spectra import excited_band
 
     rec = _recording(2000)

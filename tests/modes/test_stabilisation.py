@@ -426,7 +426,7 @@ def test_the_bridge_gives_the_same_modes_in_any_unit(realdata_dir):
 def test_a_refit_that_cannot_be_made_is_said_not_taken_for_refine_false(monkeypatch, fixtures_dir):
     """A failed frequency-domain refit leaves the ARMAX values and a ``refit_failed`` note in
     the result (and so in the JSON); refine=False leaves no such note."""
-    import armaxmodal.modes.selected_refit as selected_refit
+    import armaxmodal.modes.state as selected_refit
 
     rec = am.read_recording(fixtures_dir / "supine_random.csv")
     diagram = stabilisation_diagram(rec, range(4, 13, 2), per_sensor=False, n_jobs=1)
