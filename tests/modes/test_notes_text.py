@@ -1,0 +1,177 @@
+"""The notes' texts, word for word, built from counts whose every field is known: a note is what a
+user reads, so a number in the wrong place (the band's upper edge twice, a fall printed as a rise)
+or a branch's words lost is a wrong result. Each expected text was read against the count it
+describes when it was written (2026-11-29)."""
+
+from dataclasses import replace
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from armaxmodal.modes import notes
+from armaxmodal.modes.intervals import with_intervals
+from armaxmodal.modes.mode_count import ModeCount, Step, Wanted
+
+BAND = (1.0, 25.0)
+SAME_ROW = 0.05
+
+
+def _model(freq, damping, sd=0.01):
+    f, x = np.array(freq, float), np.array(damping, float)
+    return SimpleNamespace(freq_hz=f, damping=x, freq_sd=sd * f, damping_sd=sd * x, n_modes=f.size)
+
+
+#: two reported modes (5 Hz needs only 4.5 to leave: undecided; 12 Hz needed) and a pole above the band
+MODEL = _model((5.0, 12.0, 30.0), (0.2, 0.1, 0.9))
+KEEP = np.array([True, True, False])
+
+
+def _count(**changes) -> ModeCount:
+    """A count holding one of everything a note is written from."""
+    count = ModeCount(
+        MODEL, MODEL, (Step("add", 12.5, 44.25, 13.5), Step("remove", 17.0, 12.5, float("nan"))),
+        np.array([4.5, 80.0, 60.0]), -3.25, 21.5, 1.0, unconfirmed_hz=(14.25,),
+        alternatives=((4.5, _model((5.02, 12.1), (0.21, 0.11))),), carried_away=((8.0, 9.5),),
+        wanted=Wanted(23.5, 61.2, 12, 7.5, True, False), stand_ins=((26.0, 26.9, 15.2), (19.0, 19.8, 11.0)),
+        unsettled_hz=(18.75,),
+    )  # fmt: skip
+    return replace(count, **changes)
+
+
+def _said(found) -> list[tuple]:
+    return [(n.code, n.value, n.message) for n in found]
+
+
+def test_every_count_note_says_its_numbers_in_their_places():
+    """Steps (one whose new pole moved), an undecided removal and addition, a wanted mode, a start
+    carried away, an unsettled and an unconfirmed addition, intervals widened by an equally good
+    model, stand-ins beyond and inside the band, and a pole outside it."""
+    assert _said(notes.count_notes(_count(), KEEP, BAND, SAME_ROW)) == [
+        ('mode_count', 12.5,
+            'the maximum-likelihood modal model with every pole free: the mode at 12.500 Hz added '
+            '(its new pole settled at 13.500 Hz), the information criterion (BIC) falls by 44.2'),
+        ('mode_count', 17.0,
+            'the maximum-likelihood modal model with every pole free: the mode at 17.000 Hz left '
+            'out, the information criterion (BIC) falls by 12.5'),
+        ('count_undecided', 4.5,
+            'the record does not decide the number of modes: with one mode fewer (the rest refitted '
+            "free) the criterion rises by only 4.5 (under 10, Kass & Raftery's 'very strong'); treat "
+            'the weakest mode as tentative'),
+        ('count_undecided', 21.5,
+            'the record does not rule out one mode more (near 21.500 Hz): adding it changes the '
+            'criterion by +3.2, less than 10 either way'),
+        ('count_undecided', 23.5,
+            'the record may hold one mode more near 23.500 Hz: adding it raises the likelihood far '
+            'beyond chance (likelihood ratio 61.2 for its 12 parameters, p < 1e-06) and the mode is '
+            'the same in both halves of the record, but the criterion (BIC) rises by 7.5, so it is '
+            'not reported; pick it (--pick) to see what the record says of it'),
+        ('mode_count', 9.5,
+            'the free fit carried the starting mode at 8.000 Hz to 9.500 Hz, where it is no mode '
+            '(its damping unresolved, or not the same in both halves of the record); left out'),
+        ('count_undecided', 18.75,
+            'one mode more near 18.750 Hz lowers the criterion decisively and the diagram holds a '
+            "stable column there, but the record's halves put it 3 to 5 standard deviations apart: "
+            'the record does not settle whether it is a mode; compare another record of the '
+            "structure, or pick it ('--pick') to see what the record says of it"),
+        ('mode_count', 14.25,
+            'one mode more near 14.250 Hz fits the whole record better but not each of its halves: a '
+            'change during the record (a drifting frequency, a transient, a nonlinearity), not a '
+            'mode; left out'),
+        ('mode_count', 2.0,
+            'the 95 % intervals of the mode(s) at 5.000, 12.000 Hz also cover their values in the '
+            'models the record cannot tell from the chosen one (2 modes (+4.5) in the criterion): '
+            'the number of modes is part of their uncertainty'),
+        ('mode_count', 26.9,
+            'the free fit carried the starting mode at 26.000 Hz to 26.900 Hz, where it is no mode '
+            '(its damping unresolved, or not the same in both halves of the record), but the model '
+            'needs it (without it the criterion rises by 15.2): it stays in the model, as a pole for '
+            'what the record does not resolve there, and is not reported'),
+        ('count_undecided', 19.8,
+            'the free fit carried the starting mode at 19.000 Hz to 19.800 Hz, where it is no mode '
+            '(its damping unresolved, or not the same in both halves of the record), but the model '
+            'needs it (without it the criterion rises by 11.0): it stays in the model, as a pole for '
+            'what the record does not resolve there, and is not reported; whether a mode is there, '
+            'the record does not decide: compare another record of the structure, or pick it '
+            "('--pick') to see what the record says of it"),
+        ('mode_count', 1.0,
+            '1 pole(s) of the modal model lie outside the band 1-25 Hz, are damped beyond 0.6 or are '
+            "lines (damping at the fit's floor): 30 Hz (damping 0.90). They stand for what lies "
+            'beyond the band or for a periodic disturbance, and are not reported as modes'),
+    ]
+
+
+@pytest.mark.parametrize("unsupported", [False, True])
+def test_a_wanted_mode_says_why_it_is_not_reported_and_what_to_do(unsupported):
+    """A split the search did not try (no column to pick), and an addition refused for want of a
+    diagram column (a narrower band advised)."""
+    count = _count(steps=(), removal_rise=np.array([40.0, 80.0, 60.0]), best_addition=-30.0, unconfirmed_hz=(),
+                   alternatives=(), carried_away=(), stand_ins=(), unsettled_hz=(),
+                   wanted=Wanted(23.5, 61.2, 12, -7.5, False, unsupported))  # fmt: skip
+    said = [s for s in _said(notes.count_notes(count, KEEP, BAND, SAME_ROW)) if s[1] == 23.5]
+    assert said == [[
+        ('count_undecided', 23.5,
+            'the record may hold one mode more near 23.500 Hz: adding it raises the likelihood far '
+            'beyond chance (likelihood ratio 61.2 for its 12 parameters, p < 1e-06) and the mode is '
+            'the same in both halves of the record, but the search, which splits only the mode '
+            "nearest the residual's peak, did not try it (with it the criterion falls by 7.5), so it "
+            'is not reported; the diagram holds no stable column there to pick (its ARMAX fits merge '
+            'it with a neighbour); a longer record would decide'),
+        ('count_undecided', 23.5,
+            'the record may hold one mode more near 23.500 Hz: adding it raises the likelihood far '
+            'beyond chance (likelihood ratio 61.2 for its 12 parameters, p < 1e-06) and the mode is '
+            'the same in both halves of the record, but the diagram holds no stable column there, '
+            'which a mode the search adds must have (with it the criterion falls by 7.5), so it is '
+            'not reported; fit a narrower band that holds it (--band), so the record is fitted at a '
+            'lower rate, or use higher orders, and look for its column; the modes reported may be '
+            'too few'),
+    ][unsupported]]
+
+
+def test_pick_notes_say_which_pick_the_record_does_not_support_and_what_it_holds_more():
+    assert _said(notes.pick_notes(_count(), KEEP)) == [
+        ('pick_not_supported', 5.0,
+            'the record does not support the mode picked at 5.000 Hz: without it (the other modes '
+            'refitted free) the information criterion changes by +4.5, less than the 10 a needed '
+            'mode raises it; treat it as tentative, or pick another column of the diagram'),
+    ]
+    assert _said(notes.pick_notes(_count(best_addition=12.5), np.array([False, True, False]))) == [
+        ('mode_count', 21.5,
+            'the record holds one mode more than the modal model behind the picks, near 21.500 Hz: '
+            'adding it lowers the information criterion by 12.5'),
+    ]
+
+
+def test_a_model_that_keeps_no_mode_lists_its_poles_and_the_band():
+    said = notes.no_mode_kept_note(_count(), pd.DataFrame({"freq_hz": [5.0, 9.0]}), BAND)
+    assert _said([said]) == [
+        ('count_undecided', 2.0,
+            'the maximum-likelihood modal model keeps no mode in 1-25 Hz (its poles: 5 Hz (damping '
+            "0.20), 12 Hz (damping 0.10), 30 Hz (damping 0.90)); the 2 mode(s) of the diagram's "
+            'selection are reported, unconfirmed by it'),
+    ]
+
+
+def test_an_oversampled_record_is_told_the_band_and_rate_to_rerun_at():
+    (said,) = _said(notes.oversampling_note(np.array([2.0, 6.3]), 1000.0))
+    assert said[1] == pytest.approx(6.3 / 500)
+    assert said[::2] == [
+        ('oversampled', 0.0126,
+            'every mode found lies below 1.3 % of the Nyquist frequency (the highest at 6.3 Hz of '
+            '500 Hz): the input excites far above the structure, so the rate was kept, and at this '
+            'rate the poles crowd z = 1 where ARMAX models resolve them poorly; modes may be missed '
+            'or biased. Rerun with band=(0, 16) (CLI: --band 0:16), which resamples to 40 Hz.'),
+    ][0][::2]
+    assert notes.oversampling_note(np.array([2.0, 6.3]), 100.0) == []  # the modes reach 13 % of Nyquist
+    assert notes.oversampling_note(np.array([]), 1000.0) == []
+
+
+def test_modes_the_record_does_not_separate_are_named_with_their_distance():
+    modes = with_intervals(pd.DataFrame({"freq_hz": [10.0, 10.5, 20.0], "freq_sd": [0.2, 0.2, 0.2], "damping": 0.05,
+                                         "damping_sd": 0.001}))  # fmt: skip
+    assert _said(notes.not_separated_notes(modes, 3.0)) == [
+        ('modes_not_separated', 10.0,
+            'modes at 10.000 and 10.500 Hz are 1.8 standard deviations of their difference apart '
+            '(under 3): the record does not separate them; they may be one mode'),
+    ]
