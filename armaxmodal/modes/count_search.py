@@ -40,34 +40,33 @@ class _Search:
 
     def __init__(self, data: DftLines, hold: str, n_effective: float, max_nfev: int, n_jobs: int | None = 1,
                  settings: CountSettings = COUNT, lines: LineSettings = DEFAULTS.lines,
-                 dft: DftSettings = DEFAULTS.dft):  # fmt: skip
+                 dft: DftSettings = DEFAULTS.dft, fitter: Callable = fit_modal_model):  # fmt: skip
         self.data, self.hold, self.n_eff, self.max_nfev, self.n_jobs = data, hold, n_effective, max_nfev, n_jobs
         self.cfg, self.lines, self.dft, self.trials, self.table = settings, lines, dft, 0, ModelTable(n_effective)
+        self.fitter = fitter
         self.logged, self.unsupported = self.table.add, None
 
     def screened(self, starts: list[tuple[np.ndarray, np.ndarray]], labels: list[tuple[str, float]]
                  ) -> list[ModalModel | None]:  # fmt: skip
-        """Each start ``(freq_hz, damping)`` fitted for ``settings.screen_nfev`` steps, over the worker
-        threads (numpy releases the interpreter in their large array work); ``labels``: each
-        start's ``(action, Hz)`` for the table."""
+        """Each start ``(freq_hz, damping)`` fitted for ``settings.screen_nfev`` steps, over the worker threads
+        (numpy releases the interpreter in their array work); ``labels``: each start's ``(action, Hz)``."""
         self.trials += sum(len(f) > 0 for f, _ in starts)
 
         def one(start):
             f, x = start
-            return fit_modal_model(self.data, f, x, self.hold, self.cfg.screen_nfev, self.dft) if len(f) else None
+            return self.fitter(self.data, f, x, self.hold, self.cfg.screen_nfev, self.dft) if len(f) else None
 
         fits = parallel_map(one, starts, self.n_jobs, min_items=2)
         return [self.logged(action, f, fit) for (action, f), fit in zip(labels, fits, strict=True)]
 
     def fit(self, freq_hz, damping, max_nfev: int | None = None, counted: bool = True,
             label: tuple[str, float] | None = ("converge", float("nan"))) -> ModalModel | None:  # fmt: skip
-        """One fit to convergence (or ``max_nfev``); ``counted=False`` where the caller counts it;
-        ``label``: its ``(action, Hz)`` in the table (None: the caller logs it, as fits run in
-        threads do, in their order)."""
+        """One fit to convergence (or ``max_nfev``); ``counted=False`` where the caller counts it; ``label``:
+        its ``(action, Hz)`` in the table (None: the caller logs it, as fits run in threads do, in their order)."""
         if len(freq_hz) == 0:
             return None
         self.trials += int(counted)
-        model = fit_modal_model(self.data, freq_hz, damping, self.hold, max_nfev or self.max_nfev, self.dft)
+        model = self.fitter(self.data, freq_hz, damping, self.hold, max_nfev or self.max_nfev, self.dft)
         return model if label is None else self.logged(*label, model)
 
     def bic(self, model: ModalModel | None) -> float:
@@ -105,7 +104,7 @@ class _Search:
         """The new poles of ``trial`` (indices ``new``) agree in the record's two halves (:func:`halves_z`
         within ``settings.halves_sd``; the largest z kept in ``self.z``); the answer goes into its row."""
         self.trials += 2
-        z = halves_z(self.data, trial, halves, self.hold, self.max_nfev, self.dft)
+        z = halves_z(self.data, trial, halves, self.hold, self.max_nfev, self.dft, self.fitter)
         self.z = max((z[i] for i in new), default=0.0)
         return self.table.halves(trial, self.z <= self.cfg.halves_sd)
 
@@ -270,6 +269,7 @@ def count_modes(
     settings: CountSettings = COUNT,
     lines: LineSettings = DEFAULTS.lines,
     dft: DftSettings = DEFAULTS.dft,
+    fitter: Callable = fit_modal_model,
 ) -> ModeCount:
     """Choose the number of modes by nested tests of free refits (see the module notes).
 
@@ -300,6 +300,8 @@ def count_modes(
         The count's thresholds (:mod:`armaxmodal.modes.settings`).
     lines, dft : LineSettings, DftSettings
         Which poles are lines, not modes; the modal model's fits.
+    fitter : callable
+        The fit, as :func:`~armaxmodal.modes.dft_model.fit_modal_model` (a test's stands in for it).
 
     Returns
     -------
@@ -319,21 +321,21 @@ def count_modes(
     (['add'], [5.8, 8.3, 13.6, 16.2])
     """
     return _count_modes(data, freq_hz, damping, candidates, hold=hold, max_nfev=max_nfev, halves=halves,
-                        supported=supported, search=search, n_jobs=n_jobs, settings=settings, lines=lines, dft=dft)
+                        supported=supported, search=search, n_jobs=n_jobs, settings=settings, lines=lines, dft=dft,
+                        fitter=fitter)  # fmt: skip
 
 
-def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold: str, max_nfev: int, halves: tuple,
-                 supported: Callable[[float, float], bool] | None, search: bool, n_jobs: int | None,
-                 settings: CountSettings, lines: LineSettings, dft: DftSettings) -> ModeCount:  # fmt: skip
-    """:func:`count_modes` itself, under the caller's BLAS threads (the public function holds one)."""
-    start_model = fit_modal_model(data, freq_hz, damping, hold, max_nfev, dft)
+def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev, halves, supported, search, n_jobs,
+                 settings: CountSettings, lines, dft, fitter) -> ModeCount:  # fmt: skip
+    """:func:`count_modes` itself (its parameters), under the caller's BLAS threads (the public one holds one)."""
+    start_model = fitter(data, freq_hz, damping, hold, max_nfev, dft)
     # each sensor weighted by its noise level as the fitted start leaves it (the likelihood is
     # concentrated over those levels; the weights only steer the fits)
     data = data.noise_weighted(start_model)
-    start_model = fit_modal_model(data, start_model.freq_hz, start_model.damping, hold, max_nfev, dft)
+    start_model = fitter(data, start_model.freq_hz, start_model.damping, hold, max_nfev, dft)
     fraction = effective_fraction(start_model.residual)
     searching, search = search, _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev, n_jobs,
-                                        settings, lines, dft)  # fmt: skip
+                                        settings, lines, dft, fitter)  # fmt: skip
     search.logged("start", float("nan"), start_model)
     # a starting mode the free fit carried away (a weak mode's pole to beyond the band) is tried
     # again as an addition

@@ -351,16 +351,17 @@ def effective_fraction(residual: np.ndarray, max_lag: int = COUNT.max_correlatio
 
 
 def halves_z(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: int = COUNT.halves_nfev,
-             dft: DftSettings = DEFAULTS.dft) -> np.ndarray:  # fmt: skip
+             dft: DftSettings = DEFAULTS.dft, fitter=fit_modal_model) -> np.ndarray:  # fmt: skip
     """Per pole of ``model``: how far apart the record's two halves (``halves``, lines weighted as
     ``data``), each fitted from ``model``'s poles, put it, in standard deviations of the difference,
-    the larger of frequency's and damping's (each half's pole the one nearest the model's). Two fits.
+    the larger of frequency's and damping's (each half's pole the one nearest the model's). Two fits
+    (``fitter``, as :func:`~armaxmodal.modes.dft_model.fit_modal_model`).
 
     Returns
     -------
     (n_modes,) ndarray
     """
-    a, b = (fit_modal_model(h.weighted(data.weights), model.freq_hz, model.damping, hold, max_nfev, dft)
+    a, b = (fitter(h.weighted(data.weights), model.freq_hz, model.damping, hold, max_nfev, dft)
             for h in halves)  # fmt: skip
     z = np.zeros(model.n_modes)
     for i, f in enumerate(model.freq_hz):

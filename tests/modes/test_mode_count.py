@@ -398,6 +398,11 @@ def test_a_long_record_is_counted_on_its_start_and_fitted_whole(bundled_diagram)
     np.testing.assert_allclose(width(part), width(whole), rtol=0.05)
 
 
+def _scripted(table):
+    """A fitter for ``count_modes(fitter=...)`` whose fits are :class:`_Scored` by ``table``."""
+    return lambda data, f, x, hold, n, dft: _Scored(f, x, table)
+
+
 class _Scored:
     """A stand-in fit whose criterion depends on its number of modes only: the search's own
     rules, apart from the fits, against a known answer."""
@@ -427,17 +432,15 @@ class _Scored:
 
 
 @pytest.mark.parametrize("start", [2, 3, 4])
-def test_the_search_takes_only_steps_that_lower_the_criterion(monkeypatch, supine, start):
+def test_the_search_takes_only_steps_that_lower_the_criterion(supine, start):
     """Criterion 100, 95, 97 for 2, 3, 4 modes: from any start the search ends at 3, having
     taken only steps that lower the criterion; the removal and the addition from 3 are 5 and 2
     units worse, so both are undecided (under 10)."""
-    import armaxmodal.modes.count_search as count_search
 
     table = {1: 120.0, 2: 100.0, 3: 95.0, 4: 97.0, 5: 99.0}
-    monkeypatch.setattr(count_search, "fit_modal_model", lambda data, f, x, hold, n=40, dft=None: _Scored(f, x, table))
     data, _ = supine
     f, x = np.array([5.0, 9.0, 13.0, 17.0][:start]), np.full(start, 0.3)
-    count = count_modes(data, f, x, hold="zoh")
+    count = count_modes(data, f, x, hold="zoh", fitter=_scripted(table))
     assert count.model.n_modes == 3
     assert len(count.steps) == abs(start - 3) and all(s.bic_fall > 0 for s in count.steps)
     np.testing.assert_allclose(count.removal_rise, 5.0)
@@ -446,14 +449,12 @@ def test_the_search_takes_only_steps_that_lower_the_criterion(monkeypatch, supin
     assert sorted((d, alt.n_modes) for d, alt in count.alternatives) == [(2.0, 4), (5.0, 2), (5.0, 2), (5.0, 2)]
 
 
-def test_a_decided_count_has_no_equally_good_model(monkeypatch, supine):
+def test_a_decided_count_has_no_equally_good_model(supine):
     """Criterion 130, 95, 120 for 2, 3, 4 modes: every neighbour is worse by more than
     DECISIVE_BIC, so no other count enters the intervals."""
-    import armaxmodal.modes.count_search as count_search
 
     table = {1: 150.0, 2: 130.0, 3: 95.0, 4: 120.0, 5: 140.0}
-    monkeypatch.setattr(count_search, "fit_modal_model", lambda data, f, x, hold, n=40, dft=None: _Scored(f, x, table))
-    count = count_modes(supine[0], [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], hold="zoh")
+    count = count_modes(supine[0], [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], hold="zoh", fitter=_scripted(table))
     assert count.model.n_modes == 3 and count.alternatives == ()
 
 
@@ -466,12 +467,10 @@ def test_an_addition_the_diagram_has_no_column_for_is_named_when_the_record_want
     import armaxmodal.modes.count_search as count_search
 
     table = {2: 130.0, 3: 95.0, 4: 50.0, 5: 250.0}
-    monkeypatch.setattr(count_search, "fit_modal_model", lambda data, f, x, hold, n=40, dft=None: _Scored(f, x, table))
-    monkeypatch.setattr(count_search._Search, "in_both_halves", lambda self, trial, new, halves: True)
     monkeypatch.setattr(count_search, "_split_wanted", lambda *a, **k: ((), None))  # a stand-in fit splits as it adds
     data = supine[0]
     count = count_modes(data, [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], hold="zoh", halves=(data, data),
-                        supported=lambda f, x: column)  # fmt: skip
+                        supported=lambda f, x: column, fitter=_scripted(table))  # fmt: skip
     assert count.model.n_modes == (4 if column else 3)
     if column:
         assert count.wanted == ()
@@ -500,9 +499,8 @@ def test_a_start_mode_the_free_fit_carries_away_must_be_founded(monkeypatch, sup
     if not resolved:
         moved.damping_sd = np.array([0.003, 0.003, 0.2])  # 11 Hz: interval reaches below zero
     refits = []
-    monkeypatch.setattr(count_search, "fit_modal_model",
-                        lambda d, f, x, hold, n, dft=None: refits.append(list(f)) or _Scored(f, x, table))  # fmt: skip
-    search = count_search._Search(data, "zoh", 1.0, 40)
+    search = count_search._Search(data, "zoh", 1.0, 40, fitter=lambda d, f, x, hold, n, dft: refits.append(list(f))
+                                  or _Scored(f, x, table))  # fmt: skip
     model, carried, kept = count_search._without_unfounded(search, [5.0, 9.0, 13.0], moved,
                                                          lambda f, x: stable_there or abs(f - 11.0) > 0.5)  # fmt: skip
     if outcome == "dropped":
@@ -542,8 +540,7 @@ def test_with_the_halves_a_moved_pole_is_judged_by_them_not_by_the_diagram(monke
     import armaxmodal.modes.count_search as count_search
 
     table = {2: 100.0, 3: 100.0}  # the model does not need the moved pole
-    monkeypatch.setattr(count_search, "fit_modal_model", lambda d, f, x, hold, n, dft=None: _Scored(f, x, table))
-    search = count_search._Search(supine[0], "zoh", 1.0, 40)
+    search = count_search._Search(supine[0], "zoh", 1.0, 40, fitter=_scripted(table))
     asked = []
     monkeypatch.setattr(search, "in_both_halves", lambda m, new, h: asked.append(list(new)) or same_in_halves)
     moved = _Scored([5.0, 9.0, 11.0], [0.3, 0.3, 0.3], table)
@@ -938,12 +935,15 @@ def test_an_addition_its_halves_nearly_confirm_is_undecided_not_refused(monkeypa
     import armaxmodal.modes.count_search as count_search
 
     table = {2: 130.0, 3: 95.0, 4: 50.0, 5: 250.0}
-    monkeypatch.setattr(count_search, "fit_modal_model", lambda data, f, x, hold, n=40, dft=None: _Scored(f, x, table))
-    monkeypatch.setattr(count_search, "halves_z", lambda data, m, halves, hold, n, dft: np.full(m.n_modes, z))
     monkeypatch.setattr(count_search, "_split_wanted", lambda *a, **k: ((), None))
     data = supine[0]
-    count = count_modes(data, [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], hold="zoh", halves=(data, data),
-                        supported=lambda f, x: True)  # fmt: skip
+    second = replace(data, y=data.y[:-1], u=data.u[:-1], s=data.s[:-1], z_inv=data.z_inv[:-1])  # told apart by size
+
+    def fitter(d, f, x, hold, n, dft):  # sd 1e-3 f in each half: a shift of z sqrt(2) 1e-3 is z apart
+        return _Scored(np.asarray(f) * (1 + z * np.sqrt(2) * 1e-3 * (d.y.shape[0] == second.y.shape[0])), x, table)
+
+    count = count_modes(data, [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], hold="zoh", halves=(data, second),
+                        supported=lambda f, x: True, fitter=fitter)  # fmt: skip
     assert count.model.n_modes == (4 if said is None else 3)
     assert (len(count.unsettled_hz), len(count.unconfirmed_hz)) == {None: (0, 0), "count_undecided": (1, 0),
                                                                     "mode_count": (0, 1)}[said]  # fmt: skip
