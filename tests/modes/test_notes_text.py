@@ -41,6 +41,8 @@ def _count(**changes) -> ModeCount:
 
 
 def _said(found) -> list[tuple]:
+    """Each note's code, value and text (a note of the count names no channel)."""
+    assert all(n.channels == () for n in found)
     return [(n.code, n.value, n.message) for n in found]
 
 
@@ -175,3 +177,55 @@ def test_modes_the_record_does_not_separate_are_named_with_their_distance():
             'modes at 10.000 and 10.500 Hz are 1.8 standard deviations of their difference apart '
             '(under 3): the record does not separate them; they may be one mode'),
     ]
+
+
+def test_the_edges_of_each_rule():
+    """Where each rule's comparison flips: a step whose pole stayed within the clustering's reach, a
+    split, an undecided removal of a mode not reported, an addition exactly decisive or nowhere,
+    stand-ins on the band's edges, two alternatives and two poles outside the band."""
+    model = _model((5.0, 12.0, 30.0, 40.0), (0.2, 0.1, 0.9, 0.1))
+    count = _count(model=model, steps=(Step("add", 12.5, 20.0, 12.6), Step("split", 8.0, 15.0, 7.0)),
+                   removal_rise=np.array([4.5, 80.0, 60.0, 70.0]), best_addition=-10.0, unconfirmed_hz=(),
+                   alternatives=((4.5, _model((5.1,), (0.2,))), (6.0, _model((5.0, 12.3, 14.0), (0.2, 0.1, 0.1)))),
+                   carried_away=(), wanted=(), stand_ins=((24.0, 25.0, 15.0), (2.0, 1.0, 12.0)), unsettled_hz=())
+    said = _said(notes.count_notes(count, np.array([False, True, False, False]), BAND, SAME_ROW))
+    assert [text for _, _, text in said[:2]] == [
+        "the maximum-likelihood modal model with every pole free: the mode at 12.500 Hz added, the information "
+        "criterion (BIC) falls by 20.0",
+        "the maximum-likelihood modal model with every pole free: the mode at 8.000 Hz split in two (its new pole "
+        "settled at 7.000 Hz), the information criterion (BIC) falls by 15.0",
+    ]
+    # 5 Hz is undecided but not reported: no note of the count's doubt; an addition at exactly -10 is decided
+    assert not any("does not decide the number" in t or "rule out" in t for _, _, t in said)
+    assert "in the models the record cannot tell from the chosen one (1 modes (+4.5), 3 modes (+6.0) in" in said[2][2]
+    assert [(code, value) for code, value, _ in said[3:5]] == [("count_undecided", 25.0), ("count_undecided", 1.0)]
+    assert said[5][1:] == (2.0, "2 pole(s) of the modal model lie outside the band 1-25 Hz, are damped beyond 0.6 "
+                                "or are lines (damping at the fit's floor): 30 Hz (damping 0.90), 40 Hz (damping "
+                                "0.10). They stand for what lies beyond the band or for a periodic disturbance, "
+                                "and are not reported as modes")  # fmt: skip
+    assert len(said) == 6
+    # an addition without a place is not said; one exactly decisive is not held against the picks
+    nowhere = _count(best_addition=-3.0, best_addition_hz=float("nan"))
+    assert not any("rule out" in t for _, _, t in _said(notes.count_notes(nowhere, KEEP, BAND, SAME_ROW)))
+    assert _said(notes.pick_notes(_count(best_addition=10.0), np.array([False, True, False]))) == []
+
+
+def test_a_wanted_mode_barely_refused_says_the_criterion_rises():
+    count = _count(steps=(), best_addition=-30.0, unconfirmed_hz=(), alternatives=(), carried_away=(), stand_ins=(),
+                   unsettled_hz=(), wanted=Wanted(23.5, 61.2, 12, 0.5, True, False))  # fmt: skip
+    (text,) = [t for _, v, t in _said(notes.count_notes(count, KEEP, BAND, SAME_ROW)) if v == 23.5]
+    assert "but the criterion (BIC) rises by 0.5, so it is not reported" in text
+
+
+def test_a_model_without_poles_says_none():
+    empty = _count(model=_model((), ()), removal_rise=np.array([]))
+    (said,) = _said([notes.no_mode_kept_note(empty, pd.DataFrame({"freq_hz": [5.0]}), BAND)])
+    assert "(its poles: none); the 1 mode(s) of the diagram's selection" in said[2]
+
+
+def test_the_oversampling_rule_at_its_edge():
+    """Modes at 10 % of Nyquist are not oversampled; at 8 % they are, with the share printed to 0.1 %."""
+    assert notes.oversampling_note(np.array([50.0]), 1000.0) == []
+    (said,) = _said(notes.oversampling_note(np.array([40.0]), 1000.0))
+    assert said[2].startswith("every mode found lies below 8.0 % of the Nyquist frequency (the highest at 40 Hz")
+    assert said[2].endswith("Rerun with band=(0, 100) (CLI: --band 0:100), which resamples to 250 Hz.")
