@@ -229,3 +229,12 @@ def test_the_oversampling_rule_at_its_edge():
     (said,) = _said(notes.oversampling_note(np.array([40.0]), 1000.0))
     assert said[2].startswith("every mode found lies below 8.0 % of the Nyquist frequency (the highest at 40 Hz")
     assert said[2].endswith("Rerun with band=(0, 100) (CLI: --band 0:100), which resamples to 250 Hz.")
+
+
+def test_a_band_that_halves_the_rate_is_suggested():
+    """With every mode below 30 % of Nyquist counting as oversampled, a mode at 8 Hz of 100 Hz
+    suggests the band 0-20 Hz, which halves the rate: the smallest reduction still worth saying."""
+    from armaxmodal.modes.settings import NoteSettings
+
+    (said,) = _said(notes.oversampling_note(np.array([8.0]), 100.0, NoteSettings(oversampled_fraction=0.3)))
+    assert said[2].endswith("Rerun with band=(0, 20) (CLI: --band 0:20), which resamples to 50 Hz.")

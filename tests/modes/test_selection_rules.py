@@ -341,8 +341,12 @@ def test_unresolved_damping_notes_state_the_facts_and_the_reason():
     assert note.message.endswith("the interval covers the other models the record finds as good (another number of "
                                  "modes, two poles reported as one) or the other estimator's value, which disagree "
                                  "about this damping")  # fmt: skip
+    (note,) = _unresolved_damping_notes(_notes_modes(damping_ci95_hi=0.05, estimator_widened=True), 10)
+    assert note.message.endswith("or the other estimator's value, which disagree about this damping")
     two = pd.concat([_notes_modes(damping_ci95_lo=-0.001), _notes_modes(freq_hz=9.0, damping_ci95_lo=0.0)])
     assert [n.value for n in _unresolved_damping_notes(two, 10)] == [4.0, 9.0]
+    after_a_resolved_one = pd.concat([_notes_modes(), _notes_modes(freq_hz=9.0, damping_ci95_lo=0.0)])
+    assert [n.value for n in _unresolved_damping_notes(after_a_resolved_one, 10)] == [9.0]
 
 
 def test_per_sensor_table_and_its_weighted_averages():
