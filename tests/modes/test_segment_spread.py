@@ -100,3 +100,30 @@ def test_a_segment_that_blends_a_close_pair_measures_neither_mode():
     for failed in (None, poles(), growing):
         table = segment_spread(None, modes, lambda i: orders, 3, fitted={**fitted, (orders, 1): failed})
         assert table.segments_found.tolist() == [2, 2]
+
+
+def test_the_spread_test_by_hand():
+    """Three segments, three modes, the family-wise 1 % spread over both parameters of all three
+    (the chi-square quantile at 0.01 / 6 is 12.79): a mode seen in two segments only is not judged;
+    a frequency spread whose statistic, 2 s^2 / (3 sigma^2), is 10 stays (the rate split the wrong way,
+    quantile 8.40, would flag it); a damping spread of 66.7 is flagged, widened to t(2) s / sqrt(3), and said.
+    A frequency without a statistical interval (sigma 0) is not judged."""
+    import pandas as pd
+
+    modes = pd.DataFrame({"freq_hz": [4.0, 9.0, 16.0], "freq_sd_armax": [0.01, 0.01, 0.0],
+                          "damping_sd_armax": [0.001, 0.001, 0.001]}, index=[10, 11, 12])  # fmt: skip
+    spread = pd.DataFrame({"freq_segment_sd": [1.0, 0.01 * np.sqrt(15.0), 0.05],
+                           "damping_segment_sd": [1.0, 0.0005, 0.01], "segments_found": [2, 3, 3]},
+                          index=[3, 4, 5])  # fmt: skip
+    out, (note,) = apply_segment_spread(modes, spread, 3, alpha=0.01)
+    assert list(out.columns) == [*modes.columns, *spread.columns, "model_error_dominates", "freq_segment_half",
+                                 "damping_segment_half"]  # fmt: skip
+    assert out.model_error_dominates.tolist() == [False, False, True]
+    assert np.isnan(out.freq_segment_half).all()
+    np.testing.assert_allclose(out.damping_segment_half, [np.nan, np.nan, 4.302653 * 0.01 / np.sqrt(3)], rtol=1e-6)
+    assert (note.code, note.channels, note.value) == ("model_error_dominates", (), 1.0)
+    assert note.message == (
+        "refitted on 3 disjoint segments, 1 mode(s) scatter beyond their statistical intervals: 16 Hz (segment SD "
+        "0.05 Hz, damping 0.01). Their 95 % intervals were widened to the segments' spread. The model misses an "
+        "effect of the data (amplitude-dependent or time-varying behaviour, a disturbance, a missing mode)."
+    )
