@@ -85,10 +85,13 @@ def test_a_segment_that_blends_a_close_pair_measures_neither_mode():
         return pd.DataFrame({"freq_hz": freqs, "damping": [0.01] * len(freqs)})
 
     fitted = {(orders, 0): poles(10.11, 10.42), (orders, 1): poles(10.24), (orders, 2): poles(10.13, 10.40)}
+    fitted[(orders, 2)].damping = [0.014, 0.008]
     table = segment_spread(None, modes, lambda i: orders, 3, fitted=fitted)
     assert table.segments_found.tolist() == [2, 2]
     assert table.freq_segment_sd.to_numpy() == pytest.approx([np.std([10.11, 10.13], ddof=1),
                                                               np.std([10.42, 10.40], ddof=1)], rel=1e-9)  # fmt: skip
+    assert table.damping_segment_sd.to_numpy() == pytest.approx([np.std([0.01, 0.014], ddof=1),
+                                                                 np.std([0.01, 0.008], ddof=1)], rel=1e-9)  # fmt: skip
     # one segment holds two poles, both nearer the first mode: the second's is not taken
     crowded = {(orders, k): poles(10.10, 10.14, 10.40) for k in range(3)}
     crowded[(orders, 1)] = poles(10.10, 10.20)
@@ -127,3 +130,22 @@ def test_the_spread_test_by_hand():
         "0.05 Hz, damping 0.01). Their 95 % intervals were widened to the segments' spread. The model misses an "
         "effect of the data (amplitude-dependent or time-varying behaviour, a disturbance, a missing mode)."
     )
+
+
+def test_the_segments_fitted_here_are_those_the_selection_schedules(fixtures_dir):
+    """Without ``fitted``, ``segment_spread`` fits each representative order on each segment itself:
+    the same table as from the segment poles the selection's scheduler fits (``segment_poles``)."""
+    import pandas as pd
+
+    from armaxmodal.estimate.orders import default_nb, default_nc
+    from armaxmodal.modes.intervals import segment_jobs, segment_poles, segment_spread, split_segments
+
+    ride = am.read_recording(fixtures_dir / "supine_random.csv")
+    modes = pd.DataFrame({"freq_hz": [5.83, 8.31, 13.5], "damping": [0.3, 0.2, 0.2]})
+    orders = {8: (8, default_nb(8, -1), default_nc(8), -1), 10: (10, default_nb(10, -1), default_nc(10), -1)}
+    orders_of = [orders[8], orders[10], orders[10]].__getitem__
+    parts = split_segments(ride, 3)
+    fitted = {job: segment_poles(parts, job) for job in segment_jobs(sorted(set(orders.values())), 3)}
+    mine = segment_spread(ride, modes, orders_of, 3, n_jobs=2)
+    pd.testing.assert_frame_equal(mine, segment_spread(None, modes, orders_of, 3, fitted=fitted))
+    assert mine.segments_found.tolist()[:2] == [3, 3]  # the weakly driven 13.5 Hz mode is not in every third
