@@ -131,3 +131,45 @@ def test_neighbours_not_separated_are_taken_left_to_right_without_overlap():
     # 20.0/20.5 with SDs of 0.05 each are 7.1 apart, whatever the wider modes before them
     got = not_separated(modes([10.0, 10.1, 20.0, 20.5], [0.2, 0.2, 0.05, 0.05]), 3.0)
     assert [(i, j) for i, j, _ in got] == [(0, 1)]
+
+
+def test_the_two_estimators_test_by_hand():
+    """Three modes, the third without an earlier estimate (a pick): 4 Hz's frequency and 9 Hz's
+    damping each differ by 7.07 standard deviations of the difference, a sum of squares of 100 for
+    4 values against the 99 % point 13.3. Both modes' intervals widen, each for its own quantity,
+    and the note says where; differences within the noise change nothing."""
+    from armaxmodal.modes.intervals import covering_both_estimators
+
+    rows = pd.DataFrame({"freq_hz": [4.0, 9.0, 16.0], "freq_sd": [0.01, 0.01, 0.01], "damping": [0.05, 0.03, 0.02],
+                         "damping_sd": [0.002, 0.001, 0.001], "freq_earlier": [4.1, 9.0, np.nan],
+                         "freq_earlier_sd": [0.01, 0.01, np.nan], "damping_earlier": [0.05, 0.04, np.nan],
+                         "damping_earlier_sd": [0.002, 0.001, np.nan]})  # fmt: skip
+    out, (note,) = covering_both_estimators(rows, alpha=0.01)
+    assert out.estimator_widened.tolist() == [True, True, False]
+    np.testing.assert_allclose(out.freq_estimator_hi[:2], [4.1 + Z95 * 0.01, 9.0 + Z95 * 0.01])
+    assert np.isnan(out.freq_estimator_lo[2]) and np.isnan(out.damping_estimator_hi[2])
+    assert (note.code, note.channels) == ("estimators_disagree", ()) and note.value == pytest.approx(100.0)
+    assert note.message == (
+        "the modal model's modes and the diagram's fit of them differ beyond their noise (sum of squared standardised "
+        "differences 100.0 for 4 values, its 99 % point 13.3): one of them is biased here, by model error the two "
+        "weight differently (a nonlinearity, the inter-sample behaviour, leakage) or by orders too low for a mode. "
+        "One record cannot say which, so every mode's interval covers both estimates; widened at 4.000, 9.000 Hz"
+    )
+    near = rows.assign(freq_earlier=[4.01, 9.0, np.nan], damping_earlier=[0.05, 0.031, np.nan])
+    out, notes = covering_both_estimators(near, alpha=0.01)
+    assert notes == [] and out.estimator_widened.tolist() == [False, False, False]
+    assert out[["freq_estimator_lo", "damping_estimator_hi"]].isna().all().all()
+    # rows with no earlier estimate at all (the selection's own) are not tested
+    out, notes = covering_both_estimators(rows[["freq_hz", "freq_sd", "damping", "damping_sd"]])
+    assert notes == [] and out.freq_earlier.isna().all() and out.estimator_widened.dtype == bool
+
+
+def test_the_earlier_estimate_of_a_row():
+    """A selection row's values as the earlier estimate, NaN deviations where it has none; a row of
+    the modal model itself has no earlier estimate."""
+    from armaxmodal.modes.intervals import earlier_estimate
+
+    got = earlier_estimate({"freq_hz": 5.0, "damping": 0.1, "freq_sd": 0.02, "estimator": "armax"})
+    assert (got["freq_earlier"], got["freq_earlier_sd"], got["damping_earlier"]) == (5.0, 0.02, 0.1)
+    assert np.isnan(got["damping_earlier_sd"])
+    assert all(np.isnan(v) for v in earlier_estimate({"freq_hz": 5.0, "damping": 0.1, "estimator": "ml-zoh"}).values())
