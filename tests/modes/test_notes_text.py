@@ -238,3 +238,31 @@ def test_a_band_that_halves_the_rate_is_suggested():
 
     (said,) = _said(notes.oversampling_note(np.array([8.0]), 100.0, NoteSettings(oversampled_fraction=0.3)))
     assert said[2].endswith("Rerun with band=(0, 20) (CLI: --band 0:20), which resamples to 50 Hz.")
+
+
+def test_the_counts_json_holds_its_evidence_as_the_schema_says():
+    """``ModeCount.to_dict``: the steps, every fitted model and every pole with its verdict, NaN as
+    null, valid against the published schema's ``count``."""
+    import json
+    from pathlib import Path
+
+    import jsonschema
+
+    from armaxmodal.modes.mode_count import FittedModel
+
+    rows = (FittedModel("start", float("nan"), 3, 120.0, 30, 160.0, True, None),
+            FittedModel("add", 12.5, 4, 80.0, 40, 133.3, False, True))  # fmt: skip
+    got = _count(models=rows, trials=7, effective_fraction=0.5).to_dict()
+    schema = json.loads((Path(__file__).parents[2] / "schemas" / "stabilise.schema.json").read_text())
+    jsonschema.validate(json.loads(json.dumps(got, allow_nan=False)), schema["properties"]["count"])
+    assert (got["effective_fraction"], got["trials"]) == (0.5, 7)
+    assert got["steps"] == [{"action": "add", "freq_hz": 12.5, "bic_fall": 44.25, "settled_hz": 13.5},
+                            {"action": "remove", "freq_hz": 17.0, "bic_fall": 12.5, "settled_hz": None}]  # fmt: skip
+    assert got["models"][0] == {"action": "start", "freq_hz": None, "n_modes": 3, "neg2_loglik": 120.0, "n_params": 30,
+                                "bic": 160.0, "converged": True, "halves_agree": None}  # fmt: skip
+    assert got["models"][1]["bic"] == 133.3 and got["models"][1]["halves_agree"] is True
+    assert got["poles"] == [
+        {"freq_hz": 5.0, "damping": 0.2, "removal_rise": 4.5, "verdict": "undecided"},
+        {"freq_hz": 12.0, "damping": 0.1, "removal_rise": 80.0, "verdict": "needed"},
+        {"freq_hz": 30.0, "damping": 0.9, "removal_rise": 60.0, "verdict": "not_a_mode"},
+    ]
