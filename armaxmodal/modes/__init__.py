@@ -3,10 +3,11 @@
 * :func:`~armaxmodal.stabilisation_diagram` -- the order sweep and its pole table (:mod:`.diagram`,
   :mod:`.poles`).
 * :func:`~armaxmodal.select_modes` -- the physical modes picked from it by named stages
-  (:mod:`.pipeline`, every threshold in :mod:`.settings`, the result in :mod:`.result`;
-  :mod:`.clusters`, :mod:`.completeness`, the support tests in :mod:`.support`), refitted in the
+  (:mod:`.pipeline` over :mod:`.state`, every threshold in :mod:`.settings`, the result in :mod:`.result`;
+  :mod:`.clusters`, the FRF's support tests in :mod:`.completeness`), refitted in the
   frequency domain (:func:`.dft_model.refine_modes`), counted by nested tests of the maximum-likelihood modal
-  model (:mod:`.dft_model`, :mod:`.mode_count`, :mod:`.counted`), with intervals widened by
+  model (:mod:`.dft_model`, :mod:`.mode_count`, :mod:`.count_search`, :mod:`.counted`, notes in :mod:`.notes`),
+  with intervals widened by
   the segment spread (:mod:`.intervals`) and judged by the modal-model check (:mod:`.modal_check`,
   on the coherent lines of :mod:`.frf`).
 * :func:`~armaxmodal.identify` -- one model, its modes and the same check.
