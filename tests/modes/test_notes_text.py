@@ -266,3 +266,22 @@ def test_the_counts_json_holds_its_evidence_as_the_schema_says():
         {"freq_hz": 12.0, "damping": 0.1, "removal_rise": 80.0, "verdict": "needed"},
         {"freq_hz": 30.0, "damping": 0.9, "removal_rise": 60.0, "verdict": "not_a_mode"},
     ]
+
+
+@pytest.mark.parametrize(
+    ("peak_hz", "half_hz", "want"),
+    [(5.0, 1.05, (5.0, 1.0 / 10.0)),  # the half-power lines 4.5-5.5 Hz: damping width / 2f
+     (1.2, 1.05, (1.2, 0.7 / 2.4)),  # the half-power lines reach the band's first line, 1.0 Hz
+     (2.0, 20.0, (2.0, 0.5)),  # a hump over the whole band: the damping's cap
+     (5.0, 0.05, (5.0, 0.01))],  # one line: the damping's floor
+)  # fmt: skip
+def test_the_residual_peak_and_its_width(peak_hz, half_hz, want):
+    """Where the model misses most, from a residual power shaped as a triangle of known half width
+    on lines every 0.1 Hz from 1 to 10 Hz (two sensors, no smoothing)."""
+    from armaxmodal.modes.mode_count import residual_peak
+
+    f = np.round(np.arange(1.0, 10.05, 0.1), 10)
+    power = np.clip(1 - np.abs(f - peak_hz) / half_hz, 0, None)
+    model = SimpleNamespace(residual=np.sqrt(power / 2)[:, None] * np.ones((1, 2)) + 0j)
+    got = residual_peak(model, SimpleNamespace(s=2j * np.pi * f), width_lines=1)
+    assert got == pytest.approx(want, rel=1e-9)
