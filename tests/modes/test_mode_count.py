@@ -950,3 +950,25 @@ def test_an_addition_its_halves_nearly_confirm_is_undecided_not_refused(monkeypa
     notes = _notes(count, np.ones(count.model.n_modes, bool), data.band_hz, SAME_ROW)
     about = [n.code for n in notes if "halves" in n.message]
     assert about == ([] if said is None else [said])
+
+
+def test_a_record_of_one_mode_has_its_split_tried():
+    """One reported mode is where a close pair hides most easily: its split is screened, converged
+    and judged like any other (here wanted: a likelihood ratio of 200 for 22 parameters)."""
+    from armaxmodal.modes.count_search import _split_wanted
+
+    n_eff = 1e5
+    current = SimpleNamespace(n_params=22, freq_hz=np.array([10.0]), damping=np.array([0.05]),
+                              neg2_loglik_on=lambda n: 1000.0)  # fmt: skip
+    split = SimpleNamespace(n_params=44, freq_hz=np.array([9.8, 10.2]), damping=np.full(2, 0.03),
+                            damping_sd=np.full(2, 0.002), neg2_loglik_on=lambda n: 800.0)  # fmt: skip
+    screened = []
+    search = SimpleNamespace(
+        n_eff=n_eff, bic=lambda m: m.neg2_loglik_on(n_eff) + m.n_params * np.log(n_eff),
+        data=SimpleNamespace(band_hz=(1.0, 100.0)), cfg=CountSettings(),
+        screened=lambda starts, labels: screened.extend(labels) or [split],
+        fit=lambda f, x, nfev, label=None: split, in_both_halves=lambda m, new, halves: True,
+    )  # fmt: skip
+    wanted, model = _split_wanted(search, current, ("first half", "second half"))
+    assert screened == [("split", 10.0)] and model is split
+    assert wanted and wanted[1] == pytest.approx(200.0) and wanted[2] == 22
