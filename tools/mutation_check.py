@@ -637,14 +637,14 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/mode_count.py",
-        "z[i] = max(z[i], abs(one[j] - two[k]) / max(np.hypot(sd_one[j], sd_two[k]), 1e-300))",
-        "z[i] = max(z[i], 1e-9 * abs(one[j] - two[k]) / max(np.hypot(sd_one[j], sd_two[k]), 1e-300))",
+        "chi2[i] += (abs(one[j] - two[k]) / max(np.hypot(sd_one[j], sd_two[k]), 1e-300)) ** 2",
+        "chi2[i] += (1e-9 * abs(one[j] - two[k]) / max(np.hypot(sd_one[j], sd_two[k]), 1e-300)) ** 2",
         "the halves' agreement ignored (count)",
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "(unsettled if search.z <= settings.halves_unsettled_sd else unconfirmed)",
-        "(unconfirmed if search.z <= settings.halves_unsettled_sd else unconfirmed)",
+        "(unsettled if search.p >= agreement.unsettled_alpha else unconfirmed)",
+        "(unconfirmed if search.p >= agreement.unsettled_alpha else unconfirmed)",
         "an addition the halves nearly confirm refused as a change in time, the verdict good (count)",
     ),
     (
@@ -1007,14 +1007,14 @@ MUTANTS = [
     #   -k "estimat or no_cluster_holds")
     (
         'armaxmodal/modes/settings.py',
-        '    estimators_alpha: float = 0.01',
-        '    estimators_alpha: float = 0.05',
+        '    alpha: float = 0.01',
+        '    alpha: float = 0.05',
         'the test at 5 % (estimators)',
     ),
     (
         'armaxmodal/modes/settings.py',
-        '    estimators_alpha: float = 0.01',
-        '    estimators_alpha: float = 0.001',
+        '    alpha: float = 0.01',
+        '    alpha: float = 0.001',
         'the test at 0.1 % (estimators)',
     ),
     (
@@ -1067,7 +1067,7 @@ MUTANTS = [
     ),
     (
         'armaxmodal/modes/counted.py',
-        '    rows, disagree = covering_both_estimators(rows, settings.intervals.estimators_alpha)\n    # where two',
+        '    rows, disagree = covering_both_estimators(rows, settings.agreement.alpha)\n    # where two',
         '    disagree = []\n    # where two',
         "the estimators' test not run on the counted modes (estimators)",
     ),

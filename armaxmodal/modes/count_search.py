@@ -1,10 +1,9 @@
-"""The search of the count (the method page's "how many modes" gives its rules): from the diagram's
-selection, every step compares the current model with its neighbours, each refitted with every pole
-free (:func:`~armaxmodal.modes.dft_model.fit_modal_model`) -- a mode removed (a merge of two close
-modes is a removal), a left-out stable cluster or the residual's peak added, a mode split in two --
-and the neighbour of lowest criterion (:mod:`armaxmodal.modes.mode_count`) replaces the current
-model while it lowers it. Then the chosen model is converged, carried-away starts judged, the
-equally good models fitted and the refused additions the likelihood wants flagged.
+"""The search of the count (the method page's "how many modes" gives its rules): from the diagram's selection,
+every step compares the current model with its neighbours, each refitted with every pole free
+(:func:`~armaxmodal.modes.dft_model.fit_modal_model`) -- a mode removed (a merge of two close modes is a
+removal), a left-out stable cluster or the residual's peak added, a mode split in two -- and the neighbour
+of lowest criterion (:mod:`armaxmodal.modes.mode_count`) replaces the current model while it lowers it. Then
+the chosen model is converged, carried-away starts judged, equally good models fitted, wanted additions flagged.
 """
 
 from __future__ import annotations
@@ -24,12 +23,12 @@ from armaxmodal.modes.mode_count import (
     Step,
     Wanted,
     effective_fraction,
-    halves_z,
+    halves_chi2,
     residual_peak,
     split_start,
 )
 from armaxmodal.modes.poles import matched_poles, nearest_pole, new_poles, physical, reported, resolved
-from armaxmodal.modes.settings import DEFAULTS, CountSettings, DftSettings, LineSettings
+from armaxmodal.modes.settings import DEFAULTS, AgreementSettings, CountSettings, DftSettings, LineSettings
 from armaxmodal.stats import Z95
 
 __all__ = ["count_modes"]
@@ -40,11 +39,11 @@ class _Search:
 
     def __init__(self, data: DftLines, hold: str, n_effective: float, max_nfev: int, n_jobs: int | None = 1,
                  settings: CountSettings = COUNT, lines: LineSettings = DEFAULTS.lines,
-                 dft: DftSettings = DEFAULTS.dft, fitter: Callable = fit_modal_model):  # fmt: skip
+                 dft: DftSettings = DEFAULTS.dft, fitter: Callable = fit_modal_model,
+                 agreement: AgreementSettings = DEFAULTS.agreement):  # fmt: skip
         self.data, self.hold, self.n_eff, self.max_nfev, self.n_jobs = data, hold, n_effective, max_nfev, n_jobs
         self.cfg, self.lines, self.dft, self.trials, self.table = settings, lines, dft, 0, ModelTable(n_effective)
-        self.fitter = fitter
-        self.logged, self.unsupported = self.table.add, None
+        self.fitter, self.agreement, self.logged, self.unsupported = fitter, agreement, self.table.add, None
 
     def screened(self, starts: list[tuple[np.ndarray, np.ndarray]], labels: list[tuple[str, float]]
                  ) -> list[ModalModel | None]:  # fmt: skip
@@ -101,12 +100,12 @@ class _Search:
         return supported is None or all(supported(model.freq_hz[i], model.damping[i]) for i in new)
 
     def in_both_halves(self, trial: ModalModel, new: list[int], halves) -> bool:
-        """The new poles of ``trial`` (indices ``new``) agree in the record's two halves (:func:`halves_z`
-        within ``settings.halves_sd``; the largest z kept in ``self.z``); the answer goes into its row."""
+        """The new poles of ``trial`` (indices ``new``) agree in the record's two halves at ``agreement.alpha``,
+        pooled (:func:`halves_chi2`; the probability kept in ``self.p``); the answer goes into its row."""
         self.trials += 2
-        z = halves_z(self.data, trial, halves, self.hold, self.max_nfev, self.dft, self.fitter)
-        self.z = max((z[i] for i in new), default=0.0)
-        return self.table.halves(trial, self.z <= self.cfg.halves_sd)
+        chi2 = halves_chi2(self.data, trial, halves, self.hold, self.max_nfev, self.dft, self.fitter)
+        self.p = float(chdtrc(2 * len(new), np.sum(chi2[list(new)]))) if len(new) else 1.0  # no new pole: agreed
+        return self.table.halves(trial, self.p >= self.agreement.alpha)
 
     def removals(self, current: ModalModel) -> list[tuple[str, float, ModalModel | None]]:
         keep = [np.arange(current.n_modes) != m for m in range(current.n_modes)]
@@ -270,6 +269,7 @@ def count_modes(
     lines: LineSettings = DEFAULTS.lines,
     dft: DftSettings = DEFAULTS.dft,
     fitter: Callable = fit_modal_model,
+    agreement: AgreementSettings = DEFAULTS.agreement,
 ) -> ModeCount:
     """Choose the number of modes by nested tests of free refits (see the module notes).
 
@@ -298,8 +298,8 @@ def count_modes(
         Worker threads for the screening fits (default: all cores).
     settings : CountSettings
         The count's thresholds (:mod:`armaxmodal.modes.settings`).
-    lines, dft : LineSettings, DftSettings
-        Which poles are lines, not modes; the modal model's fits.
+    lines, dft, agreement : LineSettings, DftSettings, AgreementSettings
+        Which poles are lines, not modes; the modal model's fits; the halves' test's level.
     fitter : callable
         The fit, as :func:`~armaxmodal.modes.dft_model.fit_modal_model` (a test's stands in for it).
 
@@ -322,11 +322,11 @@ def count_modes(
     """
     return _count_modes(data, freq_hz, damping, candidates, hold=hold, max_nfev=max_nfev, halves=halves,
                         supported=supported, search=search, n_jobs=n_jobs, settings=settings, lines=lines, dft=dft,
-                        fitter=fitter)  # fmt: skip
+                        fitter=fitter, agreement=agreement)  # fmt: skip
 
 
 def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev, halves, supported, search, n_jobs,
-                 settings: CountSettings, lines, dft, fitter) -> ModeCount:  # fmt: skip
+                 settings: CountSettings, lines, dft, fitter, agreement) -> ModeCount:  # fmt: skip
     """:func:`count_modes` itself (its parameters), under the caller's BLAS threads (the public one holds one)."""
     start_model = fitter(data, freq_hz, damping, hold, max_nfev, dft)
     # each sensor weighted by its noise level as the fitted start leaves it (the likelihood is
@@ -335,7 +335,7 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev
     start_model = fitter(data, start_model.freq_hz, start_model.damping, hold, max_nfev, dft)
     fraction = effective_fraction(start_model.residual)
     searching, search = search, _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev, n_jobs,
-                                        settings, lines, dft, fitter)  # fmt: skip
+                                        settings, lines, dft, fitter, agreement)  # fmt: skip
     search.logged("start", float("nan"), start_model)
     # a starting mode the free fit carried away (a weak mode's pole to beyond the band) is tried
     # again as an addition
@@ -359,7 +359,7 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev
         if best_addition is not None and search.bic(best_addition[2]) < here and len(halves) == 2:
             new = new_poles(current.freq_hz, best_addition[2].freq_hz)
             if not search.in_both_halves(best_addition[2], new, halves):  # refused, or undecided if near
-                (unsettled if search.z <= settings.halves_unsettled_sd else unconfirmed).append(best_addition[1])
+                (unsettled if search.p >= agreement.unsettled_alpha else unconfirmed).append(best_addition[1])
                 best_addition = None
         return here, removed, best_removal, best_addition
 
@@ -397,4 +397,4 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev
         wanted = _unsupported_wanted(search, current, halves)
     return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
                      tuple(unconfirmed), alternatives, carried_away, wanted, stand_ins, settings, lines,
-                     dft, tuple(search.table.rows), data.band_hz, tuple(unsettled))  # fmt: skip
+                     dft, tuple(search.table.rows), data.band_hz, tuple(unsettled), agreement)  # fmt: skip

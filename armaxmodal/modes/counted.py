@@ -15,6 +15,7 @@ from dataclasses import replace
 
 import numpy as np
 import pandas as pd
+from scipy.special import chdtrc
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles, stable_in_diagram
 from armaxmodal.modes.count_search import count_modes
@@ -28,7 +29,7 @@ from armaxmodal.modes.intervals import (
     with_intervals,
 )
 from armaxmodal.modes.modal_check import check_modes
-from armaxmodal.modes.mode_count import ModeCount, halves_z
+from armaxmodal.modes.mode_count import ModeCount, halves_chi2
 from armaxmodal.modes.notes import count_notes, no_mode_kept_note, pick_notes
 from armaxmodal.modes.poles import mac, matched_poles, nearest_pole
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
@@ -128,7 +129,7 @@ def counted_modes(
         start_f, start_x = np.r_[start_f, model.freq_hz[hidden]], np.r_[start_x, model.damping[hidden]]
     count = count_modes(data, start_f, start_x, candidates, hold=hold, halves=halves, supported=supported,
                         search=not picked, n_jobs=n_jobs, settings=settings.count, lines=settings.lines,
-                        dft=settings.dft)  # fmt: skip
+                        dft=settings.dft, agreement=settings.agreement)  # fmt: skip
     if part is not rec:
         count = _on_whole_record(count, rec, band_hz, hold)
     verdicts = count.verdicts(data.band_hz)
@@ -141,7 +142,7 @@ def counted_modes(
     rows = pd.DataFrame([_row(modes, count, i, hold, same_row, verdicts[i]) for i in np.flatnonzero(keep)])
     rows, shapes, merged = _one_where_not_separated(rows, count.model.shapes[:, keep], count, keep, rec, band_hz, hold,
                                                     settings)  # fmt: skip
-    rows, disagree = covering_both_estimators(rows, settings.intervals.estimators_alpha)
+    rows, disagree = covering_both_estimators(rows, settings.agreement.alpha)
     # where two poles are reported as one, the check fits the model's poles, not the row's
     poles = tuple(zip(count.model.freq_hz[keep].tolist(), count.model.damping[keep].tolist(), strict=True))
     work = work.with_modes(rows, shapes, count=count, check_poles=poles if merged else None)
@@ -233,7 +234,8 @@ def confirmed_where_incoherent(diagram, work: SelectionState, settings: Selectio
     part = _counted_part(rec, count.settings.max_samples)
     data = DftLines.from_recording(part, work.refinement.band_hz).noise_weighted(m)
     halves = tuple(DftLines.from_recording(half, work.refinement.band_hz) for half in split_segments(part, 2))
-    agree = halves_z(data, m, halves, hold, count.settings.halves_nfev, count.dft) <= count.settings.halves_sd
+    chi2 = halves_chi2(data, m, halves, hold, count.settings.halves_nfev, count.dft)
+    agree = chdtrc(2, chi2) >= settings.agreement.alpha  # each pole alone: 2 degrees of freedom
     reach, needed = settings.cluster.same_row_freq, count.verdicts() == "needed"
     confirmed, notes = [], []
     for f in check.unconfirmed_hz:
@@ -319,7 +321,7 @@ def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hol
         ))  # fmt: skip
     order = np.argsort([r["freq_hz"] for r in rows])
     rows = pd.DataFrame([rows[k] for k in order])
-    rows, disagree = covering_both_estimators(rows, settings.intervals.estimators_alpha)
+    rows, disagree = covering_both_estimators(rows, settings.agreement.alpha)
     notes += disagree
     work = work.with_modes(rows, np.column_stack([shapes[k] for k in order]), count=count)
     if recording is not None:  # the check of the model the picks come from: the picks and the others

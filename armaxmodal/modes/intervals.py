@@ -34,7 +34,7 @@ of them weights by, both are consistent, and their differences are noise: each
 
 is at most standard normal (the two fits share the record, so the difference varies less than the
 sum of the variances says). Where the sum of ``z^2`` over every mode's frequency and damping ratio
-exceeds the ``estimators_alpha`` (1 %) point of its chi-squared distribution -- Hausman's specification test
+exceeds the ``AgreementSettings.alpha`` (1 %) point of its chi-squared distribution -- Hausman's specification test
 (Econometrica 46 (1978) 1251), with the two estimates taken as independent, which makes it
 conservative -- one of them is biased on this record: by model error the two weight differently
 (a nonlinearity, a hold the model lacks, leakage), or by diagram orders too low for a mode (a light
@@ -167,7 +167,7 @@ def earlier_estimate(row: dict) -> dict:
     return columns
 
 
-def covering_both_estimators(rows: pd.DataFrame, alpha: float = DEFAULTS.intervals.estimators_alpha
+def covering_both_estimators(rows: pd.DataFrame, alpha: float = DEFAULTS.agreement.alpha
                              ) -> tuple[pd.DataFrame, list[QualityWarning]]:  # fmt: skip
     """Counted ``rows`` (with :data:`EARLIER_COLUMNS`) with their intervals covering the earlier
     estimator's where the record shows the two disagree (the module's docstring).
@@ -178,7 +178,7 @@ def covering_both_estimators(rows: pd.DataFrame, alpha: float = DEFAULTS.interva
         The counted modes: ``freq_hz``, ``damping``, ``freq_sd``, ``damping_sd`` and the
         earlier estimate's columns (NaN where a mode has none).
     alpha : float
-        The test's level (:class:`~armaxmodal.modes.settings.IntervalSettings`).
+        The test's level (:class:`~armaxmodal.modes.settings.AgreementSettings`).
 
     Returns
     -------
@@ -242,7 +242,7 @@ def segment_spread(
     n_segments: int = N_SEGMENTS,
     n_jobs: int | None = None,
     fitted: dict | None = None,
-    match_freq: float = DEFAULTS.intervals.match_freq,
+    match_freq: float = DEFAULTS.agreement.match_freq,
 ):
     """Between-segment standard deviation of each mode's frequency and damping.
 
@@ -346,9 +346,9 @@ def segment_poles(parts: list[Recording], job) -> pd.DataFrame | None:
 
 
 def apply_segment_spread(modes: pd.DataFrame, spread: pd.DataFrame, n_segments: int = N_SEGMENTS,
-                         alpha: float = DEFAULTS.intervals.spread_alpha):  # fmt: skip
+                         alpha: float = DEFAULTS.agreement.alpha):  # fmt: skip
     """Join the spread to ``modes``, set the segments' part of the intervals where it dominates, and say so.
-    ``alpha``: the test's family-wise false-alarm rate over all modes and both parameters.
+    ``alpha``: the test's family-wise false-alarm rate over all modes and both parameters (Bonferroni).
 
     Returns ``(modes, warnings)``; ``modes`` gains the spread columns, ``model_error_dominates``
     (bool) and ``freq_segment_half`` / ``damping_segment_half``: the half-width of the segments'

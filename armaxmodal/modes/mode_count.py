@@ -5,8 +5,8 @@ maximum-likelihood modal model (:func:`armaxmodal.modes.dft_model.fit_modal_mode
 mode fewer, one more, or one split, and keeps the neighbour of lowest criterion while it lowers it.
 This module holds what it returns, :class:`ModeCount`, with the verdicts derived from it (which
 poles are reported, the other structures' reach), and the tests the search applies: Bartlett's
-effective share of independent lines (:func:`effective_fraction`), the two halves' agreement
-(``halves_z``), the pairing of two pole sets and the residual's peak.
+effective share of independent lines (:func:`effective_fraction`), the halves' agreement (``halves_chi2``),
+the pairing of two pole sets and the residual's peak.
 
 The criterion is Schwarz's BIC on the effective lines: the method page's "how many modes" gives
 why BIC and not a test at a fixed level, why 10 is decisive, and why the lines are counted by
@@ -24,10 +24,10 @@ import numpy as np
 from armaxmodal.modes.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.intervals import interval
 from armaxmodal.modes.poles import matched_poles, nearest_pole, reported
-from armaxmodal.modes.settings import DEFAULTS, CountSettings, DftSettings, LineSettings
+from armaxmodal.modes.settings import DEFAULTS, AgreementSettings, CountSettings, DftSettings, LineSettings
 from armaxmodal.stats import Z95
 
-__all__ = ["FittedModel", "ModeCount", "ModelTable", "Wanted", "Step", "effective_fraction", "halves_z",
+__all__ = ["FittedModel", "ModeCount", "ModelTable", "Wanted", "Step", "effective_fraction", "halves_chi2",
            "split_start"]
 
 #: the count's thresholds when none are given (:class:`~armaxmodal.modes.settings.CountSettings`)
@@ -143,8 +143,10 @@ class ModeCount:
     band_hz : (float, float)
         The band of the lines the count decided on (Hz): which poles are modes of it.
     unsettled_hz : tuple of float
-        Additions the criterion and the diagram take whose halves differ by more than the halves
-        test allows but at most ``settings.halves_unsettled_sd``: undecided (Hz, the start).
+        Additions the criterion and the diagram take whose halves differ beyond the halves test's
+        level ``agreement.alpha`` but not beyond ``agreement.unsettled_alpha``: undecided (Hz, the start).
+    agreement : AgreementSettings
+        The level of the halves' test.
 
     Examples
     --------
@@ -177,6 +179,7 @@ class ModeCount:
     models: tuple[FittedModel, ...] = ()
     band_hz: tuple[float, float] = (0.0, float("inf"))
     unsettled_hz: tuple[float, ...] = ()
+    agreement: AgreementSettings = DEFAULTS.agreement
 
     def models_table(self):
         """Every model the count fitted, one row each (``FittedModel``'s columns), in the order
@@ -350,12 +353,12 @@ def effective_fraction(residual: np.ndarray, max_lag: int = COUNT.max_correlatio
     return 1.0 / (1.0 + 2.0 * total)
 
 
-def halves_z(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: int = COUNT.halves_nfev,
-             dft: DftSettings = DEFAULTS.dft, fitter=fit_modal_model) -> np.ndarray:  # fmt: skip
+def halves_chi2(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: int = COUNT.halves_nfev,
+                dft: DftSettings = DEFAULTS.dft, fitter=fit_modal_model) -> np.ndarray:  # fmt: skip
     """Per pole of ``model``: how far apart the record's two halves (``halves``, lines weighted as
-    ``data``), each fitted from ``model``'s poles, put it, in standard deviations of the difference,
-    the larger of frequency's and damping's (each half's pole the one nearest the model's). Two fits
-    (``fitter``, as :func:`~armaxmodal.modes.dft_model.fit_modal_model`).
+    ``data``; each fitted from ``model``'s poles by ``fitter``) put it: the squared differences of its
+    frequency and damping in standard deviations of the difference, summed (each half's pole the one
+    nearest the model's): a chi-square of 2 degrees of freedom where the halves agree.
 
     Returns
     -------
@@ -363,13 +366,13 @@ def halves_z(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: int
     """
     a, b = (fitter(h.weighted(data.weights), model.freq_hz, model.damping, hold, max_nfev, dft)
             for h in halves)  # fmt: skip
-    z = np.zeros(model.n_modes)
+    chi2 = np.zeros(model.n_modes)
     for i, f in enumerate(model.freq_hz):
         j, k = nearest_pole(a.freq_hz, f), nearest_pole(b.freq_hz, f)
         for one, two, sd_one, sd_two in ((a.freq_hz, b.freq_hz, a.freq_sd, b.freq_sd),
                                          (a.damping, b.damping, a.damping_sd, b.damping_sd)):  # fmt: skip
-            z[i] = max(z[i], abs(one[j] - two[k]) / max(np.hypot(sd_one[j], sd_two[k]), 1e-300))
-    return z
+            chi2[i] += (abs(one[j] - two[k]) / max(np.hypot(sd_one[j], sd_two[k]), 1e-300)) ** 2
+    return chi2
 
 
 def residual_peak(model: ModalModel, data: DftLines, width_lines: int = COUNT.peak_width_lines) -> tuple[float, float]:

@@ -201,10 +201,10 @@ def spread(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     if ctx.segments < 2:
         return state
     modes, orders = state.modes, ctx.orders
-    limits = ctx.settings.intervals
+    limits = ctx.settings.agreement
     table = segment_spread(ctx.diagram.recording, modes, lambda i: orders[int(modes.at[i, "na"])], ctx.segments,
                            ctx.n_jobs, state.segment_fits, limits.match_freq)  # fmt: skip
-    modes, notes = apply_segment_spread(modes, table, ctx.segments, limits.spread_alpha)
+    modes, notes = apply_segment_spread(modes, table, ctx.segments, limits.alpha)
     return replace(state, modes=modes).warned(*notes)
 
 

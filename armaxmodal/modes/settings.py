@@ -1,13 +1,12 @@
 """The thresholds of the mode selection, in one place: one frozen settings object per stage of
-``select_modes`` (:mod:`armaxmodal.modes.pipeline`), each value with the
-measurement behind it.
+``select_modes`` (:mod:`armaxmodal.modes.pipeline`), each value with the measurement behind it.
 
 ``select_modes(settings=SelectionSettings(count=CountSettings(decisive_bic=6.0)))`` overrides any
 of them; the result carries the settings that made it (``ModeSelection.settings``, and
 ``"settings"`` in the JSON). Values that answer the same question are derived from one another,
 never copied: a pick's reach and a counted mode's row reach are the clustering's frequency reach,
-two modes told apart by shape use the merge's MAC, and what a line is stands in
-``LineSettings``.
+two modes told apart by shape use the merge's MAC, what a line is stands in ``LineSettings``, and
+whether the record agrees with itself is asked at one level (``AgreementSettings``).
 """
 
 from __future__ import annotations
@@ -17,7 +16,7 @@ from dataclasses import MISSING, asdict, dataclass, field, fields
 
 from armaxmodal.exceptions import SettingsError
 
-__all__ = ["ClusterSettings", "CountSettings", "DftSettings", "FrfSettings", "IntervalSettings", "LineSettings",
+__all__ = ["AgreementSettings", "ClusterSettings", "CountSettings", "DftSettings", "FrfSettings", "LineSettings",
            "NoteSettings", "Resolution", "SelectionSettings", "SweepSettings"]
 
 
@@ -47,8 +46,8 @@ NORMAL_EQUATIONS_MIN_RATIO = 1e-6
 
 
 #: the thresholds that are a probability, a share or a MAC: at most 1
-_AT_MOST_ONE = frozenset({"min_support", "merge_mac", "support_alpha", "likelihood_alpha", "spread_alpha",
-                          "estimators_alpha", "edge_fraction", "oversampled_fraction", "min_damping",
+_AT_MOST_ONE = frozenset({"min_support", "merge_mac", "support_alpha", "likelihood_alpha", "alpha",
+                          "unsettled_alpha", "edge_fraction", "oversampled_fraction", "min_damping",
                           "max_damping"})  # fmt: skip
 
 
@@ -68,7 +67,6 @@ def _checked(settings) -> None:
         if f.name in _AT_MOST_ONE and value > 1:
             raise SettingsError(f"{name}.{f.name}: a probability, share or MAC is at most 1, got {value!r} (the "
                                 f"default is {default!r}).")  # fmt: skip
-
 
 
 @dataclass(frozen=True)
@@ -248,12 +246,6 @@ class CountSettings:
     final_nfev: int = 200
     #: residual evaluations of each half's fit in the halves test
     halves_nfev: int = 40
-    #: a new pole's frequency and damping in the record's two halves may differ by this many
-    #: standard deviations of their difference (a two-sided 1 % test would take 2.6)
-    halves_sd: float = 3.0
-    #: an addition the criterion and the diagram take whose halves differ by more than ``halves_sd``
-    #: but at most this many is undecided, not refused (a weak mode's damping 3.6 apart in its halves)
-    halves_unsettled_sd: float = 5.0
     #: a candidate addition within this relative frequency of a mode is that mode
     same_mode_freq: float = 0.03
     #: the nested tests run on at most this many samples of a record (18 min at 60 Hz, 9 at 120 Hz:
@@ -272,16 +264,22 @@ class CountSettings:
 
 
 @dataclass(frozen=True)
-class IntervalSettings:
-    """What the 95 % intervals cover beyond the estimate's own deviation (stages ``segments`` and
-    ``intervals``)."""
+class AgreementSettings:
+    """Does the record agree with itself, asked three ways: its two halves (a count's new pole, a mode
+    the H1 cannot confirm), its disjoint segments (each mode's spread) and its two estimators. One
+    multiplicity policy for the three: each test is one family, its false-alarm rate over every value
+    it judges ``alpha``; values judged together pool into one chi-square of their standardised
+    differences (the halves: a trial's new poles' frequency and damping; the estimators: every
+    mode's), values judged one by one share ``alpha`` (Bonferroni: the segments' modes)."""
 
-    #: family-wise false-alarm rate of the segments' spread test over all modes and both parameters
-    spread_alpha: float = 0.01
-    #: a segment pole is the mode's when within this relative frequency of it
+    #: each test's false-alarm rate (the estimators' test: 30-59 on the F-16's levels for 12 values, 77
+    #: for 6 on a ride with a cubic spring, none on its linear twin; the 1 % points are 26.2 and 16.8)
+    alpha: float = 0.01
+    #: a new pole the halves refuse at ``alpha`` but not at this rate is undecided, not refused (a weak
+    #: mode's damping 3.6 standard deviations apart in its halves; 1e-6: one value 5.3 apart)
+    unsettled_alpha: float = 1e-6
+    #: a segment's pole is the mode's when within this relative frequency of it
     match_freq: float = 0.05
-    #: the level of the two estimators' test: the one the segments' test of model error uses
-    estimators_alpha: float = 0.01
 
     def __post_init__(self):
         _checked(self)
@@ -305,8 +303,8 @@ class SelectionSettings:
         The modal model's fits to the record's DFT.
     count : CountSettings
         The count by nested tests, and the separation of close modes.
-    intervals : IntervalSettings
-        The segments' and the two estimators' tests.
+    agreement : AgreementSettings
+        The one level of the halves', the segments' and the two estimators' tests.
     notes : NoteSettings
         The informative notes' thresholds.
 
@@ -325,7 +323,7 @@ class SelectionSettings:
     frf: FrfSettings = field(default_factory=FrfSettings)
     dft: DftSettings = field(default_factory=DftSettings)
     count: CountSettings = field(default_factory=CountSettings)
-    intervals: IntervalSettings = field(default_factory=IntervalSettings)
+    agreement: AgreementSettings = field(default_factory=AgreementSettings)
     notes: NoteSettings = field(default_factory=NoteSettings)
 
     def __post_init__(self):

@@ -569,7 +569,7 @@ def test_the_modal_model_confirms_a_mode_where_the_h1_is_not_coherent(monkeypatc
     check = replace(sel.check, unconfirmed_hz=(f0,))
     assert not check.passed
     z = 0.0 if halves_agree else 9.0  # standard deviations between the halves
-    monkeypatch.setattr(counted, "halves_z", lambda d, m, h, hold, *limits: np.full(m.n_modes, z))
+    monkeypatch.setattr(counted, "halves_chi2", lambda d, m, h, hold, *limits: np.full(m.n_modes, z**2))
     work = counted.confirmed_where_incoherent(
         bundled_diagram, SelectionState(sel.modes, sel.shapes, sel.refinement, check, count)
     )
@@ -928,10 +928,11 @@ def test_a_lightly_damped_chain_sampled_far_above_its_modes_names_what_the_sweep
 
 @pytest.mark.parametrize(("z", "said"), [(2.0, None), (4.0, "count_undecided"), (9.0, "mode_count")])
 def test_an_addition_its_halves_nearly_confirm_is_undecided_not_refused(monkeypatch, supine, z, said):
-    """Criterion 95 for 3 modes, 50 for 4, with a diagram column: the halves put the new pole z
-    standard deviations apart. Within 3 it is added; beyond 5 it is a change during the record, left
-    out with an informative note; in between the record does not settle it (a light chain's weak
-    20.75 Hz mode, its damping 3.6 apart in its halves, was left out under 'good')."""
+    """Criterion 95 for 3 modes, 50 for 4, with a diagram column: the halves put the new pole's
+    frequency z standard deviations apart (its damping the same). Within the 1 % level of a chi-square
+    of 2 degrees of freedom it is added; beyond 1e-6 it is a change during the record, left out with
+    an informative note; in between the record does not settle it (a light chain's weak 20.75 Hz
+    mode, its damping 3.6 apart in its halves, was left out under 'good')."""
     import armaxmodal.modes.count_search as count_search
 
     table = {2: 130.0, 3: 95.0, 4: 50.0, 5: 250.0}
