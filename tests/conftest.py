@@ -26,6 +26,15 @@ def realdata_dir() -> Path:
 
 
 @pytest.fixture(scope="session")
+def bundled_diagram(fixtures_dir):
+    """The bundled supine ride's shared-pole diagram, orders 2-20 (no per-sensor sweeps)."""
+    import armaxmodal as am
+
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    return am.stabilisation_diagram(rec, range(2, 21, 2), per_sensor=False)
+
+
+@pytest.fixture(scope="session")
 def light_ride():
     """Two lightly damped modes (about 4 and 11 Hz, 1-2 %) on a band-limited random ride
     with 2 % sensor noise: ``(structure, recording)``."""

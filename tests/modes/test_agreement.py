@@ -71,10 +71,10 @@ def test_a_trial_with_no_new_pole_agrees():
     assert search.in_both_halves(MODEL, [], HALVES) is True and search.p == 1.0
 
 
-def test_the_one_level_reaches_the_estimators_test(fixtures_dir):
+def test_the_one_level_reaches_the_estimators_test(bundled_diagram):
     """On the bundled ride the two estimators agree at 1 %; at a level of 1 every difference is too
     many (the chi-square's 100 % point is 0)."""
-    diagram = am.stabilisation_diagram(am.read_recording(fixtures_dir / "supine_random.csv"))
+    diagram = bundled_diagram
     default = am.select_modes(diagram, n_jobs=1, segments=0)
     every = am.select_modes(diagram, n_jobs=1, segments=0, settings=SelectionSettings(agreement=AgreementSettings(1.0)))
     assert default.quality == "good" and "estimators_disagree" not in {w.code for w in default.warnings}

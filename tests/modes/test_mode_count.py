@@ -347,12 +347,6 @@ def test_the_likelihood_does_not_depend_on_the_weights(supine):
     np.testing.assert_allclose(b.rss, a.rss, rtol=1e-9)
 
 
-@pytest.fixture(scope="module")
-def bundled_diagram(fixtures_dir):
-    rec = am.read_recording(fixtures_dir / "supine_random.csv")
-    return am.stabilisation_diagram(rec, range(2, 21, 2), per_sensor=False)
-
-
 def test_a_model_that_keeps_no_mode_leaves_the_selection_and_says_so(monkeypatch, bundled_diagram):
     before = am.select_modes(bundled_diagram, segments=0)
     monkeypatch.setattr(ModeCount, "verdicts", lambda count, band=None: np.full(count.model.freq_hz.size, "not_a_mode"))
