@@ -11,7 +11,7 @@ from scipy.special import chdtrc
 import armaxmodal as am
 from armaxmodal.modes.count_search import _Search
 from armaxmodal.modes.mode_count import halves_chi2
-from armaxmodal.modes.settings import AgreementSettings, SelectionSettings
+from armaxmodal.modes.settings import AgreementSettings, DftSettings, SelectionSettings
 
 
 class _Half:
@@ -39,14 +39,21 @@ MODEL = SimpleNamespace(freq_hz=np.array([5.0, 10.0]), damping=np.array([0.1, 0.
 HALVES = (_Half("first"), _Half("second"))
 
 
+SEEN = []
+
+
 def _fitter(data, freq_hz, damping, hold, max_nfev, dft):
+    SEEN.append((hold, max_nfev, dft, tuple(freq_hz)))
     return FITS[data.name]
 
 
 def test_the_halves_statistic_sums_both_values_squared_differences():
     # 5 Hz: 0.1 Hz apart (2 SD), damping 0.03 apart (3 SD): 4 + 9; 10 Hz: 1 SD each: 1 + 1
-    chi2 = halves_chi2(SimpleNamespace(weights=1.0), MODEL, HALVES, "zoh", fitter=_fitter)
+    SEEN.clear()
+    slow = DftSettings(fit_tol=1e-9)
+    chi2 = halves_chi2(SimpleNamespace(weights=1.0), MODEL, HALVES, "zoh", 17, slow, fitter=_fitter)
     assert chi2 == pytest.approx([13.0, 2.0])
+    assert SEEN == [("zoh", 17, slow, (5.0, 10.0))] * 2  # each half fitted from the model's poles, as asked
 
 
 @pytest.mark.parametrize(
@@ -60,10 +67,15 @@ def test_the_halves_statistic_sums_both_values_squared_differences():
     ],
 )
 def test_the_count_pools_a_trials_new_poles_at_the_one_level(new, alpha, statistic, agree):
-    search = _Search(SimpleNamespace(weights=1.0), "zoh", 1e4, 40, fitter=_fitter,
+    SEEN.clear()
+    slow = DftSettings(fit_tol=1e-9)
+    search = _Search(SimpleNamespace(weights=1.0), "bandlimited", 1e4, 23, dft=slow, fitter=_fitter,
                      agreement=AgreementSettings(alpha=alpha))  # fmt: skip
     assert search.in_both_halves(MODEL, new, HALVES) is agree
     assert search.p == pytest.approx(chdtrc(2 * len(new), statistic)) and search.trials == 2
+    assert {seen[:3] for seen in SEEN} == {("bandlimited", 23, slow)}  # the search's own fits' settings
+    search.in_both_halves(MODEL, new, HALVES)
+    assert search.trials == 4  # two fits a test
 
 
 def test_a_trial_with_no_new_pole_agrees():
