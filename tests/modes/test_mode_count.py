@@ -18,7 +18,7 @@ from armaxmodal.modes.notes import count_notes as _notes
 from armaxmodal.modes.notes import not_separated_notes
 from armaxmodal.modes.poles import reported
 from armaxmodal.modes.result import ModeSelection
-from armaxmodal.modes.settings import ClusterSettings, CountSettings, SelectionSettings
+from armaxmodal.modes.settings import AgreementSettings, ClusterSettings, CountSettings, SelectionSettings
 from armaxmodal.stats import Z95
 
 DECISIVE_BIC = CountSettings().decisive_bic  # the count's own level
@@ -547,8 +547,8 @@ def test_with_the_halves_a_moved_pole_is_judged_by_them_not_by_the_diagram(monke
     "rise, halves_agree, stand_in, confirmed",
     [(500.0, True, False, True), (5.0, True, False, False), (500.0, False, False, False), (500.0, True, True, False)],
 )
-def test_the_modal_model_confirms_a_mode_where_the_h1_is_not_coherent(monkeypatch, bundled_diagram, rise, halves_agree,
-                                                                      stand_in, confirmed):  # fmt: skip
+def test_the_modal_model_confirms_a_mode_where_the_h1_is_not_coherent(bundled_diagram, rise, halves_agree, stand_in,
+                                                                      confirmed):  # fmt: skip
     """A mode the FRF check cannot test (no coherent H1 line near it) is confirmed when the
     likelihood needs it decisively and the record's halves agree on it; else it stays unconfirmed.
     A pole the model needs that the count calls no mode (a stand-in) confirms nothing."""
@@ -562,10 +562,10 @@ def test_the_modal_model_confirms_a_mode_where_the_h1_is_not_coherent(monkeypatc
                     stand_ins=((f0, f0, rise),) if stand_in else ())  # fmt: skip
     check = replace(sel.check, unconfirmed_hz=(f0,))
     assert not check.passed
-    z = 0.0 if halves_agree else 9.0  # standard deviations between the halves
-    monkeypatch.setattr(counted, "halves_chi2", lambda d, m, h, hold, *limits: np.full(m.n_modes, z**2))
+    # the ride's halves agree on its modes at 1 %; at a level of 1 no two halves agree
+    level = SelectionSettings(agreement=AgreementSettings(alpha=0.01 if halves_agree else 1.0))
     work = counted.confirmed_where_incoherent(
-        bundled_diagram, SelectionState(sel.modes, sel.shapes, sel.refinement, check, count)
+        bundled_diagram, SelectionState(sel.modes, sel.shapes, sel.refinement, check, count), level
     )
     assert work.check.passed is confirmed and (work.check.unconfirmed_hz == ()) is confirmed
     assert [n.value for n in work.warnings] == ([f0] if confirmed else [])
