@@ -128,9 +128,9 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
         notes.append(QualityWarning(
             "count_undecided", (),
             f"one mode more near {f:.3f} Hz lowers the criterion decisively and the diagram holds a stable column "
-            f"there, but its frequency and damping differ between the record's halves beyond the halves test's "
-            f"{100 * count.agreement.alpha:g} % level, though not beyond {count.agreement.unsettled_alpha:g}: the "
-            "record does not settle whether it "
+            f"there, but its frequency and damping in the record's two halves differ by more than chance allows at "
+            f"the {100 * count.agreement.alpha:g} % level, though not by enough ({count.agreement.unsettled_alpha:g}) "
+            "to call it a change during the record: the record does not settle whether it "
             "is a mode; compare another record of "
             "the structure, or pick it ('--pick') to see what the record says of it", f,
         ))  # fmt: skip

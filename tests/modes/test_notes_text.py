@@ -74,9 +74,9 @@ def test_every_count_note_says_its_numbers_in_their_places():
             '(its damping unresolved, or not the same in both halves of the record); left out'),
         ('count_undecided', 18.75,
             'one mode more near 18.750 Hz lowers the criterion decisively and the diagram holds a '
-            "stable column there, but its frequency and damping differ between the record's halves "
-            "beyond the halves test's 1 % level, though not beyond 1e-06: the record does not settle "
-            'whether it is a mode; compare another record of the '
+            "stable column there, but its frequency and damping in the record's two halves differ by more "
+            "than chance allows at the 1 % level, though not by enough (1e-06) to call it a change during "
+            'the record: the record does not settle whether it is a mode; compare another record of the '
             "structure, or pick it ('--pick') to see what the record says of it"),
         ('mode_count', 14.25,
             'one mode more near 14.250 Hz fits the whole record better but not each of its halves: a '
