@@ -18,7 +18,7 @@ from armaxmodal.modes.notes import count_notes as _notes
 from armaxmodal.modes.notes import not_separated_notes
 from armaxmodal.modes.poles import reported
 from armaxmodal.modes.result import ModeSelection
-from armaxmodal.modes.settings import AgreementSettings, ClusterSettings, CountSettings, SelectionSettings
+from armaxmodal.modes.settings import AgreementSettings, ClusterSettings, CountSettings, LineSettings, SelectionSettings
 from armaxmodal.stats import Z95
 
 DECISIVE_BIC = CountSettings().decisive_bic  # the count's own level
@@ -347,10 +347,12 @@ def test_the_likelihood_does_not_depend_on_the_weights(supine):
     np.testing.assert_allclose(b.rss, a.rss, rtol=1e-9)
 
 
-def test_a_model_that_keeps_no_mode_leaves_the_selection_and_says_so(monkeypatch, bundled_diagram):
+def test_a_model_that_keeps_no_mode_leaves_the_selection_and_says_so(bundled_diagram):
     before = am.select_modes(bundled_diagram, segments=0)
-    monkeypatch.setattr(ModeCount, "verdicts", lambda count, band=None: np.full(count.model.freq_hz.size, "not_a_mode"))
-    sel = am.select_modes(bundled_diagram, segments=0)
+    # every pole damped below 0.9 a line: the count's model keeps no mode of the band
+    lines = SelectionSettings(lines=LineSettings(at_fit_floor=0.9))
+    sel = am.select_modes(bundled_diagram, segments=0, settings=lines)
+    assert (sel.count.verdicts() == "not_a_mode").all()
     assert len(sel.modes) == len(before.modes) == 4 and sel.quality == "uncertain"
     assert "count_undecided" in sel.uncertain_because
 
