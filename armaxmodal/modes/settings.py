@@ -283,6 +283,9 @@ class AgreementSettings:
 
     def __post_init__(self):
         _checked(self)
+        if self.unsettled_alpha >= self.alpha:
+            raise SettingsError(f"AgreementSettings: unsettled_alpha ({self.unsettled_alpha!r}) must lie below alpha "
+                                f"({self.alpha!r}).")  # fmt: skip
 
 
 @dataclass(frozen=True)
