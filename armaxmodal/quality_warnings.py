@@ -311,7 +311,9 @@ CODES: tuple[WarningCode, ...] = (
         "removing the weakest mode (the rest refitted free), or adding the best candidate, moves BIC by less than 10 "
         "(Kass & Raftery's \"very strong\"); or a starting mode the count left out (carried by the free fit to "
         "where no mode is founded) while the H1 keeps a coherent peak no mode explains within 5 % of it (a bridge "
-        "under an earthquake: the halves test is weak on a transient input)",
+        "under an earthquake: the halves test is weak on a transient input); or a pole of the modal model beyond "
+        "the band or damped beyond 0.6 whose 95 % interval reaches back into the band and below 0.6 (a heavily "
+        "damped mode near the band's top)",
         "`\"quality\": \"uncertain\"`: the weakest mode, or one more near the frequency named, is tentative",
         "Treat the mode named as tentative: compare another record of the structure, or `--pick` it to see what the "
         "record says.",

@@ -2,7 +2,8 @@
 spring and damper scaled by a factor drawn in 0.8-1.25, a 120 s ride at 60 Hz with 3 % sensor
 noise, selected as ``stabilise`` selects and judged by ``count_battery.py``'s rule (each exact mode
 within max(2 %, 3 Cramér-Rao bounds), its damping within max(10 %, 3 bounds); above 0.9 of the
-band its interval holding the exact value will do).
+band its interval holding the exact value will do, and a mode missed there is excused: the last
+tally counts those missed under ``good``).
 
     python scripts/feet_bodies.py [--seed 1] [--bodies 15] [--ride random|butter24] [--hold zoh|bandlimited]
 
@@ -39,7 +40,7 @@ def main() -> None:
     parser.add_argument("--hold", choices=("zoh", "bandlimited"), default="zoh")
     args = parser.parse_args()
     rng = np.random.default_rng(args.seed)
-    tally = {"right": 0, "wrong_good": 0, "right_flagged": 0}
+    tally = {"right": 0, "wrong_good": 0, "right_flagged": 0, "lost_good": 0}
     for i in range(args.bodies):
         s = body(rng)
         if args.ride == "random":
@@ -55,11 +56,16 @@ def main() -> None:
         tally["right"] += ok
         tally["wrong_good"] += (not ok) and sel.quality == "good"
         tally["right_flagged"] += ok and sel.quality != "good"
+        # the judge excuses a mode missed above 0.9 of the band; under 'good' a mode of the ride's band is lost still
+        top = 28.0 if args.ride == "random" else 24.0
+        lost = [f for f in truth.freq_hz if f <= top and not np.any(np.abs(sel.modes.freq_hz / f - 1) <= 0.15)]
+        tally["lost_good"] += bool(lost) and sel.quality == "good"
         verdict = "right" if ok else "WRONG: " + "; ".join(why)
         print(f"{args.seed}#{i}: exact {np.round(truth.freq_hz, 2).tolist()}, found "
               f"{np.round(sel.modes.freq_hz, 2).tolist()} {sel.quality} | {verdict}", flush=True)  # fmt: skip
     print(f"\n{tally['right']}/{args.bodies} right; {tally['wrong_good']} wrong ones say good; "
-          f"{tally['right_flagged']} right ones say uncertain or poor")
+          f"{tally['right_flagged']} right ones say uncertain or poor; "
+          f"{tally['lost_good']} lose a mode of the ride's band under good")
 
 
 if __name__ == "__main__":

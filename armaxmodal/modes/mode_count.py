@@ -23,7 +23,7 @@ import numpy as np
 
 from armaxmodal.modes.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.intervals import interval
-from armaxmodal.modes.poles import matched_poles, nearest_pole, reported
+from armaxmodal.modes.poles import borderline, matched_poles, nearest_pole, reported
 from armaxmodal.modes.settings import DEFAULTS, AgreementSettings, CountSettings, DftSettings, LineSettings
 from armaxmodal.stats import Z95
 
@@ -233,8 +233,10 @@ class ModeCount:
         * ``"stand_in"``: a start the search carried where no mode is founded but which the
           model needs (``stand_ins``, matched within ``settings.same_mode_freq``): kept in the
           model, not reported;
-        * ``"not_a_mode"``: beyond the band, damped beyond
-          ``MAX_DAMPING``, or a line (:func:`reported`).
+        * ``"not_a_mode"``: beyond the band, damped beyond ``MAX_DAMPING``, or a line (:func:`reported`);
+        * ``"borderline"``: beyond the band or ``MAX_DAMPING`` by its estimate, not by its 95 % interval
+          (:func:`~armaxmodal.modes.poles.borderline`): not reported, and the record does not decide
+          whether a mode of the band is there.
 
         Starts the search left out of the model (``carried_away``) are not among its poles.
 
@@ -250,18 +252,14 @@ class ModeCount:
         band = self.band_hz if band_hz is None else band_hz
         verdict = np.where(self.removal_rise >= self.settings.decisive_bic, "needed", "undecided").astype(object)
         verdict[~reported(self.model, band, self.lines)] = "not_a_mode"
+        verdict[borderline(self.model, band, self.lines)] = "borderline"
         for _, went, _ in self.stand_ins:
             verdict[np.abs(np.log(self.model.freq_hz / went)) <= self.settings.same_mode_freq] = "stand_in"
         return verdict
 
     def reported(self, band_hz=None) -> np.ndarray:
         """Which of the model's poles are reported as modes of the band (bool per pole): those
-        :meth:`verdicts` calls ``needed`` or ``undecided``.
-
-        Parameters
-        ----------
-        band_hz : (float, float), optional
-            The band (Hz); default ``band_hz``.
+        :meth:`verdicts` (over ``band_hz``, Hz; default ``band_hz``) calls ``needed`` or ``undecided``.
 
         Returns
         -------

@@ -16,7 +16,7 @@ from armaxmodal.modes.mode_count import ModeCount, reported
 from armaxmodal.modes.settings import DEFAULTS, NoteSettings
 from armaxmodal.prepare.resample import BAND_FRACTION_OF_FS
 from armaxmodal.quality_warnings import QualityWarning
-from armaxmodal.stats import MAX_DAMPING
+from armaxmodal.stats import MAX_DAMPING, Z95
 
 __all__ = ["count_notes", "no_mode_kept_note", "not_separated_notes", "oversampling_note", "pick_notes",
            "unresolved_damping_notes"]
@@ -162,7 +162,9 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             + ("; whether a mode is there, the record does not decide: compare another record of the structure, or "
                "pick it ('--pick') to see what the record says of it" if inside else ""), went,
         ))  # fmt: skip
-    outside = ~reported(count.model, band_hz)  # beyond the band, overdamped or lines (not the stand-ins)
+    verdicts = count.verdicts(band_hz)
+    notes += [_borderline_note(count.model, i, band_hz) for i in np.flatnonzero(verdicts == "borderline")]
+    outside = ~reported(count.model, band_hz) & (verdicts != "borderline")  # beyond the band, overdamped or lines
     hidden = int(outside.sum())
     if hidden:
         out = ", ".join(
@@ -177,6 +179,25 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             float(hidden),
         ))  # fmt: skip
     return notes
+
+
+def _borderline_note(model, i: int, band_hz) -> QualityWarning:
+    f, x, df, dx = model.freq_hz[i], model.damping[i], Z95 * model.freq_sd[i], Z95 * model.damping_sd[i]
+    where, reach = [], []
+    if not band_hz[0] <= f <= band_hz[1]:
+        where.append(f"beyond the band {band_hz[0]:.4g}-{band_hz[1]:.4g} Hz")
+        reach.append("into the band")
+    if x > MAX_DAMPING:
+        where.append(f"damped beyond {MAX_DAMPING:g}")
+        reach.append(f"below {MAX_DAMPING:g}")
+    return QualityWarning(
+        "count_undecided", (),
+        f"the modal model's pole at {f:.3f} Hz (damping {x:.2f}) lies {' and '.join(where)}, so it is not reported "
+        f"as a mode, but its 95 % interval ({f - df:.4g}-{f + df:.4g} Hz, damping {x - dx:.2f}-{x + dx:.2f}) reaches "
+        f"{' and '.join(reach)}: the record does not decide whether the band holds one mode more there (a heavily "
+        "damped mode near the band's edge is estimated so); excite and fit a band reaching past it to decide",
+        float(f),
+    )  # fmt: skip
 
 
 def oversampling_note(mode_freqs: np.ndarray, fs: float, settings: NoteSettings = DEFAULTS.notes
