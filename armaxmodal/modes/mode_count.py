@@ -8,9 +8,8 @@ poles are reported, the other structures' reach), and the tests the search appli
 effective share of independent lines (:func:`effective_fraction`), the halves' agreement (``halves_chi2``),
 the pairing of two pole sets and the residual's peak.
 
-The criterion is Schwarz's BIC on the effective lines: the method page's "how many modes" gives
-why BIC and not a test at a fixed level, why 10 is decisive, and why the lines are counted by
-their residual's correlation (:func:`effective_fraction`).
+The criterion is Schwarz's BIC on the effective lines: the method page's "how many modes" gives why BIC and
+not a test at a fixed level, why 10 is decisive, and why the lines are counted by their residual's correlation.
 """
 
 from __future__ import annotations
@@ -61,8 +60,8 @@ class FittedModel(NamedTuple):
 
 
 class ModelTable:
-    """The count's table as the search fills it: one :class:`FittedModel` per fit, in order, with
-    ``-2 ln L`` and BIC on ``n_effective`` real numbers (:func:`effective_fraction`)."""
+    """The count's table as the search fills it: one :class:`FittedModel` per fit, in order, with ``-2 ln L`` and BIC
+    on ``n_effective`` real numbers (:func:`effective_fraction`)."""
 
     def __init__(self, n_effective: float):
         self.n_eff, self.rows = n_effective, []
@@ -234,9 +233,8 @@ class ModeCount:
           model needs (``stand_ins``, matched within ``settings.same_mode_freq``): kept in the
           model, not reported;
         * ``"not_a_mode"``: beyond the band, damped beyond ``MAX_DAMPING``, or a line (:func:`reported`);
-        * ``"borderline"``: beyond the band or ``MAX_DAMPING`` by its estimate, not by its 95 % interval
-          (:func:`~armaxmodal.modes.poles.borderline`): not reported, and the record does not decide
-          whether a mode of the band is there.
+        * ``"borderline"``: not a mode by its estimate but one by its 95 % interval (:func:`.poles.borderline`):
+          not reported, and the record does not decide whether a mode of the band is there.
 
         Starts the search left out of the model (``carried_away``) are not among its poles.
 
@@ -259,7 +257,12 @@ class ModeCount:
 
     def reported(self, band_hz=None) -> np.ndarray:
         """Which of the model's poles are reported as modes of the band (bool per pole): those
-        :meth:`verdicts` (over ``band_hz``, Hz; default ``band_hz``) calls ``needed`` or ``undecided``.
+        :meth:`verdicts` calls ``needed`` or ``undecided``.
+
+        Parameters
+        ----------
+        band_hz : (float, float), optional
+            The band (Hz); default ``band_hz``.
 
         Returns
         -------
@@ -335,8 +338,7 @@ def effective_fraction(residual: np.ndarray, max_lag: int = COUNT.max_correlatio
     >>> round(effective_fraction(white + np.roll(white, 1, axis=0)), 1)  # neighbours correlated 0.5
     0.5
     """
-    r = np.asarray(residual)
-    r = r - r.mean(axis=0)
+    r = np.asarray(residual) - np.mean(residual, axis=0)
     power = np.sum(np.abs(r) ** 2)
     if power == 0 or r.shape[0] < 4:
         return 1.0

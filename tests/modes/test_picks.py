@@ -114,7 +114,8 @@ def test_a_pick_the_record_does_not_need_is_said():
     """Two kept picks: without the first the criterion rises by 4 only (under 10), without the second by 80."""
     from armaxmodal.modes.notes import pick_notes as _pick_notes
 
-    model = SimpleNamespace(freq_hz=np.array([5.0, 9.0]), damping=np.array([0.1, 0.05]))
+    model = SimpleNamespace(freq_hz=np.array([5.0, 9.0]), damping=np.array([0.1, 0.05]), freq_sd=np.full(2, 0.01),
+                            damping_sd=np.full(2, 0.001))  # fmt: skip
     count = ModeCount(model, model, (), np.array([4.0, 80.0]), -30.0, 7.0, 1.0, settings=CountSettings())
     (note,) = _pick_notes(count, np.array([True, True]))
     assert note.code == "pick_not_supported" and note.value == 5.0 and "+4.0" in note.message
@@ -130,7 +131,9 @@ def test_the_picks_model_keeps_the_poles_the_automatic_model_hides(monkeypatch, 
 
     _, diagram = ride
     sel = am.select_modes(diagram, segments=0)
-    beyond = SimpleNamespace(freq_hz=np.r_[sel.count.model.freq_hz, 40.0], damping=np.r_[sel.count.model.damping, 0.1])
+    m = sel.count.model  # the pole added at 40 Hz is beyond the band by its interval too (+-1 Hz)
+    beyond = SimpleNamespace(freq_hz=np.r_[m.freq_hz, 40.0], damping=np.r_[m.damping, 0.1],
+                             freq_sd=np.r_[m.freq_sd, 0.5], damping_sd=np.r_[m.damping_sd, 0.01])  # fmt: skip
     modes = sel.modes.assign(picked_hz=[5.9, 8.2, np.nan, np.nan])
     count = replace(sel.count, model=beyond, removal_rise=np.r_[sel.count.removal_rise, 50.0])  # one rise per pole
     work = SelectionState(modes, sel.shapes, sel.refinement, sel.check, count)
