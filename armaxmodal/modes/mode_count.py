@@ -233,7 +233,7 @@ class ModeCount:
           model needs (``stand_ins``, matched within ``settings.same_mode_freq``): kept in the
           model, not reported;
         * ``"not_a_mode"``: beyond the band, damped beyond ``MAX_DAMPING``, or a line (:func:`reported`);
-        * ``"borderline"``: not a mode by its estimate but one by its 95 % interval (:func:`.poles.borderline`):
+        * ``"borderline"``: not one by its estimate, one by its 95 % interval (``poles.borderline``):
           not reported, and the record does not decide whether a mode of the band is there.
 
         Starts the search left out of the model (``carried_away``) are not among its poles.
