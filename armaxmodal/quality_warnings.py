@@ -316,7 +316,7 @@ CODES: tuple[WarningCode, ...] = (
         "damped mode near the band's top)",
         "`\"quality\": \"uncertain\"`: the weakest mode, or one more near the frequency named, is tentative",
         "Treat the mode named as tentative: compare another record of the structure, or `--pick` it to see what the "
-        "record says.",
+        "record says; for a pole just past the band, excite and fit a band that reaches past it (`--band`).",
         uncertain=True,
     ),
     WarningCode(
