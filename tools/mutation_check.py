@@ -661,7 +661,7 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/notes.py",
-        'undecided = keep & (count.verdicts(band_hz) == "undecided")',
+        'undecided = keep & (verdicts == "undecided")',
         "undecided = count.removal_rise < decisive",
         "a weak pole kept unreported makes the reported modes undecided (count)",
     ),

@@ -93,7 +93,8 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             f"{words[step.action]}{where}, the information criterion (BIC) falls by {step.bic_fall:.1f}",
             float(step.freq_hz),
         ))  # fmt: skip
-    undecided = keep & (count.verdicts(band_hz) == "undecided")  # of the reported modes only
+    verdicts = count.verdicts(band_hz)  # each pole's, decided once by the count
+    undecided = keep & (verdicts == "undecided")  # of the reported modes only
     if undecided.any():
         rise = float(count.removal_rise[undecided].min())
         notes.append(QualityWarning(
@@ -162,9 +163,8 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             + ("; whether a mode is there, the record does not decide: compare another record of the structure, or "
                "pick it ('--pick') to see what the record says of it" if inside else ""), went,
         ))  # fmt: skip
-    verdicts = count.verdicts(band_hz)
     notes += [_borderline_note(count.model, i, band_hz) for i in np.flatnonzero(verdicts == "borderline")]
-    outside = ~reported(count.model, band_hz) & (verdicts != "borderline")  # beyond the band, overdamped or lines
+    outside = ~reported(count.model, band_hz) & (verdicts != "borderline")  # beyond the band, overdamped, lines
     hidden = int(outside.sum())
     if hidden:
         out = ", ".join(
