@@ -384,7 +384,8 @@ def severity(code: str) -> str:
 class QualityWarning:
     """One data-quality finding: ``code`` (see ``WARNING_CODES``), the channels it
     concerns, a sentence with the measured number, and that number (``value``, its unit in
-    the message).
+    the message); ``freq_hz``, the frequencies (Hz) it is about, if any (what the one-line
+    summary of the notes names).
 
     Examples
     --------
@@ -398,14 +399,18 @@ class QualityWarning:
     channels: tuple[str, ...]
     message: str
     value: float | None = None
+    freq_hz: tuple[float, ...] = ()
 
     def __post_init__(self):
         if self.code not in WARNING_CODES:
             raise ValueError(f"unknown warning code {self.code!r}; expected one of {WARNING_CODES}.")
+        object.__setattr__(self, "freq_hz", tuple(float(f) for f in self.freq_hz))
 
     def to_dict(self) -> dict:
         value = None if self.value is None or not np.isfinite(self.value) else float(self.value)
-        return {"code": self.code, "channels": list(self.channels), "message": self.message, "value": value}
+        freqs = [f for f in self.freq_hz if np.isfinite(f)]
+        return {"code": self.code, "channels": list(self.channels), "message": self.message, "value": value,
+                "freq_hz": freqs}  # fmt: skip
 
 
 def not_run(check: str, channels: tuple[str, ...], why: str) -> QualityWarning:

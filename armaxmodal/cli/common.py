@@ -140,9 +140,10 @@ NOTE_WIDTH, NOTE_LINES = 100, 23
 
 def print_notes(warnings, verbose: bool = False) -> None:
     """The notes on stderr (even with --quiet), one line per code within ``NOTE_WIDTH`` characters:
-    its severity (:func:`armaxmodal.quality_warnings.severity`), how many, the channels, what to
-    do; problems first, then warnings, then information. ``verbose``: every full text under its
-    code. The JSON and ``--report`` always hold the full texts."""
+    its severity (:func:`armaxmodal.quality_warnings.severity`), how many, the channels and the
+    frequencies (``QualityWarning.freq_hz``), what to do; problems first, then warnings, then
+    information. ``verbose``: every full text under its code. The JSON and ``--report`` always
+    hold the full texts."""
     import textwrap
 
     from armaxmodal.quality_warnings import CODES, UNCERTAIN_CODES, severity
@@ -165,6 +166,7 @@ def print_notes(warnings, verbose: bool = False) -> None:
         notes = groups[code]
         channels = sorted({c for w in notes for c in w.channels})
         where = f", {', '.join(channels)}" if channels and len(", ".join(channels)) <= 30 else ""
+        where += _frequencies(sorted({round(f, 2) for w in notes for f in w.freq_hz}))
         head, text = f"  {severity(code):<8}{code} ({len(notes)}{where}): ", advice.get(code, "")
         if len(head) + len(text) > NOTE_WIDTH and not verbose:  # cut at a word, marked
             text = text[: NOTE_WIDTH - len(head) - 4].rsplit(" ", 1)[0] + " ..."
@@ -174,6 +176,15 @@ def print_notes(warnings, verbose: bool = False) -> None:
                   file=sys.stderr)  # fmt: skip
     if len(shown) < len(codes):
         print(f"  ... {len(codes) - len(shown)} more codes (--verbose)", file=sys.stderr)
+
+
+def _frequencies(freqs: list[float], shown: int = 4) -> str:
+    """The notes' frequencies for their code's line: up to ``shown`` of them, else the range."""
+    if not freqs:
+        return ""
+    if len(freqs) <= shown:
+        return f", at {', '.join(f'{f:.4g}' for f in freqs)} Hz"
+    return f", {len(freqs)} at {freqs[0]:.4g}-{freqs[-1]:.4g} Hz"
 
 
 def write_outputs(outputs) -> None:

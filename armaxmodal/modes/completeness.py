@@ -165,14 +165,14 @@ def modes_the_record_needs(recording: Recording, work: SelectionState, band, set
                 "split_merged", (),
                 f"modes at {f_n:.3f} and {f_m:.3f} Hz overlap within their half-power bands and the measured FRF does "
                 f"not need both: {evidence} once {f_n:.3f} Hz may take the whole peak; one peak split by the model, "
-                f"{f_n:.3f} Hz is reported", float(f_m),
+                f"{f_n:.3f} Hz is reported", float(f_m), (f_n, f_m),
             )  # fmt: skip
         else:
             note = QualityWarning(
                 "mode_not_needed", (),
                 f"a stable pole at {f_m:.3f} Hz (damping {x_m:.3f}) is left out: the measured FRF does not need it, "
                 f"{evidence}: a spurious pole of the model (noise, a nonlinearity, leakage), not a mode of the record",
-                float(f_m),
+                float(f_m), (f_m,),
             )  # fmt: skip
         work = work.kept(i for i in range(len(modes)) if i != m)
         if doubts is None:

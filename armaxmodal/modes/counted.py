@@ -214,7 +214,7 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
             f"shapes agree (MAC at least {same_shape:g}): the record does not separate them. Reported as one mode "
             f"at {f:.3f} Hz (damping {x:.3g}, the model with one pole there), its intervals covering both: one "
             "resonance whose frequency moves during the record (a nonlinearity, a change) or two modes this record "
-            "cannot resolve", f,
+            "cannot resolve", f, tuple(both.freq_hz),
         ))  # fmt: skip
     kept = [i for i in range(len(rows)) if i not in gone]
     return rows.iloc[kept].reset_index(drop=True), shapes[:, kept], notes
@@ -247,7 +247,7 @@ def confirmed_where_incoherent(diagram, work: SelectionState, settings: Selectio
                 f"no output's H1 is coherent near {f:.3f} Hz, so the FRF check cannot test that mode; the maximum-"
                 f"likelihood modal model, fitted to the record's DFT, confirms it: without it the criterion rises by "
                 f"{count.removal_rise[i]:.0f}, and both halves of the record give it the same frequency and damping",
-                float(f),
+                float(f), (f,),
             ))  # fmt: skip
     if not confirmed:
         return work
@@ -275,7 +275,7 @@ def dropped_where_peaks_remain(count: ModeCount | None, peaks, same_row_freq: fl
                 f"is no mode), but the measured FRF keeps a coherent peak no mode explains at "
                 f"{', '.join(f'{f:.2f}' for f in near)} Hz: the record does not decide whether a mode is there; "
                 "compare another record of the structure, or pick it ('--pick') to see what the record says of it",
-                float(start),
+                float(start), (start, *near),
             ))  # fmt: skip
     return notes
 
@@ -308,7 +308,7 @@ def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hol
             f"the maximum-likelihood modal model takes the mode picked at {row['freq_hz']:.3f} Hz to "
             f"{m.freq_hz[i]:.3f} Hz (damping {m.damping[i]:.3g}): beyond the band, damped beyond {MAX_DAMPING:g} or "
             "a line. The record does not support a mode there; it is reported from the diagram's fit, unconfirmed",
-            float(row["freq_hz"]),
+            float(row["freq_hz"]), (row["freq_hz"],),
         ))  # fmt: skip
     others = [pairs[j] for j in np.flatnonzero(~picked) if keep[pairs[j]]]
     if others:
@@ -317,7 +317,7 @@ def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hol
             f"{len(others)} mode(s) of the record were not picked and are not reported: "
             + ", ".join(f"{m.freq_hz[i]:.3f} Hz (damping {m.damping[i]:.3g})" for i in others)
             + "; they stay in the modal model, so that the picked modes' values are not biased by their absence",
-            float(len(others)),
+            float(len(others)), tuple(m.freq_hz[others]),
         ))  # fmt: skip
     order = np.argsort([r["freq_hz"] for r in rows])
     rows = pd.DataFrame([rows[k] for k in order])

@@ -196,7 +196,7 @@ def _merged(peaks, df) -> list[QualityWarning]:
             "unexplained_peak", sensors,
             f"the measured FRF has a clear, coherent peak at {f0:.2f} Hz ({', '.join(sensors)}) that no "
             "selected mode explains: a mode the selection missed (widen --orders or --modes), or a disturbance "
-            "(run 'armaxmodal diagnose')", f0,
+            "(run 'armaxmodal diagnose')", f0, (f0,),
         ))  # fmt: skip
     return warnings
 

@@ -221,7 +221,7 @@ def covering_both_estimators(rows: pd.DataFrame, alpha: float = DEFAULTS.agreeme
         "inter-sample behaviour, leakage) or by orders too low for a mode. One record cannot say which, so every "
         "mode's interval covers both estimates"
         + (f"; widened at {where} Hz" if where else ""),
-        statistic,
+        statistic, tuple(out.freq_hz[widened]),
     )  # fmt: skip
     return out, [note]
 
@@ -394,7 +394,7 @@ def apply_segment_spread(modes: pd.DataFrame, spread: pd.DataFrame, n_segments: 
                 f"refitted on {n_segments} disjoint segments, {len(flagged)} mode(s) scatter beyond their statistical "
                 f"intervals: {listed}. Their 95 % intervals were widened to the segments' spread. The model misses "
                 "an effect of the data (amplitude-dependent or time-varying behaviour, a disturbance, a missing mode).",
-                float(len(flagged)),
+                float(len(flagged)), tuple(modes.freq_hz[flagged]),
             )
         )
     return modes, warnings

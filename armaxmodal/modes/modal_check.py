@@ -154,7 +154,7 @@ class ModalCheck:
                 f"the record does not confirm the mode(s) at {where} Hz: no output's H1 is coherent "
                 f"({H1_COHERENCE:g}) near them, so the check cannot test them (another "
                 "excitation, several moving supports, or noise dominate there). Treat them as unconfirmed",
-                float(self.unconfirmed_hz[0]),
+                float(self.unconfirmed_hz[0]), tuple(self.unconfirmed_hz),
             ))  # fmt: skip
         checked = np.isfinite(self.model_error)
         if checked.any() and np.all(self.model_error[checked] <= self.limit):

@@ -47,14 +47,14 @@ def pick_notes(count: ModeCount, keep: np.ndarray) -> list[QualityWarning]:
             "pick_not_supported", (),
             f"the record does not support the mode picked at {f:.3f} Hz: without it (the other modes refitted "
             f"free) the information criterion changes by {rise:+.1f}, less than the {decisive:g} a needed "
-            "mode raises it; treat it as tentative, or pick another column of the diagram", f,
+            "mode raises it; treat it as tentative, or pick another column of the diagram", f, (f,),
         ))  # fmt: skip
     if count.best_addition > decisive and np.isfinite(count.best_addition_hz):
         f = count.best_addition_hz
         notes.append(QualityWarning(
             "mode_count", (),
             f"the record holds one mode more than the modal model behind the picks, near {f:.3f} Hz: adding it lowers "
-            f"the information criterion by {count.best_addition:.1f}", f,
+            f"the information criterion by {count.best_addition:.1f}", f, (f,),
         ))  # fmt: skip
     return notes
 
@@ -91,24 +91,25 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             "mode_count", (),
             f"the maximum-likelihood modal model with every pole free: the mode at {step.freq_hz:.3f} Hz "
             f"{words[step.action]}{where}, the information criterion (BIC) falls by {step.bic_fall:.1f}",
-            float(step.freq_hz),
+            float(step.freq_hz), (step.freq_hz,),
         ))  # fmt: skip
     verdicts = count.verdicts(band_hz)  # each pole's, decided once by the count
     undecided = keep & (verdicts == "undecided")  # of the reported modes only
     if undecided.any():
         rise = float(count.removal_rise[undecided].min())
+        weakest = count.model.freq_hz[np.flatnonzero(undecided)[np.argmin(count.removal_rise[undecided])]]
         notes.append(QualityWarning(
             "count_undecided", (),
             f"the record does not decide the number of modes: with one mode fewer (the rest refitted free) the "
             f"criterion rises by only {rise:.1f} (under {decisive:g}, Kass & Raftery's 'very strong'); "
-            "treat the weakest mode as tentative", rise,
+            f"treat the weakest mode ({weakest:.3f} Hz) as tentative", rise, (weakest,),
         ))  # fmt: skip
     if count.best_addition > -decisive and np.isfinite(count.best_addition_hz):
         f = count.best_addition_hz
         notes.append(QualityWarning(
             "count_undecided", (),
             f"the record does not rule out one mode more (near {f:.3f} Hz): adding it changes the criterion by "
-            f"{-count.best_addition:+.1f}, less than {decisive:g} either way", f,
+            f"{-count.best_addition:+.1f}, less than {decisive:g} either way", f, (f,),
         ))  # fmt: skip
     if count.wanted:
         f, ratio, dof, rise_bic, in_diagram, unsupported = count.wanted  # a Wanted
@@ -117,13 +118,13 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             f"the record may hold one mode more near {f:.3f} Hz: adding it raises the likelihood far beyond chance "
             f"(likelihood ratio {ratio:.1f} for its {dof} parameters, p < {count.settings.likelihood_alpha:g}) and the "
             f"mode is the same in both halves of the record, but {_why_not_reported(rise_bic, unsupported)}; "
-            f"{_what_to_do(in_diagram, unsupported)}", f,
+            f"{_what_to_do(in_diagram, unsupported)}", f, (f,),
         ))  # fmt: skip
     for start, went in count.carried_away:
         notes.append(QualityWarning(
             "mode_count", (),
             f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
-            "damping unresolved, or not the same in both halves of the record); left out", went,
+            "damping unresolved, or not the same in both halves of the record); left out", went, (went,),
         ))  # fmt: skip
     for f in count.unsettled_hz:
         notes.append(QualityWarning(
@@ -133,13 +134,13 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             f"the {100 * count.agreement.alpha:g} % level, though not by enough ({count.agreement.unsettled_alpha:g}) "
             "to call it a change during the record: the record does not settle whether it "
             "is a mode; compare another record of "
-            "the structure, or pick it ('--pick') to see what the record says of it", f,
+            "the structure, or pick it ('--pick') to see what the record says of it", f, (f,),
         ))  # fmt: skip
     for f in count.unconfirmed_hz:
         notes.append(QualityWarning(
             "mode_count", (),
             f"one mode more near {f:.3f} Hz fits the whole record better but not each of its halves: a change "
-            "during the record (a drifting frequency, a transient, a nonlinearity), not a mode; left out", f,
+            "during the record (a drifting frequency, a transient, a nonlinearity), not a mode; left out", f, (f,),
         ))  # fmt: skip
     widened = [count.model.freq_hz[i] for i in np.flatnonzero(keep) if count.other_structures(i, same_row_freq)[1]]
     if widened:
@@ -148,7 +149,7 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             "mode_count", (),
             f"the 95 % intervals of the mode(s) at {', '.join(f'{f:.3f}' for f in widened)} Hz also cover their values "
             f"in the models the record cannot tell from the chosen one ({sizes} in the criterion): the number of modes "
-            "is part of their uncertainty", float(len(widened)),
+            "is part of their uncertainty", float(len(widened)), tuple(widened),
         ))  # fmt: skip
     for start, went, rise_without in count.stand_ins:
         # inside the band, a pole the likelihood needs is the record's own: it does not decide whether a mode
@@ -161,7 +162,7 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             f"the criterion rises by {rise_without:.1f}): it stays in the model, as a pole for what the record does "
             "not resolve there, and is not reported"
             + ("; whether a mode is there, the record does not decide: compare another record of the structure, or "
-               "pick it ('--pick') to see what the record says of it" if inside else ""), went,
+               "pick it ('--pick') to see what the record says of it" if inside else ""), went, (went,),
         ))  # fmt: skip
     notes += [_borderline_note(count.model, i, band_hz) for i in np.flatnonzero(verdicts == "borderline")]
     outside = ~reported(count.model, band_hz) & (verdicts != "borderline")  # beyond the band, overdamped, lines
@@ -176,7 +177,7 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             f"{hidden} pole(s) of the modal model lie outside the band {band_hz[0]:.3g}-{band_hz[1]:.3g} Hz, are "
             f"damped beyond {MAX_DAMPING:g} or are lines (damping at the fit's floor): {out}. They stand for what lies "
             "beyond the band or for a periodic disturbance, and are not reported as modes",
-            float(hidden),
+            float(hidden), tuple(count.model.freq_hz[outside]),
         ))  # fmt: skip
     return notes
 
@@ -196,7 +197,7 @@ def _borderline_note(model, i: int, band_hz) -> QualityWarning:
         f"as a mode, but its 95 % interval ({f - df:.4g}-{f + df:.4g} Hz, damping {x - dx:.2f}-{x + dx:.2f}) reaches "
         f"{' and '.join(reach)}: the record does not decide whether the band holds one mode more there (a heavily "
         "damped mode near the band's edge is estimated so); excite and fit a band reaching past it to decide",
-        float(f),
+        float(f), (f,),
     )  # fmt: skip
 
 
@@ -255,7 +256,7 @@ def not_separated_notes(modes: pd.DataFrame, separation_sd: float) -> list[Quali
     return [QualityWarning(
         "modes_not_separated", (),
         f"modes at {f[i]:.3f} and {f[j]:.3f} Hz are {gap:.1f} standard deviations of their difference apart (under "
-        f"{separation_sd:g}): the record does not separate them; they may be one mode", float(f[i]),
+        f"{separation_sd:g}): the record does not separate them; they may be one mode", float(f[i]), (f[i], f[j]),
     ) for i, j, gap in not_separated(with_intervals(modes), separation_sd)]  # fmt: skip
 
 
@@ -283,6 +284,6 @@ def unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[Quality
         notes.append(QualityWarning(
             "damping_unresolved", (),
             f"mode at {m.freq_hz:.3f} Hz ([{m.freq_ci95_lo:.4g}, {m.freq_ci95_hi:.4g}] Hz): {'; '.join(facts)}. {why}",
-            float(m.freq_hz),
+            float(m.freq_hz), (m.freq_hz,),
         ))  # fmt: skip
     return notes

@@ -233,6 +233,7 @@ def disturbance_lines(
                 f"{100 * min_energy:g} % of the strongest pole's): {where}, not a mode; {seen}. The modes near it "
                 "were fitted with it in the data: run 'armaxmodal diagnose', which fits the line and refits.",
                 freq,
+                (freq,),
             )
         )
     return warnings

@@ -41,6 +41,19 @@ def test_verbose_shows_every_full_text(capsys):
     assert all(len(line) <= 100 for line in err.splitlines() if line.startswith("      "))
 
 
+def test_a_code_line_names_its_notes_frequencies(capsys):
+    def note(code, *freqs):
+        return am.QualityWarning(code, (), "text", None, freqs)
+
+    print_notes([note("count_undecided", 28.4838), note("count_undecided", 4.4, 28.4838), note("mode_count"),
+                 *(note("unexplained_peak", f) for f in (3.0, 5.5, 7.25, 9.0, 11.75))])  # fmt: skip
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[1].startswith("  warning count_undecided (2, at 4.4, 28.48 Hz): ")  # each once, in order
+    assert lines[2].startswith("  warning unexplained_peak (5, 5 at 3-11.75 Hz): ")  # more than four: the range
+    assert lines[3].startswith("  info    mode_count (1): ")
+    assert note("mode_count", 4.4, np.nan).to_dict()["freq_hz"] == [4.4]  # strict JSON: no NaN
+
+
 def test_severity_follows_the_verdict():
     assert [severity(c) for c in ("modes_do_not_explain_frf", "count_undecided", "clipping", "resampled")] == [
         "problem", "warning", "warning", "info"]  # fmt: skip

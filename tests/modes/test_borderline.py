@@ -80,6 +80,7 @@ def test_the_count_calls_it_borderline_reports_it_not_and_says_so():
     # the note of the poles that stand for what lies beyond the band names only the decided one
     (beyond,) = [n for n in notes if n.code == "mode_count" and "outside the band" in n.message]
     assert "40 Hz" in beyond.message and "26 Hz" not in beyond.message and beyond.value == 1.0
+    assert (undecided[0].freq_hz, beyond.freq_hz) == ((26.0,), (40.0,))  # what the terminal's line names
     # the same pole decided out (a narrow interval): no doubt, and the note names both poles
     decided = replace(count, model=_model([5.0, 26.0, 40.0], [0.2, 0.45, 0.3], [0.01, 0.2, 0.5], [0.01, 0.05, 0.01]))
     assert list(decided.verdicts()) == ["needed", "not_a_mode", "not_a_mode"]
@@ -90,7 +91,7 @@ def test_an_over_damped_borderline_pole_is_said_as_such():
     count = _count([5.0, 12.0], [0.2, 0.68], [0.01, 0.5], [0.01, 0.06])
     (note,) = [n for n in count_notes(count, count.reported(), BAND, 0.05) if n.code == "count_undecided"]
     lo, hi = 0.68 - Z95 * 0.06, 0.68 + Z95 * 0.06
-    assert (note.channels, note.value) == ((), 12.0)
+    assert (note.channels, note.value, note.freq_hz) == ((), 12.0, (12.0,))
     assert note.message == (
         f"the modal model's pole at 12.000 Hz (damping 0.68) lies damped beyond {MAX_DAMPING:g}, so it is not reported "
         f"as a mode, but its 95 % interval ({12 - Z95 * 0.5:.4g}-{12 + Z95 * 0.5:.4g} Hz, damping {lo:.2f}-{hi:.2f}) "

@@ -60,7 +60,7 @@ def test_every_count_note_says_its_numbers_in_their_places():
         ('count_undecided', 4.5,
             'the record does not decide the number of modes: with one mode fewer (the rest refitted '
             "free) the criterion rises by only 4.5 (under 10, Kass & Raftery's 'very strong'); treat "
-            'the weakest mode as tentative'),
+            'the weakest mode (5.000 Hz) as tentative'),
         ('count_undecided', 21.5,
             'the record does not rule out one mode more (near 21.500 Hz): adding it changes the '
             'criterion by +3.2, less than 10 either way'),
@@ -103,6 +103,9 @@ def test_every_count_note_says_its_numbers_in_their_places():
             "lines (damping at the fit's floor): 30 Hz (damping 0.90). They stand for what lies "
             'beyond the band or for a periodic disturbance, and are not reported as modes'),
     ]
+    # the frequencies each names (the terminal's one line per code shows them)
+    assert [n.freq_hz for n in notes.count_notes(_count(), KEEP, BAND, SAME_ROW)] == [
+        (12.5,), (17.0,), (5.0,), (21.5,), (23.5,), (9.5,), (18.75,), (14.25,), (5.0, 12.0), (26.9,), (19.8,), (30.0,)]
 
 
 @pytest.mark.parametrize("unsupported", [False, True])
