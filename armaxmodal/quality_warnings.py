@@ -320,6 +320,17 @@ CODES: tuple[WarningCode, ...] = (
         uncertain=True,
     ),
     WarningCode(
+        "mode_beyond_band", "selection",
+        "a pole of the maximum-likelihood modal model whose removal raises BIC by 10 or more, whose 95 % intervals "
+        "lie wholly outside the band and below Nyquist in frequency and within (0, 0.6] in damping, and whose "
+        "half-power band f(1 ∓ damping) reaches into the band: a mode the record determines beyond the band (a "
+        "body's 27.7 Hz mode under a ride to 24 Hz, the band ending at 25.7 Hz)",
+        "not reported, since the modes reported are those of the band; named with its intervals (the JSON's "
+        "`count` → `poles`, verdict `beyond_band`). The modes of the band were fitted with it in the model",
+        "To report it, excite the structure past it and fit a band that holds it (`--band`; the band never "
+        "reaches beyond the input's excited band).",
+    ),
+    WarningCode(
         "modes_not_separated", "selection",
         "two neighbouring modes less than 3 standard deviations of their difference apart",
         "where the model's own intervals are that close and the shapes agree (MAC ≥ 0.8), the two poles are reported "
@@ -357,7 +368,7 @@ PROBLEM_CODES = ("no_modes", "modes_do_not_explain_frf")
 #: reports but cannot set right, or a result it could not complete
 ACT_ON_CODES = ("duplicate_channel", "inverted_sensor", "sensor_delay", "narrowband_input", "clipping", "offset_step",
                 "model_error_dominates", "nk_at_search_edge", "unexplained_peak", "damping_unresolved",
-                "incoherent_output", "unit_mismatch", "oversampled", "refit_failed")  # fmt: skip
+                "incoherent_output", "unit_mismatch", "oversampled", "refit_failed", "mode_beyond_band")  # fmt: skip
 
 
 def severity(code: str) -> str:

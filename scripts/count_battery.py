@@ -105,6 +105,18 @@ def _close_pairs(tf, crb_f) -> list[set]:
     return groups
 
 
+def beyond_named(truth, sel) -> tuple[int, int]:
+    """How many modes beyond the band the selection names (``mode_beyond_band``), and how many of
+    those hold an exact mode in their 95 % frequency interval."""
+    count = getattr(sel, "count", None)
+    if count is None or sel.refinement is None:
+        return 0, 0
+    m, named = count.model, np.flatnonzero(count.verdicts(sel.refinement.band_hz) == "beyond_band")
+    half = 1.96 * m.freq_sd[named]
+    held = [np.any(np.abs(truth.freq_hz - m.freq_hz[i]) <= h) for i, h in zip(named, half, strict=True)]
+    return len(named), int(sum(held))
+
+
 def judge(truth, sel, crb_f, crb_x, top_hz) -> tuple[bool, list[str]]:
     """Right or not by the issue's rule, with the reasons."""
     f, x = sel.modes.freq_hz.to_numpy(), sel.modes.damping.to_numpy()
@@ -167,7 +179,7 @@ def main() -> None:
     if args.save:
         os.makedirs(args.save, exist_ok=True)
     tally = {"cases": 0, "right": 0, "wrong_flagged": 0, "right_flagged": 0, "modes": 0, "covered": 0, "widened": 0,
-             "disagree": 0}
+             "disagree": 0, "beyond": 0, "beyond_held": 0}
     for index, (name, s, fs, top, rng) in enumerate(cases(args)):
         u = ride(rng, fs, top_hz=top)
         rec = am.simulate_recording(s, u, fs, noise=0.03, seed=int(rng.integers(1 << 30)))
@@ -195,12 +207,16 @@ def main() -> None:
         tally["modes"] += len(sel.modes)
         tally["covered"] += covered
         tally["widened"] += widened
+        named, held = beyond_named(truth, sel)
+        tally["beyond"] += named
+        tally["beyond_held"] += held
         disagree = [w.value for w in sel.warnings if w.code == "estimators_disagree"]
         tally["disagree"] += bool(disagree)
         because = getattr(sel, "uncertain_because", [])  # the verdict's reasons (absent before the ML step)
         print(f"    found {np.round(sel.modes.freq_hz, 2).tolist()} damping {np.round(sel.modes.damping, 3).tolist()}"
               f" quality {sel.quality} {because}{f' estimators disagree ({disagree[0]:.0f})' if disagree else ''}"
               f" | {'right' if ok else 'WRONG: ' + '; '.join(why)}"
+              f"{f' | beyond the band: {named} named, {held} an exact mode' if named else ''}"
               f" | {cpu:.1f} CPU-s", flush=True)  # fmt: skip
     wrong = tally["cases"] - tally["right"]
     print(f"\n{tally['right']}/{tally['cases']} right; of {wrong} wrong, {tally['wrong_flagged']} say poor or "
@@ -208,6 +224,8 @@ def main() -> None:
     print(f"{tally['covered']} of {tally['modes']} reported frequency intervals hold the nearest exact mode; "
           f"{tally['widened']} were widened to other equally good counts")  # fmt: skip
     print(f"{tally['disagree']} of {tally['cases']} rides say their two estimators disagree (estimators_disagree)")
+    print(f"{tally['beyond']} modes named beyond the band (mode_beyond_band), {tally['beyond_held']} of them holding "
+          "an exact mode in their interval")
 
 
 def _interval_coverage(truth, sel) -> tuple[int, int]:

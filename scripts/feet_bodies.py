@@ -16,7 +16,7 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
-from count_battery import bound, judge, ride  # scripts/ is on the path when a script runs
+from count_battery import beyond_named, bound, judge, ride  # scripts/ is on the path when a script runs
 
 import armaxmodal as am
 from armaxmodal.modes.state import refit_band
@@ -40,7 +40,7 @@ def main() -> None:
     parser.add_argument("--hold", choices=("zoh", "bandlimited"), default="zoh")
     args = parser.parse_args()
     rng = np.random.default_rng(args.seed)
-    tally = {"right": 0, "wrong_good": 0, "right_flagged": 0, "lost_good": 0}
+    tally = {"right": 0, "wrong_good": 0, "right_flagged": 0, "lost_good": 0, "beyond": 0, "beyond_held": 0}
     for i in range(args.bodies):
         s = body(rng)
         if args.ride == "random":
@@ -60,12 +60,17 @@ def main() -> None:
         top = 28.0 if args.ride == "random" else 24.0
         lost = [f for f in truth.freq_hz if f <= top and not np.any(np.abs(sel.modes.freq_hz / f - 1) <= 0.15)]
         tally["lost_good"] += bool(lost) and sel.quality == "good"
+        named, held = beyond_named(truth, sel)
+        tally["beyond"] += named
+        tally["beyond_held"] += held
         verdict = "right" if ok else "WRONG: " + "; ".join(why)
         print(f"{args.seed}#{i}: exact {np.round(truth.freq_hz, 2).tolist()}, found "
-              f"{np.round(sel.modes.freq_hz, 2).tolist()} {sel.quality} | {verdict}", flush=True)  # fmt: skip
+              f"{np.round(sel.modes.freq_hz, 2).tolist()} {sel.quality} | {verdict}"
+              f"{f' | beyond the band: {named} named, {held} an exact mode' if named else ''}", flush=True)  # fmt: skip
     print(f"\n{tally['right']}/{args.bodies} right; {tally['wrong_good']} wrong ones say good; "
           f"{tally['right_flagged']} right ones say uncertain or poor; "
-          f"{tally['lost_good']} lose a mode of the ride's band under good")
+          f"{tally['lost_good']} lose a mode of the ride's band under good; {tally['beyond']} modes named beyond "
+          f"the band, {tally['beyond_held']} holding an exact mode")
 
 
 if __name__ == "__main__":

@@ -159,6 +159,8 @@ class ModalModel:
         fit is meant to).
     band_hz : (float, float)
         The band of the fitted lines, Hz.
+    nyquist_hz : float
+        The highest frequency a pole can take (the fit's bound), Hz.
     hold_cost : dict
         From :func:`refine_modes`: each tried assumption's weighted residual sum of squares
         after the same first steps from the same start, the basis of its choice (empty for a
@@ -187,6 +189,7 @@ class ModalModel:
     converged: bool = True
     band_hz: tuple[float, float] = (0.0, np.inf)
     hold_cost: dict = field(default_factory=dict)
+    nyquist_hz: float = np.inf
 
     def by_frequency(self) -> ModalModel:
         """The same model, its modes sorted by frequency.
@@ -334,6 +337,7 @@ def _fit(data: DftLines, start: np.ndarray, hold: str, max_nfev: int, settings: 
         residual=resid[: data.s.size] + 1j * resid[data.s.size :],
         converged=bool(res.status > 0),  # 0: stopped at max_nfev
         band_hz=data.band_hz,
+        nyquist_hz=0.5 / data.dt,
     )
 
 

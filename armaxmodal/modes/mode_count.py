@@ -1,15 +1,11 @@
 """How many modes: the count's result and the tests it is built from.
 
-:func:`armaxmodal.modes.count_search.count_modes` compares free refits of the
-maximum-likelihood modal model (:func:`armaxmodal.modes.dft_model.fit_modal_model`) with one
-mode fewer, one more, or one split, and keeps the neighbour of lowest criterion while it lowers it.
-This module holds what it returns, :class:`ModeCount`, with the verdicts derived from it (which
-poles are reported, the other structures' reach), and the tests the search applies: Bartlett's
-effective share of independent lines (:func:`effective_fraction`), the halves' agreement (``halves_chi2``),
-the pairing of two pole sets and the residual's peak.
-
-The criterion is Schwarz's BIC on the effective lines: the method page's "how many modes" gives why BIC and
-not a test at a fixed level, why 10 is decisive, and why the lines are counted by their residual's correlation.
+:func:`armaxmodal.modes.count_search.count_modes` compares free refits of the maximum-likelihood modal model
+(:func:`armaxmodal.modes.dft_model.fit_modal_model`) with one mode fewer, one more, or one split, and keeps the
+neighbour of lowest criterion while it lowers it. This module holds what it returns, :class:`ModeCount`, with the
+verdicts derived from it, and the tests the search applies: Bartlett's effective share of independent lines
+(:func:`effective_fraction`), the halves' agreement (``halves_chi2``), the pairing of two pole sets and the
+residual's peak. The criterion is Schwarz's BIC on the effective lines (the method page's "how many modes").
 """
 
 from __future__ import annotations
@@ -22,7 +18,7 @@ import numpy as np
 
 from armaxmodal.modes.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.intervals import interval
-from armaxmodal.modes.poles import borderline, matched_poles, nearest_pole, reported
+from armaxmodal.modes.poles import beyond_band, borderline, matched_poles, nearest_pole, reported
 from armaxmodal.modes.settings import DEFAULTS, AgreementSettings, CountSettings, DftSettings, LineSettings
 from armaxmodal.stats import Z95
 
@@ -234,7 +230,9 @@ class ModeCount:
           model, not reported;
         * ``"not_a_mode"``: beyond the band, damped beyond ``MAX_DAMPING``, or a line (:func:`reported`);
         * ``"borderline"``: not one by its estimate, one by its 95 % interval (``poles.borderline``):
-          not reported, and the record does not decide whether a mode of the band is there.
+          not reported, and the record does not decide whether a mode of the band is there;
+        * ``"beyond_band"``: a needed pole the record determines as a mode outside the band
+          (``poles.beyond_band``): not reported, and named.
 
         Starts the search left out of the model (``carried_away``) are not among its poles.
 
@@ -248,9 +246,11 @@ class ModeCount:
         (n_modes,) ndarray of str
         """
         band = self.band_hz if band_hz is None else band_hz
-        verdict = np.where(self.removal_rise >= self.settings.decisive_bic, "needed", "undecided").astype(object)
+        needed = self.removal_rise >= self.settings.decisive_bic
+        verdict = np.where(needed, "needed", "undecided").astype(object)
         verdict[~reported(self.model, band, self.lines)] = "not_a_mode"
         verdict[borderline(self.model, band, self.lines)] = "borderline"
+        verdict[needed & beyond_band(self.model, band, self.lines)] = "beyond_band"
         for _, went, _ in self.stand_ins:
             verdict[np.abs(np.log(self.model.freq_hz / went)) <= self.settings.same_mode_freq] = "stand_in"
         return verdict

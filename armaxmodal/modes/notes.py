@@ -165,7 +165,9 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
                "pick it ('--pick') to see what the record says of it" if inside else ""), went, (went,),
         ))  # fmt: skip
     notes += [_borderline_note(count.model, i, band_hz) for i in np.flatnonzero(verdicts == "borderline")]
-    outside = ~reported(count.model, band_hz) & (verdicts != "borderline")  # beyond the band, overdamped, lines
+    notes += [_beyond_band_note(count.model, i, band_hz) for i in np.flatnonzero(verdicts == "beyond_band")]
+    # what stands for what lies beyond the band, over-damped poles, lines
+    outside = ~reported(count.model, band_hz) & ~np.isin(verdicts, ("borderline", "beyond_band"))
     hidden = int(outside.sum())
     if hidden:
         out = ", ".join(
@@ -180,6 +182,19 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             float(hidden), tuple(count.model.freq_hz[outside]),
         ))  # fmt: skip
     return notes
+
+
+def _beyond_band_note(model, i: int, band_hz) -> QualityWarning:
+    f, x, df, dx = model.freq_hz[i], model.damping[i], Z95 * model.freq_sd[i], Z95 * model.damping_sd[i]
+    side, edge = ("above", f + df) if f > band_hz[1] else ("below", f - df)
+    return QualityWarning(
+        "mode_beyond_band", (),
+        f"the record holds a mode {side} the band {band_hz[0]:.4g}-{band_hz[1]:.4g} Hz: the modal model needs a pole "
+        f"at {f:.3f} Hz (95 % interval {f - df:.4g}-{f + df:.4g} Hz), damping {x:.3f} ({x - dx:.3f}-{x + dx:.3f}). "
+        f"It is not reported, as it lies outside the band (the input's excited band, or --band within it); to "
+        f"report it, excite the structure and fit a band reaching {side.replace('above', 'past')} {edge:.3g} Hz",
+        float(f), (f,),
+    )  # fmt: skip
 
 
 def _borderline_note(model, i: int, band_hz) -> QualityWarning:

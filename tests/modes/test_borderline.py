@@ -2,7 +2,9 @@
 interval: the record does not decide whether the band holds a mode there, so the count calls it
 ``borderline``, does not report it, and says so in a ``count_undecided`` note (which makes the
 verdict ``uncertain``). Unseen bodies with feet lost a heavily damped top mode this way under
-``good``: 26.4 Hz estimated at 28.07 Hz in a band ending at 28.06 Hz."""
+``good``: 26.4 Hz estimated at 28.07 Hz in a band ending at 28.06 Hz. A needed pole beyond the
+band by its intervals too, its resonance reaching in, is a mode beyond the band: ``beyond_band``,
+named in a ``mode_beyond_band`` note (a body's 27.7 Hz mode under a ride to 24 Hz)."""
 
 from __future__ import annotations
 
@@ -19,18 +21,19 @@ import armaxmodal as am
 from armaxmodal.modes.dft_model import DftLines, fit_modal_model
 from armaxmodal.modes.mode_count import ModeCount
 from armaxmodal.modes.notes import count_notes
-from armaxmodal.modes.poles import borderline
+from armaxmodal.modes.poles import beyond_band, borderline
 from armaxmodal.modes.settings import ClusterSettings, LineSettings
 from armaxmodal.stats import MAX_DAMPING, Z95
 
 BAND = (1.0, 25.0)
 FLOOR = LineSettings().at_fit_floor
+NYQUIST = 50.0  # the stand-in models' bound on a pole's frequency (Hz)
 
 
 def _model(freq, damping, freq_sd, damping_sd):
     return SimpleNamespace(freq_hz=np.array(freq, float), damping=np.array(damping, float),
                            freq_sd=np.array(freq_sd, float), damping_sd=np.array(damping_sd, float),
-                           n_modes=len(freq))  # fmt: skip
+                           n_modes=len(freq), nyquist_hz=NYQUIST)  # fmt: skip
 
 
 @pytest.mark.parametrize(
@@ -66,7 +69,8 @@ def test_the_count_calls_it_borderline_reports_it_not_and_says_so():
     count = _count([5.0, 26.0, 40.0], [0.2, 0.45, 0.3], [0.01, 0.8, 0.5], [0.01, 0.05, 0.01])
     assert list(count.verdicts()) == ["needed", "borderline", "not_a_mode"]
     assert list(count.reported()) == [True, False, False]
-    assert list(count.verdicts((1.0, 30.0))) == ["needed", "needed", "not_a_mode"]  # another band: 26 Hz in it
+    # another band: 26 Hz in it, and 40 Hz a mode above it (its resonance, 28-52 Hz, reaching in)
+    assert list(count.verdicts((1.0, 30.0))) == ["needed", "needed", "beyond_band"]
     schema = json.loads((Path(__file__).parents[2] / "schemas" / "stabilise.schema.json").read_text())
     got = count.to_dict()
     jsonschema.validate(json.loads(json.dumps(got, allow_nan=False)), schema["properties"]["count"])
@@ -81,10 +85,13 @@ def test_the_count_calls_it_borderline_reports_it_not_and_says_so():
     (beyond,) = [n for n in notes if n.code == "mode_count" and "outside the band" in n.message]
     assert "40 Hz" in beyond.message and "26 Hz" not in beyond.message and beyond.value == 1.0
     assert (undecided[0].freq_hz, beyond.freq_hz) == ((26.0,), (40.0,))  # what the terminal's line names
-    # the same pole decided out (a narrow interval): no doubt, and the note names both poles
+    # the same pole decided out (a narrow interval): no doubt; a mode above the band, named as such
     decided = replace(count, model=_model([5.0, 26.0, 40.0], [0.2, 0.45, 0.3], [0.01, 0.2, 0.5], [0.01, 0.05, 0.01]))
-    assert list(decided.verdicts()) == ["needed", "not_a_mode", "not_a_mode"]
-    assert "count_undecided" not in [n.code for n in count_notes(decided, decided.reported(), BAND, 0.05)]
+    assert list(decided.verdicts()) == ["needed", "beyond_band", "not_a_mode"]
+    said = count_notes(decided, decided.reported(), BAND, 0.05)
+    assert "count_undecided" not in [n.code for n in said]
+    assert [n.freq_hz for n in said if n.code == "mode_beyond_band"] == [(26.0,)]
+    jsonschema.validate(json.loads(json.dumps(decided.to_dict(), allow_nan=False)), schema["properties"]["count"])
 
 
 def test_an_over_damped_borderline_pole_is_said_as_such():
@@ -131,8 +138,58 @@ def test_a_damped_mode_just_inside_the_top_is_not_dropped_in_silence(supine_fits
     assert [n.code for n in notes].count("count_undecided") == 1
 
 
-@pytest.mark.parametrize(("top", "verdict"), [(14.5, "not_a_mode"), (17.0, "needed")])
+@pytest.mark.parametrize(("top", "verdict"), [(14.5, "beyond_band"), (17.0, "needed")])
 def test_a_mode_well_past_the_top_or_well_inside_it_is_decided(supine_fits, top, verdict):
     """Lines up to 14.5 Hz put the 16.25 Hz mode's interval wholly beyond the band (about 14.9-18.0
-    Hz); lines up to 17.0 Hz put its estimate inside."""
-    assert supine_fits[top].verdicts()[3] == verdict
+    Hz), its resonance reaching into it: a mode above the band, named; lines up to 17.0 Hz put its
+    estimate inside."""
+    count = supine_fits[top]
+    assert count.verdicts()[3] == verdict
+    beyond = [n for n in count_notes(count, count.reported(), count.band_hz, 0.05) if n.code == "mode_beyond_band"]
+    assert len(beyond) == (top == 14.5)
+    if beyond:
+        (lo, hi), exact = beyond[0].message.split("95 % interval ")[1].split(" Hz")[0].split("-"), 16.25
+        assert float(lo) > top and float(lo) < exact < float(hi)  # the exact mode inside what is named
+
+
+@pytest.mark.parametrize(
+    ("freq", "damping", "freq_sd", "damping_sd", "want"),
+    [(27.0, 0.4, 0.5, 0.02, True),  # wholly above the band, its resonance reaching into it
+     (27.0, 0.4, 1.1, 0.02, False),  # its interval reaching back into the band: borderline, not decided
+     (25.0 + Z95 * 0.5 + 1e-9, 0.4, 0.5, 0.02, True),  # the interval's end just past the band's edge
+     (25.0 + Z95 * 0.5 - 1e-9, 0.4, 0.5, 0.02, False),
+     (25.0 / 0.7 - 1e-6, 0.3, 0.5, 0.02, True),  # the half-power band's lower end just inside the band
+     (25.0 / 0.7 + 1e-6, 0.3, 0.5, 0.02, False),  # just outside: a pole for all that lies up there
+     (40.0, 0.3, 0.5, 0.02, False),
+     (0.9, 0.3, 0.02, 0.02, True),  # below the band, its resonance reaching up into it
+     (0.6, 0.3, 0.05, 0.02, False),  # below, not reaching (0.78 Hz)
+     (27.0, 0.4, 0.5, 0.25, False),  # its damping not resolved (the interval crosses zero)
+     (27.0, 0.5, 0.5, 0.06, False),  # its damping interval past MAX_DAMPING
+     (27.0, 0.4, np.nan, 0.02, False),  # an interval not known decides nothing
+     (48.0, 0.55, 0.5, 0.02, True),
+     (NYQUIST, 0.55, 0.5, 0.02, False),  # held at the fit's bound: its interval means nothing
+     (12.0, 0.3, 0.5, 0.01, False),  # a mode of the band
+     (27.0, FLOOR, 0.5, 1e-6, False)],  # a line
+)  # fmt: skip
+def test_a_pole_is_a_mode_beyond_the_band_when_its_intervals_say_so(freq, damping, freq_sd, damping_sd, want):
+    got = beyond_band(_model([5.0, freq], [0.2, damping], [0.01, freq_sd], [0.01, damping_sd]), BAND)
+    assert got.tolist() == [False, want]
+
+
+def test_only_a_needed_pole_beyond_the_band_is_named_and_the_note_says_where_to_reach():
+    count = _count([5.0, 27.0, 0.9], [0.2, 0.4, 0.3], [0.01, 0.5, 0.02], [0.01, 0.02, 0.02])
+    assert list(count.verdicts()) == ["needed", "beyond_band", "beyond_band"]
+    assert list(count.reported()) == [True, False, False]
+    notes = count_notes(count, count.reported(), BAND, 0.05)
+    above, below = [n for n in notes if n.code == "mode_beyond_band"]
+    df, dx = Z95 * 0.5, Z95 * 0.02
+    assert above.message == (
+        f"the record holds a mode above the band 1-25 Hz: the modal model needs a pole at 27.000 Hz (95 % interval "
+        f"{27 - df:.4g}-{27 + df:.4g} Hz), damping 0.400 ({0.4 - dx:.3f}-{0.4 + dx:.3f}). It is not reported, as it "
+        "lies outside the band (the input's excited band, or --band within it); to report it, excite the structure "
+        f"and fit a band reaching past {27 + df:.3g} Hz")
+    assert below.message.endswith(f"fit a band reaching below {0.9 - Z95 * 0.02:.3g} Hz") and below.freq_hz == (0.9,)
+    assert not [n for n in notes if n.code == "mode_count" and "outside the band" in n.message]  # said once
+    weak = replace(count, removal_rise=np.array([60.0, 5.0, 5.0]))  # not needed: what lies up there, unnamed
+    assert list(weak.verdicts()) == ["needed", "not_a_mode", "not_a_mode"]
+    assert "mode_beyond_band" not in [n.code for n in count_notes(weak, weak.reported(), BAND, 0.05)]
