@@ -322,7 +322,7 @@ CODES: tuple[WarningCode, ...] = (
     WarningCode(
         "mode_beyond_band", "selection",
         "a pole of the maximum-likelihood modal model whose removal raises BIC by 10 or more, whose 95 % intervals "
-        "lie wholly outside the band and below Nyquist in frequency and within (0, 0.6] in damping, and whose "
+        "lie wholly outside the band and below Nyquist in frequency and above zero in damping (at most 0.6), and whose "
         "half-power band f(1 ∓ damping) reaches into the band: a mode the record determines beyond the band (a "
         "body's 27.7 Hz mode under a ride to 24 Hz, the band ending at 25.7 Hz)",
         "not reported, since the modes reported are those of the band; named with its intervals (the JSON's "

@@ -312,9 +312,10 @@ def borderline(model, band_hz, lines: LineSettings = DEFAULTS.lines) -> np.ndarr
 
 def beyond_band(model, band_hz, lines: LineSettings = DEFAULTS.lines) -> np.ndarray:
     """Which of a model's poles are modes the record determines outside the band (bool per pole):
-    the 95 % interval of the frequency wholly beyond the band, that of the damping within
-    (0, ``MAX_DAMPING``], below the model's Nyquist bound (a pole held at that bound has no Wald
-    interval), not a line; an interval not known decides nothing. Its resonance, the
+    the 95 % interval of the frequency wholly beyond the band and below the model's Nyquist bound
+    (a pole held at that bound has no Wald interval), the damping at most ``MAX_DAMPING`` (as for a
+    mode of the band) and resolved (its interval above zero), not a line; an interval not known
+    decides nothing. Its resonance, the
     half-power band f(1 -+ damping), must reach into the band: the band's lines then hold its peak's
     flank, which places it, while a pole farther out sees only the band's stiffness-line tail and
     stands for all that lies there. A body's 27.71 Hz mode (damping 0.42) under a ride to 24 Hz, the
@@ -323,7 +324,7 @@ def beyond_band(model, band_hz, lines: LineSettings = DEFAULTS.lines) -> np.ndar
     df, dx = Z95 * model.freq_sd, Z95 * model.damping_sd
     above = (f - df > band_hz[1]) & (f + df < model.nyquist_hz) & (f * (1 - x) < band_hz[1])
     below = (f + df < band_hz[0]) & (f * (1 + x) > band_hz[0])
-    return (above | below) & (x - dx > 0) & (x + dx <= MAX_DAMPING) & (x > lines.at_fit_floor)
+    return (above | below) & (x - dx > 0) & (x <= MAX_DAMPING) & (x > lines.at_fit_floor)
 
 
 def physical(model, band_hz) -> np.ndarray:

@@ -164,7 +164,8 @@ def test_a_mode_well_past_the_top_or_well_inside_it_is_decided(supine_fits, top,
      (0.9, 0.3, 0.02, 0.02, True),  # below the band, its resonance reaching up into it
      (0.6, 0.3, 0.05, 0.02, False),  # below, not reaching (0.78 Hz)
      (27.0, 0.4, 0.5, 0.25, False),  # its damping not resolved (the interval crosses zero)
-     (27.0, 0.5, 0.5, 0.06, False),  # its damping interval past MAX_DAMPING
+     (27.0, 0.55, 0.5, 0.06, True),  # damped at most MAX_DAMPING, as a mode of the band (its interval past it)
+     (27.0, MAX_DAMPING + 0.01, 0.5, 0.01, False),  # damped beyond it
      (27.0, 0.4, np.nan, 0.02, False),  # an interval not known decides nothing
      (48.0, 0.55, 0.5, 0.02, True),
      (NYQUIST, 0.55, 0.5, 0.02, False),  # held at the fit's bound: its interval means nothing
