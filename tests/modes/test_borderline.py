@@ -163,6 +163,7 @@ def test_a_mode_well_past_the_top_or_well_inside_it_is_decided(supine_fits, top,
      (40.0, 0.3, 0.5, 0.02, False),
      (0.9, 0.3, 0.02, 0.02, True),  # below the band, its resonance reaching up into it
      (0.6, 0.3, 0.05, 0.02, False),  # below, not reaching (0.78 Hz)
+     (0.9, 0.3, 0.1, 0.02, False),  # below, its interval reaching back into the band: borderline
      (27.0, 0.4, 0.5, 0.25, False),  # its damping not resolved (the interval crosses zero)
      (27.0, 0.55, 0.5, 0.06, True),  # damped at most MAX_DAMPING, as a mode of the band (its interval past it)
      (27.0, MAX_DAMPING + 0.01, 0.5, 0.01, False),  # damped beyond it
@@ -190,6 +191,7 @@ def test_only_a_needed_pole_beyond_the_band_is_named_and_the_note_says_where_to_
         "lies outside the band (the input's excited band, or --band within it); to report it, excite the structure "
         f"and fit a band reaching past {27 + df:.3g} Hz")
     assert below.message.endswith(f"fit a band reaching below {0.9 - Z95 * 0.02:.3g} Hz") and below.freq_hz == (0.9,)
+    assert (above.channels, above.value, above.freq_hz) == ((), 27.0, (27.0,))
     assert not [n for n in notes if n.code == "mode_count" and "outside the band" in n.message]  # said once
     weak = replace(count, removal_rise=np.array([60.0, 5.0, 5.0]))  # not needed: what lies up there, unnamed
     assert list(weak.verdicts()) == ["needed", "not_a_mode", "not_a_mode"]
