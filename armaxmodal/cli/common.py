@@ -184,7 +184,7 @@ def _frequencies(freqs: list[float], shown: int = 4) -> str:
         return ""
     if len(freqs) <= shown:
         return f", at {', '.join(f'{f:.4g}' for f in freqs)} Hz"
-    return f", {len(freqs)} at {freqs[0]:.4g}-{freqs[-1]:.4g} Hz"
+    return f", at {len(freqs)} frequencies {freqs[0]:.4g}-{freqs[-1]:.4g} Hz"
 
 
 def write_outputs(outputs) -> None:

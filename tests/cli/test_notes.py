@@ -49,7 +49,7 @@ def test_a_code_line_names_its_notes_frequencies(capsys):
                  *(note("unexplained_peak", f) for f in (3.0, 5.5, 7.25, 9.0, 11.75))])  # fmt: skip
     lines = capsys.readouterr().err.splitlines()
     assert lines[1].startswith("  warning count_undecided (2, at 4.4, 28.48 Hz): ")  # each once, in order
-    assert lines[2].startswith("  warning unexplained_peak (5, 5 at 3-11.75 Hz): ")  # more than four: the range
+    assert lines[2].startswith("  warning unexplained_peak (5, at 5 frequencies 3-11.75 Hz): ")  # more: the range
     assert lines[3].startswith("  info    mode_count (1): ")
     print_notes([note("unexplained_peak", f) for f in (3.0, 5.5, 7.25, 9.0)])  # four: each named
     assert capsys.readouterr().err.splitlines()[1].startswith("  warning unexplained_peak (4, at 3, 5.5, 7.25, 9 Hz): ")
