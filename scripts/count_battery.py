@@ -32,6 +32,7 @@ from scipy import signal
 import armaxmodal as am
 from armaxmodal.modes.dft_model import DftLines, fit_modal_model
 from armaxmodal.modes.state import refit_band
+from armaxmodal.stats import Z95
 
 FREQ_TOL, DAMPING_TOL, BOUNDS = 0.02, 0.10, 3.0
 #: exact modes above this fraction of the ride's band may be missed
@@ -112,7 +113,7 @@ def beyond_named(truth, sel) -> tuple[int, int]:
     if count is None or sel.refinement is None:
         return 0, 0
     m, named = count.model, np.flatnonzero(count.verdicts(sel.refinement.band_hz) == "beyond_band")
-    half = 1.96 * m.freq_sd[named]
+    half = Z95 * m.freq_sd[named]
     held = [np.any(np.abs(truth.freq_hz - m.freq_hz[i]) <= h) for i, h in zip(named, half, strict=True)]
     return len(named), int(sum(held))
 

@@ -184,8 +184,13 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
     return notes
 
 
+def _pole_and_reach(model, i: int) -> tuple[float, float, float, float]:
+    """A pole's frequency and damping and their 95 % intervals' half-widths (what its notes name)."""
+    return model.freq_hz[i], model.damping[i], Z95 * model.freq_sd[i], Z95 * model.damping_sd[i]
+
+
 def _beyond_band_note(model, i: int, band_hz) -> QualityWarning:
-    f, x, df, dx = model.freq_hz[i], model.damping[i], Z95 * model.freq_sd[i], Z95 * model.damping_sd[i]
+    f, x, df, dx = _pole_and_reach(model, i)
     side, edge = ("above", f + df) if f > band_hz[1] else ("below", f - df)
     return QualityWarning(
         "mode_beyond_band", (),
@@ -198,7 +203,7 @@ def _beyond_band_note(model, i: int, band_hz) -> QualityWarning:
 
 
 def _borderline_note(model, i: int, band_hz) -> QualityWarning:
-    f, x, df, dx = model.freq_hz[i], model.damping[i], Z95 * model.freq_sd[i], Z95 * model.damping_sd[i]
+    f, x, df, dx = _pole_and_reach(model, i)
     where, reach = [], []
     if not band_hz[0] <= f <= band_hz[1]:
         where.append(f"beyond the band {band_hz[0]:.4g}-{band_hz[1]:.4g} Hz")
