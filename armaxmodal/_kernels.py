@@ -332,11 +332,12 @@ def modal_basis(s, z_inv, u, lam, dt, bandlimited, basis, slopes):
             p = lam[j] if conj == 0 else np.conj(lam[j])
             mu = np.exp(p * dt)
             for line in range(n_lines):
-                held = 1.0 / (1.0 - mu * z_inv[line])
+                held = _reciprocal(1.0 - mu * z_inv[line])
                 held_slope = dt * mu * z_inv[line] * held * held
                 if bandlimited:
-                    plant = u[line] / (s[line] - p)
-                    plant_slope = plant / (s[line] - p)
+                    inverse = _reciprocal(s[line] - p)
+                    plant = u[line] * inverse
+                    plant_slope = plant * inverse
                 else:
                     plant, plant_slope = u[line] * held, u[line] * held_slope
                 slopes[conj, j, line], slopes[2 + conj, j, line] = plant_slope, held_slope
@@ -345,6 +346,16 @@ def modal_basis(s, z_inv, u, lam, dt, bandlimited, basis, slopes):
     for line in range(n_lines):
         basis[line, 2 * n], basis[n_lines + line, 2 * n] = u[line].real, u[line].imag
         basis[line, 4 * n + 1], basis[n_lines + line, 4 * n + 1] = 1.0, 0.0
+
+
+@njit(**JIT_OPTIONS)
+def _reciprocal(z):
+    """``1 / z`` as ``conj(z) / |z|^2``: numba's complex division guards against overflow by
+    scaling (Smith's method), which the basis's denominators never need (``|1 - mu z^-1|`` lies
+    in ``[1 - |mu|, 2]``, ``|s - lambda|`` is at least the pole's decay rate); it took three
+    quarters of the kernel's time."""
+    size = z.real * z.real + z.imag * z.imag
+    return complex(z.real / size, -z.imag / size)
 
 
 @njit(**JIT_OPTIONS)

@@ -15,6 +15,7 @@ import numpy as np
 import scipy.linalg
 
 from armaxmodal._kernels import modal_basis, modal_moved
+from armaxmodal._linalg import orthonormal_basis
 from armaxmodal.modes.settings import NORMAL_EQUATIONS_MIN_RATIO
 
 
@@ -72,7 +73,7 @@ class SeparableModel:
         a = np.empty((2 * lines, 4 * lam.size + 2), order="F")
         slopes = np.empty((4, lam.size, lines), complex)
         modal_basis(self.s, self.z_inv, self.u, lam, self.dt, self.hold == "bandlimited", a, slopes)
-        q, r = scipy.linalg.qr(a, mode="economic", overwrite_a=True, check_finite=False)
+        q, r = orthonormal_basis(a)
         qtb = q.T @ self.b
         self._x, self.lam, self.q, self.r, self.slopes = x.copy(), lam, q, r, slopes
         self.coef = scipy.linalg.solve_triangular(r, qtb, check_finite=False)

@@ -198,3 +198,26 @@ def test_the_normal_equations_equal_those_of_the_jacobians_rows(fixtures_dir, at
     np.testing.assert_allclose(gram, j.T @ j, rtol=1e-8, atol=1e-10 * np.abs(j.T @ j).max())
     np.testing.assert_allclose(grad, j.T @ r, rtol=1e-6, atol=1e-9 * np.abs(j.T @ r).max())
     assert power == pytest.approx(r @ r, rel=1e-12)
+
+
+#: orthonormal to rounding: LAPACK's Householder QR of a 2,000 x 12 matrix is within a few 1e-15
+ORTHONORMAL = 1e-13
+
+
+@pytest.mark.parametrize("condition", [1.0, 30.0, 1e7])
+def test_the_modal_bases_orthonormal_factor_is_a_qr_at_every_conditioning(condition):
+    """``orthonormal_basis`` against the definition of a QR factorisation, on columns of very
+    unequal norms (as the plant and transient columns are): a well conditioned basis through its
+    Gram matrix, and one conditioned beyond ``CHOLESKY_QR_MAX_CONDITION`` still orthonormal to
+    rounding (the Gram route alone would lose 2 log10(1e7) = 14 digits of it)."""
+    from armaxmodal._linalg import CHOLESKY_QR_MAX_CONDITION, orthonormal_basis
+
+    rng = np.random.default_rng(3)
+    left, _ = np.linalg.qr(rng.standard_normal((2000, 12)))
+    right, _ = np.linalg.qr(rng.standard_normal((12, 12)))
+    a = left @ np.diag(np.geomspace(1.0, 1.0 / condition, 12)) @ right * np.geomspace(1e-3, 1e4, 12)
+    q, r = orthonormal_basis(np.asfortranarray(a))
+    assert (condition > CHOLESKY_QR_MAX_CONDITION) == (condition == 1e7)  # both routes are tried
+    np.testing.assert_allclose(q.T @ q, np.eye(12), atol=ORTHONORMAL)
+    np.testing.assert_allclose(q @ r, a, rtol=0, atol=1e-13 * np.abs(a).max())
+    assert np.allclose(r, np.triu(r))

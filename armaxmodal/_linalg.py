@@ -1,0 +1,60 @@
+"""Dense linear algebra the fitters share that LAPACK offers no routine for."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg
+
+__all__ = ["CHOLESKY_QR_MAX_CONDITION", "orthonormal_basis"]
+
+#: a basis is made orthonormal through its Gram matrix (Cholesky QR: a third of a Householder
+#: QR's time) while its columns, scaled to unit norm, have at most this condition number: it then
+#: stays orthonormal to about ``condition^2 x 1e-16`` (1e-10 here, a thousandth of a BIC unit of a
+#: 20,000 x 5 record's modal model). The DFT modal bases of the benchmark chain and the bundled
+#: rides have a median of 8-80 and 95 % below 730 (2 % of the held sweep's fits are above it);
+#: beyond it (poles nearly one, a pole far out of the band) Householder's QR keeps every digit.
+CHOLESKY_QR_MAX_CONDITION = 1e3
+
+
+def orthonormal_basis(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The economic QR factorisation of a tall matrix, by its Gram matrix where that is exact enough.
+
+    Parameters
+    ----------
+    a : (m, k) float64, F-ordered, m >= k
+        Full column rank; its memory is overwritten (it holds ``Q`` on return).
+
+    Returns
+    -------
+    q : (m, k) ndarray
+        Orthonormal columns.
+    r : (k, k) ndarray
+        Upper triangular, ``a = q @ r``.
+
+    Notes
+    -----
+    Cholesky QR (``R`` from the Gram matrix of the columns scaled to unit norm, ``Q = a R^-1``)
+    where those columns' condition number is at most :data:`CHOLESKY_QR_MAX_CONDITION`, else
+    Householder reflections (LAPACK's ``geqrf``). The two agree to rounding; the first takes a
+    third of the time, which is most of a modal-model fit's.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from armaxmodal._linalg import orthonormal_basis
+    >>> a = np.asfortranarray(np.random.default_rng(0).standard_normal((100, 4)) * [1.0, 1e3, 1e-3, 7.0])
+    >>> q, r = orthonormal_basis(a.copy(order="F"))
+    >>> bool(np.allclose(q.T @ q, np.eye(4))), bool(np.allclose(q @ r, a))
+    (True, True)
+    """
+    gram = scipy.linalg.blas.dsyrk(1.0, a, trans=1)  # the upper triangle of a' a
+    scale = 1.0 / np.sqrt(np.diag(gram))
+    try:
+        unit = scipy.linalg.cholesky(gram * np.outer(scale, scale), lower=False, check_finite=False)
+        conditioned = np.linalg.cond(unit) <= CHOLESKY_QR_MAX_CONDITION
+    except np.linalg.LinAlgError:  # not positive definite in floating point: Householder's
+        conditioned = False
+    if not conditioned:
+        return scipy.linalg.qr(a, mode="economic", overwrite_a=True, check_finite=False)
+    r = unit / scale  # a D = Q U for the column scaling D, so a = Q (U D^-1)
+    return scipy.linalg.blas.dtrsm(1.0, r, a, side=1, overwrite_b=1), r
