@@ -55,11 +55,11 @@ class SeparableModel:
     def __init__(self, s, z_inv, u, y_weighted, dt, hold):
         self.s, self.z_inv, self.u, self.dt, self.hold = s, z_inv, u, dt, hold
         self.b = np.vstack([y_weighted.real, y_weighted.imag])
-        self._x = None
+        self._x = self.q = self.slopes = None
 
     def release(self) -> None:
         """Let go of the factors of the last point (the size of the data)."""
-        self._x = self.q = self.resid = self.slopes = None
+        self._x = self.q = self.resid = self.slopes = self._q_conj = None
 
     def _solve(self, x):
         if self._x is not None and np.array_equal(x, self._x):
@@ -67,17 +67,35 @@ class SeparableModel:
         lam = poles(x)
         # the real parts of the lines over their imaginary parts, filled in place by a kernel
         # (a one-hour ride has 10^5 lines or more: no complex copy of the basis, no copy for the
-        # QR, and the last point's factors are let go first)
-        self.release()
-        lines = self.s.size
-        a = np.empty((2 * lines, 4 * lam.size + 2), order="F")
-        slopes = np.empty((4, lam.size, lines), complex)
+        # QR); the last point's arrays are filled again where they fit
+        a, slopes = self._buffers(lam.size)
         modal_basis(self.s, self.z_inv, self.u, lam, self.dt, self.hold == "bandlimited", a, slopes)
         q, r = orthonormal_basis(a)
         qtb = q.T @ self.b
         self._x, self.lam, self.q, self.r, self.slopes = x.copy(), lam, q, r, slopes
         self.coef = scipy.linalg.solve_triangular(r, qtb, check_finite=False)
         self.resid = self.b - q @ qtb
+
+    def _buffers(self, n_modes: int) -> tuple[np.ndarray, np.ndarray]:
+        """The basis and slope arrays of a point with ``n_modes`` poles: the last point's where they
+        have that size (``Q`` takes the basis's memory), else new ones. A fit's points all have one
+        size, and fresh arrays of that size cost as much as the point's products: the allocator
+        hands megabytes back to the system when they are freed, and takes them again zeroed."""
+        shape, lines = (2 * self.s.size, 4 * n_modes + 2), self.s.size
+        a, slopes = self.q, self.slopes
+        self.release()
+        if a is None or a.shape != shape or not a.flags.f_contiguous or not a.flags.writeable:
+            a, slopes = np.empty(shape, order="F"), np.empty((4, n_modes, lines), complex)
+        return a, slopes
+
+    def _conj_q(self) -> np.ndarray:
+        """``conj(Q_c)`` (L, 4 n + 2) of the current point, in an array kept from point to point."""
+        lines, width = self.s.size, self.q.shape[1]
+        if getattr(self, "_q_conj", None) is None or self._q_conj.shape != (lines, width):
+            self._q_conj = np.empty((lines, width), complex)
+        self._q_conj.real[...] = self.q[:lines]
+        np.negative(self.q[lines:], out=self._q_conj.imag)
+        return self._q_conj
 
     def residual(self, x):
         self._solve(x)
@@ -109,7 +127,7 @@ class SeparableModel:
         beta = coef[2 * n + 1 : 4 * n + 1 : 2] + 1j * coef[2 * n + 2 : 4 * n + 2 : 2]
         moved = np.empty((2 * lines, width, x.size))
         modal_moved(self.slopes, alpha, beta, d_lam, moved)
-        seen = np.conj(self.slopes.reshape(4 * n, lines)) @ (resid[:lines] + 1j * resid[lines:])
+        seen = np.conj(self.slopes.reshape(4 * n, lines) @ (resid[:lines] - 1j * resid[lines:]))  # conj(S) r
         back = _basis_slopes_times(seen, d_lam, coef.shape[0])
         moved = moved.reshape(2 * lines, -1)
         # every column at once: two passes over Q
@@ -136,15 +154,15 @@ class SeparableModel:
             turn = np.conj(g) if slope % 2 else g  # the conjugate pole's slopes move with conj(d lambda)
             w[slope, own, :, own, :] = -turn * coefficient[:, :, None]
         w = w.reshape(4 * n, width, 2 * n)
+        # no conjugate copy of the slopes S, nor a new complex copy of Q: each is as large as the basis
         slopes = self.slopes.reshape(4 * n, lines)
-        slopes_h = np.conj(slopes)
-        seen = slopes_h @ (self.resid[:lines] + 1j * self.resid[lines:])
-        # Q' M = Re(Q_c^H slopes w), Q_c = Q's real rows + i its imaginary rows
-        on_basis = (np.conj(slopes_h @ (self.q[:lines] + 1j * self.q[lines:])).T @ w.reshape(4 * n, -1)).real
+        seen = np.conj(slopes @ (self.resid[:lines] - 1j * self.resid[lines:]))  # conj(S) r
+        # Q' M = Re(Q_c^H slopes w) = Re((S conj(Q_c))' w), Q_c = Q's real rows + i its imaginary rows
+        on_basis = ((slopes @ self._conj_q()).T @ w.reshape(4 * n, -1)).real
         on_basis = on_basis.reshape(-1, width, 2 * n)
         e = scipy.linalg.solve_triangular(self.r, _basis_slopes_times(seen, d_lam, coef.shape[0]).reshape(
             coef.shape[0], -1), trans="T", check_finite=False).reshape(-1, width, 2 * n)  # fmt: skip
-        slopes_gram = slopes_h @ slopes.T
+        slopes_gram = _hermitian(scipy.linalg.blas.zherk(1.0, slopes.T, trans=2))  # conj(S) S', its upper half
         m_m = np.einsum("csi,csk->ik", np.conj(w), (slopes_gram @ w.reshape(4 * n, -1)).reshape(w.shape)).real
         off_basis = m_m - np.einsum("asi,ask->ik", on_basis, on_basis)
         power = float(np.sum(self.resid**2))
@@ -157,6 +175,11 @@ class SeparableModel:
             return gram, grad, power
         gram = off_basis + np.einsum("asi,ask->ik", e, e)
         return gram, np.einsum("csi,cs->i", np.conj(w), seen).real, power
+
+
+def _hermitian(upper: np.ndarray) -> np.ndarray:
+    """The Hermitian matrix whose upper triangle BLAS's ``herk`` filled (its lower one zero)."""
+    return upper + np.conj(np.triu(upper, 1)).T
 
 
 def _basis_slopes_times(seen: np.ndarray, d_lam: np.ndarray, n_coef: int) -> np.ndarray:
