@@ -135,7 +135,7 @@ class SeparableModel:
             self.r, back.reshape(coef.shape[0], -1), trans="T", check_finite=False))  # fmt: skip
         return moved.reshape(resid.size, x.size)
 
-    def normal_equations(self, x):
+    def normal_equations(self, x, rows: bool = False):
         """``(J' J, J' r, |r|^2)`` over every sensor's rows without forming ``J``: from the Gram
         matrix of the pole slopes and their projections on the basis (``J = P_perp M - Q E``
         with ``M = -dA coef`` and ``E = R^-T dA' r``, whose two parts are orthogonal, and
@@ -166,9 +166,10 @@ class SeparableModel:
         m_m = np.einsum("csi,csk->ik", np.conj(w), (slopes_gram @ w.reshape(4 * n, -1)).reshape(w.shape)).real
         off_basis = m_m - np.einsum("asi,ask->ik", on_basis, on_basis)
         power = float(np.sum(self.resid**2))
-        if np.min(np.diag(off_basis) / np.diag(m_m)) < NORMAL_EQUATIONS_MIN_RATIO:
+        if rows or np.min(np.diag(off_basis) / np.diag(m_m)) < NORMAL_EQUATIONS_MIN_RATIO:
             # a pole's slope almost in the basis (a pole far outside the band, two poles nearly
             # one): the difference of squares has lost too many digits, so the rows are formed
+            # (``rows``: the caller found them lost)
             gram, grad = 0.0, 0.0
             for jac, resid in self.sensor_rows(x):
                 gram, grad = gram + jac.T @ jac, grad + jac.T @ resid
@@ -210,6 +211,13 @@ def sandwich_sd(blocks, n_par: int) -> np.ndarray:
     return np.sqrt(np.clip(np.diag(bread @ meat @ bread) * scale, 0, None))
 
 
+def _ridged_cholesky(gram: np.ndarray) -> np.ndarray:
+    """The upper Cholesky factor of ``gram`` plus a ridge of 1e-12 of its mean diagonal, so that a
+    null direction stays solvable."""
+    ridge = 1e-12 * np.trace(gram) / gram.shape[0]
+    return scipy.linalg.cholesky(gram + ridge * np.eye(gram.shape[0]), lower=False, check_finite=False)
+
+
 class GramCompressed:
     """The projected residual and Jacobian reduced to ``n + 1`` rows through the normal
     equations: ``[R; 0]`` and ``[R^-T J'r; sqrt(|r|^2 - |R^-T J'r|^2)]`` with ``R'R = J'J``
@@ -225,8 +233,11 @@ class GramCompressed:
     def _factor(self, x):
         if self._x is None or not np.array_equal(x, self._x):
             gram, grad, power = self.model.normal_equations(x)
-            gram = gram + 1e-12 * np.trace(gram) * np.eye(x.size) / x.size  # a null direction stays solvable
-            r = scipy.linalg.cholesky(gram, lower=False, check_finite=False)
+            try:
+                r = _ridged_cholesky(gram)
+            except np.linalg.LinAlgError:  # the difference of squares lost J'J's definiteness where two
+                gram, grad, power = self.model.normal_equations(x, rows=True)  # poles are nearly one
+                r = _ridged_cholesky(gram)
             top = scipy.linalg.solve_triangular(r, grad, trans="T", check_finite=False)
             last = np.sqrt(max(power - top @ top, 0.0))
             self._x = x.copy()

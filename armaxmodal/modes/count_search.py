@@ -45,17 +45,16 @@ class _Search:
         self.cfg, self.lines, self.dft, self.trials, self.table = settings, lines, dft, 0, ModelTable(n_effective)
         self.fitter, self.agreement, self.logged, self.unsupported = fitter, agreement, self.table.add, None
 
-    def screened(self, starts: list[tuple[np.ndarray, np.ndarray]], labels: list[tuple[str, float]]
-                 ) -> list[ModalModel | None]:  # fmt: skip
+    def screened(self, starts: list[tuple[np.ndarray, np.ndarray]], labels: list[tuple[str, float]],
+                 intervals: bool = True) -> list[ModalModel | None]:  # fmt: skip
         """Each start ``(freq_hz, damping)`` fitted for ``settings.screen_nfev`` steps, over the worker threads
-        (numpy releases the interpreter in their array work); ``labels``: each start's ``(action, Hz)``."""
+        (numpy releases the interpreter in their array work); ``labels``: each start's ``(action, Hz)``;
+        ``intervals=False``: fits compared by their criterion alone, without standard deviations."""
         self.trials += sum(len(f) > 0 for f, _ in starts)
-
         def one(start):
-            f, x = start
-            return self.fitter(self.data, f, x, self.hold, self.cfg.screen_nfev, self.dft) if len(f) else None
+            return self.fitter(self.data, *start, self.hold, self.cfg.screen_nfev, self.dft, intervals=intervals)
 
-        fits = parallel_map(one, starts, self.n_jobs, min_items=2)
+        fits = parallel_map(lambda start: one(start) if len(start[0]) else None, starts, self.n_jobs, min_items=2)
         return [self.logged(action, f, fit) for (action, f), fit in zip(labels, fits, strict=True)]
 
     def fit(self, freq_hz, damping, max_nfev: int | None = None, counted: bool = True,
@@ -109,8 +108,8 @@ class _Search:
 
     def removals(self, current: ModalModel) -> list[tuple[str, float, ModalModel | None]]:
         keep = [np.arange(current.n_modes) != m for m in range(current.n_modes)]
-        fits = self.screened([(current.freq_hz[k], current.damping[k]) for k in keep],
-                             [("remove", float(f)) for f in current.freq_hz])
+        fits = self.screened([(current.freq_hz[k], current.damping[k]) for k in keep],  # the best is converged
+                             [("remove", float(f)) for f in current.freq_hz], intervals=False)  # fmt: skip
         return [("remove", float(f), fit) for f, fit in zip(current.freq_hz, fits, strict=True)]
 
     def additions(self, current: ModalModel, candidates, peak_hz: float) -> list[tuple[str, float, ModalModel]]:
@@ -236,8 +235,8 @@ def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) 
     shown = np.flatnonzero(physical(current, search.data.band_hz))
     if len(halves) != 2 or shown.size == 0:
         return (), None
-    screened = search.screened([split_start(current, m) for m in shown],
-                               [("split", float(current.freq_hz[m])) for m in shown])  # fmt: skip
+    screened = search.screened([split_start(current, m) for m in shown],  # the best is converged
+                               [("split", float(current.freq_hz[m])) for m in shown], intervals=False)  # fmt: skip
     tried = [(m, fit) for m, fit in zip(shown, screened, strict=True) if fit is not None]
     if not tried:
         return (), None

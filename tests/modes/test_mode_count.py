@@ -396,7 +396,7 @@ def test_a_long_record_is_counted_on_its_start_and_fitted_whole(bundled_diagram)
 
 def _scripted(table):
     """A fitter for ``count_modes(fitter=...)`` whose fits are :class:`_Scored` by ``table``."""
-    return lambda data, f, x, hold, n, dft: _Scored(f, x, table)
+    return lambda data, f, x, hold, n, dft, intervals=True: _Scored(f, x, table)
 
 
 class _Scored:
@@ -862,7 +862,8 @@ def test_the_split_of_lowest_criterion_is_the_one_judged(best_resolved):
     bic = {id(m): m.neg2_loglik_on(n_eff) + m.n_params * np.log(n_eff) for m in (current, low, high)}
     search = SimpleNamespace(
         n_eff=n_eff, bic=lambda m: bic[id(m)], data=SimpleNamespace(band_hz=(1.0, 100.0)),
-        screened=lambda starts, labels: [high, low], fit=lambda f, x, nfev, label=None: low if f[1] == 14.0 else high,
+        screened=lambda starts, labels, intervals=True: [high, low],
+        fit=lambda f, x, nfev, label=None: low if f[1] == 14.0 else high,
         in_both_halves=lambda m, new, halves: True, cfg=CountSettings(),
     )  # fmt: skip
     got, model = _split_wanted(search, current, ("first half", "second half"))
@@ -936,7 +937,7 @@ def test_an_addition_its_halves_nearly_confirm_is_undecided_not_refused(monkeypa
     data = supine[0]
     second = replace(data, y=data.y[:-1], u=data.u[:-1], s=data.s[:-1], z_inv=data.z_inv[:-1])  # told apart by size
 
-    def fitter(d, f, x, hold, n, dft):  # sd 1e-3 f in each half: a shift of z sqrt(2) 1e-3 is z apart
+    def fitter(d, f, x, hold, n, dft, intervals=True):  # sd 1e-3 f in each half: a shift of z sqrt(2) 1e-3 is z apart
         return _Scored(np.asarray(f) * (1 + z * np.sqrt(2) * 1e-3 * (d.y.shape[0] == second.y.shape[0])), x, table)
 
     count = count_modes(data, [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], hold="zoh", halves=(data, second),
@@ -963,7 +964,7 @@ def test_a_record_of_one_mode_has_its_split_tried():
     search = SimpleNamespace(
         n_eff=n_eff, bic=lambda m: m.neg2_loglik_on(n_eff) + m.n_params * np.log(n_eff),
         data=SimpleNamespace(band_hz=(1.0, 100.0)), cfg=CountSettings(),
-        screened=lambda starts, labels: screened.extend(labels) or [split],
+        screened=lambda starts, labels, intervals=True: screened.extend(labels) or [split],
         fit=lambda f, x, nfev, label=None: split, in_both_halves=lambda m, new, halves: True,
     )  # fmt: skip
     wanted, model = _split_wanted(search, current, ("first half", "second half"))

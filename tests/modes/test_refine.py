@@ -221,3 +221,29 @@ def test_the_modal_bases_orthonormal_factor_is_a_qr_at_every_conditioning(condit
     np.testing.assert_allclose(q.T @ q, np.eye(12), atol=ORTHONORMAL)
     np.testing.assert_allclose(q @ r, a, rtol=0, atol=1e-13 * np.abs(a).max())
     assert np.allclose(r, np.triu(r))
+
+
+def test_normal_equations_that_lost_their_definiteness_are_formed_from_the_rows():
+    """Where the difference of squares leaves ``J'J`` indefinite (two poles nearly one: a count's
+    split screening stopped on it), the compressed problem asks for the rows' normal equations
+    instead of failing; where those are indefinite too, the error stands."""
+    from types import SimpleNamespace
+
+    from armaxmodal.modes._separable import GramCompressed
+
+    lost, formed = np.array([[1.0, 1.0 + 1e-6], [1.0 + 1e-6, 1.0]]), np.array([[1.0, 0.5], [0.5, 1.0]])
+    asked = []
+
+    def normal_equations(x, rows=False):
+        asked.append(rows)
+        return (formed if rows else lost), np.array([0.3, 0.4]), 1.0
+
+    compressed = GramCompressed(SimpleNamespace(normal_equations=normal_equations))
+    jac, res = compressed.jacobian(np.zeros(2)), compressed.residual(np.zeros(2))
+    assert asked == [False, True]
+    np.testing.assert_allclose(jac[:2].T @ jac[:2], formed, rtol=1e-10)
+    np.testing.assert_allclose(jac[:2].T @ res[:2], [0.3, 0.4], rtol=1e-10)
+    assert res @ res == pytest.approx(1.0)
+    with pytest.raises(np.linalg.LinAlgError):
+        GramCompressed(SimpleNamespace(normal_equations=lambda x, rows=False: (lost, np.ones(2), 1.0))).residual(
+            np.zeros(2))
