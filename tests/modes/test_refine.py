@@ -204,12 +204,13 @@ def test_the_normal_equations_equal_those_of_the_jacobians_rows(fixtures_dir, at
 ORTHONORMAL = 1e-13
 
 
-@pytest.mark.parametrize("condition", [1.0, 30.0, 1e7])
+@pytest.mark.parametrize("condition", [1.0, 30.0, 1e5, 1e7])
 def test_the_modal_bases_orthonormal_factor_is_a_qr_at_every_conditioning(condition):
     """``orthonormal_basis`` against the definition of a QR factorisation, on columns of very
     unequal norms (as the plant and transient columns are): a well conditioned basis through its
     Gram matrix, and one conditioned beyond ``CHOLESKY_QR_MAX_CONDITION`` still orthonormal to
-    rounding (the Gram route alone would lose 2 log10(1e7) = 14 digits of it)."""
+    rounding (the Gram route alone would lose 2 log10(1e7) = 14 digits of it, and one pass of it 10
+    at 1e5)."""
     from armaxmodal._linalg import CHOLESKY_QR_MAX_CONDITION, orthonormal_basis
 
     rng = np.random.default_rng(3)
@@ -221,6 +222,8 @@ def test_the_modal_bases_orthonormal_factor_is_a_qr_at_every_conditioning(condit
     np.testing.assert_allclose(q.T @ q, np.eye(12), atol=ORTHONORMAL)
     np.testing.assert_allclose(q @ r, a, rtol=0, atol=1e-13 * np.abs(a).max())
     assert np.allclose(r, np.triu(r))
+    if condition <= CHOLESKY_QR_MAX_CONDITION:  # the Gram route's R (Householder's has diagonal signs of its own)
+        assert np.all(np.diag(r) > 0)
 
 
 def test_normal_equations_that_lost_their_definiteness_are_formed_from_the_rows():
@@ -235,15 +238,28 @@ def test_normal_equations_that_lost_their_definiteness_are_formed_from_the_rows(
     asked = []
 
     def normal_equations(x, rows=False):
-        asked.append(rows)
+        asked.append((tuple(x), rows))
         return (formed if rows else lost), np.array([0.3, 0.4]), 1.0
 
     compressed = GramCompressed(SimpleNamespace(normal_equations=normal_equations))
-    jac, res = compressed.jacobian(np.zeros(2)), compressed.residual(np.zeros(2))
-    assert asked == [False, True]
+    jac, res = compressed.jacobian(np.array([0.5, 0.1])), compressed.residual(np.array([0.5, 0.1]))
+    assert asked == [((0.5, 0.1), False), ((0.5, 0.1), True)]  # once each, at the point asked
     np.testing.assert_allclose(jac[:2].T @ jac[:2], formed, rtol=1e-10)
     np.testing.assert_allclose(jac[:2].T @ res[:2], [0.3, 0.4], rtol=1e-10)
     assert res @ res == pytest.approx(1.0)
     with pytest.raises(np.linalg.LinAlgError):
         GramCompressed(SimpleNamespace(normal_equations=lambda x, rows=False: (lost, np.ones(2), 1.0))).residual(
             np.zeros(2))
+
+
+def test_a_null_direction_of_the_normal_equations_stays_solvable_at_any_scale():
+    """The compressed problem's Cholesky factor takes a ridge of 1e-12 of the mean diagonal: two
+    parameters that move the residual alike (rank one, ``J'J`` only semi-definite) are still
+    factored, whatever the units make of the scale."""
+    from armaxmodal.modes._separable import _ridged_cholesky
+
+    for scale in (1.0, 1e8):
+        gram = scale * np.ones((2, 2))
+        r = _ridged_cholesky(gram)
+        np.testing.assert_allclose(r.T @ r, gram, rtol=1e-9)
+        assert np.all(np.diag(r) > 0)
