@@ -1,11 +1,14 @@
 """Writing outputs: every file goes to a temporary name beside the target and is renamed over
-it when complete, so a failed run leaves nothing behind; JSON is strict (no bare NaN).
+it when complete, so a failed run leaves nothing behind; JSON is strict (no bare NaN). A target
+that is not a regular file (``/dev/null``, a named pipe) is written into, not renamed over: run
+as root, a rename puts a regular file in place of the device.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import shutil
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -18,20 +21,7 @@ from armaxmodal.recording import Recording
 # -- writers --------------------------------------------------------------------------
 def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
     """Call ``write(tmp_path)`` and move the file into place only if it succeeds."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        write(tmp)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
+    return write_all([(path, write)])[0]
 
 
 def write_all(outputs) -> list[Path]:
@@ -41,14 +31,15 @@ def write_all(outputs) -> list[Path]:
     try:
         for path, write in outputs:
             path = Path(path)
-            path.parent.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-            os.close(fd)
-            staged.append((tmp, path))
-            write(tmp)
+            staged.append((_staging_file(path), path))
+            write(staged[-1][0])
         umask = os.umask(0)
         os.umask(umask)
         for tmp, path in staged:
+            if _special(path):  # a device or a pipe takes the bytes; renamed over, it would be gone
+                with open(tmp, "rb") as src, open(path, "wb") as dst:
+                    shutil.copyfileobj(src, dst)
+                continue
             os.chmod(tmp, 0o666 & ~umask)
             os.replace(tmp, path)
     finally:
@@ -56,6 +47,23 @@ def write_all(outputs) -> list[Path]:
             if os.path.exists(tmp):
                 os.unlink(tmp)
     return [path for _, path in staged]
+
+
+def _special(path: Path) -> bool:
+    """``path`` exists and is neither a regular file nor a folder (``/dev/null``, a named pipe)."""
+    return path.exists() and not path.is_file() and not path.is_dir()
+
+
+def _staging_file(path: Path) -> str:
+    """A new temporary file beside ``path`` (its folder made if need be), or in the system's
+    temporary folder for a special target (nothing is to be created in ``/dev``)."""
+    if _special(path):
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp")
+    else:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    return tmp
 
 
 def write_recording_csv(recording: Recording, path: str | os.PathLike, float_format: str = "%.9g") -> Path:

@@ -491,3 +491,30 @@ def test_a_time_column_rounded_to_its_printed_decimals_is_read_at_its_spans_rate
     in_ms.to_csv(path, index=False)
     (note,) = am.read_recording(path).meta["read_warnings"]
     assert note.code == "time_rounded" and f"printed to 1e-0{decimals} s" in note.message
+
+
+def test_a_target_that_is_no_regular_file_is_written_into_not_renamed_over(tmp_path):
+    """``--json /dev/null`` run as root renamed a regular file over the device (the machine's
+    ``/dev/null`` became a file, and apt could no longer check its packages' signatures). A named
+    pipe stands in for the device: it stays a pipe, its reader gets the bytes, and nothing is
+    staged beside it."""
+    import os
+    import stat
+    import threading
+
+    from armaxmodal.io.write import atomic_write, write_all
+
+    pipe, regular = tmp_path / "pipe", tmp_path / "modes.json"
+    os.mkfifo(pipe)
+    for write in (lambda: write_all([(regular, lambda tmp: open(tmp, "w").write("{}")),
+                                     (pipe, lambda tmp: open(tmp, "w").write('{"ok": true}'))]),
+                  lambda: atomic_write(pipe, lambda tmp: open(tmp, "w").write('{"ok": true}'))):  # fmt: skip
+        got = []
+        reader = threading.Thread(target=lambda got=got: got.append(pipe.read_bytes()), daemon=True)
+        reader.start()
+        write()
+        reader.join(timeout=20)
+        assert stat.S_ISFIFO(os.stat(pipe).st_mode)
+        assert got == [b'{"ok": true}']
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["modes.json", "pipe"]
+        assert regular.read_text() == "{}"
