@@ -30,12 +30,11 @@ from armaxmodal.exceptions import (
     SettingsError,
     StructureError,
 )
+from armaxmodal.identification import Identification, identify
 from armaxmodal.io import read_recording, read_xsens, write_recording_csv, write_recording_uff
 from armaxmodal.modes import (
-    Identification,
     ModeSelection,
     StabilisationDiagram,
-    identify,
     select_modes,
     stabilisation_diagram,
 )

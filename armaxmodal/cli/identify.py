@@ -26,7 +26,7 @@ def add_parser(sub, parents) -> None:
 
 
 def run(args) -> int:
-    from armaxmodal.modes.identification import identify
+    from armaxmodal.identification import identify
 
     rec = load_recording(args)
     orders = None

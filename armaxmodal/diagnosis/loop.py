@@ -45,7 +45,7 @@ def _signals(recording: Recording, band) -> tuple[Signals, Recording, tuple]:
 
 def _baseline_orders(rec: Recording, baseline) -> tuple[int, int, int, int]:
     from armaxmodal.estimate.orders import choose_orders
-    from armaxmodal.modes.identification import Identification
+    from armaxmodal.identification import Identification
 
     if baseline is None:
         centred = prepare(rec, detrend="mean", align=False, resample=False, drop_incoherent=False).recording

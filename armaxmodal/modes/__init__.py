@@ -10,25 +10,21 @@
   with intervals widened by
   the segment spread (:mod:`.intervals`) and judged by the modal-model check (:mod:`.modal_check`,
   on the coherent lines of :mod:`.frf`).
-* :func:`~armaxmodal.identify` -- one model, its modes and the same check.
 """
 
 from armaxmodal.modes.diagram import StabilisationDiagram, choose_nk, stabilisation_diagram
-from armaxmodal.modes.identification import Identification, identify
 from armaxmodal.modes.modal_check import ModalCheck, check_modes
 from armaxmodal.modes.pipeline import select_modes
 from armaxmodal.modes.poles import Tolerances
 from armaxmodal.modes.result import ModeSelection
 
 __all__ = [
-    "Identification",
     "ModalCheck",
     "ModeSelection",
     "StabilisationDiagram",
     "Tolerances",
     "check_modes",
     "choose_nk",
-    "identify",
     "select_modes",
     "stabilisation_diagram",
 ]
