@@ -55,7 +55,7 @@ class SeparableModel:
     def __init__(self, s, z_inv, u, y_weighted, dt, hold):
         self.s, self.z_inv, self.u, self.dt, self.hold = s, z_inv, u, dt, hold
         self.b = np.vstack([y_weighted.real, y_weighted.imag])
-        self._x = self.q = self.slopes = None
+        self._x = self.q = self.slopes = self._q_conj = None
 
     def release(self) -> None:
         """Let go of the factors of the last point (the size of the data)."""
@@ -91,7 +91,7 @@ class SeparableModel:
     def _conj_q(self) -> np.ndarray:
         """``conj(Q_c)`` (L, 4 n + 2) of the current point, in an array kept from point to point."""
         lines, width = self.s.size, self.q.shape[1]
-        if getattr(self, "_q_conj", None) is None or self._q_conj.shape != (lines, width):
+        if self._q_conj is None or self._q_conj.shape != (lines, width):
             self._q_conj = np.empty((lines, width), complex)
         self._q_conj.real[...] = self.q[:lines]
         np.negative(self.q[lines:], out=self._q_conj.imag)

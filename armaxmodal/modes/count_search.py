@@ -51,6 +51,7 @@ class _Search:
         (numpy releases the interpreter in their array work); ``labels``: each start's ``(action, Hz)``;
         ``intervals=False``: fits compared by their criterion alone, without standard deviations."""
         self.trials += sum(len(f) > 0 for f, _ in starts)
+
         def one(start):
             return self.fitter(self.data, *start, self.hold, self.cfg.screen_nfev, self.dft, intervals=intervals)
 
