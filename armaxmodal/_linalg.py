@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-__all__ = ["CHOLESKY_QR_MAX_CONDITION", "orthonormal_basis"]
+__all__ = ["CHOLESKY_QR_MAX_CONDITION", "hermitian_from_upper", "orthonormal_basis", "ridged_cholesky"]
 
 #: a basis is made orthonormal through its Gram matrix, twice (CholeskyQR2: Fukaya et al. 2014;
 #: Yamamoto et al. 2015, a half of a Householder QR's time here), while its columns, scaled to unit
@@ -62,3 +62,15 @@ def orthonormal_basis(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     # the second pass: Q is orthonormal to condition^2 x 1e-16, so its Gram matrix is I to that
     again = scipy.linalg.cholesky(scipy.linalg.blas.dsyrk(1.0, q, trans=1), lower=False, check_finite=False)
     return scipy.linalg.blas.dtrsm(1.0, again, q, side=1, overwrite_b=1), again @ r
+
+
+def hermitian_from_upper(upper: np.ndarray) -> np.ndarray:
+    """The Hermitian matrix whose upper triangle BLAS's ``herk`` filled (its lower one zero)."""
+    return upper + np.conj(np.triu(upper, 1)).T
+
+
+def ridged_cholesky(gram: np.ndarray) -> np.ndarray:
+    """The upper Cholesky factor of ``gram`` plus a ridge of 1e-12 of its mean diagonal, so that a
+    null direction stays solvable."""
+    ridge = 1e-12 * np.trace(gram) / gram.shape[0]
+    return scipy.linalg.cholesky(gram + ridge * np.eye(gram.shape[0]), lower=False, check_finite=False)

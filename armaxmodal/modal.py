@@ -20,6 +20,10 @@ __all__ = [
     "mode_record",
     "modal_frf",
     "normalised_shape",
+    "mac",
+    "nearest_pole",
+    "matched_poles",
+    "new_poles",
 ]
 
 
@@ -160,3 +164,34 @@ def modal_frf(freq_hz, freqs, dampings, shapes):
     r = -(lam**2)[None, :] * shapes  # (n_sensors, n_modes)
     out = r[None] / (w - lam[None, None]) + np.conj(r)[None] / (w - np.conj(lam)[None, None])
     return out.sum(axis=2)
+
+
+def mac(a: np.ndarray, b: np.ndarray) -> float:
+    """The modal assurance criterion of two complex shape vectors, ``|a^H b|^2 / (|a|^2 |b|^2)``
+    (0 where either is zero)."""
+    den = np.vdot(a, a).real * np.vdot(b, b).real
+    return float(abs(np.vdot(a, b)) ** 2 / den) if den > 0 else 0.0
+
+
+def nearest_pole(freq_hz: np.ndarray, f: float) -> int:
+    """The index of the pole of ``freq_hz`` (Hz) nearest ``f`` (Hz), by log ratio."""
+    return int(np.argmin(np.abs(np.log(freq_hz / f))))
+
+
+def matched_poles(old_hz: np.ndarray, new_hz: np.ndarray) -> list[tuple[int, int]]:
+    """One-to-one pairs ``(i_new, j_old)`` of two pole sets' frequencies (Hz), nearest pairs
+    first (by log ratio); the larger set's surplus poles stay unpaired."""
+    pairs = sorted((abs(np.log(n / o)), i, j) for i, n in enumerate(new_hz) for j, o in enumerate(old_hz))
+    taken_new, taken_old, out = set(), set(), []
+    for _, i, j in pairs:
+        if i not in taken_new and j not in taken_old:
+            taken_new.add(i)
+            taken_old.add(j)
+            out.append((i, j))
+    return out
+
+
+def new_poles(old_hz: np.ndarray, new_hz: np.ndarray) -> list[int]:
+    """The poles of ``new_hz`` (indices) left over when each of ``old_hz`` takes its nearest."""
+    paired = {i for i, _ in matched_poles(old_hz, new_hz)}
+    return [i for i in range(len(new_hz)) if i not in paired]

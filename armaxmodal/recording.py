@@ -196,6 +196,23 @@ class Recording:
             dict(self.meta),
         )
 
+    def split(self, k: int) -> list[Recording]:
+        """The record cut into ``k`` disjoint, equal parts in time (the remainder dropped), each
+        with the channels and the rate but no metadata (a part's statistics are its own).
+
+        Parameters
+        ----------
+        k : int
+            The number of parts, at least 1.
+
+        Returns
+        -------
+        list of Recording
+        """
+        n = self.n_samples // k
+        return [Recording(self.fs, self.base[i * n : (i + 1) * n], self.response[i * n : (i + 1) * n], self.sensors,
+                          self.input_name) for i in range(k)]  # fmt: skip
+
     def to_frame(self) -> pd.DataFrame:
         """Columns ``time``, the input, then each sensor.
 

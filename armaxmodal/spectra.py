@@ -1,5 +1,6 @@
 """A record's spectra: Welch auto and cross spectral densities of an input and several outputs,
-the coherence, the H1 estimate with its random error, and the band the input excites.
+the coherence, the H1 estimate with its random error, the band the input excites, and the H1's
+clear, coherent peaks at a resolution chosen from the modes.
 
 Numpy only, and in the base layer, so that a :class:`~armaxmodal.Recording` carries its own
 (:meth:`~armaxmodal.Recording.welch`, computed at the first call for a segment length and kept):
@@ -9,17 +10,25 @@ to an earlier one to get them."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from armaxmodal.exceptions import DataError
-from armaxmodal.stats import welch_nperseg
+from armaxmodal.stats import H1_COHERENCE, welch_nperseg
 
 __all__ = [
+    "CoherentLines",
     "coherence",
+    "coherent_lines",
+    "coherent_peaks",
     "default_nperseg",
     "excited_band",
+    "explains",
     "h1_relative_error",
     "measured_frf",
+    "peak_prominences",
+    "resolving_nperseg",
     "welch_segments",
     "welch_spectra",
 ]
@@ -116,7 +125,7 @@ def measured_frf(recording, nperseg: int | None = None):
     """
     n = default_nperseg(recording) if nperseg is None else nperseg
     f, puu, puy, pyy = recording.welch(n)
-    return f, puy / puu[:, None], np.abs(puy) ** 2 / (puu[:, None] * pyy)
+    return f, puy / puu[:, None], coherence(puu, puy, pyy)
 
 
 def h1_relative_error(coherence: np.ndarray, n_samples: int, nperseg: int) -> np.ndarray:
@@ -134,3 +143,134 @@ def excited_band(recording, min_db: float = -30.0) -> tuple[float, float]:
     f, pxx, _, _ = recording.welch(min(recording.n_samples, 1024))
     live = f[pxx >= pxx.max() * 10 ** (min_db / 10)]
     return float(live.min()), float(live.max())
+
+
+@dataclass(frozen=True)
+class CoherentLines:
+    """One output's coherent lines of a band: frequencies (Hz), the H1 there and its random
+    error (absolute, Bendat & Piersol's from the coherence)."""
+
+    freq_hz: np.ndarray
+    h: np.ndarray
+    sigma: np.ndarray
+
+
+def coherent_lines(recording, nperseg: int, band=None) -> list[CoherentLines]:
+    """Each output's H1 on the lines of ``band`` (Hz; default: the input's excited band) where
+    its coherence is at least :data:`~armaxmodal.stats.H1_COHERENCE`, with its random error.
+
+    Returns
+    -------
+    list of CoherentLines
+        One per output, in the recording's sensor order (possibly with no line).
+    """
+    f, h, coh = measured_frf(recording, nperseg)
+    lo, hi = band if band is not None else excited_band(recording)
+    out = []
+    for k in range(h.shape[1]):
+        good = (coh[:, k] >= H1_COHERENCE) & (f > 0) & (f >= lo) & (f <= hi)
+        sigma = h1_relative_error(coh[good, k], recording.n_samples, nperseg) * np.abs(h[good, k])
+        out.append(CoherentLines(f[good], h[good, k], sigma))
+    return out
+
+
+def peak_prominences(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Local maxima of ``x`` and their prominences, as ``scipy.signal.find_peaks(x,
+    prominence=0)`` gives them (a plateau's peak at its middle, rounded down).
+
+    Written here because importing ``scipy.signal`` imports ``scipy.stats``: 0.8 s of every
+    ``stabilise`` run, for a few hundred lines of one spectrum (``tests/modes/test_frf.py``
+    checks it against scipy on random and plateau-rich data).
+
+    Parameters
+    ----------
+    x : (n,) array
+
+    Returns
+    -------
+    peaks : (m,) int array, indices of the maxima
+    prominences : (m,) array, height above the higher of the two bases
+    """
+    x = np.asarray(x, dtype=float)
+    peaks = []
+    i = 1
+    while i < x.size - 1:
+        if x[i - 1] < x[i]:
+            ahead = i + 1
+            while ahead < x.size - 1 and x[ahead] == x[i]:
+                ahead += 1
+            if x[ahead] < x[i]:
+                peaks.append((i + ahead - 1) // 2)
+                i = ahead
+        i += 1
+    prominences = []
+    for p in peaks:
+        left = p
+        while left > 0 and x[left - 1] <= x[p]:
+            left -= 1
+        right = p
+        while right < x.size - 1 and x[right + 1] <= x[p]:
+            right += 1
+        prominences.append(x[p] - max(x[left : p + 1].min(), x[p : right + 1].min()))
+    return np.array(peaks, dtype=int), np.array(prominences, dtype=float)
+
+
+def resolving_nperseg(recording, freq_hz, damping, lines_per_bandwidth: int, min_segments: int) -> int:
+    """Welch segment length whose line spacing puts ``lines_per_bandwidth`` lines in the half-power
+    bandwidth ``2 xi f`` of the narrowest mode: a power of two, at least 256 samples, within the
+    record's ``min_segments`` half-overlapping segments (whichever the record allows).
+
+    Parameters
+    ----------
+    recording : Recording
+    freq_hz, damping : (n_modes,) array_like
+        The modes (Hz, ratio); none: the longest segment the record allows.
+    lines_per_bandwidth, min_segments : int
+        The resolution asked (``armaxmodal.modes.settings.Resolution``).
+
+    Returns
+    -------
+    int
+        Samples per segment.
+    """
+    bw = 2 * np.min(np.asarray(damping, float) * np.asarray(freq_hz, float)) if len(freq_hz) else 0.0
+    longest = 2 * recording.n_samples // (min_segments + 1)
+    want = recording.fs * lines_per_bandwidth / bw if bw > 0 else longest
+    return int(np.clip(2 ** int(np.ceil(np.log2(max(want, 16)))), min(256, longest), longest))
+
+
+
+def coherent_peaks(recording, nperseg: int, span_lines: int, band=None
+                   ) -> list[tuple[float, str, float]]:  # fmt: skip
+    """Clear, coherent peaks of each sensor's measured FRF: ``(freq_hz, sensor, |H1|)``.
+
+    A clear peak: coherence at least 0.8 on it and two lines either side, a third of its
+    height above both neighbouring valleys, the highest within ``span_lines`` lines either
+    side (a mode spans that many lines at the resolution of :func:`resolving_nperseg` with as
+    many lines per bandwidth; a noise bump is a line or two wide), and at least 5 % of the
+    sensor's strongest coherent response.
+    """
+    f, h, coh = measured_frf(recording, nperseg)
+    lo, hi = band if band is not None else excited_band(recording)
+    out = []
+    for k, sensor in enumerate(recording.sensors):
+        mag = np.abs(h[:, k])
+        ok = (coh[:, k] >= H1_COHERENCE) & (f >= lo) & (f <= hi)
+        if not ok.any():
+            continue
+        peaks, prominences = peak_prominences(np.where(ok, mag, 0.0))
+        for i, prom in zip(peaks, prominences, strict=True):
+            span = slice(max(i - span_lines, 0), i + span_lines + 1)
+            if prom < 0.33 * mag[i] or mag[i] < 0.05 * mag[ok].max() or mag[i] < mag[span].max():
+                continue
+            if ok[max(i - 2, 0) : i + 3].all():
+                out.append((float(f[i]), sensor, float(mag[i])))
+    return out
+
+
+
+def explains(freq_hz: float, line_hz: float, modes_hz, damping) -> bool:
+    """A mode lies within the peak's half-power bandwidth ``2 xi f`` (at least 1 % or 3 lines)."""
+    return any(
+        abs(freq_hz - fm) <= max(2 * fm * x, 0.01 * fm, 3 * line_hz) for fm, x in zip(modes_hz, damping, strict=True)
+    )

@@ -53,13 +53,13 @@ MUTANTS = [
         "lower residual dropped (check)",
     ),
     (
-        "armaxmodal/modes/completeness.py",
+        "armaxmodal/modes/frf.py",
         'return bool(self.rise >= self.settings.model_error_rise and self.p_value <= self.settings.support_alpha)',
         'return bool(self.rise >= self.settings.model_error_rise or self.p_value <= self.settings.support_alpha)',
         "a mode needed by either criterion (check)",
     ),
     (
-        'armaxmodal/modes/completeness.py',
+        'armaxmodal/modes/frf.py',
         '    if reach == "nearest":\n        j = nearest_neighbour(f, x, m, settings.neighbour_bandwidths)\n'
         '    else:\n        j = overlapping_neighbour(f, x, m)\n',
         '    j = None\n',
@@ -72,25 +72,25 @@ MUTANTS = [
         "a mode confirmed by a far line (check)",
     ),
     (
-        "armaxmodal/modes/completeness.py",
+        "armaxmodal/modes/frf.py",
         'if abs(np.exp(best.x[0]) - 1) <= settings.neighbour_max_shift:',
         "if True:",
         "a neighbour takes over from anywhere (check)",
     ),
     (
-        "armaxmodal/modes/completeness.py",
+        "armaxmodal/modes/frf.py",
         "m = min(weak, key=lambda i: (rank.index(i), support[i].rise))",
         "m = max(weak, key=lambda i: (rank.index(i), support[i].rise))",
         "the better-supported half of a split dropped (check)",
     ),
     (
-        'armaxmodal/modes/completeness.py',
+        'armaxmodal/modes/frf.py',
         'reach="nearest",\n',
         'reach="overlapping",\n',
         'a candidate judged without its nearest neighbour refitted (check)',
     ),
     (
-        'armaxmodal/modes/completeness.py',
+        'armaxmodal/modes/frf.py',
         'if len(members) >= cluster.min_orders and np.min(np.abs(selected',
         'if len(members) >= 99 and np.min(np.abs(selected',
         'no left-out cluster is a candidate (check)',
@@ -115,7 +115,7 @@ MUTANTS = [
         "output-error gradient of the ARMAX form",
     ),
     (
-        "armaxmodal/modes/poles.py",
+        "armaxmodal/modal.py",
         "return float(abs(np.vdot(a, b)) ** 2 / den)",
         "return float(abs(np.dot(a, b)) ** 2 / den)",
         "MAC without conjugation",
@@ -624,7 +624,7 @@ MUTANTS = [
         "the automatic model's hidden poles dropped from the picks' model (pick)",
     ),
     (
-        "armaxmodal/modes/mode_count.py",
+        "armaxmodal/stats.py",
         "return 1.0 / (1.0 + 2.0 * total)",
         "return 1.0 / (1.0 + total)",
         "Bartlett's factor 2 dropped (count)",
@@ -702,7 +702,7 @@ MUTANTS = [
         "a merged row not marked widened (count)",
     ),
     (
-        "armaxmodal/modes/counted.py",
+        "armaxmodal/modes/notes.py",
         "if near:",
         "if False:",
         "a left-out start with a peak there stays decided (count)",

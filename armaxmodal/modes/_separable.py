@@ -15,7 +15,7 @@ import numpy as np
 import scipy.linalg
 
 from armaxmodal._kernels import modal_basis, modal_moved
-from armaxmodal._linalg import orthonormal_basis
+from armaxmodal._linalg import hermitian_from_upper, orthonormal_basis, ridged_cholesky
 from armaxmodal.modes.settings import NORMAL_EQUATIONS_MIN_RATIO
 
 
@@ -162,7 +162,8 @@ class SeparableModel:
         on_basis = on_basis.reshape(-1, width, 2 * n)
         e = scipy.linalg.solve_triangular(self.r, _basis_slopes_times(seen, d_lam, coef.shape[0]).reshape(
             coef.shape[0], -1), trans="T", check_finite=False).reshape(-1, width, 2 * n)  # fmt: skip
-        slopes_gram = _hermitian(scipy.linalg.blas.zherk(1.0, slopes.T, trans=2))  # conj(S) S', its upper half
+        # conj(S) S', from the upper half BLAS fills
+        slopes_gram = hermitian_from_upper(scipy.linalg.blas.zherk(1.0, slopes.T, trans=2))
         m_m = np.einsum("csi,csk->ik", np.conj(w), (slopes_gram @ w.reshape(4 * n, -1)).reshape(w.shape)).real
         off_basis = m_m - np.einsum("asi,ask->ik", on_basis, on_basis)
         power = float(np.sum(self.resid**2))
@@ -178,11 +179,6 @@ class SeparableModel:
         return gram, np.einsum("csi,cs->i", np.conj(w), seen).real, power
 
 
-def _hermitian(upper: np.ndarray) -> np.ndarray:
-    """The Hermitian matrix whose upper triangle BLAS's ``herk`` filled (its lower one zero)."""
-    return upper + np.conj(np.triu(upper, 1)).T
-
-
 def _basis_slopes_times(seen: np.ndarray, d_lam: np.ndarray, n_coef: int) -> np.ndarray:
     """``dA/dx_i' r_s``, (n_coef, S, 2 n), from ``seen`` = each pole's four slopes' conjugates
     times the complex residual, (4 n, S): a pole's plant and transient pairs move with it."""
@@ -194,28 +190,6 @@ def _basis_slopes_times(seen: np.ndarray, d_lam: np.ndarray, n_coef: int) -> np.
         u, v = (np.conj(g) * own).reshape(2 * n, width), (g * partner).reshape(2 * n, width)
         back[first, :, params], back[first + 1, :, params] = (u + v).real, (u - v).imag
     return back
-
-
-def sandwich_sd(blocks, n_par: int) -> np.ndarray:
-    """Standard errors of the nonlinear parameters from the variable-projection Jacobian,
-    heteroscedasticity-consistent (White's HC1 sandwich). The residual's variance is not
-    the same on every DFT line: input noise and the model-class gap grow with |H| near the
-    resonances, so one pooled variance understated the spread of the refit's first mode
-    2-3 times on band-limited rides (scripts/mc_coverage.py: 78 % coverage). ``blocks``
-    yields ``(jacobian rows, residual rows)``: the sums are taken a block at a time."""
-    gram, meat, rows = 0.0, 0.0, 0
-    for jac, resid in blocks:
-        gram, meat, rows = gram + jac.T @ jac, meat + (jac * resid[:, None] ** 2).T @ jac, rows + resid.size
-    bread = np.linalg.pinv(gram)
-    scale = rows / max(rows - n_par, 1)
-    return np.sqrt(np.clip(np.diag(bread @ meat @ bread) * scale, 0, None))
-
-
-def _ridged_cholesky(gram: np.ndarray) -> np.ndarray:
-    """The upper Cholesky factor of ``gram`` plus a ridge of 1e-12 of its mean diagonal, so that a
-    null direction stays solvable."""
-    ridge = 1e-12 * np.trace(gram) / gram.shape[0]
-    return scipy.linalg.cholesky(gram + ridge * np.eye(gram.shape[0]), lower=False, check_finite=False)
 
 
 class GramCompressed:
@@ -234,10 +208,10 @@ class GramCompressed:
         if self._x is None or not np.array_equal(x, self._x):
             gram, grad, power = self.model.normal_equations(x)
             try:
-                r = _ridged_cholesky(gram)
+                r = ridged_cholesky(gram)
             except np.linalg.LinAlgError:  # the difference of squares lost J'J's definiteness where two
                 gram, grad, power = self.model.normal_equations(x, rows=True)  # poles are nearly one
-                r = _ridged_cholesky(gram)
+                r = ridged_cholesky(gram)
             top = scipy.linalg.solve_triangular(r, grad, trans="T", check_finite=False)
             last = np.sqrt(max(power - top @ top, 0.0))
             self._x = x.copy()

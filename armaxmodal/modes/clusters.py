@@ -22,11 +22,12 @@ from armaxmodal.estimate.orders import information_criterion, output_mean_square
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.estimate.result import ArmaxFit
 from armaxmodal.exceptions import PickError
+from armaxmodal.modal import mac
 from armaxmodal.modes.diagram import StabilisationDiagram
-from armaxmodal.modes.frf import peak_support
-from armaxmodal.modes.poles import SHARED, UNRESOLVED_DAMPING, mac, pole_rows
-from armaxmodal.modes.settings import DEFAULTS, ClusterSettings
+from armaxmodal.modes.poles import SHARED, UNRESOLVED_DAMPING, pole_rows
+from armaxmodal.modes.settings import DEFAULTS, PEAK_RESOLUTION, ClusterSettings
 from armaxmodal.recording import Recording
+from armaxmodal.spectra import coherent_peaks, explains, resolving_nperseg
 from armaxmodal.stats import Z95
 
 
@@ -372,3 +373,15 @@ def stable_in_diagram(diagram, band, cluster: ClusterSettings):
         return len(set(na[near].tolist())) >= cluster.min_orders
 
     return supported
+
+
+def peak_support(recording: Recording, freq_hz: float, damping: float, band=None) -> float | None:
+    """Frequency of the clear, coherent FRF peak (:func:`~armaxmodal.spectra.coherent_peaks`) that a mode at
+    ``freq_hz`` explains, or None: the data's own evidence for a mode whose poles alone are
+    not conclusive (a lightly damped pole whose damping estimate crosses zero)."""
+    res = PEAK_RESOLUTION
+    n = resolving_nperseg(recording, [freq_hz], [max(damping, 1e-6)], res.lines_per_bandwidth, res.min_segments)
+    df = recording.fs / n
+    peaks = coherent_peaks(recording, n, res.lines_per_bandwidth, band)
+    near = [p for p in peaks if explains(p[0], df, [freq_hz], [max(damping, 0.0)])]
+    return max(near, key=lambda p: p[2])[0] if near else None

@@ -15,6 +15,7 @@ from scipy.special import chdtrc
 
 from armaxmodal._threads import single_blas_thread
 from armaxmodal.estimate.pool import parallel_map
+from armaxmodal.modal import matched_poles, nearest_pole, new_poles
 from armaxmodal.modes.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.mode_count import (
     COUNT,
@@ -22,14 +23,13 @@ from armaxmodal.modes.mode_count import (
     ModelTable,
     Step,
     Wanted,
-    effective_fraction,
     halves_chi2,
     residual_peak,
     split_start,
 )
-from armaxmodal.modes.poles import matched_poles, nearest_pole, new_poles, physical, reported, resolved
+from armaxmodal.modes.poles import physical, reported, resolved
 from armaxmodal.modes.settings import DEFAULTS, AgreementSettings, CountSettings, DftSettings, LineSettings
-from armaxmodal.stats import Z95
+from armaxmodal.stats import Z95, effective_fraction
 
 __all__ = ["count_modes"]
 
@@ -333,7 +333,7 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev
     # concentrated over those levels; the weights only steer the fits)
     data = data.noise_weighted(start_model)
     start_model = fitter(data, start_model.freq_hz, start_model.damping, hold, max_nfev, dft)
-    fraction = effective_fraction(start_model.residual)
+    fraction = effective_fraction(start_model.residual, settings.max_correlation_lag)
     searching, search = search, _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev, n_jobs,
                                         settings, lines, dft, fitter, agreement)  # fmt: skip
     search.logged("start", float("nan"), start_model)

@@ -5,8 +5,8 @@ Poles the model needs but that are no modes of the band -- above the fitted band
 for the modes above it, an upper residual), damped beyond ``armaxmodal.stats.MAX_DAMPING``,
 or lines at the damping floor -- stay in the model and are not reported.
 
-One module of about 520 lines on purpose: each rule here turns the count into rows and notes
-of the one working selection, and they run in the order ``counted_modes`` states.
+Each rule here turns the count into rows of the one working selection, in the order
+``counted_modes`` states; the notes' words are :mod:`armaxmodal.modes.notes`'.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 from scipy.special import chdtrc
 
+from armaxmodal.modal import mac, matched_poles, nearest_pole
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles, stable_in_diagram
 from armaxmodal.modes.count_search import count_modes
 from armaxmodal.modes.dft_model import DftLines, fit_modal_model
@@ -25,19 +26,24 @@ from armaxmodal.modes.intervals import (
     covering_both_estimators,
     earlier_estimate,
     not_separated,
-    split_segments,
     with_intervals,
 )
 from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.mode_count import ModeCount, halves_chi2
-from armaxmodal.modes.notes import count_notes, no_mode_kept_note, pick_notes
-from armaxmodal.modes.poles import mac, matched_poles, nearest_pole
+from armaxmodal.modes.notes import (
+    confirmed_where_incoherent_note,
+    count_notes,
+    no_mode_kept_note,
+    not_picked_note,
+    pick_moved_note,
+    pick_notes,
+    reported_as_one_note,
+)
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
 from armaxmodal.modes.state import SelectionState
-from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.stats import MAX_DAMPING, Z95
 
-__all__ = ["confirmed_where_incoherent", "counted_modes", "dropped_where_peaks_remain"]
+__all__ = ["confirmed_where_incoherent", "counted_modes"]
 
 #: the sweep's rejection that leaves a stable cluster a candidate still (poles/rejection_reasons)
 WEAK_RESIDUE = "negligible residue"
@@ -120,7 +126,7 @@ def counted_modes(
     offered = [(f, x) for f, x, _ in work.doubts]
     candidates = offered + [c for c in _candidates(diagram, modes, band, nas, settings)
                             if all(abs(np.log(c[0] / f)) > settings.cluster.freq for f, _ in offered)]  # fmt: skip
-    halves = tuple(DftLines.from_recording(half, band_hz) for half in split_segments(part, 2))
+    halves = tuple(DftLines.from_recording(half, band_hz) for half in part.split(2))
     supported = stable_in_diagram(diagram, band, settings.cluster)
     start_f, start_x = modes.freq_hz.to_numpy(), modes.damping.to_numpy()
     if picked and work.count is not None:  # the poles the selection's model kept unreported stay in it
@@ -161,7 +167,7 @@ def _doubts_said(work: SelectionState, reported_hz, reach: float = 0.0) -> Selec
 def _counted_part(rec, max_samples: int):
     """The part of the record the nested tests run on: the whole, or its first of equal parts of at
     most ``max_samples`` samples."""
-    return rec if rec.n_samples <= max_samples else split_segments(rec, rec.n_samples // max_samples)[0]
+    return rec if rec.n_samples <= max_samples else rec.split(rec.n_samples // max_samples)[0]
 
 
 def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: ModeCount, keep: np.ndarray, rec,
@@ -207,15 +213,7 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
         rows.loc[a, "structure_widened"] = True
         shapes[:, a] = one.shapes[:, k]
         gone.append(b)
-        notes.append(QualityWarning(
-            "modes_not_separated", (),
-            f"the modal model needs two poles at {both.freq_hz.iloc[0]:.3f} and {both.freq_hz.iloc[1]:.3f} Hz, but "
-            f"they are {gap:.1f} standard deviations of their difference apart (under {level:g}) and their "
-            f"shapes agree (MAC at least {same_shape:g}): the record does not separate them. Reported as one mode "
-            f"at {f:.3f} Hz (damping {x:.3g}, the model with one pole there), its intervals covering both: one "
-            "resonance whose frequency moves during the record (a nonlinearity, a change) or two modes this record "
-            "cannot resolve", f, tuple(both.freq_hz),
-        ))  # fmt: skip
+        notes.append(reported_as_one_note(tuple(both.freq_hz), gap, level, same_shape, f, x))
     kept = [i for i in range(len(rows)) if i not in gone]
     return rows.iloc[kept].reset_index(drop=True), shapes[:, kept], notes
 
@@ -233,7 +231,7 @@ def confirmed_where_incoherent(diagram, work: SelectionState, settings: Selectio
     rec, m, hold = diagram.recording, count.model, work.refinement.hold
     part = _counted_part(rec, count.settings.max_samples)
     data = DftLines.from_recording(part, work.refinement.band_hz).noise_weighted(m)
-    halves = tuple(DftLines.from_recording(half, work.refinement.band_hz) for half in split_segments(part, 2))
+    halves = tuple(DftLines.from_recording(half, work.refinement.band_hz) for half in part.split(2))
     chi2 = halves_chi2(data, m, halves, hold, count.settings.halves_nfev, count.dft)
     agree = chdtrc(2, chi2) >= settings.agreement.alpha  # each pole alone: 2 degrees of freedom
     reach, needed = settings.cluster.same_row_freq, count.verdicts() == "needed"
@@ -242,42 +240,11 @@ def confirmed_where_incoherent(diagram, work: SelectionState, settings: Selectio
         i = int(np.argmin(np.abs(m.freq_hz - f)))
         if abs(m.freq_hz[i] / f - 1) <= reach and needed[i] and agree[i]:
             confirmed.append(f)
-            notes.append(QualityWarning(
-                "mode_count", (),
-                f"no output's H1 is coherent near {f:.3f} Hz, so the FRF check cannot test that mode; the maximum-"
-                f"likelihood modal model, fitted to the record's DFT, confirms it: without it the criterion rises by "
-                f"{count.removal_rise[i]:.0f}, and both halves of the record give it the same frequency and damping",
-                float(f), (f,),
-            ))  # fmt: skip
+            notes.append(confirmed_where_incoherent_note(f, count.removal_rise[i]))
     if not confirmed:
         return work
     left = tuple(f for f in check.unconfirmed_hz if f not in confirmed)
     return replace(work, check=replace(check, unconfirmed_hz=left)).warned(*notes)
-
-
-def dropped_where_peaks_remain(count: ModeCount | None, peaks, same_row_freq: float) -> list[QualityWarning]:
-    """A ``count_undecided`` note for each starting mode the count left out as unfounded
-    (``count.carried_away``) while the measured FRF keeps a coherent peak that no reported mode
-    explains within ``same_row_freq`` of where it started or went (``peaks``: the
-    ``unexplained_peak`` notes). The two kinds of evidence disagree: the halves test is weak on a
-    transient input (an earthquake's record), and the H1 still shows a resonance there. (A stand-in,
-    kept in the model unreported, is undecided already inside the band: ``notes.count_notes``.)"""
-    if count is None:
-        return []
-    notes = []
-    for start, went, fate in [(start, went, "left out") for start, went in count.carried_away]:
-        near = [p.value for p in peaks
-                if min(abs(np.log(p.value / start)), abs(np.log(p.value / went))) <= same_row_freq]  # fmt: skip
-        if near:
-            notes.append(QualityWarning(
-                "count_undecided", (),
-                f"the starting mode at {start:.3f} Hz was {fate} (the free fit took it to {went:.3f} Hz, where it "
-                f"is no mode), but the measured FRF keeps a coherent peak no mode explains at "
-                f"{', '.join(f'{f:.2f}' for f in near)} Hz: the record does not decide whether a mode is there; "
-                "compare another record of the structure, or pick it ('--pick') to see what the record says of it",
-                float(start), (start, *near),
-            ))  # fmt: skip
-    return notes
 
 
 def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hold: str, settings: SelectionSettings,
@@ -303,22 +270,10 @@ def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hol
         row = work.modes.iloc[j].to_dict()
         rows.append({**row, "count_undecided": True, "structure_widened": False})
         shapes.append(work.shapes[:, j])
-        notes.append(QualityWarning(
-            "pick_not_supported", (),
-            f"the maximum-likelihood modal model takes the mode picked at {row['freq_hz']:.3f} Hz to "
-            f"{m.freq_hz[i]:.3f} Hz (damping {m.damping[i]:.3g}): beyond the band, damped beyond {MAX_DAMPING:g} or "
-            "a line. The record does not support a mode there; it is reported from the diagram's fit, unconfirmed",
-            float(row["freq_hz"]), (row["freq_hz"],),
-        ))  # fmt: skip
+        notes.append(pick_moved_note(float(row["freq_hz"]), m.freq_hz[i], m.damping[i]))
     others = [pairs[j] for j in np.flatnonzero(~picked) if keep[pairs[j]]]
     if others:
-        notes.append(QualityWarning(
-            "mode_count", (),
-            f"{len(others)} mode(s) of the record were not picked and are not reported: "
-            + ", ".join(f"{m.freq_hz[i]:.3f} Hz (damping {m.damping[i]:.3g})" for i in others)
-            + "; they stay in the modal model, so that the picked modes' values are not biased by their absence",
-            float(len(others)), tuple(m.freq_hz[others]),
-        ))  # fmt: skip
+        notes.append(not_picked_note(m, others))
     order = np.argsort([r["freq_hz"] for r in rows])
     rows = pd.DataFrame([rows[k] for k in order])
     rows, disagree = covering_both_estimators(rows, settings.agreement.alpha)

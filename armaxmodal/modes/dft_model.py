@@ -30,9 +30,10 @@ import scipy.optimize
 
 from armaxmodal._threads import single_blas_thread
 from armaxmodal.exceptions import OrderError
-from armaxmodal.modes._separable import GramCompressed, SeparableModel, poles, sandwich_sd, start_vector, x_bounds
+from armaxmodal.modes._separable import GramCompressed, SeparableModel, poles, start_vector, x_bounds
 from armaxmodal.modes.settings import DEFAULTS, DftSettings
 from armaxmodal.recording import Recording
+from armaxmodal.stats import sandwich_sd
 
 __all__ = ["DftLines", "ModalModel", "fit_modal_model", "refine_modes"]
 
@@ -222,7 +223,7 @@ class ModalModel:
         """Schwarz's criterion ``-2 ln L + p ln N`` (Schwarz 1978), with ``N`` the real numbers
         fitted. ``n_effective`` (the real numbers of independent information, at most ``N``)
         scales the likelihood and sets the penalty where the residual is correlated across
-        lines (:func:`armaxmodal.modes.mode_count.effective_fraction`).
+        lines (:func:`armaxmodal.stats.effective_fraction`).
 
         Parameters
         ----------

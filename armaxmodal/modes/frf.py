@@ -1,182 +1,264 @@
-"""What the measured FRF says: the H1 on the coherent lines of a band, at a resolution chosen from
-the modes, and its clear, coherent peaks with those no selected mode accounts for (thesis Section
-3.3.3's check, made quantitative).
+"""What the measured FRF says of the selection (thesis Section 3.3.3's check, made quantitative):
+its clear, coherent peaks no selected mode explains (``unexplained_peaks``, at ``PEAK_RESOLUTION``),
+and which candidates the record needs -- the modal-model check (:mod:`armaxmodal.modes.modal_check`,
+at ``CHECK_RESOLUTION``) drops a mode the measured FRF does not need and adds a left-out cluster
+that explains a clear peak no selected mode explains.
 
-Two checks read the measured FRF, each at its own resolution, named here so that one does not
-borrow the other's: the search for clear FRF peaks no mode explains (``unexplained_peaks``, at
-``PEAK_RESOLUTION``) and the modal-model check (:mod:`armaxmodal.modes.modal_check`, at
-``CHECK_RESOLUTION``).
+``mode_support`` is the test both use: the check's misfit with and without a mode, a neighbour
+refitted in its place (``ModeSupport``: needed when the rise is large and significant).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
+import pandas as pd
 
-from armaxmodal.modes.settings import CHECK_RESOLUTION, PEAK_RESOLUTION, Resolution
+from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, order_criteria, representative_pole
+from armaxmodal.modes.modal_check import ModalCheck, check_modes, poles_of, rss_at
+from armaxmodal.modes.notes import not_needed_note
+from armaxmodal.modes.settings import DEFAULTS, PEAK_RESOLUTION, FrfSettings, SelectionSettings
+from armaxmodal.modes.state import RefitFailure, SelectionState, refined_modes, refit_band, selection_job
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
-from armaxmodal.spectra import coherence, excited_band, h1_relative_error
-from armaxmodal.stats import H1_COHERENCE
-
-__all__ = ["CHECK_RESOLUTION", "CoherentLines", "PEAK_RESOLUTION", "Resolution", "coherent_lines", "coherent_peaks",
-           "explains", "measured_h1", "peak_support", "resolving_nperseg", "unexplained_peaks"]  # fmt: skip
-
-
-
-def resolving_nperseg(recording: Recording, freq_hz, damping, resolution: Resolution = PEAK_RESOLUTION) -> int:
-    """Welch segment length whose line spacing puts ``resolution.lines_per_bandwidth`` lines in
-    the half-power bandwidth ``2 xi f`` of the narrowest mode: a power of two, at least 256
-    samples, within the record's ``resolution.min_segments`` half-overlapping segments (whichever
-    the record allows).
-
-    Parameters
-    ----------
-    recording : Recording
-    freq_hz, damping : (n_modes,) array_like
-        The modes (Hz, ratio); none: the longest segment the record allows.
-    resolution : Resolution
-
-    Returns
-    -------
-    int
-        Samples per segment.
-    """
-    bw = 2 * np.min(np.asarray(damping, float) * np.asarray(freq_hz, float)) if len(freq_hz) else 0.0
-    longest = 2 * recording.n_samples // (resolution.min_segments + 1)
-    want = recording.fs * resolution.lines_per_bandwidth / bw if bw > 0 else longest
-    return int(np.clip(2 ** int(np.ceil(np.log2(max(want, 16)))), min(256, longest), longest))
-
-
-def measured_h1(recording: Recording, nperseg: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Every sensor's H1 over the base input and its coherence.
-
-    Returns
-    -------
-    freq_hz : (n_lines,) ndarray
-    h1 : (n_lines, n_sensors) complex ndarray
-    coherence : (n_lines, n_sensors) ndarray
-    """
-    f, puu, puy, pyy = recording.welch(nperseg)
-    return f, puy / puu[:, None], coherence(puu, puy, pyy)
+from armaxmodal.spectra import coherent_lines, coherent_peaks, explains, resolving_nperseg
 
 
 @dataclass(frozen=True)
-class CoherentLines:
-    """One output's coherent lines of a band: frequencies (Hz), the H1 there and its random
-    error (absolute, Bendat & Piersol's from the coherence)."""
+class ModeSupport:
+    """How much the check needs one mode: each output's relative misfit with and without it
+    (a neighbour within its half-power band refitted in its place), and the F-test's p."""
 
-    freq_hz: np.ndarray
-    h: np.ndarray
-    sigma: np.ndarray
+    error_with: np.ndarray
+    error_without: np.ndarray
+    p_value: float
+    refitted_neighbour: int | None
+    settings: FrfSettings = DEFAULTS.frf
+
+    @property
+    def rise(self) -> float:
+        """The largest relative rise of an output's misfit without the mode."""
+        ratio = self.error_without / np.maximum(self.error_with, 1e-300)
+        finite = ratio[np.isfinite(ratio)]
+        return float(finite.max() - 1) if finite.size else float("nan")
+
+    @property
+    def needed(self) -> bool:
+        """The rise is at least ``settings.model_error_rise`` and significant at ``settings.support_alpha``."""
+        return bool(self.rise >= self.settings.model_error_rise and self.p_value <= self.settings.support_alpha)
 
 
-def coherent_lines(recording: Recording, nperseg: int, band=None) -> list[CoherentLines]:
-    """Each output's H1 on the lines of ``band`` (Hz; default: the input's excited band) where
-    its coherence is at least :data:`~armaxmodal.stats.H1_COHERENCE`, with its random error.
+def overlapping_neighbour(freq_hz, damping, m: int) -> int | None:
+    """The nearest mode whose half-power band overlaps mode ``m``'s
+    (``|f_i - f_m| < xi_i f_i + xi_m f_m``), or None."""
+    f, x = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)
+    gap = np.abs(f - f[m])
+    close = [i for i in range(f.size) if i != m and gap[i] < x[i] * f[i] + x[m] * f[m]]
+    return min(close, key=lambda i: gap[i]) if close else None
 
-    Returns
-    -------
-    list of CoherentLines
-        One per output, in the recording's sensor order (possibly with no line).
+
+def nearest_neighbour(freq_hz, damping, m: int, bandwidths: float = DEFAULTS.frf.neighbour_bandwidths) -> int | None:
+    """The mode nearest mode ``m`` within ``bandwidths`` half-power bandwidths
+    (``2 xi f``, the wider of the two), or None: the mode whose pole may take over what
+    ``m`` fits. A spurious pole beside a lightly damped mode corrects that mode's slightly
+    biased pole at the peak; with the neighbour's pole refitted it is not needed."""
+    f, x = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)
+    gap = np.abs(f - f[m])
+    reach = bandwidths * np.maximum(2 * x * f, 2 * x[m] * f[m])
+    close = [i for i in range(f.size) if i != m and gap[i] <= reach[i]]
+    return min(close, key=lambda i: gap[i]) if close else None
+
+
+def mode_support(
+    recording: Recording, freq_hz, damping, m: int, check: ModalCheck, band=None, *, reach: str = "overlapping",
+    settings: FrfSettings = DEFAULTS.frf,
+) -> ModeSupport:
+    """How much the check of ``check`` needs mode ``m`` (see ``ModeSupport``).
+
+    The fit without the mode keeps each output's delay. A neighbour -- ``reach="overlapping"``:
+    a mode whose half-power band overlaps this one's (:func:`overlapping_neighbour`);
+    ``"nearest"``: the nearest within ``settings.neighbour_bandwidths`` (:func:`nearest_neighbour`),
+    the stricter test a mode the diagram supports weakly must pass to enter -- has its
+    frequency and damping refitted (Nelder-Mead on the summed relative residual, residues
+    projected out) so it may take over: two poles always fit one peak at least as well as
+    one, so only a refitted single pole shows whether the record needs both. A neighbour
+    that moves more than ``settings.neighbour_max_shift`` to take over is not refitted. The F-test
+    compares the summed relative residual sums with ``q = 2 n_outputs`` (the residues)
+    ``+ 2`` (the pole, unless the neighbour's refit spends them) over ``sum(lines) -
+    parameters`` degrees of freedom (one per complex line: the Hann-windowed,
+    half-overlapped lines are correlated in pairs).
     """
-    f, h, coh = measured_h1(recording, nperseg)
-    lo, hi = band if band is not None else excited_band(recording)
-    out = []
-    for k in range(h.shape[1]):
-        good = (coh[:, k] >= H1_COHERENCE) & (f > 0) & (f >= lo) & (f <= hi)
-        sigma = h1_relative_error(coh[good, k], recording.n_samples, nperseg) * np.abs(h[good, k])
-        out.append(CoherentLines(f[good], h[good, k], sigma))
-    return out
+    from scipy.optimize import minimize
+    from scipy.special import fdtrc  # F survival function without scipy.stats' import
+
+    f, x = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)
+    all_lines = coherent_lines(recording, check.nperseg, band)
+    used = [k for k, lines in enumerate(all_lines) if np.isfinite(check.error[k])]
+    norms = {k: float(np.sum(np.abs(all_lines[k].h) ** 2)) for k in used}
+
+    def relative_rss(poles) -> np.ndarray:
+        return np.array([rss_at(all_lines[k], poles, check.delay_s[k]) / norms[k] for k in used])
+
+    keep = [i for i in range(f.size) if i != m]
+    with_m = relative_rss(poles_of(f, x))
+    if reach == "nearest":
+        j = nearest_neighbour(f, x, m, settings.neighbour_bandwidths)
+    else:
+        j = overlapping_neighbour(f, x, m)
+    fk, xk = f[keep], x[keep]
+    if j is not None:
+        at = keep.index(j)
+
+        def cost(p):
+            fj, xj = fk.copy(), xk.copy()
+            fj[at], xj[at] = f[j] * np.exp(p[0]), min(x[j] * np.exp(p[1]), 0.9)
+            return float(np.sum(relative_rss(poles_of(fj, xj))))
+
+        best = minimize(cost, np.zeros(2), method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-9, "maxiter": 200})
+        if abs(np.exp(best.x[0]) - 1) <= settings.neighbour_max_shift:
+            fk, xk = fk.copy(), xk.copy()
+            fk[at], xk[at] = f[j] * np.exp(best.x[0]), min(x[j] * np.exp(best.x[1]), 0.9)
+        else:  # it took over only by leaving its own place: the two are distinct modes
+            j = None
+    without = relative_rss(poles_of(fk, xk))
+    n_obs = sum(all_lines[k].freq_hz.size for k in used)
+    q = 2 * len(used) + (0 if j is not None else 2)
+    dof = n_obs - len(used) * (2 * f.size + 5) - 2 * f.size
+    s1, s0 = float(with_m.sum()), float(without.sum())
+    stat = ((s0 - s1) / q) / (s1 / dof) if dof > 0 and s1 > 0 else float("nan")
+    p = float(fdtrc(q, dof, stat)) if np.isfinite(stat) and stat > 0 else 1.0
+    return ModeSupport(np.sqrt(with_m), np.sqrt(without), p, j, settings)
 
 
-#: a clear peak is the highest within this many lines either side: the narrowest mode spans
-#: that many at :data:`PEAK_RESOLUTION`, a noise bump a line or two
-PEAK_SPAN_LINES = PEAK_RESOLUTION.lines_per_bandwidth
+def modes_the_record_needs(recording: Recording, work: SelectionState, band, settings: SelectionSettings = DEFAULTS,
+                           doubts: list | None = None) -> SelectionState:  # fmt: skip
+    """Selection by the data: drop, one at a time and least supported first, every mode the
+    modal-model check does not need (``mode_support``: leaving it
+    out, a neighbour inside its half-power band refitted in its place, raises no output's
+    misfit by ``settings.frf.model_error_rise`` significantly). A dropped half
+    of a split peak is a ``split_merged`` note, any other a ``mode_not_needed`` note. With
+    ``doubts`` (a list), each dropped mode goes there as ``(Hz, ratio, note)`` instead of its note
+    into the selection: the count tries it again and the note stands only if it stays out.
+    Returns the selection of the modes kept, with their check."""
+    frf = settings.frf
+    while True:
+        modes = work.modes
+        check = check_modes(recording, modes.freq_hz, modes.damping, band, settings=frf)
+        work = replace(work, check=check)
+        if len(modes) < 2 or not np.isfinite(check.error).any():
+            return work
+        support = [mode_support(recording, modes.freq_hz, modes.damping, m, check, band, settings=frf)
+                   for m in range(len(modes))]  # fmt: skip
+        weak = [m for m in range(len(modes)) if not support[m].needed]
+        if not weak:
+            return work
+        # the least supported across orders goes first (of a split, the half the diagram
+        # shows less), then the least needed
+        rank = modes.sort_values(["support", "count", "energy"]).index.tolist()
+        m = min(weak, key=lambda i: (rank.index(i), support[i].rise))
+        s, f_m, x_m = support[m], modes.at[m, "freq_hz"], modes.at[m, "damping"]
+        neighbour = None if s.refitted_neighbour is None else modes.at[s.refitted_neighbour, "freq_hz"]
+        note = not_needed_note(f_m, x_m, neighbour, frf.model_error_rise, s.rise, s.p_value)
+        work = work.kept(i for i in range(len(modes)) if i != m)
+        if doubts is None:
+            work = work.warned(note)
+        else:
+            doubts.append((float(f_m), float(x_m), note))
 
 
-def peak_prominences(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Local maxima of ``x`` and their prominences, as ``scipy.signal.find_peaks(x,
-    prominence=0)`` gives them (a plateau's peak at its middle, rounded down).
-
-    Written here because importing ``scipy.signal`` imports ``scipy.stats``: 0.8 s of every
-    ``stabilise`` run, for a few hundred lines of one spectrum (``tests/modes/test_frf.py``
-    checks it against scipy on random and plateau-rich data).
-
-    Parameters
-    ----------
-    x : (n,) array
-
-    Returns
-    -------
-    peaks : (m,) int array, indices of the maxima
-    prominences : (m,) array, height above the higher of the two bases
-    """
-    x = np.asarray(x, dtype=float)
-    peaks = []
-    i = 1
-    while i < x.size - 1:
-        if x[i - 1] < x[i]:
-            ahead = i + 1
-            while ahead < x.size - 1 and x[ahead] == x[i]:
-                ahead += 1
-            if x[ahead] < x[i]:
-                peaks.append((i + ahead - 1) // 2)
-                i = ahead
-        i += 1
-    prominences = []
-    for p in peaks:
-        left = p
-        while left > 0 and x[left - 1] <= x[p]:
-            left -= 1
-        right = p
-        while right < x.size - 1 and x[right + 1] <= x[p]:
-            right += 1
-        prominences.append(x[p] - max(x[left : p + 1].min(), x[p : right + 1].min()))
-    return np.array(peaks, dtype=int), np.array(prominences, dtype=float)
+def each_once(doubts) -> tuple:
+    """The doubts by frequency, a mode the check dropped in both of its passes once (its first note)."""
+    once = {f: (f, x, note) for f, x, note in reversed(doubts)}
+    return tuple(sorted(once.values(), key=lambda d: d[0]))
 
 
-def coherent_peaks(recording: Recording, nperseg: int, band=None) -> list[tuple[float, str, float]]:
-    """Clear, coherent peaks of each sensor's measured FRF: ``(freq_hz, sensor, |H1|)``.
+def refit_with_added(diagram, work: SelectionState, band, settings: SelectionSettings = DEFAULTS) -> SelectionState:
+    """The frequency-domain refit again, of every mode once the check has added some: a mode
+    missing from a refit biases its neighbours (a five-segment chain's 13.5 Hz mode came out
+    at 12.5 Hz while the 24.8 Hz one was missing, and its refit was refused as too far; now
+    13.3 Hz for the exact 13.54). A refit that cannot be made leaves the modes, said."""
+    refit = selection_job(diagram.recording, [], work.modes, ("refit", refit_band(diagram.recording, band)),
+                          settings.dft)  # fmt: skip
+    if isinstance(refit, RefitFailure):
+        work = work.warned(*refit.notes("the modes with those the check added", uncounted=False))
+    else:  # the first refit's start lacked these modes: its refusals may not stand
+        c = settings.cluster
+        work = refined_modes(diagram, work, refit, c.freq, c.damping, c.merge_mac, relaxed=True)
+    check = check_modes(diagram.recording, work.modes.freq_hz, work.modes.damping, band, settings=settings.frf)
+    return replace(work, check=check)
 
-    A clear peak: coherence at least 0.8 on it and two lines either side, a third of its
-    height above both neighbouring valleys, the highest within :data:`PEAK_SPAN_LINES`
-    lines either side (a mode spans that many lines at the resolution of
-    :func:`resolving_nperseg`; a noise bump is a line or two wide), and at least 5 % of the
-    sensor's strongest coherent response.
-    """
-    f, h, coh = measured_h1(recording, nperseg)
-    lo, hi = band if band is not None else excited_band(recording)
-    out = []
-    for k, sensor in enumerate(recording.sensors):
-        mag = np.abs(h[:, k])
-        ok = (coh[:, k] >= H1_COHERENCE) & (f >= lo) & (f <= hi)
-        if not ok.any():
+
+def modes_the_check_adds(diagram, work: SelectionState, band, nas, settings: SelectionSettings = DEFAULTS
+                        ) -> SelectionState:  # fmt: skip
+    """Stable clusters the support rule left out enter when the modal-model check needs them
+    (as :func:`modes_the_record_needs` judges, but with the nearest mode refitted in its place,
+    not only an overlapping one: one at a time, the largest first): the
+    candidates are the cluster of poles of at least ``frf.peak_cluster_min_orders`` orders
+    within ``frf.peak_cluster_freq`` of each clear, coherent H1 peak no selected mode
+    explains (:func:`unexplained_peaks`), and every cluster of kept
+    poles of at least three orders away from the selected modes (heavily damped modes make
+    no clear peak, and their poles scatter over the orders; these need a damping the record
+    resolves, as a peak's cluster does not). A peak left unexplained is listed at the end as
+    before. Returns the selection with those added, by frequency, and its check."""
+    bic, frf = order_criteria(diagram), settings.frf
+    modes, shapes, check = work.modes, work.shapes, work.check
+    for sub, at_peak in _left_out_clusters(diagram, modes, band, nas, settings):
+        # the cluster's centre is tried: its lowest-BIC pole may sit at its edge
+        centre = float(sub.freq_hz.median()), float(sub.damping.median())
+        if np.any(np.abs(modes.freq_hz.to_numpy() / centre[0] - 1) <= frf.duplicate_freq):
+            continue  # a selected mode's own pole
+        trial = np.r_[modes.freq_hz, centre[0]], np.r_[modes.damping, centre[1]]
+        trial_check = check_modes(diagram.recording, *trial, band, settings=frf)
+        if centre[0] in trial_check.unconfirmed_hz:
+            continue  # no coherent line there: the check cannot judge it, so it cannot enter
+        if not mode_support(diagram.recording, *trial, len(modes), trial_check, band, reach="nearest",
+                            settings=frf).needed:  # fmt: skip
             continue
-        peaks, prominences = peak_prominences(np.where(ok, mag, 0.0))
-        for i, prom in zip(peaks, prominences, strict=True):
-            span = slice(max(i - PEAK_SPAN_LINES, 0), i + PEAK_SPAN_LINES + 1)
-            if prom < 0.33 * mag[i] or mag[i] < 0.05 * mag[ok].max() or mag[i] < mag[span].max():
-                continue
-            if ok[max(i - 2, 0) : i + 3].all():
-                out.append((float(f[i]), sensor, float(mag[i])))
-    return out
+        core = sub[np.abs(sub.freq_hz / centre[0] - 1) <= frf.peak_cluster_freq]  # reported from near the centre
+        rep = representative_pole(diagram, core if len(core) else sub, bic, {}, settings.cluster.finished_max_shift)
+        if rep is None or (not at_peak and not rep.damping_ci95_lo > 0):
+            continue  # without a peak, a pole whose damping the record does not resolve is no evidence
+        row = {**mode_row(rep, sub, len(nas)), "orders_damping_unresolved": 0, "estimator": "armax"}
+        row["freq_sd_armax"], row["damping_sd_armax"] = row["freq_sd"], row["damping_sd"]
+        modes = pd.concat([modes, pd.DataFrame([row])], ignore_index=True)
+        shapes = np.column_stack([shapes, rep.vector])
+        check = check_modes(diagram.recording, modes.freq_hz, modes.damping, band, settings=frf)
+    return work.with_modes(modes, shapes, check=check).kept(modes.sort_values("freq_hz").index)
 
 
-def explains(freq_hz: float, line_hz: float, modes_hz, damping) -> bool:
-    """A mode lies within the peak's half-power bandwidth ``2 xi f`` (at least 1 % or 3 lines)."""
-    return any(
-        abs(freq_hz - fm) <= max(2 * fm * x, 0.01 * fm, 3 * line_hz) for fm, x in zip(modes_hz, damping, strict=True)
-    )
+def _left_out_clusters(diagram, modes: pd.DataFrame, band, nas, settings: SelectionSettings
+                       ) -> list[tuple[pd.DataFrame, bool]]:  # fmt: skip
+    """The candidate clusters of :func:`modes_the_check_adds`, the largest first, each with
+    whether it stands at an unexplained peak."""
+    cluster, frf = settings.cluster, settings.frf
+    cand = candidate_poles(diagram.poles, band)
+    cand = cand[cand.damping > 0]
+    found = []
+    for peak in unexplained_peaks(diagram.recording, modes.freq_hz.to_numpy(), modes.damping.to_numpy(), band):
+        near = cand[np.abs(cand.freq_hz / peak.value - 1) <= frf.peak_cluster_freq]
+        clusters = [c for c in cluster_poles(near, nas, frf.peak_cluster_freq, None)
+                    if len(c) >= frf.peak_cluster_min_orders]  # fmt: skip
+        if clusters:
+            found.append((near.loc[max(clusters, key=len)], True))
+    # away from a peak, a cluster in the top of the input's band is its edge's, not a mode
+    top = frf.edge_fraction * refit_band(diagram.recording, band)[1]
+    kept = cand[(cand.rejected == "") & (cand.freq_hz <= top)]
+    selected = modes.freq_hz.to_numpy()
+    for members in cluster_poles(kept, nas, cluster.freq, cluster.damping):
+        sub = kept.loc[members]
+        if len(members) >= cluster.min_orders and np.min(np.abs(selected / sub.freq_hz.median() - 1)) > cluster.freq:
+            found.append((sub, False))
+    return sorted(found, key=lambda item: len(item[0]), reverse=True)
 
 
 def unexplained_peaks(recording: Recording, freq_hz, damping, band=None) -> list[QualityWarning]:
-    """Coherent peaks of the measured FRF (:func:`coherent_peaks`) with no selected mode
-    within its half-power bandwidth: each a ``unexplained_peak`` warning."""
-    n = resolving_nperseg(recording, freq_hz, damping)
+    """Coherent peaks of the measured FRF (:func:`~armaxmodal.spectra.coherent_peaks`, at ``PEAK_RESOLUTION``)
+    with no selected mode within its half-power bandwidth: each a ``unexplained_peak`` warning."""
+    res = PEAK_RESOLUTION
+    n = resolving_nperseg(recording, freq_hz, damping, res.lines_per_bandwidth, res.min_segments)
     df = recording.fs / n
-    peaks = coherent_peaks(recording, n, band)
+    peaks = coherent_peaks(recording, n, res.lines_per_bandwidth, band)
     return _merged([p for p in peaks if not explains(p[0], df, freq_hz, damping)], df)
 
 
@@ -199,13 +281,3 @@ def _merged(peaks, df) -> list[QualityWarning]:
             "(run 'armaxmodal diagnose')", f0, (f0,),
         ))  # fmt: skip
     return warnings
-
-
-def peak_support(recording: Recording, freq_hz: float, damping: float, band=None) -> float | None:
-    """Frequency of the clear, coherent FRF peak (:func:`coherent_peaks`) that a mode at
-    ``freq_hz`` explains, or None: the data's own evidence for a mode whose poles alone are
-    not conclusive (a lightly damped pole whose damping estimate crosses zero)."""
-    n = resolving_nperseg(recording, [freq_hz], [max(damping, 1e-6)])
-    df = recording.fs / n
-    near = [p for p in coherent_peaks(recording, n, band) if explains(p[0], df, [freq_hz], [max(damping, 0.0)])]
-    return max(near, key=lambda p: p[2])[0] if near else None

@@ -70,7 +70,7 @@ from armaxmodal.stats import Z95, damping_interval
 
 __all__ = ["EARLIER_COLUMNS", "QUANTITIES", "N_SEGMENTS", "apply_segment_spread", "covering_both_estimators",
            "earlier_estimate", "interval", "interval_columns", "not_separated", "segment_jobs", "segment_poles",
-           "segment_spread", "split_segments", "with_intervals"]
+           "segment_spread", "with_intervals"]
 
 #: ``(part prefix, value column)`` of each quantity that has an interval
 QUANTITIES = (("freq", "freq_hz"), ("damping", "damping"))
@@ -225,16 +225,6 @@ def covering_both_estimators(rows: pd.DataFrame, alpha: float = DEFAULTS.agreeme
     )  # fmt: skip
     return out, [note]
 
-def split_segments(recording: Recording, k: int = N_SEGMENTS) -> list[Recording]:
-    """The record cut into ``k`` disjoint, equal parts (the remainder dropped)."""
-    n = recording.n_samples // k
-    return [
-        Recording(recording.fs, recording.base[i * n : (i + 1) * n], recording.response[i * n : (i + 1) * n],
-                  recording.sensors, recording.input_name)
-        for i in range(k)
-    ]  # fmt: skip
-
-
 def segment_spread(
     recording: Recording,
     modes: pd.DataFrame,
@@ -277,7 +267,7 @@ def segment_spread(
     todo = [job for job in jobs if job not in fitted]
     if todo:
         # every segment refit of every representative order at once, over the worker threads
-        parts = split_segments(recording, n_segments)
+        parts = recording.split(n_segments)
         found = parallel_map(partial(segment_poles, parts), todo, n_jobs, cost=lambda job: job[0][0], min_items=2)
         fitted.update(zip(todo, found, strict=True))
     poles_by_orders: dict = {orders: [] for orders in wanted}

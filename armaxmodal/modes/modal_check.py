@@ -21,7 +21,7 @@ lines, reported beside the H1's own random error in the same norm (Bendat & Pier
 does not account for, ``sqrt(max(e^2 - e_random^2, 0))``, is the *model error*; the modes
 explain the record when it is at most ``FrfSettings.model_error_limit`` on every output.
 
-``mode_support`` in :mod:`armaxmodal.modes.completeness` gives the evidence :func:`armaxmodal.select_modes`
+``mode_support`` in :mod:`armaxmodal.modes.frf` gives the evidence :func:`armaxmodal.select_modes`
 keeps a mode by: how much this check worsens without it (with a neighbour inside its half-power
 band refitted in its place, so that one half of a split peak is not needed when the other
 can take the whole peak).
@@ -33,10 +33,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from armaxmodal.modes.frf import CHECK_RESOLUTION, CoherentLines, coherent_lines, resolving_nperseg
-from armaxmodal.modes.settings import DEFAULTS, FrfSettings
+from armaxmodal.modes.settings import CHECK_RESOLUTION, DEFAULTS, FrfSettings
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
+from armaxmodal.spectra import CoherentLines, coherent_lines, resolving_nperseg
 from armaxmodal.stats import H1_COHERENCE
 
 __all__ = ["ModalCheck", "check_modes", "confirmed_modes", "poles_of", "rss_at"]
@@ -239,8 +239,9 @@ def _coefficients_to_terms(coef: np.ndarray, n_modes: int) -> tuple[np.ndarray, 
 
 
 def check_nperseg(recording: Recording, freq_hz, damping) -> int:
-    """Welch segment length of the check (:data:`~armaxmodal.modes.frf.CHECK_RESOLUTION`)."""
-    return resolving_nperseg(recording, freq_hz, damping, CHECK_RESOLUTION)
+    """Welch segment length of the check (:data:`~armaxmodal.modes.settings.CHECK_RESOLUTION`)."""
+    res = CHECK_RESOLUTION
+    return resolving_nperseg(recording, freq_hz, damping, res.lines_per_bandwidth, res.min_segments)
 
 
 def _fit_delays(lines: CoherentLines, basis: np.ndarray, fs: float, search: bool, settings: FrfSettings
@@ -336,7 +337,7 @@ def check_modes(recording: Recording, freq_hz, damping, band=None, *, fit_delay:
 
 def confirmed_modes(all_lines: list[CoherentLines], freq_hz, damping, line_hz: float,
                     confirm_lines: int = DEFAULTS.frf.confirm_lines) -> np.ndarray:  # fmt: skip
-    """Per mode: does some output have a coherent line (:func:`~armaxmodal.modes.frf.coherent_lines`) within
+    """Per mode: does some output have a coherent line (:func:`~armaxmodal.spectra.coherent_lines`) within
     ``|f - f_m| <= xi_m f_m + confirm_lines`` lines? A mode where no H1 is coherent is
     one the record cannot confirm: the check's fit never sees it. (The lines next to a sharp
     peak lose coherence to the H1's own bias: right modes on the measured records have their

@@ -3,9 +3,9 @@
 :func:`armaxmodal.modes.count_search.count_modes` compares free refits of the maximum-likelihood modal model
 (:func:`armaxmodal.modes.dft_model.fit_modal_model`) with one mode fewer, one more, or one split, and keeps the
 neighbour of lowest criterion while it lowers it. This module holds what it returns, :class:`ModeCount`, with the
-verdicts derived from it, and the tests the search applies: Bartlett's effective share of independent lines
-(:func:`effective_fraction`), the halves' agreement (``halves_chi2``), the pairing of two pole sets and the
-residual's peak. The criterion is Schwarz's BIC on the effective lines (the method page's "how many modes").
+verdicts derived from it, and the tests the search applies: the halves' agreement (``halves_chi2``), the pairing of
+two pole sets and the residual's peak (the lines' effective share: :func:`armaxmodal.stats.effective_fraction`).
+The criterion is Schwarz's BIC on the effective lines (the method page's "how many modes").
 """
 
 from __future__ import annotations
@@ -16,13 +16,14 @@ from typing import NamedTuple
 
 import numpy as np
 
+from armaxmodal.modal import matched_poles, nearest_pole
 from armaxmodal.modes.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.intervals import interval
-from armaxmodal.modes.poles import beyond_band, borderline, matched_poles, nearest_pole, reported
+from armaxmodal.modes.poles import beyond_band, borderline, reported
 from armaxmodal.modes.settings import DEFAULTS, AgreementSettings, CountSettings, DftSettings, LineSettings
 from armaxmodal.stats import Z95
 
-__all__ = ["FittedModel", "ModeCount", "ModelTable", "Wanted", "Step", "effective_fraction", "halves_chi2",
+__all__ = ["FittedModel", "ModeCount", "ModelTable", "Wanted", "Step", "halves_chi2",
            "split_start"]
 
 #: the count's thresholds when none are given (:class:`~armaxmodal.modes.settings.CountSettings`)
@@ -57,7 +58,7 @@ class FittedModel(NamedTuple):
 
 class ModelTable:
     """The count's table as the search fills it: one :class:`FittedModel` per fit, in order, with ``-2 ln L`` and BIC
-    on ``n_effective`` real numbers (:func:`effective_fraction`)."""
+    on ``n_effective`` real numbers (:func:`armaxmodal.stats.effective_fraction`)."""
 
     def __init__(self, n_effective: float):
         self.n_eff, self.rows = n_effective, []
@@ -309,48 +310,6 @@ class ModeCount:
                     reach[f"{q}_other_lo"] = float(np.fmin(reach[f"{q}_other_lo"], lo))
                     reach[f"{q}_other_hi"] = float(np.fmax(reach[f"{q}_other_hi"], hi))
         return reach, widened
-
-
-def effective_fraction(residual: np.ndarray, max_lag: int = COUNT.max_correlation_lag) -> float:
-    """The fraction of DFT lines that are independent, from the residual's correlation across
-    lines: ``1 / (1 + 2 sum_k rho_k)`` (Bartlett's effective sample size), the sum over lags
-    ``k = 1, 2, ...`` up to the first non-positive ``rho_k`` or ``max_lag``.
-
-    Parameters
-    ----------
-    residual : (n_lines, n_sensors) complex ndarray
-        A fit's residual on consecutive lines.
-    max_lag : int
-        The last lag summed.
-
-    Returns
-    -------
-    float
-        In (0, 1]; 1 when neighbouring lines are uncorrelated (white noise's DFT).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from armaxmodal.modes.mode_count import effective_fraction
-    >>> white = np.random.default_rng(0).standard_normal((4000, 4)) @ [[1, 0], [1j, 0], [0, 1], [0, 1j]]
-    >>> round(effective_fraction(white), 1)
-    1.0
-    >>> round(effective_fraction(white + np.roll(white, 1, axis=0)), 1)  # neighbours correlated 0.5
-    0.5
-    """
-    r = np.asarray(residual) - np.mean(residual, axis=0)
-    power = np.sum(np.abs(r) ** 2)
-    if power == 0 or r.shape[0] < 4:
-        return 1.0
-    total = 0.0
-    for k in range(1, min(max_lag, r.shape[0] // 4) + 1):
-        # complex correlation of lines k apart, pooled over sensors; its real part is what
-        # shares information between the two lines
-        rho = float(np.real(np.sum(np.conj(r[:-k]) * r[k:])) / power)
-        if rho <= 0:
-            break
-        total += rho
-    return 1.0 / (1.0 + 2.0 * total)
 
 
 def halves_chi2(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: int = COUNT.halves_nfev,

@@ -1,9 +1,8 @@
-"""The notes of the selection written from what the stages found: the count's
-(:mod:`armaxmodal.modes.mode_count`) -- what the search did, where the record does not decide the
-number of modes, what the picks are worth, which poles stay in the model unreported -- the
-record's being sampled far above its modes, and the final modes' (two the record does not separate, a
-damping it does not resolve). No decision is taken here: each note reads a result
-(the count's steps, margins, equally good models, stand-ins) and the levels it carries.
+"""The notes of the selection written from what the stages found: the FRF check's (a mode it does
+not need), the count's (:mod:`armaxmodal.modes.mode_count`: what the search did, where the record does
+not decide the number of modes, what the picks are worth, which poles stay in the model unreported),
+the record's being sampled far above its modes, and the final modes' (two the record does not separate,
+a damping it does not resolve). No decision is taken here: each note reads a result and its levels.
 """
 
 from __future__ import annotations
@@ -18,8 +17,9 @@ from armaxmodal.prepare.resample import BAND_FRACTION_OF_FS
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.stats import MAX_DAMPING, Z95
 
-__all__ = ["count_notes", "no_mode_kept_note", "not_separated_notes", "oversampling_note", "pick_notes",
-           "unresolved_damping_notes"]
+__all__ = ["confirmed_where_incoherent_note", "count_notes", "dropped_where_peaks_remain", "no_mode_kept_note",
+           "not_needed_note", "not_picked_note", "not_separated_notes", "oversampling_note", "pick_moved_note",
+           "pick_notes", "reported_as_one_note", "unresolved_damping_notes"]
 
 
 def no_mode_kept_note(count: ModeCount, modes: pd.DataFrame, band_hz) -> QualityWarning:
@@ -307,3 +307,91 @@ def unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[Quality
             float(m.freq_hz), (m.freq_hz,),
         ))  # fmt: skip
     return notes
+
+def reported_as_one_note(pair_hz, gap: float, level: float, same_shape: float, f: float, x: float) -> QualityWarning:
+    """Two poles of the count reported as one mode at ``f`` Hz (damping ``x``): ``gap`` standard
+    deviations apart (under ``level``), their shapes' MAC at least ``same_shape``."""
+    return QualityWarning(
+        "modes_not_separated", (),
+        f"the modal model needs two poles at {pair_hz[0]:.3f} and {pair_hz[1]:.3f} Hz, but they are {gap:.1f} "
+        f"standard deviations of their difference apart (under {level:g}) and their shapes agree (MAC at least "
+        f"{same_shape:g}): the record does not separate them. Reported as one mode at {f:.3f} Hz (damping {x:.3g}, "
+        "the model with one pole there), its intervals covering both: one resonance whose frequency moves during "
+        "the record (a nonlinearity, a change) or two modes this record cannot resolve", f, tuple(pair_hz),
+    )  # fmt: skip
+
+
+def confirmed_where_incoherent_note(f: float, rise: float) -> QualityWarning:
+    """A mode at ``f`` Hz no coherent H1 line tests, confirmed by the modal model (``rise``: the
+    criterion's rise without it)."""
+    return QualityWarning(
+        "mode_count", (),
+        f"no output's H1 is coherent near {f:.3f} Hz, so the FRF check cannot test that mode; the maximum-likelihood "
+        f"modal model, fitted to the record's DFT, confirms it: without it the criterion rises by {rise:.0f}, and "
+        "both halves of the record give it the same frequency and damping", float(f), (f,),
+    )  # fmt: skip
+
+
+def pick_moved_note(picked_hz: float, f: float, x: float) -> QualityWarning:
+    """A pick the modal model takes to ``f`` Hz (damping ``x``), where it is no mode of the band."""
+    return QualityWarning(
+        "pick_not_supported", (),
+        f"the maximum-likelihood modal model takes the mode picked at {picked_hz:.3f} Hz to {f:.3f} Hz (damping "
+        f"{x:.3g}): beyond the band, damped beyond {MAX_DAMPING:g} or a line. The record does not support a mode "
+        "there; it is reported from the diagram's fit, unconfirmed", float(picked_hz), (picked_hz,),
+    )  # fmt: skip
+
+
+def not_picked_note(model, others) -> QualityWarning:
+    """The modes of ``model`` (indices ``others``) no pick took: kept in the model, not reported."""
+    return QualityWarning(
+        "mode_count", (),
+        f"{len(others)} mode(s) of the record were not picked and are not reported: "
+        + ", ".join(f"{model.freq_hz[i]:.3f} Hz (damping {model.damping[i]:.3g})" for i in others)
+        + "; they stay in the modal model, so that the picked modes' values are not biased by their absence",
+        float(len(others)), tuple(model.freq_hz[others]),
+    )  # fmt: skip
+
+
+def dropped_where_peaks_remain(count: ModeCount | None, peaks, same_row_freq: float) -> list[QualityWarning]:
+    """A ``count_undecided`` note for each starting mode the count left out as unfounded
+    (``count.carried_away``) while the measured FRF keeps a coherent peak that no reported mode
+    explains within ``same_row_freq`` of where it started or went (``peaks``: the
+    ``unexplained_peak`` notes). The two kinds of evidence disagree: the halves test is weak on a
+    transient input (an earthquake's record), and the H1 still shows a resonance there. (A stand-in,
+    kept in the model unreported, is undecided already inside the band: :func:`count_notes`.)"""
+    if count is None:
+        return []
+    notes = []
+    for start, went, fate in [(start, went, "left out") for start, went in count.carried_away]:
+        near = [p.value for p in peaks
+                if min(abs(np.log(p.value / start)), abs(np.log(p.value / went))) <= same_row_freq]  # fmt: skip
+        if near:
+            notes.append(QualityWarning(
+                "count_undecided", (),
+                f"the starting mode at {start:.3f} Hz was {fate} (the free fit took it to {went:.3f} Hz, where it "
+                f"is no mode), but the measured FRF keeps a coherent peak no mode explains at "
+                f"{', '.join(f'{f:.2f}' for f in near)} Hz: the record does not decide whether a mode is there; "
+                "compare another record of the structure, or pick it ('--pick') to see what the record says of it",
+                float(start), (start, *near),
+            ))  # fmt: skip
+    return notes
+
+def not_needed_note(f: float, x: float, neighbour_hz: float | None, level: float, rise: float, p: float
+                    ) -> QualityWarning:  # fmt: skip
+    """The mode at ``f`` Hz (damping ``x``) the measured FRF does not need: its misfit rises by
+    ``rise`` (under ``level``, or not significant: ``p``) without it; with ``neighbour_hz``, the
+    mode there took the whole peak (a ``split_merged`` note), else a ``mode_not_needed`` one."""
+    evidence = f"without it no output's misfit rises by {100 * level:g} % (at most {100 * rise:+.1f} %, p = {p:.2g})"
+    if neighbour_hz is not None:
+        return QualityWarning(
+            "split_merged", (),
+            f"modes at {neighbour_hz:.3f} and {f:.3f} Hz overlap within their half-power bands and the measured FRF "
+            f"does not need both: {evidence} once {neighbour_hz:.3f} Hz may take the whole peak; one peak split by "
+            f"the model, {neighbour_hz:.3f} Hz is reported", float(f), (neighbour_hz, f),
+        )  # fmt: skip
+    return QualityWarning(
+        "mode_not_needed", (),
+        f"a stable pole at {f:.3f} Hz (damping {x:.3f}) is left out: the measured FRF does not need it, {evidence}: "
+        "a spurious pole of the model (noise, a nonlinearity, leakage), not a mode of the record", float(f), (f,),
+    )  # fmt: skip

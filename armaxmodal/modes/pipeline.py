@@ -27,12 +27,17 @@ import pandas as pd
 from armaxmodal._threads import one_blas_thread
 from armaxmodal.exceptions import PickError
 from armaxmodal.modes.clusters import check_picks, clustered_modes, merge_duplicates, picked_modes, why_no_mode
-from armaxmodal.modes.completeness import each_once, modes_the_check_adds, modes_the_record_needs, refit_with_added
-from armaxmodal.modes.counted import confirmed_where_incoherent, counted_modes, dropped_where_peaks_remain
+from armaxmodal.modes.counted import confirmed_where_incoherent, counted_modes
 from armaxmodal.modes.diagram import StabilisationDiagram
+from armaxmodal.modes.frf import each_once, modes_the_check_adds, modes_the_record_needs, refit_with_added
 from armaxmodal.modes.intervals import N_SEGMENTS, apply_segment_spread, segment_spread, with_intervals
 from armaxmodal.modes.modal_check import check_modes
-from armaxmodal.modes.notes import not_separated_notes, oversampling_note, unresolved_damping_notes
+from armaxmodal.modes.notes import (
+    dropped_where_peaks_remain,
+    not_separated_notes,
+    oversampling_note,
+    unresolved_damping_notes,
+)
 from armaxmodal.modes.result import ModeSelection, filled_samples_scale, no_mode_selection, per_sensor_table
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
 from armaxmodal.modes.state import RefitFailure, SelectionContext, SelectionState, refined_modes, refit_and_segment_fits
@@ -101,7 +106,7 @@ def segment_fits(state: SelectionState, ctx: SelectionContext) -> SelectionState
 
 def screen_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     """Without a count: a mode the H1's LSFD check does not need goes, with its note; a left-out
-    cluster it needs comes in (:mod:`armaxmodal.modes.completeness`)."""
+    cluster it needs comes in (:mod:`armaxmodal.modes.frf`)."""
     return _screened(state, ctx, None)
 
 
@@ -116,7 +121,7 @@ def propose_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionSta
 
 
 def _screened(state: SelectionState, ctx: SelectionContext, doubts: list | None) -> SelectionState:
-    """The check's drops (into ``doubts`` when given) and additions (:mod:`armaxmodal.modes.completeness`)."""
+    """The check's drops (into ``doubts`` when given) and additions (:mod:`armaxmodal.modes.frf`)."""
     rec, n_before, settings = ctx.diagram.recording, len(state.modes), ctx.settings
     state = modes_the_record_needs(rec, state, ctx.band, settings, doubts)
     state = modes_the_check_adds(ctx.diagram, state, ctx.band, ctx.nas, settings)

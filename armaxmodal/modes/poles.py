@@ -23,14 +23,15 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.estimate.result import ArmaxFit
+from armaxmodal.modal import mac
 from armaxmodal.modes.settings import DEFAULTS, LineSettings
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.spectra import excited_band
 from armaxmodal.stats import MAX_DAMPING, Z95
 
-__all__ = ["Tolerances", "pole_rows", "stability_classes", "rejection_reasons", "mac", "POLE_COLUMNS", "borderline",
-           "disturbance_lines", "matched_poles", "nearest_pole", "new_poles", "physical", "reported", "resolved"]
+__all__ = ["Tolerances", "pole_rows", "stability_classes", "rejection_reasons", "POLE_COLUMNS", "borderline",
+           "disturbance_lines", "physical", "reported", "resolved"]
 
 SHARED = "shared"
 
@@ -65,11 +66,6 @@ class Tolerances:
     min_energy: float = 0.01  #: residue energy relative to the largest pole at that order (lower it
     #: to keep weakly excited modes; 0.1 % admits weak extra poles on real and band-limited data)
     min_input_db: float = -30.0  #: input PSD below this (dB re its peak): no excitation there
-
-
-def mac(a: np.ndarray, b: np.ndarray) -> float:
-    den = np.vdot(a, a).real * np.vdot(b, b).real
-    return float(abs(np.vdot(a, b)) ** 2 / den) if den > 0 else 0.0
 
 
 POLE_COLUMNS = [
@@ -263,30 +259,6 @@ def _groups(freqs: np.ndarray, tol: float) -> list[list[int]]:
         else:
             groups.append([int(i)])
     return groups
-
-
-def nearest_pole(freq_hz: np.ndarray, f: float) -> int:
-    """The index of the pole of ``freq_hz`` (Hz) nearest ``f`` (Hz), by log ratio."""
-    return int(np.argmin(np.abs(np.log(freq_hz / f))))
-
-
-def matched_poles(old_hz: np.ndarray, new_hz: np.ndarray) -> list[tuple[int, int]]:
-    """One-to-one pairs ``(i_new, j_old)`` of two pole sets' frequencies (Hz), nearest pairs
-    first (by log ratio); the larger set's surplus poles stay unpaired."""
-    pairs = sorted((abs(np.log(n / o)), i, j) for i, n in enumerate(new_hz) for j, o in enumerate(old_hz))
-    taken_new, taken_old, out = set(), set(), []
-    for _, i, j in pairs:
-        if i not in taken_new and j not in taken_old:
-            taken_new.add(i)
-            taken_old.add(j)
-            out.append((i, j))
-    return out
-
-
-def new_poles(old_hz: np.ndarray, new_hz: np.ndarray) -> list[int]:
-    """The poles of ``new_hz`` (indices) left over when each of ``old_hz`` takes its nearest."""
-    paired = {i for i, _ in matched_poles(old_hz, new_hz)}
-    return [i for i in range(len(new_hz)) if i not in paired]
 
 
 def reported(model, band_hz, lines: LineSettings = DEFAULTS.lines) -> np.ndarray:

@@ -23,7 +23,7 @@ from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.clusters import merge_duplicates
 from armaxmodal.modes.dft_model import refine_modes
-from armaxmodal.modes.intervals import segment_jobs, segment_poles, split_segments
+from armaxmodal.modes.intervals import segment_jobs, segment_poles
 from armaxmodal.modes.settings import DEFAULTS, DftSettings
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
@@ -171,7 +171,7 @@ def refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, or
     jobs: list = [("refit", refit_band(diagram.recording, band))] if refine else []
     if segments >= 2:
         jobs += [("segment", job) for job in segment_jobs(sorted({orders[int(na)] for na in modes.na}), segments)]
-    parts = split_segments(diagram.recording, segments) if segments >= 2 else []
+    parts = diagram.recording.split(segments) if segments >= 2 else []
     task = partial(selection_job, diagram.recording, parts, modes, dft=dft)
     # the refit first: it is the longest job (a frequency-domain fit of every mode)
     cost = lambda job: np.inf if job[0] == "refit" else job[1][0][0]  # noqa: E731

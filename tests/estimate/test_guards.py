@@ -15,9 +15,9 @@ import armaxmodal.estimate.parameters as parameters_mod
 import armaxmodal.estimate.pem as pem_mod
 import armaxmodal.estimate.starts as starts_mod
 from armaxmodal.estimate.orders import default_nb
-from armaxmodal.modal import discrete_modal_parameters, pole_uncertainty
+from armaxmodal.modal import discrete_modal_parameters, mac, pole_uncertainty
 from armaxmodal.modes.dft_model import refine_modes
-from armaxmodal.modes.poles import Tolerances, mac, rejection_reasons
+from armaxmodal.modes.poles import Tolerances, rejection_reasons
 from armaxmodal.spectra import excited_band
 
 FS = 60.0

@@ -10,8 +10,10 @@ from scipy.signal import find_peaks
 
 import armaxmodal as am
 from armaxmodal.modes.diagram import stabilisation_diagram
-from armaxmodal.modes.frf import peak_prominences, resolving_nperseg, unexplained_peaks
+from armaxmodal.modes.frf import unexplained_peaks
 from armaxmodal.modes.pipeline import select_modes
+from armaxmodal.modes.settings import PEAK_RESOLUTION
+from armaxmodal.spectra import peak_prominences, resolving_nperseg
 
 
 @pytest.fixture(scope="module")
@@ -41,7 +43,9 @@ def test_a_missing_lightly_damped_mode_is_named_at_its_frequency(light):
     s, rec = light
     modes = s.modes()
     assert np.all(modes.damping < 0.02)
-    assert resolving_nperseg(rec, modes.freq_hz, modes.damping) >= 512  # lines fine enough for 1 % damping
+    res = PEAK_RESOLUTION
+    n = resolving_nperseg(rec, modes.freq_hz, modes.damping, res.lines_per_bandwidth, res.min_segments)
+    assert n >= 512  # lines fine enough for 1 % damping
     assert unexplained_peaks(rec, modes.freq_hz, modes.damping) == []
     (w,) = unexplained_peaks(rec, modes.freq_hz[:1], modes.damping[:1])
     assert w.code == "unexplained_peak" and w.value == pytest.approx(modes.damped_freq_hz[1], rel=0.01)
@@ -49,7 +53,7 @@ def test_a_missing_lightly_damped_mode_is_named_at_its_frequency(light):
 
 
 def test_mode_support_merges_a_fake_split_and_keeps_real_close_modes(light, fixtures_dir):
-    from armaxmodal.modes.completeness import mode_support, overlapping_neighbour
+    from armaxmodal.modes.frf import mode_support, overlapping_neighbour
     from armaxmodal.modes.modal_check import check_modes
 
     def support(rec, f, x, m):

@@ -92,7 +92,7 @@ def test_the_verdict_is_the_limit_on_every_checked_output():
 
 
 def test_a_cluster_the_support_rule_left_out_enters_when_the_check_needs_it(light_ride):
-    from armaxmodal.modes.completeness import modes_the_check_adds
+    from armaxmodal.modes.frf import modes_the_check_adds
     from armaxmodal.modes.state import SelectionState
 
     s, rec = light_ride
@@ -129,8 +129,8 @@ def test_a_mode_where_no_h1_is_coherent_is_unconfirmed_and_fails_the_verdict(lig
     """A mode at 24.8 Hz, at the edge of the ride's band where no output responds
     coherently (as the bridge's 20.7 Hz 'mode' inside a low-coherence band): the fit cannot
     see it, so the check cannot pass it."""
-    from armaxmodal.modes.frf import coherent_lines
     from armaxmodal.modes.modal_check import confirmed_modes
+    from armaxmodal.spectra import coherent_lines
 
     s, rec = light_ride
     m = s.modes()
@@ -172,9 +172,9 @@ def test_a_refit_may_move_a_mode_halfway_to_its_neighbour_within_twice_the_clust
 
 
 def test_a_mode_is_confirmed_by_a_coherent_line_within_its_half_width_and_four_lines():
-    from armaxmodal.modes.completeness import ModeSupport
-    from armaxmodal.modes.frf import CoherentLines
+    from armaxmodal.modes.frf import ModeSupport
     from armaxmodal.modes.modal_check import confirmed_modes
+    from armaxmodal.spectra import CoherentLines
 
     f = np.arange(1.0, 2.0001, 0.1)  # coherent lines 1.0-2.0 Hz, 0.1 Hz apart
     lines = [CoherentLines(f, np.ones(f.size, complex), np.full(f.size, 0.01))]

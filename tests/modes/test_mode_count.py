@@ -10,16 +10,16 @@ import pytest
 
 import armaxmodal as am
 from armaxmodal.modes.count_search import count_modes
-from armaxmodal.modes.counted import _one_where_not_separated, dropped_where_peaks_remain
+from armaxmodal.modes.counted import _one_where_not_separated
 from armaxmodal.modes.dft_model import DftLines, fit_modal_model
 from armaxmodal.modes.intervals import not_separated, with_intervals
-from armaxmodal.modes.mode_count import ModeCount, Wanted, effective_fraction
+from armaxmodal.modes.mode_count import ModeCount, Wanted
 from armaxmodal.modes.notes import count_notes as _notes
-from armaxmodal.modes.notes import not_separated_notes
+from armaxmodal.modes.notes import dropped_where_peaks_remain, not_separated_notes
 from armaxmodal.modes.poles import reported
 from armaxmodal.modes.result import ModeSelection
 from armaxmodal.modes.settings import AgreementSettings, ClusterSettings, CountSettings, LineSettings, SelectionSettings
-from armaxmodal.stats import Z95
+from armaxmodal.stats import Z95, effective_fraction
 
 DECISIVE_BIC = CountSettings().decisive_bic  # the count's own level
 SAME_ROW = ClusterSettings().same_row_freq  # the clustering's reach
@@ -154,11 +154,11 @@ def test_the_penalty_grows_with_the_data(supine):
 def test_effective_fraction_is_bartletts_for_white_and_smoothed_noise():
     rng = np.random.default_rng(5)
     white = rng.standard_normal((20000, 3)) + 1j * rng.standard_normal((20000, 3))
-    assert effective_fraction(white) > 0.95
+    assert effective_fraction(white, 400) > 0.95
     # a moving average over w lines: 1 + 2 sum (1 - k / w) = w, so a fraction of 1 / w
     w = 8
     smooth = np.apply_along_axis(lambda c: np.convolve(c, np.ones(w) / w, mode="valid"), 0, white)
-    assert effective_fraction(smooth) == pytest.approx(1 / w, rel=0.15)
+    assert effective_fraction(smooth, 400) == pytest.approx(1 / w, rel=0.15)
 
 
 def _model(freq, damping, sd=0.01):
@@ -309,7 +309,6 @@ def test_a_change_during_the_record_is_not_counted_as_modes():
     """A two-mass chain that stiffens 4 % halfway (a set-up that settles, a joint that warms):
     the whole record is fitted better by a cascade of lightly damped doublets near the first
     mode, which the likelihood alone accepts; each half needs none of them."""
-    from armaxmodal.modes.intervals import split_segments
     from armaxmodal.recording import Recording
 
     def chain(scale):
@@ -320,7 +319,7 @@ def test_a_change_during_the_record_is_not_counted_as_modes():
     second = am.simulate_recording(chain(1.04), u[3600:], 60.0, noise=0.01, seed=2)
     rec = Recording(60.0, np.r_[first.base, second.base], np.r_[first.response, second.response], first.sensors)
     data = DftLines.from_recording(rec, (0.5, 27.0))
-    halves = tuple(DftLines.from_recording(h, (0.5, 27.0)) for h in split_segments(rec, 2))
+    halves = tuple(DftLines.from_recording(h, (0.5, 27.0)) for h in rec.split(2))
     exact = chain(1.0).modes()
     alone = count_modes(data, exact.freq_hz, exact.damping, hold="zoh")
     assert alone.model.n_modes > 2  # the likelihood alone over-models
@@ -698,7 +697,6 @@ def test_a_split_of_a_mode_the_search_did_not_split_is_tried_for_the_likelihood(
     from scipy.special import chdtrc
 
     from armaxmodal.modes.count_search import _Search, _split_wanted
-    from armaxmodal.modes.intervals import split_segments
 
     data, truth = supine
     f, x = truth.freq_hz.copy(), truth.damping.copy()
@@ -707,7 +705,7 @@ def test_a_split_of_a_mode_the_search_did_not_split_is_tried_for_the_likelihood(
     current = fit_modal_model(data, f, x, "zoh", max_nfev=200)
     search = _Search(data, "zoh", data.n_real * data.y.shape[1], 40)
     halves = tuple(DftLines.from_recording(h, data.band_hz).weighted(data.weights)
-                   for h in split_segments(supine_ride, 2))  # fmt: skip
+                   for h in supine_ride.split(2))  # fmt: skip
     got, _ = _split_wanted(search, current, halves, supported=lambda f, x: False)
     if not merged:
         assert got == ()

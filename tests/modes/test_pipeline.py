@@ -242,6 +242,6 @@ def test_a_threshold_no_setting_can_take_is_refused_by_name(make, message):
 def test_a_mode_the_check_drops_twice_is_one_doubt_with_its_first_note():
     first, second, other = (QualityWarning("mode_not_needed", (), text, 5.99) for text in ("first", "second", "other"))
     doubts = [(5.99, 0.13, first), (8.57, 0.03, other), (5.99, 0.13, second)]
-    from armaxmodal.modes.completeness import each_once
+    from armaxmodal.modes.frf import each_once
 
     assert each_once(doubts) == ((5.99, 0.13, first), (8.57, 0.03, other))

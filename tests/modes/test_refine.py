@@ -127,7 +127,7 @@ def test_sandwich_errors_equal_statsmodels_hc1_on_a_linear_regression():
     """White's HC1 covariance of a heteroscedastic linear regression, against statsmodels."""
     import statsmodels.api as sm
 
-    from armaxmodal.modes._separable import sandwich_sd as _sandwich_sd
+    from armaxmodal.stats import sandwich_sd as _sandwich_sd
 
     rng = np.random.default_rng(3)
     x = np.column_stack([np.ones(400), rng.standard_normal(400), rng.uniform(0, 3, 400)])
@@ -256,10 +256,10 @@ def test_a_null_direction_of_the_normal_equations_stays_solvable_at_any_scale():
     """The compressed problem's Cholesky factor takes a ridge of 1e-12 of the mean diagonal: two
     parameters that move the residual alike (rank one, ``J'J`` only semi-definite) are still
     factored, whatever the units make of the scale."""
-    from armaxmodal.modes._separable import _ridged_cholesky
+    from armaxmodal._linalg import ridged_cholesky
 
     for scale in (1.0, 1e8):
         gram = scale * np.ones((2, 2))
-        r = _ridged_cholesky(gram)
+        r = ridged_cholesky(gram)
         np.testing.assert_allclose(r.T @ r, gram, rtol=1e-9)
         assert np.all(np.diag(r) > 0)

@@ -138,13 +138,13 @@ def test_the_segments_fitted_here_are_those_the_selection_schedules(fixtures_dir
     import pandas as pd
 
     from armaxmodal.estimate.orders import default_nb, default_nc
-    from armaxmodal.modes.intervals import segment_jobs, segment_poles, segment_spread, split_segments
+    from armaxmodal.modes.intervals import segment_jobs, segment_poles, segment_spread
 
     ride = am.read_recording(fixtures_dir / "supine_random.csv")
     modes = pd.DataFrame({"freq_hz": [5.83, 8.31, 13.5], "damping": [0.3, 0.2, 0.2]})
     orders = {8: (8, default_nb(8, -1), default_nc(8), -1), 10: (10, default_nb(10, -1), default_nc(10), -1)}
     orders_of = [orders[8], orders[10], orders[10]].__getitem__
-    parts = split_segments(ride, 3)
+    parts = ride.split(3)
     fitted = {job: segment_poles(parts, job) for job in segment_jobs(sorted(set(orders.values())), 3)}
     mine = segment_spread(ride, modes, orders_of, 3, n_jobs=2)
     pd.testing.assert_frame_equal(mine, segment_spread(None, modes, orders_of, 3, fitted=fitted))

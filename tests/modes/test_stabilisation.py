@@ -238,7 +238,7 @@ def test_poles_crossing_zero_without_an_frf_peak_stay_rejected(light_diagram):
 
 
 def test_a_split_the_frf_does_not_need_is_merged_and_said(light_diagram):
-    from armaxmodal.modes.completeness import modes_the_record_needs
+    from armaxmodal.modes.frf import modes_the_record_needs
     from armaxmodal.modes.state import SelectionState
 
     s, diagram = light_diagram
@@ -275,7 +275,7 @@ def test_a_spurious_heavily_damped_neighbour_is_left_out_and_said(light_diagram)
     """A 20 %-damped pole 15 % above a 1 %-damped mode (as measured beside the stiff
     1-storey model's storey mode) is not needed by the FRF once the mode's own pole is
     refitted: left out, as a split of that peak (its half-power band covers the mode)."""
-    from armaxmodal.modes.completeness import modes_the_record_needs
+    from armaxmodal.modes.frf import modes_the_record_needs
     from armaxmodal.modes.state import SelectionState
 
     s, diagram = light_diagram
