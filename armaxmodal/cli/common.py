@@ -166,7 +166,9 @@ def print_notes(warnings, verbose: bool = False) -> None:
         notes = groups[code]
         channels = sorted({c for w in notes for c in w.channels})
         where = f", {', '.join(channels)}" if channels and len(", ".join(channels)) <= 30 else ""
-        where += _frequencies(sorted({round(f, 2) for w in notes for f in w.freq_hz}))
+        # each frequency once, to 0.01 Hz, or to three digits below 1 Hz (a drift's 0.00417 Hz is not 0)
+        shown_hz = {round(f, 2) if abs(f) >= 1 else float(f"{f:.3g}") for w in notes for f in w.freq_hz}
+        where += _frequencies(sorted(shown_hz))
         head, text = f"  {severity(code):<8}{code} ({len(notes)}{where}): ", advice.get(code, "")
         if len(head) + len(text) > NOTE_WIDTH and not verbose:  # cut at a word, marked
             text = text[: NOTE_WIDTH - len(head) - 4].rsplit(" ", 1)[0] + " ..."

@@ -166,6 +166,9 @@ class ModalModel:
         From :func:`refine_modes`: each tried assumption's weighted residual sum of squares
         after the same first steps from the same start, the basis of its choice (empty for a
         plain fit).
+    at_bound : (n_modes,) bool ndarray or None
+        The pole's frequency or damping is held at a bound of the fit (the solver's active set):
+        its Wald interval means nothing there. None: not known.
 
     Examples
     --------
@@ -191,6 +194,7 @@ class ModalModel:
     band_hz: tuple[float, float] = (0.0, np.inf)
     hold_cost: dict = field(default_factory=dict)
     nyquist_hz: float = np.inf
+    at_bound: np.ndarray | None = None
 
     def by_frequency(self) -> ModalModel:
         """The same model, its modes sorted by frequency.
@@ -202,7 +206,8 @@ class ModalModel:
         """
         order = np.argsort(self.freq_hz)
         return replace(self, freq_hz=self.freq_hz[order], damping=self.damping[order], freq_sd=self.freq_sd[order],
-                       damping_sd=self.damping_sd[order], shapes=self.shapes[:, order])  # fmt: skip
+                       damping_sd=self.damping_sd[order], shapes=self.shapes[:, order],
+                       at_bound=None if self.at_bound is None else self.at_bound[order])  # fmt: skip
 
     @property
     def n_modes(self) -> int:
@@ -334,7 +339,8 @@ def _fit(data: DftLines, start: np.ndarray, hold: str, max_nfev: int, settings: 
                       shapes=-r / lam**2, rss=rss, n_real=data.n_real, hold=hold,
                       residual=resid[: data.s.size] + 1j * resid[data.s.size :],
                       converged=bool(res.status > 0),  # 0: stopped at max_nfev
-                      band_hz=data.band_hz, nyquist_hz=0.5 / data.dt)  # fmt: skip
+                      band_hz=data.band_hz, nyquist_hz=0.5 / data.dt,
+                      at_bound=(res.active_mask != 0).reshape(n, 2).any(axis=1))  # fmt: skip
 
 
 @single_blas_thread

@@ -275,11 +275,15 @@ def borderline(model, band_hz, lines: LineSettings = DEFAULTS.lines) -> np.ndarr
     ``MAX_DAMPING`` (bool per pole; lines excluded; an interval not known reaches). The record does
     not decide whether a mode of the band stands there: a heavily damped mode near the band's top
     comes out just past it (unseen bodies with feet: 26.4 Hz, damping 0.33, estimated at 28.07 Hz
-    in a band ending at 28.06; 26.8 Hz, 0.51, estimated damped 0.63 +- 0.11)."""
+    in a band ending at 28.06; 26.8 Hz, 0.51, estimated damped 0.63 +- 0.11). A pole held at a bound
+    of the fit (``at_bound``) has no Wald interval and is none: it stands for what lies beyond the band
+    (a drifting record's two poles at half its lowest line, damping 0.95, "reached" -0.01 to 0.02 Hz)."""
     f, x = model.freq_hz, model.damping
     df, dx = Z95 * model.freq_sd, Z95 * model.damping_sd
     decided_out = (f + df < band_hz[0]) | (f - df > band_hz[1]) | (x - dx > MAX_DAMPING)
-    return ~decided_out & ~reported(model, band_hz, lines) & (x > lines.at_fit_floor)
+    pinned = getattr(model, "at_bound", None)
+    pinned = np.zeros(f.shape, bool) if pinned is None else pinned
+    return ~decided_out & ~pinned & ~reported(model, band_hz, lines) & (x > lines.at_fit_floor)
 
 
 def beyond_band(model, band_hz, lines: LineSettings = DEFAULTS.lines) -> np.ndarray:

@@ -53,6 +53,8 @@ def test_a_code_line_names_its_notes_frequencies(capsys):
     assert lines[3].startswith("  info    mode_count (1): ")
     print_notes([note("unexplained_peak", f) for f in (3.0, 5.5, 7.25, 9.0)])  # four: each named
     assert capsys.readouterr().err.splitlines()[1].startswith("  warning unexplained_peak (4, at 3, 5.5, 7.25, 9 Hz): ")
+    print_notes([note("mode_count", 0.0041667, 15.7291), note("mode_count", 0.0041667)])  # a drift's pole: not "0"
+    assert capsys.readouterr().err.splitlines()[1].startswith("  info    mode_count (2, at 0.00417, 15.73 Hz): ")
     assert note("mode_count", 4.4, np.nan).to_dict()["freq_hz"] == [4.4]  # strict JSON: no NaN
 
 

@@ -60,6 +60,32 @@ def test_a_pole_is_borderline_when_its_interval_reaches_what_its_estimate_does_n
     assert got.tolist() == [False, want]
 
 
+def test_a_pole_held_at_a_bound_of_the_fit_is_not_borderline():
+    """Its Wald interval means nothing at a bound: the same pole, reaching into the band by it, is
+    borderline off the bound and not at it (``at_bound``, the solver's active set)."""
+    model = _model([5.0, 0.8], [0.2, 0.95], [0.01, 0.2], [0.01, 0.6])
+    assert borderline(model, BAND).tolist() == [False, True]
+    model.at_bound = np.array([False, True])
+    assert borderline(model, BAND).tolist() == [False, False]
+
+
+def test_the_fit_marks_the_poles_it_holds_at_a_bound():
+    """A drift (a slow ramp on every sensor) takes a pole at half the lowest line, damping at its
+    bound (the snapshot's drift-damaged copy had two there, their intervals "reaching" -0.01 to
+    0.02 Hz, each said ``count_undecided``). The solver's active set marks it, and only it, in the
+    model's frequency order (the start lists it last)."""
+    body = am.supine_human()
+    exact = body.modes()
+    ride = am.simulate_recording(body, am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03, seed=2)
+    ramp = 0.05 * ride.time[:, None] * np.ones(len(ride.sensors))
+    drifting = am.Recording(ride.fs, ride.base, ride.response + ramp, ride.sensors, ride.input_name)
+    data = DftLines.from_recording(drifting, (1 / 60, 28.0))
+    model = fit_modal_model(data, np.r_[exact.freq_hz, 0.01], np.r_[exact.damping, 0.9], hold="zoh")
+    assert model.at_bound.tolist() == [True, False, False, False, False]
+    assert model.freq_hz[0] == pytest.approx(data.band_hz[0] / 2) and model.damping[0] == pytest.approx(0.95)
+    np.testing.assert_allclose(model.freq_hz[1:], exact.freq_hz, rtol=0.02)
+
+
 def _count(freq, damping, freq_sd, damping_sd):
     model = _model(freq, damping, freq_sd, damping_sd)
     return ModeCount(model, model, (), np.full(len(freq), 60.0), -40.0, 12.0, 1.0, band_hz=BAND)
@@ -196,3 +222,22 @@ def test_only_a_needed_pole_beyond_the_band_is_named_and_the_note_says_where_to_
     weak = replace(count, removal_rise=np.array([60.0, 5.0, 5.0]))  # not needed: what lies up there, unnamed
     assert list(weak.verdicts()) == ["needed", "not_a_mode", "not_a_mode"]
     assert "mode_beyond_band" not in [n.code for n in count_notes(weak, weak.reported(), BAND, 0.05)]
+
+
+def test_a_drifting_record_is_uncertain_for_its_drift_alone(tmp_path):
+    """The snapshot's drift-damaged fixture (every sensor ramping 0.05 m/s^2 a second): the count
+    keeps two poles at half the lowest line that stand for the drift, one with its damping just off
+    its bound (only its frequency held). They are no modes of the band and not borderline: the
+    verdict is ``uncertain`` for the drift, with no ``count_undecided`` note about them."""
+    import pandas as pd
+
+    frame = pd.read_csv(Path(__file__).parents[2] / "fixtures" / "supine_random.csv", comment="#")
+    outs = ["head", "chest", "pelvis", "legs"]
+    frame[outs] += 0.05 * np.arange(len(frame))[:, None] / 60.0
+    frame.to_csv(tmp_path / "drift.csv", index=False)
+    selection = am.select_modes(am.stabilisation_diagram(am.read_recording(tmp_path / "drift.csv")))
+    codes = {w.code for w in selection.warnings}
+    assert selection.uncertain_because == ["drift"] and "count_undecided" not in codes
+    low = selection.count.model.freq_hz < selection.count.band_hz[0]
+    assert low.sum() == 2 and set(selection.count.verdicts()[low]) == {"not_a_mode"}
+    np.testing.assert_allclose(selection.modes.freq_hz, am.supine_human().modes().freq_hz, rtol=0.02)
