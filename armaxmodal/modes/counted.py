@@ -299,7 +299,7 @@ def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str, same_row_freq
         row.update(earlier_estimate(row))
     else:  # a mode the diagram's clusters did not hold
         # nor an ARMAX estimate: the segments' spread is judged against the modal model's own
-        # deviation (as a mode the completeness test adds), not the neighbouring row's
+        # deviation (as a mode the FRF screen adds), not the neighbouring row's
         row.update(count=0, support=0.0, freq_spread=np.nan, damping_spread=np.nan, medoid_freq_hz=np.nan,
                    medoid_damping=np.nan, orders_damping_unresolved=0, energy=np.nan,
                    freq_sd_armax=m.freq_sd[i], damping_sd_armax=m.damping_sd[i],

@@ -159,7 +159,7 @@ def modes_the_record_needs(recording: Recording, work: SelectionState, band, set
         m = min(weak, key=lambda i: (rank.index(i), support[i].rise))
         s, f_m, x_m = support[m], modes.at[m, "freq_hz"], modes.at[m, "damping"]
         neighbour = None if s.refitted_neighbour is None else modes.at[s.refitted_neighbour, "freq_hz"]
-        note = not_needed_note(f_m, x_m, neighbour, frf.model_error_rise, s.rise, s.p_value)
+        note = not_needed_note(f_m, x_m, neighbour, frf.model_error_rise, frf.support_alpha, s.rise, s.p_value)
         work = work.kept(i for i in range(len(modes)) if i != m)
         if doubts is None:
             work = work.warned(note)

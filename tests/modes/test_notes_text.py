@@ -289,3 +289,67 @@ def test_the_residual_peak_and_its_width(peak_hz, half_hz, want):
     model = SimpleNamespace(residual=np.sqrt(power / 2)[:, None] * np.ones((1, 2)) + 0j)
     got = residual_peak(model, SimpleNamespace(s=2j * np.pi * f), width_lines=1)
     assert got == pytest.approx(want, rel=1e-9)
+
+
+def _facts(note) -> tuple:
+    return note.code, note.channels, note.value, note.freq_hz, note.message
+
+
+def test_the_count_and_screen_notes_say_their_numbers_in_their_places():
+    """The notes the count's rows and the FRF screen write, each from known facts (read against
+    them 2026-12-01): a pair reported as one, a mode only the modal model confirms, a pick the model
+    takes away, the modes not picked, and a mode the FRF does not need, alone or beside a neighbour."""
+    assert _facts(notes.reported_as_one_note((6.356, 6.395), 0.2, 3.0, 0.8, 6.371, 0.0133)) == (
+        "modes_not_separated", (), 6.371, (6.356, 6.395),
+        "the modal model needs two poles at 6.356 and 6.395 Hz, but they are 0.2 standard deviations of their "
+        "difference apart (under 3) and their shapes agree (MAC at least 0.8): the record does not separate them. "
+        "Reported as one mode at 6.371 Hz (damping 0.0133, the model with one pole there), its intervals covering "
+        "both: one resonance whose frequency moves during the record (a nonlinearity, a change) or two modes this "
+        "record cannot resolve")  # fmt: skip
+    assert _facts(notes.confirmed_where_incoherent_note(39.67, 27.4)) == (
+        "mode_count", (), 39.67, (39.67,),
+        "no output's H1 is coherent near 39.670 Hz, so the FRF check cannot test that mode; the maximum-likelihood "
+        "modal model, fitted to the record's DFT, confirms it: without it the criterion rises by 27, and both halves "
+        "of the record give it the same frequency and damping")  # fmt: skip
+    assert _facts(notes.pick_moved_note(9.5, 31.2, 0.72)) == (
+        "pick_not_supported", (), 9.5, (9.5,),
+        "the maximum-likelihood modal model takes the mode picked at 9.500 Hz to 31.200 Hz (damping 0.72): beyond "
+        "the band, damped beyond 0.6 or a line. The record does not support a mode there; it is reported from the "
+        "diagram's fit, unconfirmed")  # fmt: skip
+    assert _facts(notes.not_picked_note(MODEL, [0, 2])) == (
+        "mode_count", (), 2.0, (5.0, 30.0),
+        "2 mode(s) of the record were not picked and are not reported: 5.000 Hz (damping 0.2), 30.000 Hz (damping "
+        "0.9); they stay in the modal model, so that the picked modes' values are not biased by their absence")
+    assert _facts(notes.not_needed_note(8.57, 0.034, None, 0.2, 0.01, 0.15, 0.31)) == (
+        "mode_not_needed", (), 8.57, (8.57,),
+        "a stable pole at 8.570 Hz (damping 0.034) is left out: the measured FRF does not need it, without it no "
+        "output's misfit rises by 20 % (at most +15.0 %, p = 0.31): a spurious pole of the model (noise, a "
+        "nonlinearity, leakage), not a mode of the record")  # fmt: skip
+    assert _facts(notes.not_needed_note(13.6, 0.3, 13.1, 0.05, 0.01, -0.004, 0.87)) == (
+        "split_merged", (), 13.6, (13.1, 13.6),
+        "modes at 13.100 and 13.600 Hz overlap within their half-power bands and the measured FRF does not need "
+        "both: without it no output's misfit rises by 5 % (at most -0.4 %, p = 0.87) once 13.100 Hz may take the "
+        "whole peak; one peak split by the model, 13.100 Hz is reported")  # fmt: skip
+    # a rise past the level that chance explains is said as such, not as a rise under it
+    assert notes.not_needed_note(8.57, 0.034, None, 0.05, 0.01, 0.35, 0.31).message == (
+        "a stable pole at 8.570 Hz (damping 0.034) is left out: the measured FRF does not need it, without it an "
+        "output's misfit rises by +35.0 %, but not significantly (p = 0.31, above 0.01): a spurious pole of the "
+        "model (noise, a nonlinearity, leakage), not a mode of the record")  # fmt: skip
+    at_the_level = notes.not_needed_note(8.57, 0.03, None, 0.05, 0.01, 0.05, 0.2)
+    assert "rises by +5.0 %, but not significantly" in at_the_level.message
+
+
+def test_a_left_out_start_beside_a_coherent_peak_is_said_undecided_with_every_peak_near_it():
+    """Two unexplained peaks near where a carried-away start began and went, one far from both, and
+    a second start with no peak near: one note, naming both near peaks."""
+    from armaxmodal.quality_warnings import QualityWarning
+
+    peaks = [QualityWarning("unexplained_peak", (s,), "a peak", f, (f,)) for s, f in
+             (("head", 8.05), ("legs", 9.52), ("legs", 14.0))]  # fmt: skip
+    (note,) = notes.dropped_where_peaks_remain(SimpleNamespace(carried_away=((8.0, 9.5), (20.0, 21.0))), peaks, 0.05)
+    assert _facts(note) == (
+        "count_undecided", (), 8.0, (8.0, 8.05, 9.52),
+        "the starting mode at 8.000 Hz was left out (the free fit took it to 9.500 Hz, where it is no mode), but the "
+        "measured FRF keeps a coherent peak no mode explains at 8.05, 9.52 Hz: the record does not decide whether a "
+        "mode is there; compare another record of the structure, or pick it ('--pick') to see what the record says "
+        "of it")  # fmt: skip
