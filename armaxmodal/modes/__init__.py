@@ -9,7 +9,7 @@
   model (:mod:`.dft_model`, :mod:`.mode_count`, :mod:`.count_search`, :mod:`.counted`, notes in :mod:`.notes`),
   with intervals widened by
   the segment spread (:mod:`.intervals`) and judged by the modal-model check (:mod:`.modal_check`,
-  on the H1's coherent lines, :func:`armaxmodal.spectra.coherent_lines`).
+  on the H1's coherent lines, :mod:`armaxmodal.spectra`).
 """
 
 from armaxmodal.modes.diagram import StabilisationDiagram, choose_nk, stabilisation_diagram
