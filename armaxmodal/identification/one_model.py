@@ -21,10 +21,11 @@ from armaxmodal.estimate.orders import OrderChoice, choose_orders
 from armaxmodal.estimate.result import ArmaxFit
 from armaxmodal.modal import mode_record
 from armaxmodal.modes.modal_check import ModalCheck, check_modes, finite_or_none
-from armaxmodal.modes.notes import oversampling_note
 from armaxmodal.modes.poles import POLE_COLUMNS, SHARED, Tolerances, pole_rows, rejection_reasons
 from armaxmodal.modes.result import record_header
+from armaxmodal.modes.settings import DEFAULTS
 from armaxmodal.prepare.preparation import Preparation, prepare
+from armaxmodal.prepare.resample import oversampling_note
 from armaxmodal.recording import Recording
 from armaxmodal.stats import MAX_DAMPING
 
@@ -82,7 +83,8 @@ class Identification:
         return (
             *found,
             *unexplained_peaks(self.recording, freq, damping, band),
-            *oversampling_note(freq, self.recording.fs),
+            *oversampling_note(freq, self.recording.fs, DEFAULTS.notes.oversampled_fraction,
+                               DEFAULTS.notes.suggested_band_factor),
             *self.check.warnings(),
         )
 

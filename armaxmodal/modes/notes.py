@@ -1,9 +1,8 @@
 """The notes of the selection written from what the stages found: the FRF check's (a mode it does
 not need), the count's (:mod:`armaxmodal.modes.mode_count`: what the search did, where the record does
-not decide the number of modes, what the picks are worth, which poles stay in the model unreported),
-the record's being sampled far above its modes, and the final modes' (two the record does not separate,
-a damping it does not resolve). No decision is taken here: each note reads a result and its levels.
-"""
+not decide the number of modes, what the picks are worth, which poles stay in the model unreported)
+and the final modes' (two the record does not separate, a damping it does not resolve). No decision
+is taken here: each note reads a result and its levels (the oversampled record's: ``prepare.resample``)."""
 
 from __future__ import annotations
 
@@ -12,17 +11,16 @@ import pandas as pd
 
 from armaxmodal.modes.intervals import not_separated, with_intervals
 from armaxmodal.modes.mode_count import ModeCount, reported
-from armaxmodal.modes.settings import DEFAULTS, NoteSettings
-from armaxmodal.prepare.resample import BAND_FRACTION_OF_FS
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.stats import MAX_DAMPING, Z95
 
 __all__ = ["confirmed_where_incoherent_note", "count_notes", "dropped_where_peaks_remain", "no_mode_kept_note",
-           "not_needed_note", "not_picked_note", "not_separated_notes", "oversampling_note", "pick_moved_note",
-           "pick_notes", "reported_as_one_note", "unresolved_damping_notes"]
+           "not_needed_note", "not_picked_note", "not_separated_notes", "pick_moved_note", "pick_notes",
+           "reported_as_one_note", "unresolved_damping_notes"]
 
 
 def no_mode_kept_note(count: ModeCount, modes: pd.DataFrame, band_hz) -> QualityWarning:
+    """The ``count_undecided`` note of a count that keeps no mode in ``band_hz`` (Hz): ``modes`` stand."""
     poles = ", ".join(
         f"{f:.3g} Hz (damping {x:.2f})" for f, x in zip(count.model.freq_hz, count.model.damping, strict=True)
     )
@@ -81,9 +79,34 @@ def _what_to_do(in_diagram: bool, unsupported: bool = False) -> str:
 
 
 def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: float) -> list[QualityWarning]:
-    decisive = count.settings.decisive_bic
-    notes = []
-    words = {"remove": "left out", "add": "added", "split": "split in two"}
+    """Every note of the count, from its steps, verdicts, margins and equally good models.
+
+    Parameters
+    ----------
+    count : ModeCount
+        The count's result.
+    keep : (n_poles,) bool ndarray
+        The poles reported as modes.
+    band_hz : (float, float)
+        The band the count decided on, Hz.
+    same_row_freq : float
+        The relative frequency within which two poles are one mode.
+
+    Returns
+    -------
+    list of QualityWarning
+        What the search did, where the record does not decide, the starts it left out or kept
+        unreported, the intervals widened, and the poles that are no modes of the band.
+    """
+    verdicts = count.verdicts(band_hz)  # each pole's, decided once by the count
+    return [*_step_notes(count, same_row_freq), *_undecided_notes(count, keep, verdicts),
+            *_left_out_notes(count), *_widened_notes(count, keep, same_row_freq), *_stand_in_notes(count, band_hz),
+            *_outside_notes(count, verdicts, band_hz)]  # fmt: skip
+
+
+def _step_notes(count: ModeCount, same_row_freq: float) -> list[QualityWarning]:
+    """One ``mode_count`` note per accepted step of the search."""
+    words, notes = {"remove": "left out", "add": "added", "split": "split in two"}, []
     for step in count.steps:
         moved = np.isfinite(step.settled_hz) and abs(np.log(step.settled_hz / step.freq_hz)) > same_row_freq
         where = f" (its new pole settled at {step.settled_hz:.3f} Hz)" if moved else ""
@@ -93,7 +116,12 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             f"{words[step.action]}{where}, the information criterion (BIC) falls by {step.bic_fall:.1f}",
             float(step.freq_hz), (step.freq_hz,),
         ))  # fmt: skip
-    verdicts = count.verdicts(band_hz)  # each pole's, decided once by the count
+    return notes
+
+
+def _undecided_notes(count: ModeCount, keep: np.ndarray, verdicts: np.ndarray) -> list[QualityWarning]:
+    """Where the criterion does not decide: a reported mode, one mode more, a mode the likelihood wants."""
+    decisive, notes = count.settings.decisive_bic, []
     undecided = keep & (verdicts == "undecided")  # of the reported modes only
     if undecided.any():
         rise = float(count.removal_rise[undecided].min())
@@ -120,6 +148,12 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             f"mode is the same in both halves of the record, but {_why_not_reported(rise_bic, unsupported)}; "
             f"{_what_to_do(in_diagram, unsupported)}", f, (f,),
         ))  # fmt: skip
+    return notes
+
+
+def _left_out_notes(count: ModeCount) -> list[QualityWarning]:
+    """The starts the search carried away, and the additions the halves leave unsettled or refuse."""
+    notes = []
     for start, went in count.carried_away:
         notes.append(QualityWarning(
             "mode_count", (),
@@ -132,9 +166,8 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             f"one mode more near {f:.3f} Hz lowers the criterion decisively and the diagram holds a stable column "
             f"there, but its frequency and damping in the record's two halves differ by more than chance allows at "
             f"the {100 * count.agreement.alpha:g} % level, though not by enough ({count.agreement.unsettled_alpha:g}) "
-            "to call it a change during the record: the record does not settle whether it "
-            "is a mode; compare another record of "
-            "the structure, or pick it ('--pick') to see what the record says of it", f, (f,),
+            "to call it a change during the record: the record does not settle whether it is a mode; compare another "
+            "record of the structure, or pick it ('--pick') to see what the record says of it", f, (f,),
         ))  # fmt: skip
     for f in count.unconfirmed_hz:
         notes.append(QualityWarning(
@@ -142,15 +175,26 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             f"one mode more near {f:.3f} Hz fits the whole record better but not each of its halves: a change "
             "during the record (a drifting frequency, a transient, a nonlinearity), not a mode; left out", f, (f,),
         ))  # fmt: skip
+    return notes
+
+
+def _widened_notes(count: ModeCount, keep: np.ndarray, same_row_freq: float) -> list[QualityWarning]:
+    """The reported intervals that cover the equally good models' values."""
     widened = [count.model.freq_hz[i] for i in np.flatnonzero(keep) if count.other_structures(i, same_row_freq)[1]]
-    if widened:
-        sizes = ", ".join(f"{alt.n_modes} modes ({d:+.1f})" for d, alt in count.alternatives)
-        notes.append(QualityWarning(
-            "mode_count", (),
-            f"the 95 % intervals of the mode(s) at {', '.join(f'{f:.3f}' for f in widened)} Hz also cover their values "
-            f"in the models the record cannot tell from the chosen one ({sizes} in the criterion): the number of modes "
-            "is part of their uncertainty", float(len(widened)), tuple(widened),
-        ))  # fmt: skip
+    if not widened:
+        return []
+    sizes = ", ".join(f"{alt.n_modes} modes ({d:+.1f})" for d, alt in count.alternatives)
+    return [QualityWarning(
+        "mode_count", (),
+        f"the 95 % intervals of the mode(s) at {', '.join(f'{f:.3f}' for f in widened)} Hz also cover their values "
+        f"in the models the record cannot tell from the chosen one ({sizes} in the criterion): the number of modes "
+        "is part of their uncertainty", float(len(widened)), tuple(widened),
+    )]  # fmt: skip
+
+
+def _stand_in_notes(count: ModeCount, band_hz) -> list[QualityWarning]:
+    """The starts carried where no mode is founded but which the model needs."""
+    notes = []
     for start, went, rise_without in count.stand_ins:
         # inside the band, a pole the likelihood needs is the record's own: it does not decide whether a mode
         # is there (a body's 17.40 Hz mode stood there, its halves disagreeing, under 'good')
@@ -164,16 +208,19 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
             + ("; whether a mode is there, the record does not decide: compare another record of the structure, or "
                "pick it ('--pick') to see what the record says of it" if inside else ""), went, (went,),
         ))  # fmt: skip
-    notes += [_borderline_note(count.model, i, band_hz) for i in np.flatnonzero(verdicts == "borderline")]
+    return notes
+
+
+def _outside_notes(count: ModeCount, verdicts: np.ndarray, band_hz) -> list[QualityWarning]:
+    """The borderline poles, the modes beyond the band, and the poles that stand for what lies there."""
+    notes = [_borderline_note(count.model, i, band_hz) for i in np.flatnonzero(verdicts == "borderline")]
     notes += [_beyond_band_note(count.model, i, band_hz) for i in np.flatnonzero(verdicts == "beyond_band")]
     # what stands for what lies beyond the band, over-damped poles, lines
     outside = ~reported(count.model, band_hz) & ~np.isin(verdicts, ("borderline", "beyond_band"))
     hidden = int(outside.sum())
     if hidden:
-        out = ", ".join(
-            f"{f:.3g} Hz (damping {x:.2f})"
-            for f, x in zip(count.model.freq_hz[outside], count.model.damping[outside], strict=True)
-        )
+        poles = zip(count.model.freq_hz[outside], count.model.damping[outside], strict=True)
+        out = ", ".join(f"{f:.3g} Hz (damping {x:.2f})" for f, x in poles)
         notes.append(QualityWarning(
             "mode_count", (),
             f"{hidden} pole(s) of the modal model lie outside the band {band_hz[0]:.3g}-{band_hz[1]:.3g} Hz, are "
@@ -219,53 +266,6 @@ def _borderline_note(model, i: int, band_hz) -> QualityWarning:
         "damped mode near the band's edge is estimated so); excite and fit a band reaching past it to decide",
         float(f), (f,),
     )  # fmt: skip
-
-
-def oversampling_note(mode_freqs: np.ndarray, fs: float, settings: NoteSettings = DEFAULTS.notes
-                      ) -> list[QualityWarning]:  # fmt: skip
-    """An ``oversampled`` warning when every mode found lies below
-    ``settings.oversampled_fraction`` of the Nyquist frequency: the input excites far above the
-    structure (so the rate was kept), the poles crowd ``z = 1`` and the swept orders resolve
-    them poorly (the supine ride at 1 kHz under a 0.5-400 Hz ride gave one of its four modes;
-    with the band suggested here, all four). The band suggested ends at
-    ``settings.suggested_band_factor`` times the highest mode found.
-
-    Parameters
-    ----------
-    mode_freqs : (n_modes,) ndarray
-        Natural frequencies of the modes found, Hz.
-    fs : float
-        The analysis rate, Hz.
-    settings : NoteSettings
-        The share of Nyquist that makes a record oversampled, and the band suggested.
-
-    Returns
-    -------
-    list of QualityWarning
-        Empty, or one warning whose value is the highest mode's share of the Nyquist frequency.
-    """
-    mode_freqs = np.asarray(mode_freqs, dtype=float)
-    if mode_freqs.size == 0 or mode_freqs.max() >= settings.oversampled_fraction * fs / 2:
-        return []
-    top = float(mode_freqs.max())
-    hi = float(np.ceil(settings.suggested_band_factor * top))
-    factor = int(np.floor(BAND_FRACTION_OF_FS * fs / hi))
-    if factor < 2:  # the band suggested keeps the rate: no lower rate to suggest
-        return []
-    new_fs = fs / factor
-    share = top / (fs / 2)
-    return [
-        QualityWarning(
-            "oversampled",
-            (),
-            f"every mode found lies below {100 * share:.1f} % of the Nyquist frequency (the highest at "
-            f"{top:.3g} Hz of {fs / 2:g} Hz): the input excites far above the structure, so the rate was kept, "
-            "and at this rate the poles crowd z = 1 where ARMAX models resolve them poorly; modes may be "
-            f"missed or biased. Rerun with band=(0, {hi:g}) (CLI: --band 0:{hi:g}), which resamples to "
-            f"{new_fs:.4g} Hz.",
-            share,
-        )
-    ]
 
 
 def not_separated_notes(modes: pd.DataFrame, separation_sd: float) -> list[QualityWarning]:

@@ -35,12 +35,12 @@ from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.notes import (
     dropped_where_peaks_remain,
     not_separated_notes,
-    oversampling_note,
     unresolved_damping_notes,
 )
 from armaxmodal.modes.result import ModeSelection, filled_samples_scale, no_mode_selection, per_sensor_table
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
 from armaxmodal.modes.state import RefitFailure, SelectionContext, SelectionState, refined_modes, refit_and_segment_fits
+from armaxmodal.prepare.resample import oversampling_note
 
 __all__ = ["AUTOMATIC", "FIXED_COUNT", "PICKED", "Stage", "select_modes", "stages_for"]
 
@@ -217,7 +217,7 @@ def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     """The intervals' parts combined, once; the per-sensor tables; the notes read off the final modes."""
     from armaxmodal.modes.frf import unexplained_peaks
 
-    diagram = ctx.diagram
+    diagram, notes = ctx.diagram, ctx.settings.notes
     scale, widened = filled_samples_scale(diagram.recording, diagram.preparation)
     modes = with_intervals(state.modes, scale)
     state = replace(state, modes=modes).warned(*(widened if len(modes) else ()))
@@ -232,7 +232,7 @@ def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     state = state.warned(
         *peaks,
         *dropped_where_peaks_remain(state.count, peaks, ctx.settings.cluster.same_row_freq),
-        *oversampling_note(freq, diagram.recording.fs, ctx.settings.notes),
+        *oversampling_note(freq, diagram.recording.fs, notes.oversampled_fraction, notes.suggested_band_factor),
         *unresolved_damping_notes(modes, len(ctx.nas)),
         *state.check.warnings(),
     )

@@ -13,7 +13,7 @@ import numpy as np
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 
-__all__ = ["BAND_FRACTION_OF_FS", "RESAMPLE_EDGE", "decimate", "resample_to_band"]
+__all__ = ["BAND_FRACTION_OF_FS", "RESAMPLE_EDGE", "decimate", "oversampling_note", "resample_to_band"]
 
 #: the band's upper edge sits at this fraction of the analysis rate (0.8 of its Nyquist),
 #: well inside the anti-alias filter's pass band
@@ -78,3 +78,51 @@ def decimate(data: np.ndarray, factor: int) -> np.ndarray:
     return np.column_stack(
         [np.convolve(col, h, mode="valid")[::factor][:n_out] for col in np.asarray(data, dtype=float).T]
     )
+
+
+def oversampling_note(mode_freqs: np.ndarray, fs: float, oversampled_fraction: float, suggested_band_factor: float
+                      ) -> list[QualityWarning]:  # fmt: skip
+    """An ``oversampled`` warning when every mode found lies below ``oversampled_fraction`` of the
+    Nyquist frequency: the input excites far above the structure (so the rate was kept), the poles
+    crowd ``z = 1`` and the swept orders resolve them poorly (the supine ride at 1 kHz under a
+    0.5-400 Hz ride gave one of its four modes; with the band suggested here, all four). The band
+    suggested ends at ``suggested_band_factor`` times the highest mode found, and the rate it
+    resamples to is what :func:`resample_to_band` would choose for it.
+
+    Parameters
+    ----------
+    mode_freqs : (n_modes,) ndarray
+        Natural frequencies of the modes found, Hz.
+    fs : float
+        The analysis rate, Hz.
+    oversampled_fraction, suggested_band_factor : float
+        The share of Nyquist that makes a record oversampled, and the band suggested
+        (``armaxmodal.modes.settings.NoteSettings``, with their calibration).
+
+    Returns
+    -------
+    list of QualityWarning
+        Empty, or one warning whose value is the highest mode's share of the Nyquist frequency.
+    """
+    mode_freqs = np.asarray(mode_freqs, dtype=float)
+    if mode_freqs.size == 0 or mode_freqs.max() >= oversampled_fraction * fs / 2:
+        return []
+    top = float(mode_freqs.max())
+    hi = float(np.ceil(suggested_band_factor * top))
+    factor = int(np.floor(BAND_FRACTION_OF_FS * fs / hi))
+    if factor < 2:  # the band suggested keeps the rate: no lower rate to suggest
+        return []
+    new_fs = fs / factor
+    share = top / (fs / 2)
+    return [
+        QualityWarning(
+            "oversampled",
+            (),
+            f"every mode found lies below {100 * share:.1f} % of the Nyquist frequency (the highest at "
+            f"{top:.3g} Hz of {fs / 2:g} Hz): the input excites far above the structure, so the rate was kept, "
+            "and at this rate the poles crowd z = 1 where ARMAX models resolve them poorly; modes may be "
+            f"missed or biased. Rerun with band=(0, {hi:g}) (CLI: --band 0:{hi:g}), which resamples to "
+            f"{new_fs:.4g} Hz.",
+            share,
+        )
+    ]

@@ -13,6 +13,8 @@ import pytest
 from armaxmodal.modes import notes
 from armaxmodal.modes.intervals import with_intervals
 from armaxmodal.modes.mode_count import ModeCount, Step, Wanted
+from armaxmodal.modes.settings import NoteSettings
+from armaxmodal.prepare.resample import oversampling_note
 
 BAND = (1.0, 25.0)
 SAME_ROW = 0.05
@@ -159,8 +161,14 @@ def test_a_model_that_keeps_no_mode_lists_its_poles_and_the_band():
     ]
 
 
+def _oversampled(freq_hz, fs, settings=None):
+    """The oversampling note under ``settings`` (the selection's ``NoteSettings``, as ``finish`` passes them)."""
+    s = NoteSettings() if settings is None else settings
+    return oversampling_note(np.array(freq_hz, float), fs, s.oversampled_fraction, s.suggested_band_factor)
+
+
 def test_an_oversampled_record_is_told_the_band_and_rate_to_rerun_at():
-    (said,) = _said(notes.oversampling_note(np.array([2.0, 6.3]), 1000.0))
+    (said,) = _said(_oversampled([2.0, 6.3], 1000.0))
     assert said[1] == pytest.approx(6.3 / 500)
     assert said[::2] == [
         ('oversampled', 0.0126,
@@ -169,8 +177,8 @@ def test_an_oversampled_record_is_told_the_band_and_rate_to_rerun_at():
             'rate the poles crowd z = 1 where ARMAX models resolve them poorly; modes may be missed '
             'or biased. Rerun with band=(0, 16) (CLI: --band 0:16), which resamples to 40 Hz.'),
     ][0][::2]
-    assert notes.oversampling_note(np.array([2.0, 6.3]), 100.0) == []  # the modes reach 13 % of Nyquist
-    assert notes.oversampling_note(np.array([]), 1000.0) == []
+    assert _oversampled([2.0, 6.3], 100.0) == []  # the modes reach 13 % of Nyquist
+    assert _oversampled([], 1000.0) == []
 
 
 def test_modes_the_record_does_not_separate_are_named_with_their_distance():
@@ -229,8 +237,8 @@ def test_a_model_without_poles_says_none():
 
 def test_the_oversampling_rule_at_its_edge():
     """Modes at 10 % of Nyquist are not oversampled; at 8 % they are, with the share printed to 0.1 %."""
-    assert notes.oversampling_note(np.array([50.0]), 1000.0) == []
-    (said,) = _said(notes.oversampling_note(np.array([40.0]), 1000.0))
+    assert _oversampled([50.0], 1000.0) == []
+    (said,) = _said(_oversampled([40.0], 1000.0))
     assert said[2].startswith("every mode found lies below 8.0 % of the Nyquist frequency (the highest at 40 Hz")
     assert said[2].endswith("Rerun with band=(0, 100) (CLI: --band 0:100), which resamples to 250 Hz.")
 
@@ -238,9 +246,7 @@ def test_the_oversampling_rule_at_its_edge():
 def test_a_band_that_halves_the_rate_is_suggested():
     """With every mode below 30 % of Nyquist counting as oversampled, a mode at 8 Hz of 100 Hz
     suggests the band 0-20 Hz, which halves the rate: the smallest reduction still worth saying."""
-    from armaxmodal.modes.settings import NoteSettings
-
-    (said,) = _said(notes.oversampling_note(np.array([8.0]), 100.0, NoteSettings(oversampled_fraction=0.3)))
+    (said,) = _said(_oversampled([8.0], 100.0, NoteSettings(oversampled_fraction=0.3)))
     assert said[2].endswith("Rerun with band=(0, 20) (CLI: --band 0:20), which resamples to 50 Hz.")
 
 

@@ -570,7 +570,8 @@ def test_a_record_sampled_far_above_its_structure_says_so_and_its_advice_finds_t
     structure, so the rate is kept, and the sweep found one of the four modes with nothing
     said. Every mode found lies below 10 % of the Nyquist frequency: 'oversampled' names it
     and the band to use; with that band all four modes are found, within 1.5 %."""
-    from armaxmodal.modes.notes import oversampling_note
+    from armaxmodal.modes.settings import DEFAULTS
+    from armaxmodal.prepare.resample import oversampling_note
 
     system = am.supine_human()
     ride = am.random_vibration(1000.0, 15.0, (0.5, 400.0), seed=1)
@@ -596,8 +597,10 @@ def test_a_record_sampled_far_above_its_structure_says_so_and_its_advice_finds_t
         ident = am.identify(rec, (8, 9, 8, -1))
     assert [w["code"] for w in ident.to_dict()["warnings"]].count("oversampled") == 1
     # the threshold: the highest mode at 10 % of the Nyquist frequency is not oversampled
-    assert oversampling_note(np.array([3.0, 50.0]), 1000.0) == [] and oversampling_note(np.array([]), 1000.0) == []
-    assert oversampling_note(np.array([49.9]), 1000.0)[0].value == pytest.approx(0.0998)
+    limits = DEFAULTS.notes.oversampled_fraction, DEFAULTS.notes.suggested_band_factor
+    assert oversampling_note(np.array([3.0, 50.0]), 1000.0, *limits) == []
+    assert oversampling_note(np.array([]), 1000.0, *limits) == []
+    assert oversampling_note(np.array([49.9]), 1000.0, *limits)[0].value == pytest.approx(0.0998)
 
 
 def test_a_lightly_damped_sensor_is_a_response_though_the_input_drives_it_little_elsewhere():
