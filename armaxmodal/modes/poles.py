@@ -281,8 +281,7 @@ def borderline(model, band_hz, lines: LineSettings = DEFAULTS.lines) -> np.ndarr
     f, x = model.freq_hz, model.damping
     df, dx = Z95 * model.freq_sd, Z95 * model.damping_sd
     decided_out = (f + df < band_hz[0]) | (f - df > band_hz[1]) | (x - dx > MAX_DAMPING)
-    pinned = getattr(model, "at_bound", None)
-    pinned = np.zeros(f.shape, bool) if pinned is None else pinned
+    pinned = np.zeros(f.shape, bool) if model.at_bound is None else model.at_bound
     return ~decided_out & ~pinned & ~reported(model, band_hz, lines) & (x > lines.at_fit_floor)
 
 

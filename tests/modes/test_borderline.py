@@ -33,7 +33,7 @@ NYQUIST = 50.0  # the stand-in models' bound on a pole's frequency (Hz)
 def _model(freq, damping, freq_sd, damping_sd):
     return SimpleNamespace(freq_hz=np.array(freq, float), damping=np.array(damping, float),
                            freq_sd=np.array(freq_sd, float), damping_sd=np.array(damping_sd, float),
-                           n_modes=len(freq), nyquist_hz=NYQUIST)  # fmt: skip
+                           n_modes=len(freq), nyquist_hz=NYQUIST, at_bound=None)  # fmt: skip
 
 
 @pytest.mark.parametrize(

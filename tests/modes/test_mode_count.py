@@ -164,7 +164,7 @@ def test_effective_fraction_is_bartletts_for_white_and_smoothed_noise():
 def _model(freq, damping, sd=0.01):
     freq, damping = np.array(freq, float), np.array(damping, float)
     return SimpleNamespace(freq_hz=freq, damping=damping, freq_sd=sd * freq, damping_sd=sd * damping,
-                           n_modes=freq.size, nyquist_hz=50.0)  # fmt: skip
+                           n_modes=freq.size, nyquist_hz=50.0, at_bound=None)  # fmt: skip
 
 
 def _count(rise, best_addition, best_hz=12.0, freq=(5.0, 30.0), damping=(0.2, 0.9), alternatives=()):
@@ -409,7 +409,7 @@ class _Scored:
         self.n_real, self.rss, self.table = 100, np.ones(4), table  # the supine ride: 4 sensors
         self.residual = np.random.default_rng(0).standard_normal((50, 2)) + 0j
 
-    converged, nyquist_hz = True, 30.0  # the supine ride at 60 Hz
+    converged, nyquist_hz, at_bound = True, 30.0, None  # the supine ride at 60 Hz
 
     @property
     def n_modes(self):
