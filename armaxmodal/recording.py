@@ -208,7 +208,14 @@ class Recording:
         Returns
         -------
         list of Recording
+
+        Raises
+        ------
+        DataError
+            ``k`` is not a whole number from 1 to the number of samples.
         """
+        if isinstance(k, bool) or not isinstance(k, int | np.integer) or not 1 <= k <= self.n_samples:
+            raise DataError(f"k: expected a whole number of parts from 1 to {self.n_samples} (the samples), got {k!r}.")
         n = self.n_samples // k
         return [Recording(self.fs, self.base[i * n : (i + 1) * n], self.response[i * n : (i + 1) * n], self.sensors,
                           self.input_name) for i in range(k)]  # fmt: skip
