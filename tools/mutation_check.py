@@ -862,7 +862,7 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/mode_count.py",
-        'verdict[np.abs(np.log(self.model.freq_hz / went)) <= self.settings.same_mode_freq] = "stand_in"',
+        'verdict[np.abs(np.log(self.model.freq_hz / stand_in.went_hz)) <= self.settings.same_mode_freq] = "stand_in"',
         "pass",
         "a stand-in reported (stand-in)",
     ),

@@ -18,7 +18,6 @@ from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.modal import matched_poles, nearest_pole, new_poles
 from armaxmodal.modes.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.mode_count import (
-    COUNT,
     ModeCount,
     ModelTable,
     Step,
@@ -38,7 +37,7 @@ class _Search:
     """One search's fits: each candidate screened (``screen_nfev``), the best of a kind converged."""
 
     def __init__(self, data: DftLines, hold: str, n_effective: float, max_nfev: int, n_jobs: int | None = 1,
-                 settings: CountSettings = COUNT, lines: LineSettings = DEFAULTS.lines,
+                 settings: CountSettings = DEFAULTS.count, lines: LineSettings = DEFAULTS.lines,
                  dft: DftSettings = DEFAULTS.dft, fitter: Callable = fit_modal_model,
                  agreement: AgreementSettings = DEFAULTS.agreement):  # fmt: skip
         self.data, self.hold, self.n_eff, self.max_nfev, self.n_jobs = data, hold, n_effective, max_nfev, n_jobs
@@ -265,7 +264,7 @@ def count_modes(
     supported: Callable[[float, float], bool] | None = None,
     search: bool = True,
     n_jobs: int | None = None,
-    settings: CountSettings = COUNT,
+    settings: CountSettings = DEFAULTS.count,
     lines: LineSettings = DEFAULTS.lines,
     dft: DftSettings = DEFAULTS.dft,
     fitter: Callable = fit_modal_model,
@@ -337,8 +336,7 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev
     searching, search = search, _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev, n_jobs,
                                         settings, lines, dft, fitter, agreement)  # fmt: skip
     search.logged("start", float("nan"), start_model)
-    # a starting mode the free fit carried away (a weak mode's pole to beyond the band) is tried
-    # again as an addition
+    # a start the free fit carried away (a weak mode's pole to beyond the band) is tried again as an addition
     lost = [(f, x) for f, x in zip(np.atleast_1d(freq_hz), np.atleast_1d(damping), strict=True)
             if np.min(np.abs(np.log(start_model.freq_hz / f))) > settings.same_mode_freq]  # fmt: skip
     current, steps, candidates, unconfirmed, unsettled = start_model, [], list(candidates) + lost, [], []
@@ -395,6 +393,8 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev
             alternatives += ((wanted.rise, split),)
     if searching and not wanted and close is None:
         wanted = _unsupported_wanted(search, current, halves)
-    return ModeCount(current, start_model, tuple(steps), rise, float(gain), new_hz, fraction, search.trials,
-                     tuple(unconfirmed), alternatives, carried_away, wanted, stand_ins, settings, lines,
-                     dft, tuple(search.table.rows), data.band_hz, tuple(unsettled), agreement)  # fmt: skip
+    return ModeCount(model=current, start=start_model, steps=tuple(steps), removal_rise=rise, best_addition=float(gain),
+                     best_addition_hz=new_hz, effective_fraction=fraction, trials=search.trials, wanted=wanted,
+                     unconfirmed_hz=tuple(unconfirmed), unsettled_hz=tuple(unsettled), alternatives=alternatives,
+                     carried_away=carried_away, stand_ins=stand_ins, models=tuple(search.table.rows),
+                     band_hz=data.band_hz, settings=settings, lines=lines, dft=dft, agreement=agreement)  # fmt: skip

@@ -23,8 +23,8 @@ from armaxmodal.modes.poles import beyond_band, borderline, reported
 from armaxmodal.modes.settings import DEFAULTS, AgreementSettings, CountSettings, DftSettings, LineSettings
 from armaxmodal.stats import Z95
 
-__all__ = ["FittedModel", "ModeCount", "ModelTable", "Wanted", "Step", "halves_chi2",
-           "split_start"]
+__all__ = ["Alternative", "FittedModel", "LeftOut", "ModeCount", "ModelTable", "StandIn", "Step", "Wanted",
+           "halves_chi2", "split_start"]
 
 #: the count's thresholds when none are given (:class:`~armaxmodal.modes.settings.CountSettings`)
 COUNT = DEFAULTS.count
@@ -80,6 +80,28 @@ class ModelTable:
         return agree
 
 
+class Alternative(NamedTuple):
+    """A model the record cannot tell from the chosen one (:attr:`ModeCount.alternatives`)."""
+
+    bic_difference: float  #: its criterion less the chosen model's
+    model: ModalModel
+
+
+class LeftOut(NamedTuple):
+    """A start the search carried to where no mode is founded, left out (:attr:`ModeCount.carried_away`)."""
+
+    start_hz: float  #: where the start was (Hz)
+    went_hz: float  #: where the free fit took it (Hz)
+
+
+class StandIn(NamedTuple):
+    """A start carried to where no mode is founded that the model needs (:attr:`ModeCount.stand_ins`)."""
+
+    start_hz: float  #: where the start was (Hz)
+    went_hz: float  #: where the free fit took it (Hz)
+    rise: float  #: the criterion's rise without it
+
+
 class Wanted(NamedTuple):
     """One mode more the likelihood wants and the criterion refuses (:attr:`ModeCount.wanted`)."""
 
@@ -117,23 +139,23 @@ class ModeCount:
         Fits the search ran.
     unconfirmed_hz : tuple of float
         Additions the whole record accepted but one of its halves did not (Hz, the start).
-    alternatives : tuple of (float, ModalModel)
+    alternatives : tuple of Alternative
         The models with one mode fewer or more that the record cannot tell from the chosen one:
         each converged, with its criterion's difference from the chosen model's (under
         ``settings.decisive_bic``). The reported intervals cover their modes
         (``armaxmodal.modes.counted.counted_modes``).
-    carried_away : tuple of (float, float)
+    carried_away : tuple of LeftOut
         Starting modes the search carried to where no mode is founded, and which were left out
-        of the chosen model: (start Hz, where it went Hz). See ``_without_unfounded``.
+        of the chosen model. See ``_without_unfounded``.
     wanted : Wanted or ()
         The best addition BIC refuses decisively while its likelihood ratio is significant
         (beyond ``settings.likelihood_alpha``) and its mode is the same in both halves, or else the best
         split of a reported mode that passes the same test (its criterion's change either way:
         the search splits only one mode). Empty: none.
-    stand_ins : tuple of (float, float, float)
+    stand_ins : tuple of StandIn
         Starting modes the search carried to where no mode is founded but which the model needs
         (the criterion rises decisively without them): kept in the model, not reported, as
-        out-of-band poles are. (start Hz, where it went Hz, the criterion's rise without them).
+        out-of-band poles are.
     models : tuple of FittedModel
         Every model the count fitted, in the order fitted (:meth:`models_table`).
     band_hz : (float, float)
@@ -165,10 +187,10 @@ class ModeCount:
     effective_fraction: float
     trials: int = field(default=0)
     unconfirmed_hz: tuple[float, ...] = ()
-    alternatives: tuple[tuple[float, ModalModel], ...] = ()
-    carried_away: tuple[tuple[float, float], ...] = ()
+    alternatives: tuple[Alternative, ...] = ()
+    carried_away: tuple[LeftOut, ...] = ()
     wanted: Wanted | tuple = ()
-    stand_ins: tuple[tuple[float, float, float], ...] = ()
+    stand_ins: tuple[StandIn, ...] = ()
     settings: CountSettings = COUNT
     lines: LineSettings = DEFAULTS.lines
     dft: DftSettings = DEFAULTS.dft
@@ -176,6 +198,11 @@ class ModeCount:
     band_hz: tuple[float, float] = (0.0, float("inf"))
     unsettled_hz: tuple[float, ...] = ()
     agreement: AgreementSettings = DEFAULTS.agreement
+
+    def __post_init__(self):
+        # the search hands its findings over as plain tuples; the result holds them by name
+        for name, kind in (("alternatives", Alternative), ("carried_away", LeftOut), ("stand_ins", StandIn)):
+            object.__setattr__(self, name, tuple(kind(*item) for item in getattr(self, name)))
 
     def models_table(self):
         """Every model the count fitted, one row each (``FittedModel``'s columns), in the order
@@ -252,8 +279,8 @@ class ModeCount:
         verdict[~reported(self.model, band, self.lines)] = "not_a_mode"
         verdict[borderline(self.model, band, self.lines)] = "borderline"
         verdict[needed & beyond_band(self.model, band, self.lines)] = "beyond_band"
-        for _, went, _ in self.stand_ins:
-            verdict[np.abs(np.log(self.model.freq_hz / went)) <= self.settings.same_mode_freq] = "stand_in"
+        for stand_in in self.stand_ins:
+            verdict[np.abs(np.log(self.model.freq_hz / stand_in.went_hz)) <= self.settings.same_mode_freq] = "stand_in"
         return verdict
 
     def reported(self, band_hz=None) -> np.ndarray:
@@ -298,7 +325,7 @@ class ModeCount:
                "damping": list(interval("damping", m.damping[i], Z95 * m.damping_sd[i]))}  # fmt: skip
         reach = dict.fromkeys(("freq_other_lo", "freq_other_hi", "damping_other_lo", "damping_other_hi"), np.nan)
         widened = False
-        for _, alt in self.alternatives:
+        for alt in (alternative.model for alternative in self.alternatives):
             for k, j in matched_poles(m.freq_hz, alt.freq_hz):
                 if j != i or abs(np.log(alt.freq_hz[k] / m.freq_hz[i])) > same_row_freq:
                     continue

@@ -172,6 +172,16 @@ def _count(rise, best_addition, best_hz=12.0, freq=(5.0, 30.0), damping=(0.2, 0.
     return ModeCount(model, model, (), np.array(rise), best_addition, best_hz, 1.0, alternatives=alternatives)
 
 
+def test_the_count_names_what_the_search_hands_over_as_plain_tuples():
+    fewer = _model([10.4], [0.06])
+    count = ModeCount(_model((5.0,), (0.2,)), _model((5.0,), (0.2,)), (), np.array([40.0]), -40.0, 12.0, 1.0,
+                      alternatives=((2.0, fewer),), carried_away=((8.0, 9.5),), stand_ins=((26.0, 26.9, 15.2),))
+    (alternative,), (left,), (stand_in,) = count.alternatives, count.carried_away, count.stand_ins
+    assert (alternative.bic_difference, alternative.model) == (2.0, fewer)
+    assert (left.start_hz, left.went_hz) == (8.0, 9.5)
+    assert (stand_in.start_hz, stand_in.went_hz, stand_in.rise) == (26.0, 26.9, 15.2)
+
+
 def test_undecided_counts_and_out_of_band_poles_are_said():
     keep = reported(SimpleNamespace(freq_hz=np.array([5.0, 30.0, 10.0]), damping=np.array([0.2, 0.3, 0.9])), (1, 25))
     assert keep.tolist() == [True, False, False]  # above the band; damped beyond MAX_DAMPING
