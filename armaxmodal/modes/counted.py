@@ -28,7 +28,6 @@ from armaxmodal.modes.intervals import (
     not_separated,
     with_intervals,
 )
-from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.mode_count import ModeCount, halves_chi2
 from armaxmodal.modes.notes import (
     confirmed_where_incoherent_note,
@@ -142,7 +141,7 @@ def counted_modes(
     keep = np.isin(verdicts, ("needed", "undecided"))
     same_row = settings.cluster.same_row_freq
     if picked:
-        return _picked_result(_doubts_said(work, ()), count, keep, hold, settings, rec, band)
+        return _picked_result(_doubts_said(work, ()), count, keep, hold, settings)
     if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
         return _doubts_said(work, ()).warned(no_mode_kept_note(count, modes, data.band_hz), count=count)
     rows = pd.DataFrame([_row(modes, count, i, hold, same_row, verdicts[i]) for i in np.flatnonzero(keep)])
@@ -218,16 +217,18 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
     return rows.iloc[kept].reset_index(drop=True), shapes[:, kept], notes
 
 
-def confirmed_where_incoherent(diagram, work: SelectionState, settings: SelectionSettings = DEFAULTS) -> SelectionState:
-    """The modes the modal-model check leaves unconfirmed (no coherent H1 line near them) that the
-    maximum-likelihood modal model confirms: the likelihood needs it decisively (its removal raises
-    the criterion by the count's ``decisive_bic`` or more) and the record's two
+def confirmed_where_incoherent(diagram, work: SelectionState, unconfirmed_hz, settings: SelectionSettings = DEFAULTS
+                               ) -> tuple[tuple[float, ...], list]:  # fmt: skip
+    """Of the modes the modal-model check cannot confirm (``unconfirmed_hz``: no coherent H1 line near
+    them), those the maximum-likelihood modal model confirms: the likelihood needs it decisively (its
+    removal raises the criterion by the count's ``decisive_bic`` or more) and the record's two
     halves give it the same frequency and damping. The modal model fits the DFT of the record, not
     its H1, and has no coherence to lose near a sharp peak (the stiff 3-storey frame's 39.67 Hz
-    mode, damping 0.006, under Northridge: no coherent line within 1.3 Hz of it)."""
-    check, count = work.check, work.count
-    if check is None or count is None or not check.unconfirmed_hz:
-        return work
+    mode, damping 0.006, under Northridge: no coherent line within 1.3 Hz of it). Returns
+    ``(confirmed Hz, their notes)``; none without a count."""
+    count = work.count
+    if count is None or not unconfirmed_hz:
+        return (), []
     rec, m, hold = diagram.recording, count.model, work.refinement.hold
     part = _counted_part(rec, count.settings.max_samples)
     data = DftLines.from_recording(part, work.refinement.band_hz).noise_weighted(m)
@@ -236,23 +237,20 @@ def confirmed_where_incoherent(diagram, work: SelectionState, settings: Selectio
     agree = chdtrc(2, chi2) >= settings.agreement.alpha  # each pole alone: 2 degrees of freedom
     reach, needed = settings.cluster.same_row_freq, count.verdicts() == "needed"
     confirmed, notes = [], []
-    for f in check.unconfirmed_hz:
+    for f in unconfirmed_hz:
         i = int(np.argmin(np.abs(m.freq_hz - f)))
         if abs(m.freq_hz[i] / f - 1) <= reach and needed[i] and agree[i]:
             confirmed.append(f)
             notes.append(confirmed_where_incoherent_note(f, count.removal_rise[i]))
-    if not confirmed:
-        return work
-    left = tuple(f for f in check.unconfirmed_hz if f not in confirmed)
-    return replace(work, check=replace(check, unconfirmed_hz=left)).warned(*notes)
+    return tuple(confirmed), notes
 
 
-def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hold: str, settings: SelectionSettings,
-                   recording=None, band=None) -> SelectionState:  # fmt: skip
+def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hold: str, settings: SelectionSettings
+                   ) -> SelectionState:  # fmt: skip
     """The picked rows (finite ``picked_hz``) reported: from the modal model where it keeps the pick
     as a mode of the band, else as the selection had it (the diagram's or the refit's values) with a
     ``pick_not_supported`` note that says where the model took it. The rows not picked stay in the
-    model, said in a note; the check (with ``recording``) judges every mode of the model in the band."""
+    model, said in a note; the check judges every mode of the model in the band (``check_poles``)."""
     m, rows, shapes, same_row = count.model, [], [], settings.cluster.same_row_freq
     picked = np.isfinite(work.modes.picked_hz.to_numpy())
     pairs = dict((j, i) for i, j in matched_poles(work.modes.freq_hz.to_numpy(), m.freq_hz))  # row -> pole
@@ -278,11 +276,10 @@ def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hol
     rows = pd.DataFrame([rows[k] for k in order])
     rows, disagree = covering_both_estimators(rows, settings.agreement.alpha)
     notes += disagree
-    work = work.with_modes(rows, np.column_stack([shapes[k] for k in order]), count=count)
-    if recording is not None:  # the check of the model the picks come from: the picks and the others
-        f = np.r_[work.modes.freq_hz.to_numpy(), m.freq_hz[others]]
-        x = np.r_[work.modes.damping.to_numpy(), m.damping[others]]
-        work = replace(work, check=check_modes(recording, f, x, band, settings=settings.frf))
+    # the check stage judges the model the picks come from: the picks and the modes not picked
+    f, x = np.r_[rows.freq_hz.to_numpy(), m.freq_hz[others]], np.r_[rows.damping.to_numpy(), m.damping[others]]
+    work = work.with_modes(rows, np.column_stack([shapes[k] for k in order]), count=count,
+                           check_poles=tuple(zip(f.tolist(), x.tolist(), strict=True)))
     return work.warned(*notes)
 
 

@@ -164,8 +164,8 @@ def add_picks(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     modes = pd.concat([modes, rows.loc[forced]], ignore_index=True)
     shapes = np.column_stack([state.shapes, *[vectors[k] for k in forced]]) if forced else state.shapes
     state = state.with_modes(modes, shapes)
-    if state.refinement is None:  # no modal model to fit them with: the picks as the diagram has them, checked
-        return replace(state.kept(np.flatnonzero(np.isfinite(modes.picked_hz.to_numpy()))), check=None)
+    if state.refinement is None:  # no modal model to fit them with: the picks as the diagram has them
+        return state.kept(np.flatnonzero(np.isfinite(modes.picked_hz.to_numpy())))
     hold, band_hz = state.refinement.hold, state.refinement.band_hz
     return counted_modes(ctx.diagram, state, band_hz, hold, ctx.nas, ctx.settings, ctx.band, picked=True,
                          n_jobs=ctx.n_jobs)  # fmt: skip
@@ -180,24 +180,19 @@ def separate(state: SelectionState, ctx: SelectionContext) -> SelectionState:
 
 def check(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     """The modal-model check of the modes (:mod:`armaxmodal.modes.modal_check`): the LSFD fit of every
-    output's H1 by the selected poles, or by the model's two poles where one row reports a pair."""
+    output's H1 by the selected poles, or by the model's where they are not the rows' (``check_poles``:
+    its two poles where one row reports a pair; with picks, the picks and the modes not picked). A mode
+    no coherent H1 line is near, which the check cannot test, is confirmed where the counted modal
+    model needs it decisively and alike in both halves of the record (``confirmed_where_incoherent``):
+    the check's result is made here, once, from both."""
     f, x = state.modes.freq_hz, state.modes.damping
     if state.check_poles:
         f, x = zip(*state.check_poles, strict=True)
     checked = check_modes(ctx.diagram.recording, np.array(f), np.array(x), ctx.band, settings=ctx.settings.frf)
-    return replace(state, check=checked)
-
-
-def check_unless_counted(state: SelectionState, ctx: SelectionContext) -> SelectionState:
-    """The check of picks: the count already checked the model the picks come from (the picks and
-    the modes not picked); without a count, the picks are checked as they stand."""
-    return state if state.check is not None else check(state, ctx)
-
-
-def confirm(state: SelectionState, ctx: SelectionContext) -> SelectionState:
-    """Modes the check leaves unconfirmed (no coherent line near them) that the modal model
-    confirms decisively and alike in both halves of the record."""
-    return confirmed_where_incoherent(ctx.diagram, state, ctx.settings)
+    confirmed, notes = confirmed_where_incoherent(ctx.diagram, state, checked.unconfirmed_hz, ctx.settings)
+    if confirmed:
+        checked = replace(checked, unconfirmed_hz=tuple(f for f in checked.unconfirmed_hz if f not in confirmed))
+    return replace(state, check=checked).warned(*notes)
 
 
 def spread(state: SelectionState, ctx: SelectionContext) -> SelectionState:
@@ -243,27 +238,26 @@ def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
 
 # -- the stage lists -----------------------------------------------------------------------------
 #: the diagram's candidates, with those the FRF proposes, counted by the modal model
-AUTOMATIC: tuple[Stage, ...] = (candidates, merge, refit, propose_by_frf, count, check, confirm, spread, separate,
-                                finish)  # fmt: skip
+AUTOMATIC: tuple[Stage, ...] = (candidates, merge, refit, propose_by_frf, count, check, spread, separate, finish)
 #: ``n_modes`` given: the best-supported candidates, refitted and checked; nothing dropped or added
 FIXED_COUNT: tuple[Stage, ...] = (candidates, merge, best_n, refit, check, spread, separate, finish)
 #: ``picks`` given: the picked clusters reported from the model the automatic selection counted
 PICKED: tuple[Stage, ...] = (take_picks, candidates, merge, refit, propose_by_frf, count, add_picks,
-                             check_unless_counted, confirm, spread, separate, finish)  # fmt: skip
+                             check, spread, separate, finish)  # fmt: skip
 
 
 def stages_for(n_modes: int | None, picks, refine: bool) -> tuple[Stage, ...]:
     """The stage list of a call: :data:`AUTOMATIC`, :data:`FIXED_COUNT` or :data:`PICKED`; without
     the refit (``refine=False``) the same with ``segment_fits`` for ``refit`` and no ``count``
-    (the modal model is fitted under the hold the refit chooses) nor ``confirm`` (the count's),
-    and so ``screen_by_frf``, whose drops stand, for ``propose_by_frf``, whose drops the count judges."""
+    (the modal model is fitted under the hold the refit chooses), and so ``screen_by_frf``, whose
+    drops stand, for ``propose_by_frf``, whose drops the count judges."""
     if picks is not None and n_modes is not None:
         raise PickError("picks and n_modes do not mix: pick the modes, or give their number, not both.")
     stages = PICKED if picks is not None else FIXED_COUNT if n_modes is not None else AUTOMATIC
     if refine:
         return stages
     swap = {refit: segment_fits, propose_by_frf: screen_by_frf}
-    return tuple(swap.get(s, s) for s in stages if s not in (count, confirm))
+    return tuple(swap.get(s, s) for s in stages if s is not count)
 
 
 # -- the entry point -----------------------------------------------------------------------------
@@ -299,10 +293,10 @@ def select_modes(
        decides the number of modes by nested tests (BIC on the effective lines; an addition's new
        poles the same in both halves and stable across orders): it removes, adds or splits modes,
        and says where the record does not decide (``count_undecided``).
-    5. **check**, **confirm**, **spread**, **separate**, **finish** -- the modal-model check, the
-       intervals widened by the segments' spread and the other structures and estimators, a
-       ``modes_not_separated`` note (and so ``uncertain``) for neighbours the reported intervals do
-       not separate, and the verdict.
+    5. **check**, **spread**, **separate**, **finish** -- the modal-model check (where no coherent
+       H1 line is near a mode, the counted model may confirm it), the intervals widened by the
+       segments' spread and the other structures and estimators, a ``modes_not_separated`` note
+       (and so ``uncertain``) for neighbours the reported intervals do not separate, and the verdict.
 
     ``n_modes``, ``picks`` and ``refine=False`` run other named stage lists (``stages_for``).
 

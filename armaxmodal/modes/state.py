@@ -62,7 +62,8 @@ class SelectionState:
         What the stages said, in order.
     check_poles : tuple of (float, float) or None
         The poles the check fits, ``(Hz, ratio)``, where they are not the rows': the model's two
-        poles of a pair the record does not separate, which one row reports. None: the rows'.
+        poles of a pair the record does not separate, which one row reports, or with picks the
+        picks and the model's modes not picked. None: the rows'.
     picked : (DataFrame, list of ndarray) or None
         The picks' clusters as rows and shape vectors (``picks=``), taken before any fit.
     segment_fits : dict

@@ -23,8 +23,7 @@ from armaxmodal.modes.state import SelectionContext, SelectionState
 from armaxmodal.quality_warnings import QualityWarning
 from tests.cli.test_schemas import _validator
 
-AUTOMATIC = ["candidates", "merge", "refit", "propose_by_frf", "count", "check", "confirm", "spread", "separate",
-             "finish"]  # fmt: skip
+AUTOMATIC = ["candidates", "merge", "refit", "propose_by_frf", "count", "check", "spread", "separate", "finish"]
 
 
 @pytest.fixture(scope="module")
@@ -55,7 +54,7 @@ def test_the_arguments_choose_a_named_stage_list(diagram):
     assert selection.refinement is None and selection.count is None
     picked, selection = _traced(diagram, picks=[8.3], segments=0)
     assert picked == ["take_picks", "candidates", "merge", "refit", "propose_by_frf", "count", "add_picks",
-                      "check_unless_counted", "confirm", "spread", "separate", "finish"]  # fmt: skip
+                      "check", "spread", "separate", "finish"]  # fmt: skip
     assert selection.picks == [8.3]
     with pytest.raises(am.PickError, match="do not mix"):
         pipeline.stages_for(2, [8.3], True)
