@@ -100,7 +100,7 @@ def run(args) -> int:
         prep = diagram.preparation
         if prep is not None and prep.analysis_fs != prep.original_fs:
             print(f"analysis at {prep.analysis_fs:g} Hz (resampled from {prep.original_fs:g} Hz)")
-        print_modes(selection.modes)
+        print_modes(selection.modes, selection.picks is not None)
         if selection.check is not None:
             print_check(selection.check)
     outputs = _diagram_outputs(args, diagram, selection, plot_format)
@@ -181,11 +181,11 @@ def _fill(text: str) -> str:
     return textwrap.fill(text, NOTE_WIDTH, subsequent_indent="  ", break_on_hyphens=False)
 
 
-def print_modes(modes) -> None:
+def print_modes(modes, picked: bool = False) -> None:
     """The modes as a person reads them, within the notes' width: frequency and damping, each
-    with its 95 % interval, the orders that support it, and the pick it answers (the JSON and
-    ``--csv`` hold every column)."""
-    picked = "picked_hz" in modes and np.isfinite(modes.picked_hz.to_numpy(float)).any()
+    with its 95 % interval, the orders that support it, and the pick it answers where the modes were
+    ``picked`` by hand (the JSON and ``--csv`` hold every column)."""
+    picked = picked and bool(np.isfinite(modes.picked_hz.to_numpy(float)).any())
     print(f"{'mode':>4} {'f (Hz)':>9}  {'95 % interval (Hz)':<22} {'damping':>7}  {'95 % interval':<16} {'orders':>6}"
           + ("  picked (Hz)" if picked else ""))  # fmt: skip
     for k, m in enumerate(modes.itertuples(index=False), start=1):

@@ -150,7 +150,7 @@ def counted_modes(
     rows, disagree = covering_both_estimators(rows, settings.agreement.alpha)
     # where two poles are reported as one, the check fits the model's poles, not the row's
     poles = tuple(zip(count.model.freq_hz[keep].tolist(), count.model.damping[keep].tolist(), strict=True))
-    work = work.with_modes(rows, shapes, count=count, check_poles=poles if merged else None)
+    work = work.with_modes(rows, shapes, count=count, check_poles=poles if merged else None, counted=True)
     work = _doubts_said(work, count.model.freq_hz[keep], same_row)
     return work.warned(*count_notes(count, keep, data.band_hz, same_row), *merged, *disagree)
 
@@ -278,7 +278,7 @@ def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hol
     notes += disagree
     # the check stage judges the model the picks come from: the picks and the modes not picked
     f, x = np.r_[rows.freq_hz.to_numpy(), m.freq_hz[others]], np.r_[rows.damping.to_numpy(), m.damping[others]]
-    work = work.with_modes(rows, np.column_stack([shapes[k] for k in order]), count=count,
+    work = work.with_modes(rows, np.column_stack([shapes[k] for k in order]), count=count, counted=True,
                            check_poles=tuple(zip(f.tolist(), x.tolist(), strict=True)))
     return work.warned(*notes)
 

@@ -220,7 +220,7 @@ def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     freq, damping = modes.freq_hz.to_numpy(), modes.damping.to_numpy()
     # a peak a mode of the model explains is explained, picked or not (the check's poles are the model's)
     explaining = (freq, damping)
-    if "picked_hz" in modes or state.check_poles is not None:
+    if ctx.picks is not None or state.check_poles is not None:
         poles = state.check.poles
         explaining = (np.abs(poles) / (2 * np.pi), -poles.real / np.abs(poles))
     peaks = unexplained_peaks(diagram.recording, *explaining, ctx.band)
@@ -231,8 +231,9 @@ def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
         *unresolved_damping_notes(modes, len(ctx.nas)),
         *state.check.warnings(),
     )
+    picks = None if ctx.picks is None else sorted(float(f) for f in ctx.picks)
     result = ModeSelection(modes, state.shapes, per_sensor, weighted, diagram, state.refinement, state.warnings,
-                           state.check, state.count, ctx.settings)  # fmt: skip
+                           state.check, state.count, ctx.settings, picks, state.counted, ctx.segments)  # fmt: skip
     return replace(state, result=result)
 
 

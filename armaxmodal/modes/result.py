@@ -22,7 +22,7 @@ import pandas as pd
 from armaxmodal.modal import mode_record
 from armaxmodal.modes.dft_model import ModalModel
 from armaxmodal.modes.diagram import StabilisationDiagram
-from armaxmodal.modes.modal_check import ModalCheck
+from armaxmodal.modes.modal_check import ModalCheck, finite_or_none
 from armaxmodal.modes.mode_count import ModeCount
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
 from armaxmodal.prepare.preparation import Preparation
@@ -65,6 +65,13 @@ class ModeSelection:
         The maximum-likelihood count, when it ran.
     settings : SelectionSettings
         The thresholds that made this selection (:mod:`armaxmodal.modes.settings`).
+    picks : list of float or None
+        The frequencies (Hz) the modes were picked at by hand, sorted; None for an automatic selection.
+    counted : bool
+        The modes are the count's (``modes`` holds its columns: ``count_undecided``, ``structure_widened``,
+        ``estimator_widened``); False where no count ran or it kept no mode of the band.
+    segments : int
+        The disjoint segments of the segment spread (``modes`` holds its columns where at least 2).
 
     Examples
     --------
@@ -88,13 +95,9 @@ class ModeSelection:
     check: ModalCheck | None = None
     count: ModeCount | None = None
     settings: SelectionSettings = field(default=DEFAULTS, repr=False)
-
-    @property
-    def picks(self) -> list[float] | None:
-        """The frequencies (Hz) the modes were picked at by hand, or None for an automatic pick."""
-        if "picked_hz" not in self.modes:
-            return None
-        return sorted(float(f) for f in self.modes.picked_hz if np.isfinite(f))
+    picks: list[float] | None = None
+    counted: bool = False
+    segments: int = 0
 
     @property
     def reconstruction_error(self) -> float:
@@ -170,18 +173,17 @@ class ModeSelection:
                 freq_spread_hz=float(row.freq_spread),
                 damping_spread=float(row.damping_spread),
             )
-            if "segments_found" in self.modes:
+            if self.segments >= 2:
                 record["segment_spread"] = {
                     "segments_found": int(row.segments_found),
-                    "freq_sd_hz": _finite_or_none(row.freq_segment_sd),
-                    "damping_sd": _finite_or_none(row.damping_segment_sd),
+                    "freq_sd_hz": finite_or_none(row.freq_segment_sd),
+                    "damping_sd": finite_or_none(row.damping_segment_sd),
                 }
                 record["model_error_dominates"] = bool(row.model_error_dominates)
-            record["picked"] = bool(np.isfinite(getattr(row, "picked_hz", np.nan)))
-            if "structure_widened" in self.modes:  # the modal model's count (modes/counted.py)
+            record["picked"] = self.picks is not None and bool(np.isfinite(row.picked_hz))
+            if self.counted:  # the modal model's count (modes/counted.py), the two estimators (modes/intervals.py)
                 record["count_undecided"] = bool(row.count_undecided)
                 record["interval_covers_other_counts"] = bool(row.structure_widened)
-            if "estimator_widened" in self.modes:  # the two estimators disagree (modes/intervals.py)
                 record["interval_covers_other_estimator"] = bool(row.estimator_widened)
             modes.append(record)
         per_sensor = [
@@ -196,7 +198,7 @@ class ModeSelection:
             "orders_na": [o.na for o in self.diagram.orders],
             "tolerances": {"freq": t.freq, "damping": t.damping, "shape": t.shape, "max_damping": t.max_damping},
             "quality": self.quality,
-            "reconstruction_error": _finite_or_none(self.reconstruction_error),
+            "reconstruction_error": finite_or_none(self.reconstruction_error),
             "modal_check": None if self.check is None else self.check.to_dict(),
             "intersample_hold": None if self.refinement is None else self.refinement.hold,
             "estimator": sorted(set(self.modes.estimator)),
@@ -269,10 +271,6 @@ def no_mode_selection(diagram: StabilisationDiagram, why: str, settings: Selecti
     shapes = np.zeros((len(diagram.recording.sensors), 0), dtype=complex)
     return ModeSelection(empty, shapes, per_sensor, pd.DataFrame(columns=["mode"]), diagram, None, (note,), None,
                          settings=settings)  # fmt: skip
-
-
-def _finite_or_none(value) -> float | None:
-    return float(value) if np.isfinite(value) else None
 
 
 def record_header(recording: Recording, preparation: Preparation | None, warnings) -> dict:

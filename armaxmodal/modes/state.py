@@ -72,6 +72,8 @@ class SelectionState:
     doubts : tuple of (float, float, QualityWarning)
         The modes the measured FRF's check does not need, ``(Hz, ratio, note)``: out of the
         selection, offered to the count as candidates; a note stands where the count leaves it out.
+    counted : bool
+        The modes are the count's rows (:attr:`armaxmodal.ModeSelection.counted`).
     result : ModeSelection or None
         The finished selection; a stage that sets it ends the pipeline (a diagram with no mode).
     """
@@ -86,6 +88,7 @@ class SelectionState:
     picked: tuple[pd.DataFrame, list] | None = field(default=None, repr=False)
     segment_fits: dict = field(default_factory=dict, repr=False)
     doubts: tuple[tuple[float, float, QualityWarning], ...] = ()
+    counted: bool = False
     result: ModeSelection | None = field(default=None, repr=False)
 
     def __post_init__(self):

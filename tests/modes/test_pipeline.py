@@ -43,19 +43,24 @@ def test_one_recording_visits_each_stage_once_in_order(diagram):
     assert entered == AUTOMATIC
     assert [s.__name__ for s in pipeline.AUTOMATIC] == AUTOMATIC
     assert selection.count is not None and len(selection.modes) == 4  # the count ran and kept the four modes
+    # what ran is said by typed fields, not by which columns the modes table happens to hold
+    assert (selection.counted, selection.segments, selection.picks) == (True, pipeline.N_SEGMENTS, None)
+    assert {"count_undecided", "interval_covers_other_estimator"} <= set(selection.to_dict()["modes"][0])
 
 
 def test_the_arguments_choose_a_named_stage_list(diagram):
     fixed, selection = _traced(diagram, n_modes=2, segments=0)
     assert fixed == ["candidates", "merge", "best_n", "refit", "check", "spread", "separate", "finish"]
     assert len(selection.modes) == 2 and selection.count is None  # the count does not run on a fixed number
+    assert (selection.counted, selection.segments) == (False, 0)
+    assert not {"count_undecided", "segment_spread"} & set(selection.to_dict()["modes"][0])
     plain, selection = _traced(diagram, refine=False, segments=0)
     assert plain == ["candidates", "merge", "segment_fits", "screen_by_frf", "check", "spread", "separate", "finish"]
     assert selection.refinement is None and selection.count is None
     picked, selection = _traced(diagram, picks=[8.3], segments=0)
     assert picked == ["take_picks", "candidates", "merge", "refit", "propose_by_frf", "count", "add_picks",
                       "check", "spread", "separate", "finish"]  # fmt: skip
-    assert selection.picks == [8.3]
+    assert selection.picks == [8.3] and selection.counted
     with pytest.raises(am.PickError, match="do not mix"):
         pipeline.stages_for(2, [8.3], True)
 
