@@ -20,13 +20,13 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
-from armaxmodal.estimate.fit import fit_armax
+from armaxmodal.estimate.fit import fit_armax, fit_resumable
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.estimate.result import ArmaxFit
 from armaxmodal.exceptions import OrderError
 from armaxmodal.recording import Recording
 
-__all__ = ["choose_orders", "OrderChoice", "Orders", "default_nb", "default_nc"]
+__all__ = ["choose_delay", "choose_orders", "OrderChoice", "Orders", "default_nb", "default_nc", "order_criteria"]
 
 
 def default_nb(na: int, nk: int) -> int:
@@ -158,6 +158,14 @@ def output_mean_squares(recording: Recording) -> np.ndarray:
     return np.where(ms > 0, ms, 1.0)
 
 
+def order_criteria(fits: Iterable[ArmaxFit], recording: Recording) -> dict[int, float]:
+    """``{na: BIC}`` of fits of one record, one per order, each output's errors in its mean square
+    (:func:`output_mean_squares`): the orders fit windows a few samples apart, where a plain BIC
+    depends on the data's unit."""
+    unit = output_mean_squares(recording)
+    return {fit.orders[0]: information_criterion(fit, unit=unit) for fit in fits}
+
+
 def fit_or_none(recording, orders, **options):
     """A fit, or None when the record cannot support the orders (candidates are skipped)."""
     try:
@@ -166,14 +174,51 @@ def fit_or_none(recording, orders, **options):
         return None
 
 
+def choose_delay(recording: Recording, nk_values: Iterable[int], na_values: Iterable[int], *, max_iter: int,
+                 tol: float, n_jobs: int | None = None, bar=None) -> tuple[int, dict]:  # fmt: skip
+    """The input delay of the lowest-BIC shared-pole model over the orders ``na_values``, each
+    delay fitted at each order for at most ``max_iter`` iterations (the delay and the order
+    interact: band-limited data trade non-causal taps for poles, so they are chosen jointly).
+    Only the criterion is needed: no covariances.
+
+    Parameters
+    ----------
+    recording : Recording
+    nk_values, na_values : iterables of int
+        The delays (samples; negative: non-causal taps) and the orders each is fitted at.
+    max_iter : int
+        Iterations of each candidate's fit.
+    tol : float
+        A fit stops when an iteration lowers its loss by less than this fraction.
+    n_jobs : int, optional
+        Worker threads (default: all cores).
+    bar : tqdm, optional
+        Counts the fits.
+
+    Returns
+    -------
+    nk : int
+        The delay of the lowest criterion (measured in each output's mean square).
+    checkpoints : dict
+        ``{Orders: checkpoint}`` of the chosen delay's fits, where they stopped: a sweep continues
+        them instead of fitting those orders again.
+    """
+    candidates = [Orders(na, default_nb(na, nk), default_nc(na), nk) for na in na_values for nk in nk_values]
+    fit = partial(_resumable_or_none, recording, max_iter=max_iter, tol=tol)
+    fits = parallel_map(fit, candidates, n_jobs, bar, cost=lambda orders: orders.na)
+    unit = output_mean_squares(recording)
+    scores = [information_criterion(f, unit=unit) if f is not None else np.inf for f, _ in fits]
+    nk = candidates[int(np.argmin(scores))].nk
+    return nk, {o: ck for o, (_, ck) in zip(candidates, fits, strict=True) if o.nk == nk and ck is not None}
 
 
-
-
-
-
-
-
+def _resumable_or_none(recording: Recording, orders: Orders, max_iter: int, tol: float):
+    """``(fit, checkpoint)`` of a shared-pole candidate, ``(None, None)`` when the record cannot support it."""
+    try:
+        return fit_resumable(recording, orders, shared_poles=True, max_iter=max_iter, tol=tol, stop="decrease",
+                             warn=False, covariance=False)  # fmt: skip
+    except OrderError:
+        return None, None
 
 
 def choose_orders(

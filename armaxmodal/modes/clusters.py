@@ -18,7 +18,6 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.estimate.fit import fit_armax
-from armaxmodal.estimate.orders import information_criterion, output_mean_squares
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.estimate.result import ArmaxFit
 from armaxmodal.exceptions import PickError
@@ -31,13 +30,6 @@ from armaxmodal.spectra import coherent_peaks, explains, resolving_nperseg
 from armaxmodal.stats import Z95
 
 
-def order_criteria(diagram: StabilisationDiagram) -> dict[int, float]:
-    """``{na: BIC}`` of the sweep's shared fits, each output's errors in its mean square: the
-    orders fit windows a few samples apart, where a plain BIC depends on the data's unit."""
-    unit = output_mean_squares(diagram.recording)
-    return {na: information_criterion(fit, unit=unit) for (src, na), fit in diagram.fits.items() if src == SHARED}
-
-
 def clustered_modes(diagram, band, nas, cluster: ClusterSettings, n_jobs, bar=None):
     """One mode per supported cluster (the kept poles', then the rescued lightly damped
     ones), each from its representative fit: ``(modes, shape vectors)``. ``bar`` (tqdm)
@@ -47,7 +39,7 @@ def clustered_modes(diagram, band, nas, cluster: ClusterSettings, n_jobs, bar=No
     clusters = [c for c in clusters if _supported(len(c), len(nas), cluster)]
     left = cand.drop(index=[m for c in clusters for m in c])
     clusters += _rescued_clusters(diagram, left, nas, cluster, band)
-    bic = order_criteria(diagram)
+    bic = diagram.order_bic
     firsts = [_ranked(cand.loc[c][cand.loc[c].damping > 0], bic) for c in clusters]
     finished = _finish_fits(diagram, {ranked[0] for ranked in firsts if ranked}, n_jobs, bar)
     rows, vectors = [], []
@@ -326,7 +318,7 @@ def picked_modes(diagram, picks: np.ndarray, band, nas, cluster: ClusterSettings
     clusters = cluster_poles(kept, nas, cluster.freq, cluster.damping)
     clusters = [c for c in clusters if len(set(kept.loc[c].na)) >= cluster.min_orders]
     centres = np.array([float(kept.loc[c].freq_hz.median()) for c in clusters])
-    bic = order_criteria(diagram)
+    bic = diagram.order_bic
     rows, vectors = [], []
     for f in picks:
         if not centres.size:

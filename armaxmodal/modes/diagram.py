@@ -12,12 +12,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from functools import cached_property, partial
 
-import numpy as np
 import pandas as pd
 
 from armaxmodal._threads import one_blas_thread
 from armaxmodal.estimate.fit import fit_resumable
-from armaxmodal.estimate.orders import Orders, default_nb, default_nc, information_criterion, output_mean_squares
+from armaxmodal.estimate.orders import Orders, choose_delay, default_nb, default_nc, order_criteria
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.poles import (
@@ -100,6 +99,11 @@ class StabilisationDiagram:
         found += _nk_edge_warning(self.orders[0].nk, self.recording)
         return tuple(found + disturbance_lines(self.poles, self.tolerances.min_energy, self.recording, SHARED))
 
+    @cached_property
+    def order_bic(self) -> dict[int, float]:
+        """``{na: BIC}`` of the sweep's shared fits (``estimate.orders.order_criteria``), once."""
+        return order_criteria([fit for (source, _), fit in self.fits.items() if source == SHARED], self.recording)
+
     def to_frame(self) -> pd.DataFrame:
         """The tidy pole table without the complex columns (for CSV).
 
@@ -180,24 +184,15 @@ def choose_nk(recording: Recording, nk_values=NK_SEARCH, na_values=DELAY_CHOICE_
 
 
 def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=True, bar=None):
-    """``(nk, {(SHARED, orders): checkpoint})``: the chosen delay and where its fits stopped,
-    which the sweep continues instead of fitting those orders again. ``bar`` (tqdm) counts
-    the fits; the extension counts its own on a bar of its own, so that no total grows."""
-    jobs = [(SHARED, (na, default_nb(na, nk), default_nc(na), nk)) for na in na_values for nk in nk_values]
-    # 8 iterations settle the choice where delays differ by tens of BIC units or more (checked
-    # on every fixture, a lightly damped structure and the real recordings against 20 and 50);
-    # where BIC is flatter the cap decides between delays the record does not tell apart
-    # (docs/performance.md). Only the criterion is needed here: no covariances.
-    fits = parallel_map(
-        partial(sweep_fit, recording, max_iter=DELAY_CHOICE_ITERATIONS, tol=tol, covariance=False),
-        jobs,
-        n_jobs,
-        bar,
-        cost=partial(_job_cost, n_sensors=len(recording.sensors)),
-    )
-    unit = output_mean_squares(recording)
-    scores = [information_criterion(f, unit=unit) if f is not None else np.inf for f, _ in fits]
-    nk = int(jobs[int(np.argmin(scores))][1][3])
+    """``(nk, {(SHARED, orders): checkpoint})``: the delay :func:`~armaxmodal.estimate.orders.choose_delay`
+    chooses and where its fits stopped, which the sweep continues instead of fitting those orders
+    again. ``bar`` (tqdm) counts the fits; the extension counts its own on a bar of its own, so that no
+    total grows. 8 iterations settle the choice where delays differ by tens of BIC units or more
+    (checked on every fixture, a lightly damped structure and the real recordings against 20 and 50);
+    where BIC is flatter the cap decides between delays the record does not tell apart
+    (docs/performance.md)."""
+    nk, known = choose_delay(recording, nk_values, na_values, max_iter=DELAY_CHOICE_ITERATIONS, tol=tol,
+                             n_jobs=n_jobs, bar=bar)  # fmt: skip
     if extend and nk == min(nk_values):
         # the best delay is the most non-causal one searched: look NK_EXTENSION further, once
         from tqdm import tqdm
@@ -206,7 +201,7 @@ def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=Tr
         with tqdm(total=len(further) * len(na_values), desc=f"input delay choice beyond nk = {nk}", unit="fit",
                   disable=bar is None or bar.disable) as more:  # fmt: skip
             return _choose_nk(recording, further, na_values, n_jobs, tol, extend=False, bar=more)
-    return nk, {job: ck for job, (_, ck) in zip(jobs, fits, strict=True) if job[1][3] == nk and ck is not None}
+    return nk, {(SHARED, orders): checkpoint for orders, checkpoint in known.items()}
 
 
 def stabilisation_diagram(

@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
-from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, order_criteria, representative_pole
+from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, representative_pole
 from armaxmodal.modes.modal_check import ModalCheck, check_modes, poles_of, rss_at
 from armaxmodal.modes.notes import not_needed_note
 from armaxmodal.modes.settings import DEFAULTS, PEAK_RESOLUTION, FrfSettings, SelectionSettings
@@ -201,7 +201,7 @@ def modes_the_check_adds(diagram, work: SelectionState, band, nas, settings: Sel
     no clear peak, and their poles scatter over the orders; these need a damping the record
     resolves, as a peak's cluster does not). A peak left unexplained is listed at the end as
     before. Returns the selection with those added, by frequency, and its check."""
-    bic, frf = order_criteria(diagram), settings.frf
+    bic, frf = diagram.order_bic, settings.frf
     modes, shapes, check = work.modes, work.shapes, work.check
     for sub, at_peak in _left_out_clusters(diagram, modes, band, nas, settings):
         # the cluster's centre is tried: its lowest-BIC pole may sit at its edge

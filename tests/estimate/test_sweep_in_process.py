@@ -82,6 +82,17 @@ def test_the_delay_is_the_lowest_bic_one(ride, diagram):
     assert [o for o in diagram.orders] == [(na, default_nb(na, nk), default_nc(na), nk) for na in ORDERS]
 
 
+def test_the_diagram_computes_each_orders_criterion_once(diagram):
+    """The clustering and the FRF screen read one ``{na: BIC}`` of the shared fits, in each output's
+    mean square, made on first use: the criterion the delay choice ranks fits by."""
+    from armaxmodal.estimate.orders import output_mean_squares
+
+    unit = output_mean_squares(diagram.recording)
+    expected = {na: information_criterion(diagram.fits[(SHARED, na)], unit=unit) for na in ORDERS}
+    assert diagram.order_bic == expected and diagram.order_bic is diagram.order_bic
+    assert min(expected, key=expected.get) == 4  # two modes: the lowest order that holds them
+
+
 def _same_fit(a, b) -> bool:
     """The same fit up to rounding: the same iteration count and stop, every coefficient and
     loss to 1e-7 and the joint covariance to 1e-4 of its largest entry. Not bit for bit: a
