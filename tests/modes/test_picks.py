@@ -37,6 +37,8 @@ def test_three_picks_are_the_three_exact_modes_and_the_fourth_is_said_to_be_ther
     (other,) = [w for w in sel.warnings if w.code == "mode_count" and "not picked" in w.message]
     assert other.value == 1 and "16.2" in other.message
     assert sel.check.passed and len(sel.check.residues[0]) == 4  # the check judges the model: 4 modes
+    # the picks are reported from the model the selection carries (the picks' fit, not the automatic search's)
+    assert set(sel.modes.freq_hz) <= set(sel.count.model.freq_hz) and sel.counted
     record = sel.to_dict()
     assert record["picks"] == [5.9, 8.2, 13.6] and all(m["picked"] for m in record["modes"])
     assert am.select_modes(diagram, segments=0).to_dict()["picks"] is None
