@@ -82,6 +82,23 @@ def test_the_delay_is_the_lowest_bic_one(ride, diagram):
     assert [o for o in diagram.orders] == [(na, default_nb(na, nk), default_nc(na), nk) for na in ORDERS]
 
 
+def test_the_delay_choice_fits_stop_at_their_cap(ride):
+    """``choose_delay``'s fits run ``max_iter`` iterations and no more: continued to 2 in all, the
+    checkpoint of a 1-iteration choice is the fresh 2-iteration fit, not a converged one."""
+    from armaxmodal._threads import one_blas_thread
+    from armaxmodal.estimate.orders import choose_delay
+
+    rec = ride[1]
+    with one_blas_thread():
+        nk, checkpoints = choose_delay(rec, (0, -1), (4,), max_iter=1, tol=SWEEP_TOL, n_jobs=1)
+        ((orders, checkpoint),) = checkpoints.items()
+        assert orders == (4, default_nb(4, nk), default_nc(4), nk)
+        continued = sweep_fit(rec, (SHARED, orders, checkpoint), 2, SWEEP_TOL)[0]
+        options = {"shared_poles": True, "tol": SWEEP_TOL, "stop": "decrease", "warn": False}
+        fresh, converged = (am.fit_armax(rec, *orders, max_iter=n, **options) for n in (2, 30))
+    assert _same_fit(continued, fresh) and not _same_fit(fresh, converged)
+
+
 def test_the_diagram_computes_each_orders_criterion_once(diagram):
     """The clustering and the FRF screen read one ``{na: BIC}`` of the shared fits, in each output's
     mean square, made on first use: the criterion the delay choice ranks fits by."""

@@ -96,6 +96,10 @@ def test_real_shake_table_fundamental(realdata_dir, model, period_s):
     assert len(selection.modes) == 3  # a three-storey model
     fundamental = selection.modes.freq_hz.iloc[0]
     assert abs(fundamental * period_s - 1) < REAL_PERIOD_RTOL, fundamental
+    if model == "stiff3":  # no output's H1 is coherent near the 39.67 Hz mode: the counted model confirms it
+        (top,) = [w.value for w in selection.warnings if "cannot test that mode" in w.message]
+        assert top == pytest.approx(selection.modes.freq_hz.iloc[2]) and selection.check.unconfirmed_hz == ()
+        assert selection.check.passed and selection.quality == "good"
 
 
 def test_selection_is_deterministic_and_tables_follow_the_thesis(supine_selection):
