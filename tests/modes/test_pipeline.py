@@ -46,6 +46,16 @@ def test_one_recording_visits_each_stage_once_in_order(diagram):
     # what ran is said by typed fields, not by which columns the modes table happens to hold
     assert (selection.counted, selection.segments, selection.picks) == (True, pipeline.N_SEGMENTS, None)
     assert {"count_undecided", "interval_covers_other_estimator"} <= set(selection.to_dict()["modes"][0])
+    # the count's and the estimators' flags, as the modes table holds them, mode by mode
+    flags = {"count_undecided": "count_undecided", "structure_widened": "interval_covers_other_counts",
+             "estimator_widened": "interval_covers_other_estimator", "model_error_dominates": "model_error_dominates"}
+    for column, key in flags.items():
+        flagged = replace(selection, modes=selection.modes.assign(**{column: [True, False, False, True]}))
+        assert [m[key] for m in flagged.to_dict()["modes"]] == [True, False, False, True], key
+    # each mode's spread over the segments, as the modes table holds it
+    spread = [m["segment_spread"] for m in selection.to_dict()["modes"]]
+    assert [s["segments_found"] for s in spread] == selection.modes.segments_found.tolist() == [pipeline.N_SEGMENTS] * 4
+    assert [s["freq_sd_hz"] for s in spread] == selection.modes.freq_segment_sd.tolist()
 
 
 def test_the_arguments_choose_a_named_stage_list(diagram):
@@ -54,6 +64,8 @@ def test_the_arguments_choose_a_named_stage_list(diagram):
     assert len(selection.modes) == 2 and selection.count is None  # the count does not run on a fixed number
     assert (selection.counted, selection.segments) == (False, 0)
     assert not {"count_undecided", "segment_spread"} & set(selection.to_dict()["modes"][0])
+    halves = am.select_modes(diagram, n_modes=2, segments=2, n_jobs=1)  # the fewest segments a spread has
+    assert halves.segments == 2 and halves.to_dict()["modes"][0]["segment_spread"]["segments_found"] <= 2
     plain, selection = _traced(diagram, refine=False, segments=0)
     assert plain == ["candidates", "merge", "segment_fits", "screen_by_frf", "check", "spread", "separate", "finish"]
     assert selection.refinement is None and selection.count is None
