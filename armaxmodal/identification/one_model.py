@@ -19,8 +19,9 @@ from armaxmodal._threads import single_blas_thread
 from armaxmodal.estimate.fit import fit_armax
 from armaxmodal.estimate.orders import OrderChoice, choose_orders
 from armaxmodal.estimate.result import ArmaxFit
+from armaxmodal.io.write import finite_or_none
 from armaxmodal.modal import mode_record
-from armaxmodal.modes.modal_check import ModalCheck, check_modes, finite_or_none
+from armaxmodal.modes.modal_check import ModalCheck, check_modes
 from armaxmodal.modes.poles import POLE_COLUMNS, SHARED, Tolerances, pole_rows, rejection_reasons
 from armaxmodal.modes.result import record_header
 from armaxmodal.modes.settings import DEFAULTS

@@ -175,6 +175,11 @@ def write_recording_uff(recording: Recording, path: str | os.PathLike) -> Path:
     return atomic_write(path, write)
 
 
+def finite_or_none(value) -> float | None:
+    """``value`` as a plain float, or None where it is None, NaN or infinite (a strict-JSON number)."""
+    return float(value) if value is not None and np.isfinite(value) else None
+
+
 def strict_json(obj):
     """``obj`` with numpy values made plain and every non-finite float made ``None``: strict
     JSON has no NaN or Infinity, and strict parsers reject them."""

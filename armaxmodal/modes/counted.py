@@ -141,7 +141,7 @@ def counted_modes(
     keep = np.isin(verdicts, ("needed", "undecided"))
     same_row = settings.cluster.same_row_freq
     if picked:
-        return _picked_result(_doubts_said(work, ()), count, keep, hold, settings)
+        return _picked_result(_doubts_said(work, ()), count, keep, verdicts, hold, settings)
     if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
         return _doubts_said(work, ()).warned(no_mode_kept_note(count, modes, data.band_hz), count=count)
     rows = pd.DataFrame([_row(modes, count, i, hold, same_row, verdicts[i]) for i in np.flatnonzero(keep)])
@@ -245,12 +245,13 @@ def confirmed_where_incoherent(diagram, work: SelectionState, unconfirmed_hz, se
     return tuple(confirmed), notes
 
 
-def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hold: str, settings: SelectionSettings
-                   ) -> SelectionState:  # fmt: skip
+def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, verdicts: np.ndarray, hold: str,
+                   settings: SelectionSettings) -> SelectionState:  # fmt: skip
     """The picked rows (finite ``picked_hz``) reported: from the modal model where it keeps the pick
     as a mode of the band, else as the selection had it (the diagram's or the refit's values) with a
     ``pick_not_supported`` note that says where the model took it. The rows not picked stay in the
-    model, said in a note; the check judges every mode of the model in the band (``check_poles``)."""
+    model, said in a note; the check judges every mode of the model in the band (``check_poles``).
+    ``keep`` marks the poles that are modes of the band, by the count's ``verdicts``."""
     m, rows, shapes, same_row = count.model, [], [], settings.cluster.same_row_freq
     picked = np.isfinite(work.modes.picked_hz.to_numpy())
     pairs = dict((j, i) for i, j in matched_poles(work.modes.freq_hz.to_numpy(), m.freq_hz))  # row -> pole
@@ -261,7 +262,7 @@ def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, hol
     for j in np.flatnonzero(picked):
         i = pairs[j]
         if keep[i]:
-            rows.append({**_row(work.modes, count, i, hold, same_row, count.verdicts()[i]),
+            rows.append({**_row(work.modes, count, i, hold, same_row, verdicts[i]),
                          "picked_hz": work.modes.picked_hz.iloc[j]})
             shapes.append(m.shapes[:, i])
             continue

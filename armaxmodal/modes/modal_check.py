@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from armaxmodal.io.write import finite_or_none
 from armaxmodal.modes.settings import CHECK_RESOLUTION, DEFAULTS, FrfSettings
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
@@ -203,10 +204,6 @@ class ModalCheck:
             "bands": [{"output": s, "lo_hz": lo, "hi_hz": hi} for s, lo, hi in self.bands],
             "unconfirmed_hz": [float(f) for f in self.unconfirmed_hz],
         }
-
-
-def finite_or_none(value) -> float | None:
-    return float(value) if np.isfinite(value) else None
 
 
 def poles_of(freq_hz, damping) -> np.ndarray:

@@ -16,6 +16,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from armaxmodal.io.write import finite_or_none as finite  # strict JSON: None for NaN
 from armaxmodal.modal import matched_poles, nearest_pole
 from armaxmodal.modes.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.intervals import interval
@@ -230,9 +231,6 @@ class ModeCount:
             ``effective_fraction``, ``trials``, ``steps``, ``models`` and ``poles``, strict-JSON-ready (None for NaN),
             as ``schemas/stabilise.schema.json``'s ``count`` describes.
         """
-
-        def finite(value):
-            return float(value) if value is not None and np.isfinite(value) else None
 
         return {
             "effective_fraction": finite(self.effective_fraction),

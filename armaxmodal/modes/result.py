@@ -19,10 +19,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from armaxmodal.io.write import finite_or_none
 from armaxmodal.modal import mode_record
 from armaxmodal.modes.dft_model import ModalModel
 from armaxmodal.modes.diagram import StabilisationDiagram
-from armaxmodal.modes.modal_check import ModalCheck, finite_or_none
+from armaxmodal.modes.modal_check import ModalCheck
 from armaxmodal.modes.mode_count import ModeCount
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
 from armaxmodal.prepare.preparation import Preparation

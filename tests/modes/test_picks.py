@@ -86,7 +86,9 @@ def test_a_pick_the_modal_model_takes_out_of_the_band_is_reported_and_said():
     )  # fmt: skip
 
     count = ModeCount(model, model, (), np.array([80.0, -3.0, 60.0]), -50.0, np.nan, 1.0)
-    out = _picked_result(work, count, np.array([True, False, True]), "bandlimited", SelectionSettings())
+    verdicts = count.verdicts((1.0, 25.0))
+    assert verdicts.tolist() == ["needed", "not_a_mode", "needed"]  # the 20 Hz pole is a line
+    out = _picked_result(work, count, verdicts != "not_a_mode", verdicts, "bandlimited", SelectionSettings())
     assert out.modes.freq_hz.tolist() == [5.1, 9.0] and out.shapes.tolist() == [[3.0, 2.0]]
     assert out.modes.count_undecided.tolist() == [False, True] and out.modes.picked_hz.tolist() == [5.1, 9.0]
     (said,) = [n for n in out.warnings if n.code == "pick_not_supported"]

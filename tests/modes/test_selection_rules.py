@@ -246,10 +246,10 @@ def test_delay_edge_warning_says_the_range_and_what_to_do():
 
 
 def test_finite_or_none_keeps_numbers_and_drops_nan_and_inf():
-    from armaxmodal.modes.modal_check import finite_or_none
+    from armaxmodal.io.write import finite_or_none
 
     assert finite_or_none(np.float64(2.5)) == 2.5 and type(finite_or_none(np.float64(2.5))) is float
-    assert finite_or_none(float("nan")) is None and finite_or_none(np.inf) is None
+    assert finite_or_none(float("nan")) is None and finite_or_none(np.inf) is None and finite_or_none(None) is None
 
 
 def test_candidates_are_shared_poles_kept_or_unresolved_inside_the_band():
