@@ -17,7 +17,7 @@ for a band-limited input or in ``z`` for a held one; :func:`refine_modes` fits b
 data choose.
 
 The residues, direct and transient terms enter linearly and are projected out (the private
-``armaxmodal.modes._separable``): only the frequencies and damping ratios are iterated, all free.
+``armaxmodal._separable``): only the frequencies and damping ratios are iterated, all free.
 """
 
 from __future__ import annotations
@@ -28,9 +28,9 @@ import numpy as np
 import scipy.linalg
 import scipy.optimize
 
+from armaxmodal._separable import GramCompressed, SeparableModel, poles, start_vector, x_bounds
 from armaxmodal._threads import single_blas_thread
 from armaxmodal.exceptions import OrderError
-from armaxmodal.modes._separable import GramCompressed, SeparableModel, poles, start_vector, x_bounds
 from armaxmodal.modes.settings import DEFAULTS, DftSettings
 from armaxmodal.recording import Recording
 from armaxmodal.stats import sandwich_sd

@@ -39,10 +39,6 @@ PEAK_RESOLUTION = Resolution(lines_per_bandwidth=4, min_segments=4)
 CHECK_RESOLUTION = Resolution(lines_per_bandwidth=2, min_segments=8)
 #: the record's parts the spread is measured over, when not given (``select_modes(segments=...)``)
 N_SEGMENTS = 3
-#: the modal model's normal equations take ``|P_perp M|^2`` as ``|M|^2 - |Q'M|^2``, which keeps
-#: about 16 + log10 of this ratio of the two digits; below it the Jacobian's rows are formed
-#: (a light pole at the Nyquist frequency kept none)
-NORMAL_EQUATIONS_MIN_RATIO = 1e-6
 
 
 #: the thresholds that are a probability, a share or a MAC: at most 1

@@ -76,7 +76,7 @@ def test_variable_projection_jacobian_matches_finite_differences(fixtures_dir, h
 
 
 def _supine_model(fixtures_dir, hold):
-    from armaxmodal.modes._separable import SeparableModel as _SeparableModel
+    from armaxmodal._separable import SeparableModel as _SeparableModel
 
     rec = am.read_recording(fixtures_dir / "supine_random.csv")
     dt = 1 / rec.fs
@@ -95,7 +95,7 @@ def test_the_compressed_fit_takes_the_full_problems_steps(fixtures_dir, hold):
     3 % off."""
     import scipy.optimize
 
-    from armaxmodal.modes._separable import GramCompressed
+    from armaxmodal._separable import GramCompressed
 
     model = _supine_model(fixtures_dir, hold)
     small = GramCompressed(model)
@@ -162,7 +162,7 @@ def test_the_modal_kernels_equal_their_column_by_column_references(hold):
     """The basis, the pole slopes and ``-dA/dx coef`` from the kernels, against numpy built a
     column at a time (tests/naive.py), on random lines, poles and coefficients."""
     from armaxmodal._kernels import modal_basis, modal_moved
-    from armaxmodal.modes._separable import pole_derivatives as _pole_derivatives
+    from armaxmodal._separable import pole_derivatives as _pole_derivatives
     from tests import naive
 
     rng = np.random.default_rng(7)
@@ -235,7 +235,7 @@ def test_normal_equations_that_lost_their_definiteness_are_formed_from_the_rows(
     instead of failing; where those are indefinite too, the error stands."""
     from types import SimpleNamespace
 
-    from armaxmodal.modes._separable import GramCompressed
+    from armaxmodal._separable import GramCompressed
 
     lost, formed = np.array([[1.0, 1.0 + 1e-6], [1.0 + 1e-6, 1.0]]), np.array([[1.0, 0.5], [0.5, 1.0]])
     asked = []

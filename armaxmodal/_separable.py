@@ -1,5 +1,6 @@
-"""The separable least-squares problem of a modal model on DFT lines, for
-:mod:`armaxmodal.modes.dft_model`'s fitter.
+"""The separable least-squares problem of a modal model on DFT lines: the numerical core of
+:mod:`armaxmodal.modes.dft_model`'s fitter, kept beside ``_kernels`` and ``_linalg`` as they are
+(private numerics behind a validated wrapper: no selection rule and no threshold of the stages).
 
 The modal sum with continuous poles (``1 / (s - lambda)`` for a band-limited input, its held
 form in ``z`` for a zero-order hold) and the transient (leakage) term ``T(z)`` with the same
@@ -16,7 +17,11 @@ import scipy.linalg
 
 from armaxmodal._kernels import modal_basis, modal_moved
 from armaxmodal._linalg import hermitian_from_upper, orthonormal_basis, ridged_cholesky
-from armaxmodal.modes.settings import NORMAL_EQUATIONS_MIN_RATIO
+
+#: the normal equations take ``|P_perp M|^2`` as ``|M|^2 - |Q'M|^2``, which keeps about
+#: 16 + log10 of this ratio of the two digits; below it the Jacobian's rows are formed (a light
+#: pole at the Nyquist frequency kept none). A guard of the arithmetic, as ``_linalg``'s are.
+NORMAL_EQUATIONS_MIN_RATIO = 1e-6
 
 
 def poles(x: np.ndarray) -> np.ndarray:
