@@ -70,9 +70,8 @@ def _candidates(diagram, modes: pd.DataFrame, band, nas, settings: SelectionSett
     return [(f, x) for _, _, f, x in sorted(found)[: settings.count.max_candidates]]
 
 
-def _on_whole_record(count: ModeCount, rec, band_hz, hold: str) -> ModeCount:
-    """The counted model fitted to the whole record from where the search left it."""
-    whole = DftLines.from_recording(rec, band_hz)
+def _on_whole_record(count: ModeCount, whole: DftLines, hold: str) -> ModeCount:
+    """The counted model fitted to the whole record's lines (``whole``) from where the search left it."""
     start = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, 1, count.dft)
     whole = whole.noise_weighted(start)
     final = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, count.settings.final_nfev, count.dft)
@@ -135,22 +134,24 @@ def counted_modes(
     count = count_modes(data, start_f, start_x, candidates, hold=hold, halves=halves, supported=supported,
                         search=not picked, n_jobs=n_jobs, settings=settings.count, lines=settings.lines,
                         dft=settings.dft, agreement=settings.agreement)  # fmt: skip
+    whole = data if part is rec else DftLines.from_recording(rec, band_hz)  # each cut's lines built once
     if part is not rec:
-        count = _on_whole_record(count, rec, band_hz, hold)
+        count = _on_whole_record(count, whole, hold)
+    lines = {"count": count, "count_lines": (data, halves)}
     verdicts = count.verdicts(data.band_hz)
     keep = np.isin(verdicts, ("needed", "undecided"))
     same_row = settings.cluster.same_row_freq
     if picked:
-        return _picked_result(_doubts_said(work, ()), count, keep, verdicts, hold, settings)
+        return replace(_picked_result(_doubts_said(work, ()), count, keep, verdicts, hold, settings), **lines)
     if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
-        return _doubts_said(work, ()).warned(no_mode_kept_note(count, modes, data.band_hz), count=count)
+        return _doubts_said(work, ()).warned(no_mode_kept_note(count, modes, data.band_hz), **lines)
     rows = pd.DataFrame([_row(modes, count, i, hold, same_row, verdicts[i]) for i in np.flatnonzero(keep)])
-    rows, shapes, merged = _one_where_not_separated(rows, count.model.shapes[:, keep], count, keep, rec, band_hz, hold,
+    rows, shapes, merged = _one_where_not_separated(rows, count.model.shapes[:, keep], count, keep, whole, hold,
                                                     settings)  # fmt: skip
     rows, disagree = covering_both_estimators(rows, settings.agreement.alpha)
     # where two poles are reported as one, the check fits the model's poles, not the row's
     poles = tuple(zip(count.model.freq_hz[keep].tolist(), count.model.damping[keep].tolist(), strict=True))
-    work = work.with_modes(rows, shapes, count=count, check_poles=poles if merged else None, counted=True)
+    work = work.with_modes(rows, shapes, check_poles=poles if merged else None, counted=True, **lines)
     work = _doubts_said(work, count.model.freq_hz[keep], same_row)
     return work.warned(*count_notes(count, keep, data.band_hz, same_row), *merged, *disagree)
 
@@ -169,8 +170,8 @@ def _counted_part(rec, max_samples: int):
     return rec if rec.n_samples <= max_samples else rec.split(rec.n_samples // max_samples)[0]
 
 
-def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: ModeCount, keep: np.ndarray, rec,
-                             band_hz, hold: str, settings: SelectionSettings = DEFAULTS):  # fmt: skip
+def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: ModeCount, keep: np.ndarray,
+                             whole: DftLines, hold: str, settings: SelectionSettings = DEFAULTS):  # fmt: skip
     """Two counted modes the record does not separate -- neither by frequency (:func:`not_separated`,
     on the model's own intervals) nor by shape (MAC at least the merge's ``merge_mac``) -- reported as
     one: the
@@ -178,7 +179,8 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
     criterion), whose mode's intervals are widened to cover both. The likelihood may need two poles
     for one resonance whose frequency moves during the record (a nonlinearity: the F-16 at its
     highest level had two poles at 6.356 and 6.395 Hz, 0.2 SD apart), but their values are not
-    two modes. Returns ``(rows, shapes, notes)``; a ``modes_not_separated`` note per merge."""
+    two modes. ``whole``: the whole record's lines. Returns ``(rows, shapes, notes)``; a
+    ``modes_not_separated`` note per merge."""
     poles, m = np.flatnonzero(keep), count.model
     # judged on the model's own intervals and shapes: two bodies' heavily damped modes 7-8 % apart
     # were 1.8 and 2.3 SD apart, and their shapes told them apart (MAC 0.70 and 0.05); the F-16's
@@ -190,7 +192,7 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
              if mac(m.shapes[:, poles[a]], m.shapes[:, poles[b]]) >= same_shape]  # fmt: skip
     if not pairs:
         return rows, shapes, []
-    data = DftLines.from_recording(rec, band_hz).noise_weighted(count.model)
+    data = whole.noise_weighted(count.model)
     rows, shapes, notes, gone = rows.copy(), shapes.copy(), [], []
     for a, b, gap in pairs:
         fits = [fit_modal_model(data, np.delete(m.freq_hz, k), np.delete(m.damping, k), hold, settings.count.final_nfev,
@@ -217,7 +219,7 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
     return rows.iloc[kept].reset_index(drop=True), shapes[:, kept], notes
 
 
-def confirmed_where_incoherent(diagram, work: SelectionState, unconfirmed_hz, settings: SelectionSettings = DEFAULTS
+def confirmed_where_incoherent(work: SelectionState, unconfirmed_hz, settings: SelectionSettings = DEFAULTS
                                ) -> tuple[tuple[float, ...], list]:  # fmt: skip
     """Of the modes the modal-model check cannot confirm (``unconfirmed_hz``: no coherent H1 line near
     them), those the maximum-likelihood modal model confirms: the likelihood needs it decisively (its
@@ -225,14 +227,13 @@ def confirmed_where_incoherent(diagram, work: SelectionState, unconfirmed_hz, se
     halves give it the same frequency and damping. The modal model fits the DFT of the record, not
     its H1, and has no coherence to lose near a sharp peak (the stiff 3-storey frame's 39.67 Hz
     mode, damping 0.006, under Northridge: no coherent line within 1.3 Hz of it). Returns
-    ``(confirmed Hz, their notes)``; none without a count."""
+    ``(confirmed Hz, their notes)``; none without a count. Judged on the count's own lines
+    (``work.count_lines``), not built again."""
     count = work.count
-    if count is None or not unconfirmed_hz:
+    if count is None or work.count_lines is None or not unconfirmed_hz:
         return (), []
-    rec, m, hold = diagram.recording, count.model, work.refinement.hold
-    part = _counted_part(rec, count.settings.max_samples)
-    data = DftLines.from_recording(part, work.refinement.band_hz).noise_weighted(m)
-    halves = tuple(DftLines.from_recording(half, work.refinement.band_hz) for half in part.split(2))
+    m, hold, (data, halves) = count.model, work.refinement.hold, work.count_lines  # the count's own lines
+    data = data.noise_weighted(m)
     chi2 = halves_chi2(data, m, halves, hold, count.settings.halves_nfev, count.dft)
     agree = chdtrc(2, chi2) >= settings.agreement.alpha  # each pole alone: 2 degrees of freedom
     reach, needed = settings.cluster.same_row_freq, count.verdicts() == "needed"

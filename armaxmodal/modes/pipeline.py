@@ -189,7 +189,7 @@ def check(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     if state.check_poles:
         f, x = zip(*state.check_poles, strict=True)
     checked = check_modes(ctx.diagram.recording, np.array(f), np.array(x), ctx.band, settings=ctx.settings.frf)
-    confirmed, notes = confirmed_where_incoherent(ctx.diagram, state, checked.unconfirmed_hz, ctx.settings)
+    confirmed, notes = confirmed_where_incoherent(state, checked.unconfirmed_hz, ctx.settings)
     if confirmed:
         checked = replace(checked, unconfirmed_hz=tuple(f for f in checked.unconfirmed_hz if f not in confirmed))
     return replace(state, check=checked).warned(*notes)

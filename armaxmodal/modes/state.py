@@ -30,7 +30,7 @@ from armaxmodal.recording import Recording
 from armaxmodal.spectra import excited_band
 
 if TYPE_CHECKING:  # types only: the stages that make them import this module
-    from armaxmodal.modes.dft_model import ModalModel
+    from armaxmodal.modes.dft_model import DftLines, ModalModel
     from armaxmodal.modes.diagram import StabilisationDiagram
     from armaxmodal.modes.modal_check import ModalCheck
     from armaxmodal.modes.mode_count import ModeCount
@@ -74,6 +74,9 @@ class SelectionState:
         selection, offered to the count as candidates; a note stands where the count leaves it out.
     counted : bool
         The modes are the count's rows (:attr:`armaxmodal.ModeSelection.counted`).
+    count_lines : (DftLines, tuple of DftLines) or None
+        The lines the count decided on and those of their two halves, built once by the count
+        and read again by the check's confirmation (unweighted).
     result : ModeSelection or None
         The finished selection; a stage that sets it ends the pipeline (a diagram with no mode).
     """
@@ -89,6 +92,7 @@ class SelectionState:
     segment_fits: dict = field(default_factory=dict, repr=False)
     doubts: tuple[tuple[float, float, QualityWarning], ...] = ()
     counted: bool = False
+    count_lines: tuple[DftLines, tuple[DftLines, ...]] | None = field(default=None, repr=False)
     result: ModeSelection | None = field(default=None, repr=False)
 
     def __post_init__(self):

@@ -279,7 +279,8 @@ def test_two_poles_the_record_does_not_separate_are_reported_as_one(supine, supi
         rows.loc[[1, 2], "freq_other_hi"] = rows.freq_hz[[1, 2]] + 0.3
     keep = np.ones(model.n_modes, dtype=bool)
     count = SimpleNamespace(model=model)
-    out, shapes, notes = _one_where_not_separated(rows, model.shapes, count, keep, supine_ride, data.band_hz, "zoh")
+    whole = DftLines.from_recording(supine_ride, data.band_hz)
+    out, shapes, notes = _one_where_not_separated(rows, model.shapes, count, keep, whole, "zoh")
     assert [n.code for n in notes] == (["modes_not_separated"] if planted == "own" else [])
     if planted != "own":
         pd.testing.assert_frame_equal(out, rows)
@@ -573,9 +574,11 @@ def test_the_modal_model_confirms_a_mode_where_the_h1_is_not_coherent(bundled_di
                     stand_ins=((f0, f0, rise),) if stand_in else ())  # fmt: skip
     # the ride's halves agree on its modes at 1 %; at a level of 1 no two halves agree
     level = SelectionSettings(agreement=AgreementSettings(alpha=0.01 if halves_agree else 1.0))
-    found, notes = counted.confirmed_where_incoherent(
-        bundled_diagram, SelectionState(sel.modes, sel.shapes, sel.refinement, sel.check, count), (f0,), level
-    )
+    # the count's lines as the count cut them: the whole ride (under the count's max_samples) and its halves
+    rec, band_hz = bundled_diagram.recording, sel.refinement.band_hz
+    lines = (DftLines.from_recording(rec, band_hz), tuple(DftLines.from_recording(h, band_hz) for h in rec.split(2)))
+    state = SelectionState(sel.modes, sel.shapes, sel.refinement, sel.check, count, count_lines=lines)
+    found, notes = counted.confirmed_where_incoherent(state, (f0,), level)
     assert found == ((f0,) if confirmed else ())
     assert [n.value for n in notes] == ([f0] if confirmed else [])
 
