@@ -71,6 +71,9 @@ class ModalCheck:
         the record cannot confirm them, whatever the misfit.
     limit : float
         The largest model error of an output whose modes explain it (``FrfSettings.model_error_limit``).
+    checked_hz : tuple of (float, float)
+        Per output, the lowest and highest coherent line it was checked on (Hz; NaN where it was
+        not checked): outside them the fitted FRF is an extrapolation of its residual terms.
 
     Examples
     --------
@@ -96,6 +99,7 @@ class ModalCheck:
     poles: np.ndarray
     unconfirmed_hz: tuple = ()
     limit: float = DEFAULTS.frf.model_error_limit
+    checked_hz: tuple = ()
 
     @property
     def passed(self) -> bool:
@@ -321,11 +325,14 @@ def check_modes(recording: Recording, freq_hz, damping, band=None, *, fit_delay:
         error[k] = np.sqrt(rss / norm)
         rand[k] = np.sqrt(np.sum(lines.sigma**2) / norm)
     model = np.sqrt(np.clip(error**2 - rand**2, 0.0, None))
+    checked_hz = tuple((float(ln.freq_hz[0]), float(ln.freq_hz[-1])) if np.isfinite(error[k]) else (np.nan, np.nan)
+                       for k, ln in enumerate(all_lines))  # fmt: skip
     seen = confirmed_modes(all_lines, freq_hz, damping, recording.fs / nperseg, settings.confirm_lines)
     check = ModalCheck(
         tuple(recording.sensors), error, rand, model, delay,
         np.array([ln.freq_hz.size for ln in all_lines]), nperseg, (), residues, terms, poles,
         tuple(float(f) for f, ok in zip(freq_hz, seen, strict=True) if not ok), settings.model_error_limit,
+        checked_hz,
     )  # fmt: skip
     if check.passed:
         return check

@@ -463,6 +463,33 @@ def test_the_figure_draws_the_h1_and_coherence_the_check_judged(diagram, monkeyp
     plt.close("all")
 
 
+def test_the_fitted_frf_is_drawn_over_the_lines_each_output_was_checked_on(bundled_diagram):
+    """The check's LSFD curve of an output is drawn from its lowest to its highest coherent line
+    only: beyond them it is its residual terms extrapolated (the Inglewood bridge's rose tenfold
+    over its H1 below 1.5 Hz). On the bundled ride the legs' coherence ends near 17 Hz, the
+    other outputs' reach the top of the band."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from armaxmodal.spectra import coherent_lines
+
+    selection = select_modes(bundled_diagram, n_jobs=1, segments=0)
+    check = selection.check
+    lines = coherent_lines(bundled_diagram.recording, check.nperseg)
+    assert check.checked_hz == tuple((ln.freq_hz[0], ln.freq_hz[-1]) for ln in lines)
+    top, _ = bundled_diagram.plot(selection)
+    dashed = [line for a in top.figure.axes for line in a.get_lines() if line.get_linestyle() == "--"]
+    assert len(dashed) == len(lines)  # one curve per output, in the sensors' order
+    for line, (lo, hi) in zip(dashed, check.checked_hz, strict=True):
+        assert line.get_xdata().min() >= lo and line.get_xdata().max() <= hi
+        assert line.get_xdata().max() == pytest.approx(hi, abs=1e-9)
+    legs = bundled_diagram.recording.sensors.index("legs")
+    assert check.checked_hz[legs][1] < 0.8 * min(hi for k, (_, hi) in enumerate(check.checked_hz) if k != legs)
+    plt.close("all")
+
+
 def test_the_frf_axis_spans_the_curves_inside_the_input_band():
     """Beyond the input's excited band an H1 is noise over noise and may rise far above the
     structure's response: the axis is set by the curves inside the band (twice their peak),

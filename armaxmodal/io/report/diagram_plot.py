@@ -101,7 +101,7 @@ def plot_stabilisation(diagram, selection=None, ax=None):
         from matplotlib.patches import Patch
 
         h2, l2 = h2 + [Patch(color=_LOW_COHERENCE, alpha=0.5)], l2 + [f"coherence < {COHERENT:g}"]
-    fig.legend(h1 + h2, l1 + l2, fontsize=7, loc="outside lower center", ncol=5, frameon=False)
+    fig.legend(h1 + h2, l1 + l2, fontsize=7, loc="outside lower center", ncol=4, frameon=False)
     ax_d.set_ylabel("damping ratio")
     ax_d.set_xlabel("frequency (Hz)")
     ax_d.set_ylim(0, tol.max_damping)
@@ -114,10 +114,17 @@ def _draw_check(ax, ax_f, f, selection) -> None:
     check = selection.check
     if check is None:
         return
-    fitted = check.frf(f[f > 0])
+    fitted, labelled = check.frf(f[f > 0]), False
     for k in range(fitted.shape[1]):
-        label = "modal model (LSFD, residual terms, delay)" if k == 0 else None
-        ax_f.semilogy(f[f > 0], np.abs(fitted[:, k]), lw=1.0, ls="--", color="k", alpha=0.6, label=label)
+        # drawn over the lines the output was checked on only: beyond them the curve is the residual
+        # terms extrapolated (a bridge's rose tenfold over its H1 below the lowest coherent line)
+        lo, hi = check.checked_hz[k] if check.checked_hz else (-np.inf, np.inf)
+        on = (f[f > 0] >= lo) & (f[f > 0] <= hi)
+        if not on.any():
+            continue
+        label = None if labelled else "modal model (LSFD) on the checked lines"
+        ax_f.semilogy(f[f > 0][on], np.abs(fitted[on, k]), lw=1.0, ls="--", color="k", alpha=0.6, label=label)
+        labelled = True
     for i, (_, lo, hi) in enumerate(check.bands):
         label = "not explained by the modes" if i == 0 else None
         ax.axvspan(lo, hi, color=_MISFIT, alpha=0.25, zorder=0, lw=0, label=label)
