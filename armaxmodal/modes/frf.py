@@ -179,7 +179,7 @@ def refit_with_added(diagram, work: SelectionState, band, settings: SelectionSet
     at 12.5 Hz while the 24.8 Hz one was missing, and its refit was refused as too far; now
     13.3 Hz for the exact 13.54). A refit that cannot be made leaves the modes, said."""
     refit = selection_job(diagram.recording, [], work.modes, ("refit", refit_band(diagram.recording, band)),
-                          settings.dft)  # fmt: skip
+                          settings)  # fmt: skip
     if isinstance(refit, RefitFailure):
         work = work.warned(*refit.notes("the modes with those the check added", uncounted=False))
     else:  # the first refit's start lacked these modes: its refusals may not stand

@@ -90,7 +90,7 @@ def refit(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     (:func:`armaxmodal.modes.dft_model.refine_modes`), reported for a band-limited record, with the segment refits
     of every mode's representative orders run beside it over the worker threads."""
     fitted = refit_and_segment_fits(ctx.diagram, state.modes, ctx.band, True, ctx.segments, ctx.orders, ctx.n_jobs,
-                                    ctx.bar, ctx.settings.dft)  # fmt: skip
+                                    ctx.bar, ctx.settings)  # fmt: skip
     done = fitted.pop("refit")
     c = ctx.settings.cluster
     state = refined_modes(ctx.diagram, replace(state, segment_fits=fitted), done, c.freq, c.damping, c.merge_mac)

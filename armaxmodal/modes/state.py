@@ -24,7 +24,7 @@ from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.clusters import merge_duplicates
 from armaxmodal.modes.dft_model import refine_modes
 from armaxmodal.modes.intervals import segment_jobs, segment_poles
-from armaxmodal.modes.settings import DEFAULTS, DftSettings
+from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.spectra import excited_band
@@ -35,7 +35,6 @@ if TYPE_CHECKING:  # types only: the stages that make them import this module
     from armaxmodal.modes.modal_check import ModalCheck
     from armaxmodal.modes.mode_count import ModeCount
     from armaxmodal.modes.result import ModeSelection
-    from armaxmodal.modes.settings import SelectionSettings
 
 __all__ = ["SelectionContext", "SelectionState"]
 
@@ -171,7 +170,7 @@ class SelectionContext:
 
 
 def refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, orders: dict, n_jobs, bar=None,
-                           dft: DftSettings = DEFAULTS.dft) -> dict:  # fmt: skip
+                           settings: SelectionSettings = DEFAULTS) -> dict:  # fmt: skip
     """The frequency-domain refit (key ``"refit"``) and the segment refits of every mode's
     representative orders (keys ``(orders, k)``), run together over the worker threads:
     the refit ran alone in this process before, while the workers waited. ``bar`` (tqdm)
@@ -180,7 +179,7 @@ def refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, or
     if segments >= 2:
         jobs += [("segment", job) for job in segment_jobs(sorted({orders[int(na)] for na in modes.na}), segments)]
     parts = diagram.recording.split(segments) if segments >= 2 else []
-    task = partial(selection_job, diagram.recording, parts, modes, dft=dft)
+    task = partial(selection_job, diagram.recording, parts, modes, settings=settings)
     # the refit first: it is the longest job (a frequency-domain fit of every mode)
     cost = lambda job: np.inf if job[0] == "refit" else job[1][0][0]  # noqa: E731
     done = parallel_map(task, jobs, n_jobs, bar, cost=cost, min_items=2)
@@ -194,14 +193,15 @@ def refit_band(recording: Recording, band) -> tuple[float, float]:
     return (lo, hi) if band is None else (max(lo, band[0]), min(hi, band[1]))
 
 
-def selection_job(recording: Recording, parts: list, modes: pd.DataFrame, job, dft: DftSettings = DEFAULTS.dft):
+def selection_job(recording: Recording, parts: list, modes: pd.DataFrame, job, settings: SelectionSettings = DEFAULTS):
     """One job of :func:`refit_and_segment_fits`: a segment's refit, or the frequency-domain refit
     (a :class:`RefitFailure` where it cannot be made)."""
     kind, what = job
     if kind == "segment":
         return segment_poles(parts, what)
     try:
-        return refine_modes(recording, modes.freq_hz, modes.damping, band_hz=what, settings=dft)
+        return refine_modes(recording, modes.freq_hz, modes.damping, band_hz=what, settings=settings.dft,
+                            decisive=settings.count.decisive_bic)  # fmt: skip
     except (OrderError, np.linalg.LinAlgError) as exc:
         return RefitFailure(str(exc))  # too few lines or a degenerate basis: the ARMAX values stand, said
 

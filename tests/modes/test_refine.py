@@ -33,6 +33,29 @@ def test_the_data_choose_the_hold_and_the_refit_finds_the_modes(fixtures_dir, na
     assert np.all(np.abs(ref.freq_hz - f) < 4 * ref.freq_sd) and np.all(np.abs(ref.damping - x) < 4 * ref.damping_sd)
 
 
+def test_where_a_few_steps_do_not_decide_the_hold_both_are_converged():
+    """A held ride of the five-segment body with feet, started from dampings 50 % high: after four
+    steps the band-limited form leads by 8.9, less than the count's decisive 10, so both forms are
+    converged, and there the held one is lower by far and finds the exact dampings. Decided on the
+    four steps alone (``decisive=0``), the band-limited form is taken and its dampings are biased."""
+    body = am.supine_with_feet()
+    exact = body.modes()
+    ride = am.simulate_recording(body, am.random_vibration(60.0, 120.0, (0.5, 24.0), seed=1), 60.0, noise=0.03, seed=2)
+    start = (exact.freq_hz, 1.5 * exact.damping)
+    ref = refine_modes(ride, *start, band_hz=(0.5, 24.0))
+    assert ref.hold == "zoh" and ref.hold_cost["bandlimited"] - ref.hold_cost["zoh"] > 10.0  # converged costs
+    assert np.all(np.abs(ref.damping - exact.damping) < 4 * ref.damping_sd)
+    assert np.all(np.abs(ref.freq_hz - exact.freq_hz) < 4 * ref.freq_sd)
+    hasty = refine_modes(ride, *start, band_hz=(0.5, 24.0), decisive=0.0)
+    assert hasty.hold == "bandlimited" and abs(hasty.hold_cost["zoh"] - hasty.hold_cost["bandlimited"]) < 10.0
+    assert np.any(np.abs(hasty.damping - exact.damping) > 4 * hasty.damping_sd)  # what the rule prevents
+    # from the exact modes four steps decide (by hundreds): only the chosen form is converged
+    f, x = exact.freq_hz, exact.damping
+    near, steps = (refine_modes(ride, f, x, band_hz=(0.5, 24.0), decisive=d) for d in (10.0, 0.0))
+    assert near.hold_cost == steps.hold_cost
+    assert near.hold == "zoh" and near.hold_cost["bandlimited"] - near.hold_cost["zoh"] > 100.0
+
+
 def test_refit_shapes_match_the_exact_modal_constants(fixtures_dir):
     rec = am.read_recording(fixtures_dir / "supine_random.csv")
     f, x, f0, x0 = _start(fixtures_dir, "supine_random")

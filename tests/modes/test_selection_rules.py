@@ -16,7 +16,7 @@ from armaxmodal.modes.clusters import _supported, cluster_poles, merge_duplicate
 from armaxmodal.modes.diagram import SAMPLES_PER_PARAMETER, _check_top_order, _nk_edge_warning
 from armaxmodal.modes.intervals import with_intervals
 from armaxmodal.modes.poles import Tolerances, stability_classes
-from armaxmodal.modes.settings import ClusterSettings
+from armaxmodal.modes.settings import ClusterSettings, CountSettings
 from armaxmodal.modes.state import SelectionState, _apply_refinement
 from armaxmodal.stats import Z95
 
@@ -434,8 +434,9 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     lo, hi = excited_band(rec)
     seen = []
 
-    def refit(recording, freq_hz, damping, band_hz, settings=None):
+    def refit(recording, freq_hz, damping, band_hz, settings=None, decisive=None):
         seen.append(band_hz)
+        assert decisive == CountSettings().decisive_bic  # the hold is decided at the count's level
         return SimpleNamespace(hold=hold)
 
     monkeypatch.setattr(st, "refine_modes", refit)
@@ -451,7 +452,7 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     # a held input: the ARMAX values are reported
     assert out.refinement is ref and out.modes is modes and out.shapes is shapes
 
-    def failing(recording, freq_hz, damping, band_hz, settings=None):
+    def failing(recording, freq_hz, damping, band_hz, settings=None, decisive=None):
         raise OrderError("too few lines")
 
     monkeypatch.setattr(st, "refine_modes", failing)
