@@ -555,6 +555,28 @@ def test_with_the_halves_a_moved_pole_is_judged_by_them_not_by_the_diagram(monke
     assert (carried == ()) is same_in_halves and model.n_modes == (3 if same_in_halves else 2)
 
 
+@pytest.mark.parametrize("max_samples", [None, "half"])
+def test_the_count_hands_forward_the_lines_it_decided_on(bundled_diagram, max_samples):
+    """The count cuts the record once: the lines it decided on (the whole ride, or its first part
+    past ``max_samples``) and their two halves go forward in the state for the check's confirmation,
+    exactly as the record's DFT gives them (unweighted)."""
+    import armaxmodal.modes.counted as counted
+    from armaxmodal.modes.state import SelectionState
+
+    sel = am.select_modes(bundled_diagram, segments=0)
+    rec, band_hz = bundled_diagram.recording, sel.refinement.band_hz
+    limit = CountSettings().max_samples if max_samples is None else rec.n_samples // 2
+    work = SelectionState(sel.modes, sel.shapes, sel.refinement, sel.check)
+    out = counted.counted_modes(bundled_diagram, work, band_hz, sel.refinement.hold, [2, 4, 6, 8],
+                                SelectionSettings(count=CountSettings(max_samples=limit)), n_jobs=1)  # fmt: skip
+    part = rec if max_samples is None else rec.split(2)[0]
+    data, halves = out.count_lines
+    np.testing.assert_array_equal(data.y, DftLines.from_recording(part, band_hz).y)
+    assert np.all(data.weights == 1.0) and len(halves) == 2
+    for half, cut in zip(halves, part.split(2), strict=True):
+        np.testing.assert_array_equal(half.y, DftLines.from_recording(cut, band_hz).y)
+
+
 @pytest.mark.parametrize(
     "rise, halves_agree, stand_in, confirmed",
     [(500.0, True, False, True), (5.0, True, False, False), (500.0, False, False, False), (500.0, True, True, False)],
