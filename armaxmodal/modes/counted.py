@@ -230,7 +230,7 @@ def confirmed_where_incoherent(work: SelectionState, unconfirmed_hz, settings: S
     ``(confirmed Hz, their notes)``; none without a count. Judged on the count's own lines
     (``work.count_lines``), not built again."""
     count = work.count
-    if count is None or work.count_lines is None or not unconfirmed_hz:
+    if count is None or not unconfirmed_hz:  # a count always comes with its lines (count_lines)
         return (), []
     m, hold, (data, halves) = count.model, work.refinement.hold, work.count_lines  # the count's own lines
     data = data.noise_weighted(m)
