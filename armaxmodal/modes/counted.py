@@ -11,6 +11,7 @@ Each rule here turns the count into rows of the one working selection, in the or
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -80,7 +81,7 @@ def _on_whole_record(count: ModeCount, whole: DftLines, hold: str) -> ModeCount:
 
 def counted_modes(
     diagram, work: SelectionState, band_hz, hold: str, nas, settings: SelectionSettings = DEFAULTS, band=None, *,
-    picked: bool = False, n_jobs: int | None = None,
+    picked: bool = False, n_jobs: int | None = None, counter: Callable = count_modes,
 ) -> SelectionState:
     """Count the modes from the selection's and return them as the selection reports modes.
 
@@ -107,6 +108,8 @@ def counted_modes(
         says which picks the record does not need); the rest stay in the model.
     n_jobs : int, optional
         Worker threads for the count's screening fits (default: all cores).
+    counter : callable
+        The count, as :func:`~armaxmodal.modes.count_search.count_modes` (a test's stands in for it).
 
     Returns
     -------
@@ -131,9 +134,9 @@ def counted_modes(
         model = work.count.model
         hidden = ~work.count.reported(band_hz)
         start_f, start_x = np.r_[start_f, model.freq_hz[hidden]], np.r_[start_x, model.damping[hidden]]
-    count = count_modes(data, start_f, start_x, candidates, hold=hold, halves=halves, supported=supported,
-                        search=not picked, n_jobs=n_jobs, settings=settings.count, lines=settings.lines,
-                        dft=settings.dft, agreement=settings.agreement)  # fmt: skip
+    count = counter(data, start_f, start_x, candidates, hold=hold, halves=halves, supported=supported,
+                    search=not picked, n_jobs=n_jobs, settings=settings.count, lines=settings.lines,
+                    dft=settings.dft, agreement=settings.agreement)  # fmt: skip
     whole = data if part is rec else DftLines.from_recording(rec, band_hz)  # each cut's lines built once
     if part is not rec:
         count = _on_whole_record(count, whole, hold)

@@ -10,12 +10,14 @@ refitted in its place (``ModeSupport``: needed when the rise is large and signif
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, representative_pole
+from armaxmodal.modes.dft_model import refine_modes
 from armaxmodal.modes.modal_check import ModalCheck, check_modes, poles_of, rss_at
 from armaxmodal.modes.notes import not_needed_note
 from armaxmodal.modes.settings import DEFAULTS, PEAK_RESOLUTION, FrfSettings, SelectionSettings
@@ -173,13 +175,14 @@ def each_once(doubts) -> tuple:
     return tuple(sorted(once.values(), key=lambda d: d[0]))
 
 
-def refit_with_added(diagram, work: SelectionState, band, settings: SelectionSettings = DEFAULTS) -> SelectionState:
+def refit_with_added(diagram, work: SelectionState, band, settings: SelectionSettings = DEFAULTS,
+                     refine: Callable = refine_modes) -> SelectionState:  # fmt: skip
     """The frequency-domain refit again, of every mode once the check has added some: a mode
     missing from a refit biases its neighbours (a five-segment chain's 13.5 Hz mode came out
     at 12.5 Hz while the 24.8 Hz one was missing, and its refit was refused as too far; now
-    13.3 Hz for the exact 13.54). A refit that cannot be made leaves the modes, said."""
+    13.3 Hz for the exact 13.54). A refit that cannot be made (by ``refine``) leaves the modes, said."""
     refit = selection_job(diagram.recording, [], work.modes, ("refit", refit_band(diagram.recording, band)),
-                          settings)  # fmt: skip
+                          settings, refine)  # fmt: skip
     if isinstance(refit, RefitFailure):
         work = work.warned(*refit.notes("the modes with those the check added", uncounted=False))
     else:  # the first refit's start lacked these modes: its refusals may not stand

@@ -32,14 +32,17 @@ from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.frf import each_once, modes_the_check_adds, modes_the_record_needs, refit_with_added
 from armaxmodal.modes.intervals import N_SEGMENTS, apply_segment_spread, segment_spread, with_intervals
 from armaxmodal.modes.modal_check import check_modes
-from armaxmodal.modes.notes import (
-    dropped_where_peaks_remain,
-    not_separated_notes,
-    unresolved_damping_notes,
-)
+from armaxmodal.modes.notes import dropped_where_peaks_remain, not_separated_notes, unresolved_damping_notes
 from armaxmodal.modes.result import ModeSelection, filled_samples_scale, no_mode_selection, per_sensor_table
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
-from armaxmodal.modes.state import RefitFailure, SelectionContext, SelectionState, refined_modes, refit_and_segment_fits
+from armaxmodal.modes.state import (
+    Fitters,
+    RefitFailure,
+    SelectionContext,
+    SelectionState,
+    refined_modes,
+    refit_and_segment_fits,
+)
 from armaxmodal.prepare.resample import oversampling_note
 
 __all__ = ["AUTOMATIC", "FIXED_COUNT", "PICKED", "Stage", "select_modes", "stages_for"]
@@ -90,7 +93,7 @@ def refit(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     (:func:`armaxmodal.modes.dft_model.refine_modes`), reported for a band-limited record, with the segment refits
     of every mode's representative orders run beside it over the worker threads."""
     fitted = refit_and_segment_fits(ctx.diagram, state.modes, ctx.band, True, ctx.segments, ctx.orders, ctx.n_jobs,
-                                    ctx.bar, ctx.settings)  # fmt: skip
+                                    ctx.bar, ctx.settings, ctx.fitters)  # fmt: skip
     done = fitted.pop("refit")
     c = ctx.settings.cluster
     state = refined_modes(ctx.diagram, replace(state, segment_fits=fitted), done, c.freq, c.damping, c.merge_mac)
@@ -128,7 +131,7 @@ def _screened(state: SelectionState, ctx: SelectionContext, doubts: list | None)
     if len(state.modes) > n_before:
         state = modes_the_record_needs(rec, state, ctx.band, settings, doubts)
     if ctx.refine and len(state.modes) > n_before:  # the refit saw fewer modes than are reported
-        state = refit_with_added(ctx.diagram, state, ctx.band, settings)
+        state = refit_with_added(ctx.diagram, state, ctx.band, settings, ctx.fitters.refine)
     return state
 
 
@@ -140,7 +143,7 @@ def count(state: SelectionState, ctx: SelectionContext) -> SelectionState:
         return replace(state, doubts=()).warned(*(note for _, _, note in state.doubts)) if state.doubts else state
     hold, band_hz = state.refinement.hold, state.refinement.band_hz
     state = counted_modes(ctx.diagram, state, band_hz, hold, ctx.nas, ctx.settings, ctx.band,
-                          n_jobs=ctx.n_jobs)  # fmt: skip
+                          n_jobs=ctx.n_jobs, counter=ctx.fitters.count)  # fmt: skip
     ctx.update_bar(state.count.trials)
     return state
 
@@ -274,6 +277,7 @@ def select_modes(
     progress: bool = False,
     picks=None,
     on_stage: Callable[[str], None] | None = None,
+    fitters: Fitters | None = None,
 ) -> ModeSelection:
     """Pick the physical modes from the shared-pole poles of a diagram.
 
@@ -329,6 +333,8 @@ def select_modes(
         record does not need is said to be (``pick_not_supported``). Not with ``n_modes``.
     on_stage : callable, optional
         Called with each stage's name as it is entered.
+    fitters : Fitters, optional
+        The refit and the count the stages run (default: the package's; a test hands in others).
 
     Returns
     -------
@@ -365,7 +371,7 @@ def select_modes(
     checked = None if picks is None else check_picks(picks, band, diagram.recording.fs, settings.cluster)
     with one_blas_thread(), tqdm(desc="mode selection", unit="fit", disable=not progress) as bar:
         ctx = SelectionContext(diagram, settings, band, sorted({o.na for o in diagram.orders}), n_modes, checked,
-                               segments, refine, n_jobs, bar, on_stage)  # fmt: skip
+                               segments, refine, n_jobs, bar, on_stage, fitters or Fitters())  # fmt: skip
         return run_stages(stages, SelectionState.empty(len(diagram.recording.sensors)), ctx)
 
 

@@ -22,6 +22,7 @@ import pandas as pd
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.clusters import merge_duplicates
+from armaxmodal.modes.count_search import count_modes
 from armaxmodal.modes.dft_model import refine_modes
 from armaxmodal.modes.intervals import segment_jobs, segment_poles
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
@@ -36,7 +37,7 @@ if TYPE_CHECKING:  # types only: the stages that make them import this module
     from armaxmodal.modes.mode_count import ModeCount
     from armaxmodal.modes.result import ModeSelection
 
-__all__ = ["SelectionContext", "SelectionState"]
+__all__ = ["Fitters", "SelectionContext", "SelectionState"]
 
 
 @dataclass(frozen=True)
@@ -118,6 +119,16 @@ class SelectionState:
 
 
 @dataclass(frozen=True)
+class Fitters:
+    """The selection's two fits, handed to the stages by the context, not imported by them: the
+    frequency-domain refit (as :func:`~armaxmodal.modes.dft_model.refine_modes`) and the count (as
+    :func:`~armaxmodal.modes.count_search.count_modes`). A test hands in one that fails or records."""
+
+    refine: Callable = refine_modes
+    count: Callable = count_modes
+
+
+@dataclass(frozen=True)
 class SelectionContext:
     """What every stage reads and none changes.
 
@@ -144,6 +155,8 @@ class SelectionContext:
         The progress bar that counts the selection's fits.
     on_stage : callable or None
         Called with each stage's name as it is entered (the progress bar's label; a test's trace).
+    fitters : Fitters
+        The refit and the count the stages run.
     """
 
     diagram: StabilisationDiagram
@@ -157,6 +170,7 @@ class SelectionContext:
     n_jobs: int | None = None
     bar: Any = field(default=None, repr=False)
     on_stage: Callable[[str], None] | None = field(default=None, repr=False)
+    fitters: Fitters = field(default=Fitters(), repr=False)
 
     @property
     def orders(self) -> dict:
@@ -170,16 +184,16 @@ class SelectionContext:
 
 
 def refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, orders: dict, n_jobs, bar=None,
-                           settings: SelectionSettings = DEFAULTS) -> dict:  # fmt: skip
+                           settings: SelectionSettings = DEFAULTS, fitters: Fitters = Fitters()) -> dict:  # fmt: skip
     """The frequency-domain refit (key ``"refit"``) and the segment refits of every mode's
     representative orders (keys ``(orders, k)``), run together over the worker threads:
     the refit ran alone in this process before, while the workers waited. ``bar`` (tqdm)
-    counts them."""
+    counts them; ``fitters.refine`` makes the refit."""
     jobs: list = [("refit", refit_band(diagram.recording, band))] if refine else []
     if segments >= 2:
         jobs += [("segment", job) for job in segment_jobs(sorted({orders[int(na)] for na in modes.na}), segments)]
     parts = diagram.recording.split(segments) if segments >= 2 else []
-    task = partial(selection_job, diagram.recording, parts, modes, settings=settings)
+    task = partial(selection_job, diagram.recording, parts, modes, settings=settings, refine=fitters.refine)
     # the refit first: it is the longest job (a frequency-domain fit of every mode)
     cost = lambda job: np.inf if job[0] == "refit" else job[1][0][0]  # noqa: E731
     done = parallel_map(task, jobs, n_jobs, bar, cost=cost, min_items=2)
@@ -193,15 +207,16 @@ def refit_band(recording: Recording, band) -> tuple[float, float]:
     return (lo, hi) if band is None else (max(lo, band[0]), min(hi, band[1]))
 
 
-def selection_job(recording: Recording, parts: list, modes: pd.DataFrame, job, settings: SelectionSettings = DEFAULTS):
-    """One job of :func:`refit_and_segment_fits`: a segment's refit, or the frequency-domain refit
-    (a :class:`RefitFailure` where it cannot be made)."""
+def selection_job(recording: Recording, parts: list, modes: pd.DataFrame, job, settings: SelectionSettings = DEFAULTS,
+                  refine: Callable = refine_modes):  # fmt: skip
+    """One job of :func:`refit_and_segment_fits`: a segment's refit, or the frequency-domain refit by
+    ``refine`` (a :class:`RefitFailure` where it cannot be made)."""
     kind, what = job
     if kind == "segment":
         return segment_poles(parts, what)
     try:
-        return refine_modes(recording, modes.freq_hz, modes.damping, band_hz=what, settings=settings.dft,
-                            decisive=settings.count.decisive_bic)  # fmt: skip
+        return refine(recording, modes.freq_hz, modes.damping, band_hz=what, settings=settings.dft,
+                      decisive=settings.count.decisive_bic)  # fmt: skip
     except (OrderError, np.linalg.LinAlgError) as exc:
         return RefitFailure(str(exc))  # too few lines or a degenerate basis: the ARMAX values stand, said
 

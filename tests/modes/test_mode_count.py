@@ -367,20 +367,17 @@ def test_a_model_that_keeps_no_mode_leaves_the_selection_and_says_so(bundled_dia
     assert "count_undecided" in sel.uncertain_because
 
 
-def test_a_stand_in_stays_out_of_the_selection(monkeypatch, bundled_diagram):
+def test_a_stand_in_stays_out_of_the_selection(bundled_diagram):
     """The count's stand-ins are not reported: the bundled ride's 16.23 Hz pole made one (as if
     the count had found it unfounded but needed) leaves three modes and its note."""
-    import armaxmodal.modes.counted as counted
-
-    real = counted.count_modes
+    from armaxmodal.modes.state import Fitters
 
     def with_a_stand_in(*args, **kwargs):
-        count = real(*args, **kwargs)
+        count = count_modes(*args, **kwargs)
         top = float(count.model.freq_hz.max())
         return replace(count, stand_ins=((top, top, 50.0),))
 
-    monkeypatch.setattr(counted, "count_modes", with_a_stand_in)
-    sel = am.select_modes(bundled_diagram, segments=0)
+    sel = am.select_modes(bundled_diagram, segments=0, fitters=Fitters(count=with_a_stand_in))
     assert len(sel.modes) == 3 and sel.modes.freq_hz.max() < 14.0
     assert any("stays in the model" in w.message for w in sel.warnings)
     assert sel.quality == "uncertain" and "count_undecided" in sel.uncertain_because  # in the band: undecided
@@ -404,21 +401,27 @@ def test_a_long_record_is_counted_on_its_start_and_fitted_whole(bundled_diagram)
     np.testing.assert_allclose(width(part), width(whole), rtol=0.05)
 
 
-def _scripted(table):
-    """A fitter for ``count_modes(fitter=...)`` whose fits are :class:`_Scored` by ``table``."""
-    return lambda data, f, x, hold, n, dft, intervals=True: _Scored(f, x, table)
+def _scripted(table, start=None):
+    """A fitter for ``count_modes(fitter=...)`` whose fits are :class:`_Scored` by ``table``, each
+    knowing ``start``, the count's starting frequencies (Hz), so that a split of one is told apart."""
+    return lambda data, f, x, hold, n, dft, intervals=True: _Scored(f, x, table, start)
 
 
 class _Scored:
     """A stand-in fit whose criterion depends on its number of modes only: the search's own
-    rules, apart from the fits, against a known answer."""
+    rules, apart from the fits, against a known answer. Its poles stay where they start, so a model
+    of more modes than ``start`` that lacks one of them (Hz) split that one (the search's split puts
+    two poles either side of a mode, 15 % off at damping 0.3); ``table["split"]``, or
+    ``table[("split", f)]`` for the split of ``f``, is then its criterion where given."""
 
-    def __init__(self, freq_hz, damping, table):
+    def __init__(self, freq_hz, damping, table, start=None):
         order = np.argsort(freq_hz)
         self.freq_hz, self.damping = np.asarray(freq_hz, float)[order], np.asarray(damping, float)[order]
         self.freq_sd, self.damping_sd = 1e-3 * self.freq_hz, 1e-3 * np.ones_like(self.freq_hz)
         self.n_real, self.rss, self.table = 100, np.ones(4), table  # the supine ride: 4 sensors
         self.residual = np.random.default_rng(0).standard_normal((50, 2)) + 0j
+        lost = [f for f in (start if start is not None else ()) if np.min(np.abs(np.log(self.freq_hz / f))) > 0.05]
+        self.split_of = lost[0] if len(lost) == 1 and self.n_modes > len(start) else None
 
     converged, nyquist_hz, at_bound = True, 30.0, None  # the supine ride at 60 Hz
 
@@ -431,7 +434,8 @@ class _Scored:
         return self.n_modes * (2 + 4 * self.rss.size)
 
     def bic(self, n_effective=None):
-        return self.table[self.n_modes]
+        split = [k for k in (("split", self.split_of), "split") if self.split_of is not None and k in self.table]
+        return self.table[split[0] if split else self.n_modes]
 
     def neg2_loglik_on(self, n_effective=None):
         return self.bic(n_effective) - self.n_params * np.log(n_effective)
@@ -465,18 +469,15 @@ def test_a_decided_count_has_no_equally_good_model(supine):
 
 
 @pytest.mark.parametrize("column", [False, True])
-def test_an_addition_the_diagram_has_no_column_for_is_named_when_the_record_wants_it(monkeypatch, supine, column):
-    """Criterion 95 for 3 modes, 50 for 4, and the new pole the same in both halves: with a stable
-    column in the diagram the fourth mode is added; without one (ARMAX fits that do not resolve it:
-    a six-mass chain at 400 Hz) it is not, but the count names it and says the modes may be too
-    few, so the verdict cannot be good."""
-    import armaxmodal.modes.count_search as count_search
-
-    table = {2: 130.0, 3: 95.0, 4: 50.0, 5: 250.0}
-    monkeypatch.setattr(count_search, "_split_wanted", lambda *a, **k: ((), None))  # a stand-in fit splits as it adds
-    data = supine[0]
-    count = count_modes(data, [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], hold="zoh", halves=(data, data),
-                        supported=lambda f, x: column, fitter=_scripted(table))  # fmt: skip
+def test_an_addition_the_diagram_has_no_column_for_is_named_when_the_record_wants_it(supine, column):
+    """Criterion 95 for 3 modes, 50 for 4 (a split 250), and the new pole the same in both halves: with
+    a stable column in the diagram the fourth mode is added; without one (ARMAX fits that do not
+    resolve it: a six-mass chain at 400 Hz) it is not, but the count names it and says the modes may
+    be too few, so the verdict cannot be good."""
+    table = {2: 130.0, 3: 95.0, 4: 50.0, 5: 250.0, "split": 250.0}
+    data, start = supine[0], [5.0, 9.0, 13.0]
+    count = count_modes(data, start, [0.3, 0.3, 0.3], hold="zoh", halves=(data, data),
+                        supported=lambda f, x: column, fitter=_scripted(table, start))  # fmt: skip
     assert count.model.n_modes == (4 if column else 3)
     if column:
         assert count.wanted == ()
@@ -491,7 +492,7 @@ def test_an_addition_the_diagram_has_no_column_for_is_named_when_the_record_want
     [(False, True, False, "dropped"), (True, False, False, "dropped"), (True, True, False, "kept"),
      (False, True, True, "stand-in"), (True, False, True, "stand-in")],
 )  # fmt: skip
-def test_a_start_mode_the_free_fit_carries_away_must_be_founded(monkeypatch, supine, stable_there, resolved, needed,
+def test_a_start_mode_the_free_fit_carries_away_must_be_founded(supine, stable_there, resolved, needed,
                                                                 outcome):  # fmt: skip
     """The search's converged model holds the 13 Hz start at 11 Hz: a new pole, which is reported
     only when its damping is resolved and the diagram holds a pole there (as an addition must).
@@ -540,18 +541,26 @@ def test_a_stand_in_is_in_the_model_but_not_reported_and_is_said():
 
 
 @pytest.mark.parametrize("same_in_halves", [True, False])
-def test_with_the_halves_a_moved_pole_is_judged_by_them_not_by_the_diagram(monkeypatch, supine, same_in_halves):
+def test_with_the_halves_a_moved_pole_is_judged_by_them_not_by_the_diagram(supine, same_in_halves):
     """Where the ARMAX fits are biased the diagram holds no pole where the model moves one (a stuck
-    pelvis's 13.50 Hz mode sat at 14.69 Hz in every order): with the halves, they decide."""
+    pelvis's 13.50 Hz mode sat at 14.69 Hz in every order): with the halves, they decide. Only the
+    moved pole is put to them: the second half moves the others 10 SD where it keeps the moved one."""
     import armaxmodal.modes.count_search as count_search
 
     table = {2: 100.0, 3: 100.0}  # the model does not need the moved pole
-    search = count_search._Search(supine[0], "zoh", 1.0, 40, fitter=_scripted(table))
-    asked = []
-    monkeypatch.setattr(search, "in_both_halves", lambda m, new, h: asked.append(list(new)) or same_in_halves)
+    data = supine[0]
+    second = replace(data, y=data.y[:-1], u=data.u[:-1], s=data.s[:-1], z_inv=data.z_inv[:-1])  # told apart by size
+
+    def fitter(d, f, x, hold, n, dft, intervals=True):  # sd 1e-3 f in each half: 10 SD is a shift of 1.41 %
+        f = np.asarray(f, float)
+        moved = np.abs(f - 11.0) < 0.5
+        shift = np.where(moved != same_in_halves, 10 * np.sqrt(2) * 1e-3, 0.0) * (d.y.shape[0] == second.y.shape[0])
+        return _Scored(f * (1 + shift), x, table)
+
+    search = count_search._Search(data, "zoh", 1.0, 40, fitter=fitter)
     moved = _Scored([5.0, 9.0, 11.0], [0.3, 0.3, 0.3], table)
-    model, carried, _ = count_search._without_unfounded(search, [5.0, 9.0, 13.0], moved, lambda f, x: False, ("a", "b"))
-    assert asked == [[2]]  # only the moved pole is put to the halves
+    model, carried, _ = count_search._without_unfounded(search, [5.0, 9.0, 13.0], moved, lambda f, x: False,
+                                                        (data, second))  # fmt: skip
     assert (carried == ()) is same_in_halves and model.n_modes == (3 if same_in_halves else 2)
 
 
@@ -905,19 +914,19 @@ def test_the_split_of_lowest_criterion_is_the_one_judged(best_resolved):
 
 
 @pytest.mark.parametrize(("rise", "joins"), [(-2.9, True), (6.0, True), (40.0, False), (-40.0, False)])
-def test_a_wanted_split_as_good_as_the_chosen_model_is_one_of_the_equally_good(monkeypatch, supine, rise, joins):
+def test_a_wanted_split_as_good_as_the_chosen_model_is_one_of_the_equally_good(supine, rise, joins):
     """A wanted split whose criterion stays within the decisive 10 of the chosen model's is a model
     the record cannot tell from it: the intervals cover its modes. Beyond that, either way, it is
-    not (a decisive rise is BIC's verdict; a decisive fall the search would have taken had it tried)."""
-    import armaxmodal.modes.count_search as count_search
-
-    data, truth = supine
-    split = fit_modal_model(data, truth.freq_hz, truth.damping, "zoh", max_nfev=1)
-    wanted = Wanted(14.0, 200.0, 22, rise, False)
-    monkeypatch.setattr(count_search, "_split_wanted", lambda *a, **k: (wanted, split))
-    count = count_modes(data, truth.freq_hz, truth.damping, hold="zoh")
-    assert count.wanted == wanted
-    assert any(m is split for _, m in count.alternatives) == joins
+    not (a decisive rise is BIC's verdict; a decisive fall the search would have taken had it tried).
+    Criterion 100 for the three modes, 1000 for any addition or split but that of 13 Hz, 100 + rise."""
+    data, start = supine[0], [5.0, 9.0, 13.0]
+    table = {2: 200.0, 3: 100.0, 4: 1000.0, "split": 1000.0, ("split", 13.0): 100.0 + rise}
+    count = count_modes(data, start, [0.3, 0.3, 0.3], hold="zoh", halves=(data, data), supported=lambda f, x: True,
+                        fitter=_scripted(table, start))  # fmt: skip
+    assert count.model.n_modes == 3 and count.wanted.rise == pytest.approx(rise) and not count.wanted.unsupported
+    assert 11.0 < count.wanted.freq_hz < 15.0  # a pole of the 13 Hz split
+    split = [alt for _, alt in count.alternatives if alt.split_of == 13.0]
+    assert len(split) == joins and all(d == pytest.approx(rise) for d, alt in count.alternatives if alt in split)
 
 
 def test_a_doubt_the_count_takes_back_goes_unsaid_and_one_it_leaves_out_is_said():
@@ -955,23 +964,21 @@ def test_a_lightly_damped_chain_sampled_far_above_its_modes_names_what_the_sweep
 
 
 @pytest.mark.parametrize(("z", "said"), [(2.0, None), (4.0, "count_undecided"), (9.0, "mode_count")])
-def test_an_addition_its_halves_nearly_confirm_is_undecided_not_refused(monkeypatch, supine, z, said):
+def test_an_addition_its_halves_nearly_confirm_is_undecided_not_refused(supine, z, said):
     """Criterion 95 for 3 modes, 50 for 4, with a diagram column: the halves put the new pole's
     frequency z standard deviations apart (its damping the same). Within the 1 % level of a chi-square
     of 2 degrees of freedom it is added; beyond 1e-6 it is a change during the record, left out with
     an informative note; in between the record does not settle it (a light chain's weak 20.75 Hz
     mode, its damping 3.6 apart in its halves, was left out under 'good')."""
-    import armaxmodal.modes.count_search as count_search
-
-    table = {2: 130.0, 3: 95.0, 4: 50.0, 5: 250.0}
-    monkeypatch.setattr(count_search, "_split_wanted", lambda *a, **k: ((), None))
-    data = supine[0]
+    table = {2: 130.0, 3: 95.0, 4: 50.0, 5: 250.0, "split": 250.0}
+    data, start = supine[0], [5.0, 9.0, 13.0]
     second = replace(data, y=data.y[:-1], u=data.u[:-1], s=data.s[:-1], z_inv=data.z_inv[:-1])  # told apart by size
 
     def fitter(d, f, x, hold, n, dft, intervals=True):  # sd 1e-3 f in each half: a shift of z sqrt(2) 1e-3 is z apart
-        return _Scored(np.asarray(f) * (1 + z * np.sqrt(2) * 1e-3 * (d.y.shape[0] == second.y.shape[0])), x, table)
+        return _Scored(np.asarray(f) * (1 + z * np.sqrt(2) * 1e-3 * (d.y.shape[0] == second.y.shape[0])), x, table,
+                       start)  # fmt: skip
 
-    count = count_modes(data, [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], hold="zoh", halves=(data, second),
+    count = count_modes(data, start, [0.3, 0.3, 0.3], hold="zoh", halves=(data, second),
                         supported=lambda f, x: True, fitter=fitter)  # fmt: skip
     assert count.model.n_modes == (4 if said is None else 3)
     assert (len(count.unsettled_hz), len(count.unconfirmed_hz)) == {None: (0, 0), "count_undecided": (1, 0),

@@ -127,7 +127,7 @@ def test_a_pick_the_record_does_not_need_is_said():
     assert _pick_notes(count, np.array([False, True])) == []  # only the picked poles are judged
 
 
-def test_the_picks_model_keeps_the_poles_the_automatic_model_hides(monkeypatch, ride):
+def test_the_picks_model_keeps_the_poles_the_automatic_model_hides(ride):
     """A pole the automatic model holds beyond the band (it stands for the modes above it) stays in
     the model the picks are fitted with: leaving it out biases the top picks."""
     from dataclasses import replace
@@ -149,9 +149,8 @@ def test_the_picks_model_keeps_the_poles_the_automatic_model_hides(monkeypatch, 
         seen.append((list(freq_hz), search))
         raise KeyboardInterrupt  # what was asked is all this test needs
 
-    monkeypatch.setattr(counted, "count_modes", stop)
     with pytest.raises(KeyboardInterrupt):
         counted.counted_modes(diagram, work, sel.refinement.band_hz, "bandlimited", [2, 4], SelectionSettings(),
-                              picked=True)
+                              picked=True, counter=stop)
     (starts, search), = seen
     assert starts[-1] == 40.0 and len(starts) == 5 and search is False

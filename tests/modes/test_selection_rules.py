@@ -6,6 +6,8 @@ run (mutmut) over that module."""
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -424,9 +426,7 @@ def test_finished_pole_takes_the_nearest_finished_estimate_within_five_percent()
     assert _finished_pole(diagram, sweep, {8: finished.iloc[:0]}, reach).freq_hz == 5.0  # nothing finished
 
 
-def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_data(monkeypatch):
-    from types import SimpleNamespace
-
+def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_data():
     import armaxmodal.modes.state as st
     from armaxmodal.spectra import excited_band
 
@@ -437,15 +437,13 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     def refit(recording, freq_hz, damping, band_hz, settings=None, decisive=None):
         seen.append(band_hz)
         assert decisive == CountSettings().decisive_bic  # the hold is decided at the count's level
-        return SimpleNamespace(hold=hold)
+        return SimpleNamespace(hold="zoh")
 
-    monkeypatch.setattr(st, "refine_modes", refit)
     modes, shapes = _modes([5.0, 9.0], [0.1, 0.05], [1.0, 1.0]), np.eye(2, dtype=complex)
     diagram = SimpleNamespace(recording=rec)
     assert st.refit_band(rec, (4.0, 12.0)) == (max(lo, 4.0), min(hi, 12.0))
     assert st.refit_band(rec, None) == (lo, hi)
-    hold = "zoh"
-    ref = st.selection_job(rec, [], modes, ("refit", (4.0, 12.0)))
+    ref = st.selection_job(rec, [], modes, ("refit", (4.0, 12.0)), refine=refit)
     assert seen[-1] == (4.0, 12.0) and ref.hold == "zoh"
     work = SelectionState(modes, shapes)
     out = st.refined_modes(diagram, work, ref, 0.05, 0.5, 0.8)
@@ -455,22 +453,53 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     def failing(recording, freq_hz, damping, band_hz, settings=None, decisive=None):
         raise OrderError("too few lines")
 
-    monkeypatch.setattr(st, "refine_modes", failing)
-    failed = st.selection_job(rec, [], modes, ("refit", (lo, hi)))
+    failed = st.selection_job(rec, [], modes, ("refit", (lo, hi)), refine=failing)
     assert isinstance(failed, st.RefitFailure) and failed.reason == "too few lines"  # said, not silent
     (note,) = failed.notes()
     assert note.code == "refit_failed" and "too few lines" in note.message
     out = st.refined_modes(diagram, work, failed, 0.05, 0.5, 0.8)
     assert out.refinement is None and out.modes is modes and out.shapes is shapes  # the ARMAX values stand
-    monkeypatch.setattr(st, "refine_modes", refit)
-    hold = "bandlimited"
-    calls = []
-    monkeypatch.setattr(st, "_apply_refinement", lambda m, s, r, f, x, relaxed=False: (calls.append((f, x)) or (m, s)))
-    monkeypatch.setattr(st, "merge_duplicates", lambda m, v, mac, dur: (calls.append((len(v), mac, dur)) or [1]))
-    out = st.refined_modes(diagram, work, SimpleNamespace(hold=hold), 0.05, 0.5, 0.8)
-    assert calls == [(0.05, 0.5), (2, 0.8, rec.duration)]
-    assert out.modes.freq_hz.tolist() == [9.0] and out.modes.index.tolist() == [0]
+
+
+def _band_limited_refit(freq_hz, damping, shapes):
+    freq_hz, damping = np.asarray(freq_hz, float), np.asarray(damping, float)
+    return SimpleNamespace(hold="bandlimited", freq_hz=freq_hz, damping=damping, freq_sd=1e-3 * freq_hz,
+                           damping_sd=1e-3 * damping, shapes=shapes)  # fmt: skip
+
+
+@pytest.mark.parametrize(("freq_hz", "damping", "reported"), [
+    ((5.2, 9.4), (0.11, 0.07), (True, True)),  # 4 % and 4.4 % in frequency, 10 % and 40 % in damping
+    ((5.3, 9.0), (0.1, 0.05), (False, True)),  # 6 % in frequency: beyond the reach of 5 %
+    ((5.0, 9.1), (0.1, 0.08), (True, False)),  # 60 % in damping: beyond 50 %
+])  # fmt: skip
+def test_a_band_limited_refit_is_reported_within_its_reach_else_the_armax_value_stays(freq_hz, damping, reported):
+    import armaxmodal.modes.state as st
+
+    modes = _modes([5.0, 9.0], [0.1, 0.05], [1.0, 1.0]).assign(estimator="armax", freq_sd=0.5, damping_sd=0.5)
+    refit_shapes = np.array([[1.0, 0.2], [0.3, 1.0]], dtype=complex)
+    ref = _band_limited_refit(freq_hz, damping, refit_shapes)
+    out = st.refined_modes(SimpleNamespace(recording=_recording(2000)), SelectionState(modes, np.eye(2, dtype=complex)),
+                           ref, 0.05, 0.5, 0.8)  # fmt: skip
+    assert out.refinement is ref and len(out.modes) == 2
+    for i, taken in enumerate(reported):
+        expected = (freq_hz[i], damping[i], 1e-3 * freq_hz[i]) if taken else (modes.freq_hz[i], modes.damping[i], 0.5)
+        assert tuple(out.modes.loc[i, ["freq_hz", "damping", "freq_sd"]]) == pytest.approx(expected)
+        assert out.modes.estimator[i] == ("fd-bandlimited" if taken else "armax (refit moved too far)")
+        np.testing.assert_array_equal(out.shapes[:, i], refit_shapes[:, i] if taken else np.eye(2)[:, i])
+
+
+def test_two_modes_a_band_limited_refit_brings_together_are_one_unless_picked():
+    """5.00 and 5.25 Hz refitted to 5.10 and 5.12 Hz: closer than 2 / T (T = 33 s), one mode, the
+    better supported one; with ``merge_mac`` None (picks) both stay."""
+    import armaxmodal.modes.state as st
+
+    modes = _modes([5.0, 5.25], [0.1, 0.1], [0.5, 1.0]).assign(estimator="armax", freq_sd=0.5, damping_sd=0.5)
+    ref = _band_limited_refit([5.10, 5.12], [0.1, 0.1], np.eye(2, dtype=complex))
+    diagram, work = SimpleNamespace(recording=_recording(2000)), SelectionState(modes, np.eye(2, dtype=complex))
+    out = st.refined_modes(diagram, work, ref, 0.05, 0.5, 0.8)
+    assert out.modes.freq_hz.tolist() == [5.12] and out.modes.index.tolist() == [0]
     assert out.shapes.tolist() == [[0.0], [1.0]]
+    assert st.refined_modes(diagram, work, ref, 0.05, 0.5, None).modes.freq_hz.tolist() == [5.10, 5.12]
 
 
 def test_filled_samples_widen_every_interval_by_the_information_they_lack():

@@ -427,10 +427,10 @@ def test_the_bridge_gives_the_same_modes_in_any_unit(realdata_dir):
     np.testing.assert_allclose(found[1][2], found[0][2], rtol=1e-6)
 
 
-def test_a_refit_that_cannot_be_made_is_said_not_taken_for_refine_false(monkeypatch, fixtures_dir):
+def test_a_refit_that_cannot_be_made_is_said_not_taken_for_refine_false(fixtures_dir):
     """A failed frequency-domain refit leaves the ARMAX values and a ``refit_failed`` note in
     the result (and so in the JSON); refine=False leaves no such note."""
-    import armaxmodal.modes.state as selected_refit
+    from armaxmodal.modes.state import Fitters
 
     rec = am.read_recording(fixtures_dir / "supine_random.csv")
     diagram = stabilisation_diagram(rec, range(4, 13, 2), per_sensor=False, n_jobs=1)
@@ -438,8 +438,7 @@ def test_a_refit_that_cannot_be_made_is_said_not_taken_for_refine_false(monkeypa
     def cannot(*args, **kwargs):
         raise OrderError("too few lines in the band")
 
-    monkeypatch.setattr(selected_refit, "refine_modes", cannot)
-    failed = select_modes(diagram, segments=0, n_jobs=1)
+    failed = select_modes(diagram, segments=0, n_jobs=1, fitters=Fitters(refine=cannot))
     plain = select_modes(diagram, refine=False, segments=0, n_jobs=1)
     notes = [w for w in failed.warnings if w.code == "refit_failed"]
     assert notes and "too few lines in the band" in notes[0].message

@@ -2,50 +2,61 @@
 of its spectra once: every later stage reads what the record carries (Recording.welch)."""
 
 import hashlib
+import inspect
+import sys
+from contextlib import contextmanager
 
 import numpy as np
 
 import armaxmodal as am
-import armaxmodal.modes.diagram as diagram_module
-import armaxmodal.recording as recording_module
+from armaxmodal.modes.poles import disturbance_lines
+from armaxmodal.prepare.preparation import prepare
+from armaxmodal.spectra import welch_spectra
+
+
+@contextmanager
+def calls_of(func):
+    """Every call of ``func`` in this thread while the block runs, as its arguments on entry: seen
+    by a profile hook, so no module global is replaced and the code under test runs as shipped."""
+    code, seen, before = inspect.unwrap(func).__code__, [], sys.getprofile()
+
+    def hook(frame, event, arg):
+        if event == "call" and frame.f_code is code:
+            seen.append(dict(frame.f_locals))
+        if before is not None:  # one hook per thread: an outer block's still sees its calls
+            before(frame, event, arg)
+
+    sys.setprofile(hook)
+    try:
+        yield seen
+    finally:
+        sys.setprofile(before)
 
 
 def _digest(*arrays) -> str:
     return hashlib.sha1(b"".join(np.ascontiguousarray(a).tobytes() for a in arrays)).hexdigest()
 
 
-def test_prepared_once_and_each_spectrum_computed_once(monkeypatch, fixtures_dir):
+def test_prepared_once_and_each_spectrum_computed_once(fixtures_dir):
     rec = am.read_recording(fixtures_dir / "supine_random.csv")
-    preparations, spectra = [], []
-    prepare, welch_spectra = diagram_module.prepare, recording_module.welch_spectra
-
-    def counted_prepare(*args, **kwargs):
-        preparations.append(args[0])
-        return prepare(*args, **kwargs)
-
-    def counted_welch(u, y, fs, nperseg):
-        spectra.append((_digest(u, y), fs, nperseg))
-        return welch_spectra(u, y, fs, nperseg)
-
-    monkeypatch.setattr(diagram_module, "prepare", counted_prepare)
-    monkeypatch.setattr(recording_module, "welch_spectra", counted_welch)
-    selection = am.select_modes(am.stabilisation_diagram(rec, orders=range(4, 17, 2), n_jobs=1), n_jobs=1)
+    with calls_of(prepare) as preparations, calls_of(welch_spectra) as calls:
+        selection = am.select_modes(am.stabilisation_diagram(rec, orders=range(4, 17, 2), n_jobs=1), n_jobs=1)
     assert selection.modes.shape[0] >= 3  # the pipeline ran to the end
-    assert len(preparations) == 1
+    assert len(preparations) == 1 and preparations[0]["recording"] is rec
+    spectra = [(_digest(c["u"], c["y"]), c["fs"], c["nperseg"]) for c in calls]
     assert len(spectra) >= 2  # the checks' and the selection's segment lengths
     assert len(set(spectra)) == len(spectra), "a record's spectra computed twice"
 
 
-def test_the_diagrams_warnings_are_found_once_however_often_they_are_read(monkeypatch, fixtures_dir):
+def test_the_diagrams_warnings_are_found_once_however_often_they_are_read(fixtures_dir):
     """A selection's quality, verdict and JSON each read the diagram's warnings; the disturbance
     lines behind them are found once per diagram, and a reader's list is its own copy."""
     rec = am.read_recording(fixtures_dir / "supine_random.csv")
     diagram = am.stabilisation_diagram(rec, orders=range(4, 13, 2), n_jobs=1)
-    found, lines = [], diagram_module.disturbance_lines
-    monkeypatch.setattr(diagram_module, "disturbance_lines", lambda *a, **k: found.append(1) or lines(*a, **k))
-    selection = am.select_modes(diagram, n_jobs=1, segments=0)
-    codes = [w.code for w in selection.warnings]
-    selection.to_dict(), selection.quality, selection.verdict
-    assert found == [1] and [w.code for w in selection.warnings] == codes
+    with calls_of(disturbance_lines) as found:
+        selection = am.select_modes(diagram, n_jobs=1, segments=0)
+        codes = [w.code for w in selection.warnings]
+        selection.to_dict(), selection.quality, selection.verdict
+    assert len(found) == 1 and [w.code for w in selection.warnings] == codes
     diagram.warnings.clear()
     assert [w.code for w in selection.warnings] == codes
