@@ -59,7 +59,8 @@ class Recording:
     subject: str | None = None
     mass_kg: float | None = None
     meta: dict = field(default_factory=dict)
-    #: this record's Welch spectra by segment length (:meth:`welch`): computed once, for every stage
+    #: this record's Welch spectra by segment length (:meth:`welch`) and its DFT (key ``"dft"``,
+    #: :meth:`dft`): computed once, for every stage
     _spectra: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -153,6 +154,37 @@ class Recording:
                 array.flags.writeable = False  # shared by every stage that reads them
             self._spectra[nperseg] = spectra
         return self._spectra[nperseg]
+
+    def dft(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The record's DFT, computed at the first call and kept with the record (read-only), as
+        :meth:`welch`'s spectra are: the frequency-domain refit and the count fit lines of one cut of
+        the record, and each reads them from here.
+
+        Returns
+        -------
+        freq_hz : (n_samples // 2 + 1,) ndarray
+            The DFT's frequencies, Hz.
+        base : (n_freq,) complex ndarray
+            The input's DFT.
+        response : (n_freq, n_sensors) complex ndarray
+            The outputs' DFTs.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import armaxmodal as am
+        >>> rec = am.Recording(10.0, np.r_[1.0, np.zeros(7)], np.arange(8.0)[:, None], ("a",))  # an impulse in
+        >>> freq, base, response = rec.dft()
+        >>> freq.tolist(), base.real.tolist(), response.shape, rec.dft()[1] is base  # computed once
+        ([0.0, 1.25, 2.5, 3.75, 5.0], [1.0, 1.0, 1.0, 1.0, 1.0], (5, 1), True)
+        """
+        if "dft" not in self._spectra:
+            dft = (np.fft.rfftfreq(self.n_samples, 1.0 / self.fs), np.fft.rfft(self.base),
+                   np.fft.rfft(self.response, axis=0))  # fmt: skip
+            for array in dft:
+                array.flags.writeable = False  # shared by every stage that reads them
+            self._spectra["dft"] = dft
+        return self._spectra["dft"]
 
     def with_meta(self, meta: dict) -> Recording:
         """The same record with other metadata, sharing the spectra computed so far (the samples

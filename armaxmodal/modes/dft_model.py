@@ -86,8 +86,7 @@ class DftLines:
     def from_recording(cls, recording: Recording, band_hz: tuple[float, float]) -> DftLines:
         """The lines of ``recording`` in ``band_hz`` (Hz), with unit weights (see
         :meth:`weighted`)."""
-        dt = 1.0 / recording.fs
-        freq = np.fft.rfftfreq(recording.n_samples, dt)
+        dt, (freq, base, response) = 1.0 / recording.fs, recording.dft()  # the record's DFT, computed once
         lines = (freq >= band_hz[0]) & (freq <= band_hz[1]) & (freq > 0)
         if lines.sum() < 8:
             raise OrderError(
@@ -95,8 +94,7 @@ class DftLines:
                 "record longer or widen the band."
             )
         w = 2 * np.pi * freq[lines]
-        u = np.fft.rfft(recording.base)[lines]
-        y = np.fft.rfft(recording.response, axis=0)[lines]
+        u, y = base[lines], response[lines]
         band = (float(freq[lines][0]), float(freq[lines][-1]))
         return cls(1j * w, np.exp(-1j * w * dt), u, y, np.ones(y.shape[1]), dt, band)
 

@@ -5,6 +5,7 @@ import hashlib
 import inspect
 import sys
 from contextlib import contextmanager
+from dataclasses import replace
 
 import numpy as np
 
@@ -60,3 +61,16 @@ def test_the_diagrams_warnings_are_found_once_however_often_they_are_read(fixtur
     assert len(found) == 1 and [w.code for w in selection.warnings] == codes
     diagram.warnings.clear()
     assert [w.code for w in selection.warnings] == codes
+
+
+def test_each_cut_of_the_record_is_transformed_once(bundled_diagram):
+    """The refit, the count and the check's confirmation fit DFT lines of the same record, its two
+    halves among them: each signal of each cut is transformed once (Recording.dft), however many
+    stages fit its lines."""
+    fresh = replace(bundled_diagram, recording=replace(bundled_diagram.recording))  # no DFT kept from another test
+    with calls_of(np.fft.rfft) as calls:
+        selection = am.select_modes(fresh, segments=0, n_jobs=1)
+    assert selection.count is not None and selection.refinement is not None  # both fitted lines
+    signals = [_digest(c["a"]) for c in calls]
+    assert len(signals) >= 2 * 2  # the whole record and its halves, input and outputs
+    assert len(set(signals)) == len(signals), "a cut of the record transformed twice"
