@@ -1,20 +1,18 @@
 """The modal model fitted to the record's DFT lines: one fitter for the refit of the selected
 modes and for the maximum-likelihood count (beyond the thesis).
 
-Every sensor's DFT over the excited band is fitted as ``Y = G(Omega) U + T(z) + E``: ``G`` the
-modal sum with continuous poles, residues and a direct term, ``T`` the transient (leakage) term
-with the same poles, exact for a finite record (Pintelon & Schoukens, *System Identification: a
-Frequency Domain Approach*, 2nd ed., Ch. 6-7). The method page's "modal model by maximum
-likelihood" gives the likelihood, why this form and not a fit to the H1, and the intervals.
+Every sensor's DFT over the excited band is fitted as ``Y = G(Omega) U + T(z) + E``: ``G`` the modal sum with
+continuous poles, residues and a direct term, ``T`` the transient (leakage) term with the same poles, exact for
+a finite record (Pintelon & Schoukens, *System Identification: a Frequency Domain Approach*, 2nd ed., Ch. 6-7).
+The method page's "modal model by maximum likelihood" gives the likelihood, why this form and not a fit to the
+H1, and the intervals.
 
-**Inter-sample behaviour.** A discrete ARMAX model is the exact model class only when the
-input is held between samples (zero-order hold). Measured signals pass anti-aliasing filters
-and are band-limited: their discrete transfer function equals the continuous one below
-Nyquist, which no low-order rational function of ``z`` matches, so the PEM poles carry a
-model-class bias that depends on where the input has power (measured: a 0.5-20 Hz sweep puts
-the 16.2 Hz mode 2.9 % low and mode 3's damping 12 % high). ``G`` is written in ``s = i w``
-for a band-limited input or in ``z`` for a held one; :func:`refine_modes` fits both and the
-data choose.
+**Inter-sample behaviour.** A discrete ARMAX model is the exact model class only when the input is held between
+samples (zero-order hold). Measured signals pass anti-aliasing filters and are band-limited: their discrete
+transfer function equals the continuous one below Nyquist, which no low-order rational function of ``z``
+matches, so the PEM poles carry a model-class bias that depends on where the input has power (measured: a 0.5-20
+Hz sweep puts the 16.2 Hz mode 2.9 % low and mode 3's damping 12 % high). ``G`` is written in ``s = i w`` for a
+band-limited input or in ``z`` for a held one; :func:`refine_modes` fits both and the data choose.
 
 The residues, direct and transient terms enter linearly and are projected out (the private
 ``armaxmodal._separable``): only the frequencies and damping ratios are iterated, all free.
@@ -37,6 +35,7 @@ from armaxmodal.stats import sandwich_sd
 __all__ = ["DftLines", "ModalModel", "fit_modal_model", "refine_modes"]
 
 HOLDS = ("bandlimited", "zoh")
+COUNT = DEFAULTS.count  # the count's thresholds decide the hold too (refine_modes)
 
 
 @dataclass(frozen=True)
@@ -337,16 +336,16 @@ def _fit(data: DftLines, start: np.ndarray, hold: str, max_nfev: int, settings: 
 
 @single_blas_thread
 def refine_modes(recording: Recording, freq_hz, damping, *, band_hz: tuple[float, float], hold: str = "auto",
-                 max_nfev: int = 60, settings: DftSettings = DEFAULTS.dft,
-                 decisive: float = DEFAULTS.count.decisive_bic) -> ModalModel:  # fmt: skip
+                 max_nfev: int = 60, settings: DftSettings = DEFAULTS.dft, decisive: float = COUNT.decisive_bic,
+                 negligible: float = COUNT.negligible_bic) -> ModalModel:  # fmt: skip
     """Refit selected modes to the DFT of a recording, choosing the inter-sample behaviour.
 
-    Both assumptions are fitted a few steps from the same start, with the same lines and the
-    same number of parameters; the one with the lower weighted residual is the data's choice
-    and is iterated to convergence (see the module notes). Where the few steps leave the two
-    within ``decisive``, both are converged and the lower residual there chooses (a five-segment
-    body's held ride: band-limited led after four steps, held by far converged, and only it gave the
-    exact dampings). Each sensor is weighted by one over its noise level at the start.
+    Both assumptions are fitted a few steps from the same start, with the same lines and the same number of
+    parameters; the one with the lower weighted residual is the data's choice and is iterated to convergence
+    (see the module notes). Where the few steps leave the two within ``decisive``, both are converged and the
+    lower residual there chooses, unless within ``negligible`` again (a five-segment body's held ride:
+    band-limited led after four steps, held by far converged, and only it gave the exact dampings). Each
+    sensor is weighted by one over its noise level at the start.
 
     Parameters
     ----------
@@ -361,9 +360,9 @@ def refine_modes(recording: Recording, freq_hz, damping, *, band_hz: tuple[float
         Cap on residual evaluations of the chosen assumption's fit.
     settings : DftSettings
         The damping bounds and the stopping tolerance.
-    decisive : float
-        The difference of weighted residual sums of squares (``-2 ln L`` at unit noise) that
-        decides: the count's ``decisive_bic``.
+    decisive, negligible : float
+        Differences of weighted residual sums of squares (``-2 ln L`` at unit noise): one that
+        decides, and one that decides nothing (the count's ``decisive_bic`` and ``negligible_bic``).
 
     Returns
     -------
@@ -390,9 +389,12 @@ def refine_modes(recording: Recording, freq_hz, damping, *, band_hz: tuple[float
     data = data.weighted(1.0 / held.residual_rms(np.clip(start, lo, hi)))
     fits = {h: _fit(data, start, h, 4 if hold == "auto" else max_nfev, settings) for h in HOLDS if hold in (h, "auto")}
     cost = {h: float(np.sum(m.rss * data.weights**2)) for h, m in fits.items()}
+    leader = min(cost, key=cost.get)
     if hold == "auto":  # a few steps tell the assumptions apart, unless within ``decisive``: then both converge
         close = abs(cost["zoh"] - cost["bandlimited"]) < decisive
         fits = {h: _fit(data, start_vector(m.freq_hz, m.damping), h, max_nfev, settings) for h, m in fits.items()
-                if close or cost[h] == min(cost.values())}  # fmt: skip
-        cost = {h: float(np.sum(m.rss * data.weights**2)) for h, m in fits.items()} if close else cost
-    return replace(fits[min(fits, key=cost.get)], hold_cost=cost)
+                if close or h == leader}  # fmt: skip
+        if close:  # converged, the lower residual chooses where it is lower by ``negligible`` or more
+            cost = {h: float(np.sum(m.rss * data.weights**2)) for h, m in fits.items()}
+            leader = min(cost, key=cost.get) if abs(cost["zoh"] - cost["bandlimited"]) >= negligible else leader
+    return replace(fits[leader], hold_cost=cost)

@@ -223,6 +223,9 @@ class CountSettings:
     #: a change of the criterion this large is "very strong" evidence (Kass & Raftery 1995): a
     #: mode's removal, or a candidate's addition, that moves it less leaves the count undecided
     decisive_bic: float = 10.0
+    #: ... and one below this is "not worth more than a bare mention": the refit's two inter-sample
+    #: forms, both converged, that close leave the form of the first steps (a held ride 0.5 apart)
+    negligible_bic: float = 2.0
     #: a refused addition whose likelihood ratio a chi-square of its parameters puts beyond this
     #: probability leaves the count undecided (when its mode is the same in both halves). BIC's
     #: penalty grows with the data, so a weakly seen mode can raise the likelihood far beyond chance

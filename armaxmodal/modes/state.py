@@ -216,7 +216,7 @@ def selection_job(recording: Recording, parts: list, modes: pd.DataFrame, job, s
         return segment_poles(parts, what)
     try:
         return refine(recording, modes.freq_hz, modes.damping, band_hz=what, settings=settings.dft,
-                      decisive=settings.count.decisive_bic)  # fmt: skip
+                      decisive=settings.count.decisive_bic, negligible=settings.count.negligible_bic)  # fmt: skip
     except (OrderError, np.linalg.LinAlgError) as exc:
         return RefitFailure(str(exc))  # too few lines or a degenerate basis: the ARMAX values stand, said
 
