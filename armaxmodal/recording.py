@@ -148,12 +148,7 @@ class Recording:
             The outputs' PSDs.
         """
         nperseg = int(nperseg)
-        if nperseg not in self._spectra:
-            spectra = welch_spectra(self.base, self.response, self.fs, nperseg)
-            for array in spectra:
-                array.flags.writeable = False  # shared by every stage that reads them
-            self._spectra[nperseg] = spectra
-        return self._spectra[nperseg]
+        return self._kept(nperseg, lambda: welch_spectra(self.base, self.response, self.fs, nperseg))
 
     def dft(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The record's DFT, computed at the first call and kept with the record (read-only), as
@@ -178,13 +173,18 @@ class Recording:
         >>> freq.tolist(), base.real.tolist(), response.shape, rec.dft()[1] is base  # computed once
         ([0.0, 1.25, 2.5, 3.75, 5.0], [1.0, 1.0, 1.0, 1.0, 1.0], (5, 1), True)
         """
-        if "dft" not in self._spectra:
-            dft = (np.fft.rfftfreq(self.n_samples, 1.0 / self.fs), np.fft.rfft(self.base),
-                   np.fft.rfft(self.response, axis=0))  # fmt: skip
-            for array in dft:
-                array.flags.writeable = False  # shared by every stage that reads them
-            self._spectra["dft"] = dft
-        return self._spectra["dft"]
+        return self._kept("dft", lambda: (np.fft.rfftfreq(self.n_samples, 1.0 / self.fs), np.fft.rfft(self.base),
+                                          np.fft.rfft(self.response, axis=0)))  # fmt: skip
+
+    def _kept(self, key, compute) -> tuple[np.ndarray, ...]:
+        """``compute()``'s arrays, computed at the first call for ``key`` and kept read-only: every stage
+        that holds this record reads the same ones."""
+        if key not in self._spectra:
+            arrays = compute()
+            for array in arrays:
+                array.flags.writeable = False
+            self._spectra[key] = arrays
+        return self._spectra[key]
 
     def with_meta(self, meta: dict) -> Recording:
         """The same record with other metadata, sharing the spectra computed so far (the samples
