@@ -414,9 +414,9 @@ MUTANTS = [
     ),
     (
         'armaxmodal/recording.py',
-        'if nperseg not in self._spectra:',
+        'if key not in self._spectra:',
         'if not self._spectra:',
-        'spectra cache ignores the segment (layout)',
+        'spectra cache ignores the segment and the DFT (layout)',
     ),
     (
         'armaxmodal/modes/pipeline.py',
