@@ -1,5 +1,5 @@
 """The separable least-squares problem of a modal model on DFT lines: the numerical core of
-:mod:`armaxmodal.modes.dft_model`'s fitter, kept beside ``_kernels`` and ``_linalg`` as they are
+:mod:`armaxmodal.estimate.dft_model`'s fitter, kept beside ``_kernels`` and ``_linalg`` as they are
 (private numerics behind a validated wrapper: no selection rule and no threshold of the stages).
 
 The modal sum with continuous poles (``1 / (s - lambda)`` for a band-limited input, its held

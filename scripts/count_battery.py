@@ -24,15 +24,21 @@ from __future__ import annotations
 import argparse
 import os
 import time
+from functools import partial
 
 import numpy as np
 import pandas as pd
 from scipy import signal
 
 import armaxmodal as am
-from armaxmodal.modes.dft_model import DftLines, fit_modal_model
+from armaxmodal.estimate import dft_model
+from armaxmodal.estimate.dft_model import DftLines
+from armaxmodal.modes.settings import DEFAULTS
 from armaxmodal.modes.state import refit_band
 from armaxmodal.stats import Z95
+
+# the fitter under the selection's default damping bounds and tolerance
+fit_modal_model = partial(dft_model.fit_modal_model, settings=DEFAULTS.dft)
 
 FREQ_TOL, DAMPING_TOL, BOUNDS = 0.02, 0.10, 3.0
 #: exact modes above this fraction of the ride's band may be missed

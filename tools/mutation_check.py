@@ -127,7 +127,7 @@ MUTANTS = [
         "return na - min(nk, 0)",
         "default_nb one tap short",
     ),
-    ("armaxmodal/modes/dft_model.py", "r = r * mu * lam / (mu - 1.0)", "r = r", "zoh residue conversion dropped"),
+    ("armaxmodal/estimate/dft_model.py", "r = r * mu * lam / (mu - 1.0)", "r = r", "zoh residue conversion dropped"),
     ("armaxmodal/modes/poles.py", "if row.damping <= 0:", "if row.damping < 0:", "a zero-damping pole kept"),
     (
         "armaxmodal/modes/poles.py",
@@ -136,7 +136,33 @@ MUTANTS = [
         "Nyquist rule loosened",
     ),
     ("armaxmodal/modal.py", "lam = np.log(mu) * fs", "lam = np.log(mu) / fs", "time step inverted"),
-    ("armaxmodal/modes/dft_model.py", "shapes=-r / lam**2,", "shapes=r / lam**2,", "EPFRF modal constant sign"),
+    ("armaxmodal/estimate/dft_model.py", "shapes=-r / lam**2,", "shapes=r / lam**2,", "EPFRF modal constant sign"),
+    # the fitter in estimate/, the refit's choice in modes/state.py (twenty-second session); run with
+    # --match "(fitter)" --tests tests/estimate/test_dft_model.py tests/modes/test_refine.py
+    (
+        "armaxmodal/estimate/dft_model.py",
+        'held = SeparableModel(self.s, self.z_inv, self.u, self.y / self.weights, self.dt, "zoh")',
+        'held = SeparableModel(self.s, self.z_inv, self.u, self.y, self.dt, "zoh")',
+        "the earlier weights kept in the start's noise level (fitter)",
+    ),
+    (
+        "armaxmodal/estimate/dft_model.py",
+        "return model.by_frequency() if by_frequency else model",
+        "return model.by_frequency()",
+        "the start's order lost (fitter)",
+    ),
+    (
+        "armaxmodal/modes/state.py",
+        """**({"max_nfev": 4} if hold == "auto" else {})""",
+        """**({"max_nfev": 4} if hold != "auto" else {})""",
+        "the first steps' cap on a given form, none on auto (fitter)",
+    ),
+    (
+        "armaxmodal/modes/state.py",
+        "fit = partial(fit_modal_model, data, max_nfev=max_nfev, settings=settings, by_frequency=False)",
+        "fit = partial(fit_modal_model, data, max_nfev=max_nfev, settings=settings)",
+        "the refit's modes by frequency, not in the start's order (fitter)",
+    ),
     # continuing a capped fit (issue 13's performance round)
     (
         "armaxmodal/estimate/_gauss_newton.py",
@@ -528,19 +554,19 @@ MUTANTS = [
     ),
     # --match "(count)" --tests tests/modes/test_mode_count.py
     (
-        "armaxmodal/modes/dft_model.py",
+        "armaxmodal/estimate/dft_model.py",
         "return self.neg2_loglik_on(n_eff) + self.n_params * np.log(n_eff)",
         "return self.neg2_loglik_on(n_eff) + 2 * self.n_params",
         "AIC's fixed penalty for BIC's (count)",
     ),
     (
-        "armaxmodal/modes/dft_model.py",
+        "armaxmodal/estimate/dft_model.py",
         "return self.n_modes * (2 + 4 * self.rss.size)",
         "return self.n_modes * (2 + 2 * self.rss.size)",
         "the transient terms not counted as parameters (count)",
     ),
     (
-        "armaxmodal/modes/dft_model.py",
+        "armaxmodal/estimate/dft_model.py",
         "rss = np.sum(resid**2, axis=0) / data.weights**2",
         "rss = np.sum(resid**2, axis=0)",
         "residual sums in weighted units (count)",

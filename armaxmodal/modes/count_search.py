@@ -1,6 +1,6 @@
 """The search of the count (the method page's "how many modes" gives its rules): from the diagram's selection,
 every step compares the current model with its neighbours, each refitted with every pole free
-(:func:`~armaxmodal.modes.dft_model.fit_modal_model`) -- a mode removed (a merge of two close modes is a
+(:func:`~armaxmodal.estimate.dft_model.fit_modal_model`) -- a mode removed (a merge of two close modes is a
 removal), a left-out stable cluster or the residual's peak added, a mode split in two -- and the neighbour
 of lowest criterion (:mod:`armaxmodal.modes.mode_count`) replaces the current model while it lowers it. Then
 the chosen model is converged, carried-away starts judged, equally good models fitted, wanted additions flagged.
@@ -9,14 +9,15 @@ the chosen model is converged, carried-away starts judged, equally good models f
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import partial
 
 import numpy as np
 from scipy.special import chdtrc
 
 from armaxmodal._threads import single_blas_thread
+from armaxmodal.estimate.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.modal import matched_poles, nearest_pole, new_poles
-from armaxmodal.modes.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.mode_count import (
     ModeCount,
     ModelTable,
@@ -51,10 +52,9 @@ class _Search:
         ``intervals=False``: fits compared by their criterion alone, without standard deviations."""
         self.trials += sum(len(f) > 0 for f, _ in starts)
 
-        def one(start):
-            return self.fitter(self.data, *start, self.hold, self.cfg.screen_nfev, self.dft, intervals=intervals)
-
-        fits = parallel_map(lambda start: one(start) if len(start[0]) else None, starts, self.n_jobs, min_items=2)
+        one = partial(self.fitter, self.data, settings=self.dft, intervals=intervals)
+        fits = parallel_map(lambda start: one(*start, self.hold, self.cfg.screen_nfev) if len(start[0]) else None,
+                            starts, self.n_jobs, min_items=2)  # fmt: skip
         return [self.logged(action, f, fit) for (action, f), fit in zip(labels, fits, strict=True)]
 
     def fit(self, freq_hz, damping, max_nfev: int | None = None, counted: bool = True,
@@ -64,7 +64,7 @@ class _Search:
         if len(freq_hz) == 0:
             return None
         self.trials += int(counted)
-        model = self.fitter(self.data, freq_hz, damping, self.hold, max_nfev or self.max_nfev, self.dft)
+        model = self.fitter(self.data, freq_hz, damping, self.hold, max_nfev or self.max_nfev, settings=self.dft)
         return model if label is None else self.logged(*label, model)
 
     def bic(self, model: ModalModel | None) -> float:
@@ -300,7 +300,7 @@ def count_modes(
     lines, dft, agreement : LineSettings, DftSettings, AgreementSettings
         Which poles are lines, not modes; the modal model's fits; the halves' test's level.
     fitter : callable
-        The fit, as :func:`~armaxmodal.modes.dft_model.fit_modal_model` (a test's stands in for it).
+        The fit, as :func:`~armaxmodal.estimate.dft_model.fit_modal_model` (a test's stands in for it).
 
     Returns
     -------
@@ -313,9 +313,9 @@ def count_modes(
     >>> import armaxmodal as am
     >>> body, exact = am.supine_human(), am.supine_human().modes()  # exact: 5.83, 8.31, 13.50, 16.25 Hz
     >>> ride = am.simulate_recording(body, am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03, seed=2)
-    >>> from armaxmodal.modes import count_search, dft_model
-    >>> data = dft_model.DftLines.from_recording(ride, (0.5, 28.0))
-    >>> count = count_search.count_modes(data, exact.freq_hz[:3], exact.damping[:3], hold="zoh")
+    >>> from armaxmodal.estimate.dft_model import DftLines
+    >>> data = DftLines.from_recording(ride, (0.5, 28.0))
+    >>> count = am.modes.count_search.count_modes(data, exact.freq_hz[:3], exact.damping[:3], hold="zoh")
     >>> [step.action for step in count.steps], [round(float(f), 1) for f in sorted(count.model.freq_hz)]
     (['add'], [5.8, 8.3, 13.6, 16.2])
     """
@@ -327,11 +327,11 @@ def count_modes(
 def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev, halves, supported, search, n_jobs,
                  settings: CountSettings, lines, dft, fitter, agreement) -> ModeCount:  # fmt: skip
     """:func:`count_modes` itself (its parameters), under the caller's BLAS threads (the public one holds one)."""
-    start_model = fitter(data, freq_hz, damping, hold, max_nfev, dft)
+    start_model = fitter(data, freq_hz, damping, hold, max_nfev, settings=dft)
     # each sensor weighted by its noise level as the fitted start leaves it (the likelihood is
     # concentrated over those levels; the weights only steer the fits)
     data = data.noise_weighted(start_model)
-    start_model = fitter(data, start_model.freq_hz, start_model.damping, hold, max_nfev, dft)
+    start_model = fitter(data, start_model.freq_hz, start_model.damping, hold, max_nfev, settings=dft)
     fraction = effective_fraction(start_model.residual, settings.max_correlation_lag)
     searching, search = search, _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev, n_jobs,
                                         settings, lines, dft, fitter, agreement)  # fmt: skip

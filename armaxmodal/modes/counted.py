@@ -18,10 +18,10 @@ import numpy as np
 import pandas as pd
 from scipy.special import chdtrc
 
+from armaxmodal.estimate.dft_model import DftLines, fit_modal_model
 from armaxmodal.modal import mac, matched_poles, nearest_pole
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles, stable_in_diagram
 from armaxmodal.modes.count_search import count_modes
-from armaxmodal.modes.dft_model import DftLines, fit_modal_model
 from armaxmodal.modes.intervals import (
     EARLIER_COLUMNS,
     covering_both_estimators,
@@ -73,9 +73,10 @@ def _candidates(diagram, modes: pd.DataFrame, band, nas, settings: SelectionSett
 
 def _on_whole_record(count: ModeCount, whole: DftLines, hold: str) -> ModeCount:
     """The counted model fitted to the whole record's lines (``whole``) from where the search left it."""
-    start = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, 1, count.dft)
+    start = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, 1, settings=count.dft)
     whole = whole.noise_weighted(start)
-    final = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, count.settings.final_nfev, count.dft)
+    final = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, count.settings.final_nfev,
+                            settings=count.dft)
     return replace(count, model=final)
 
 
@@ -199,7 +200,7 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
     rows, shapes, notes, gone = rows.copy(), shapes.copy(), [], []
     for a, b, gap in pairs:
         fits = [fit_modal_model(data, np.delete(m.freq_hz, k), np.delete(m.damping, k), hold, settings.count.final_nfev,
-                                settings.dft)
+                                settings=settings.dft)
                 for k in (poles[a], poles[b])]  # fmt: skip
         one = min(fits, key=lambda fit: fit.bic())
         both = rows.loc[[a, b]]

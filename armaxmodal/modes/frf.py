@@ -17,11 +17,10 @@ import numpy as np
 import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, representative_pole
-from armaxmodal.modes.dft_model import refine_modes
 from armaxmodal.modes.modal_check import ModalCheck, check_modes, poles_of, rss_at
 from armaxmodal.modes.notes import not_needed_note
 from armaxmodal.modes.settings import DEFAULTS, PEAK_RESOLUTION, FrfSettings, SelectionSettings
-from armaxmodal.modes.state import RefitFailure, SelectionState, refined_modes, refit_band, selection_job
+from armaxmodal.modes.state import RefitFailure, SelectionState, refine_modes, refined_modes, refit_band, selection_job
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.spectra import coherent_lines, coherent_peaks, explains, resolving_nperseg

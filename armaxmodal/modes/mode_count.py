@@ -1,7 +1,7 @@
 """How many modes: the count's result and the tests it is built from.
 
 :func:`armaxmodal.modes.count_search.count_modes` compares free refits of the maximum-likelihood modal model
-(:func:`armaxmodal.modes.dft_model.fit_modal_model`) with one mode fewer, one more, or one split, and keeps the
+(:func:`armaxmodal.estimate.dft_model.fit_modal_model`) with one mode fewer, one more, or one split, and keeps the
 neighbour of lowest criterion while it lowers it. This module holds what it returns, :class:`ModeCount`, with the
 verdicts derived from it, and the tests the search applies: the halves' agreement (``halves_chi2``), the pairing of
 two pole sets and the residual's peak (the lines' effective share: :func:`armaxmodal.stats.effective_fraction`).
@@ -16,9 +16,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from armaxmodal.estimate.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.io.write import finite_or_none as finite  # strict JSON: None for NaN
 from armaxmodal.modal import matched_poles, nearest_pole
-from armaxmodal.modes.dft_model import DftLines, ModalModel, fit_modal_model
 from armaxmodal.modes.intervals import interval
 from armaxmodal.modes.poles import beyond_band, borderline, reported
 from armaxmodal.modes.settings import DEFAULTS, AgreementSettings, CountSettings, DftSettings, LineSettings
@@ -172,9 +172,10 @@ class ModeCount:
     >>> import armaxmodal as am
     >>> body, exact = am.supine_human(), am.supine_human().modes()  # exact: 5.83, 8.31, 13.50, 16.25 Hz
     >>> ride = am.simulate_recording(body, am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03, seed=2)
-    >>> from armaxmodal.modes import count_search, dft_model
-    >>> data = dft_model.DftLines.from_recording(ride, (0.5, 28.0))
-    >>> count = count_search.count_modes(data, exact.freq_hz, exact.damping, hold="zoh")
+    >>> from armaxmodal.estimate.dft_model import DftLines
+    >>> data = DftLines.from_recording(ride, (0.5, 28.0))
+    >>> from armaxmodal.modes.count_search import count_modes
+    >>> count = count_modes(data, exact.freq_hz, exact.damping, hold="zoh")
     >>> count.model.n_modes, count.verdicts(), round(count.effective_fraction, 1)
     (4, array(['needed', 'needed', 'needed', 'needed'], dtype=object), 1.0)
     """
@@ -348,7 +349,7 @@ def halves_chi2(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: 
     -------
     (n_modes,) ndarray
     """
-    a, b = (fitter(h.weighted(data.weights), model.freq_hz, model.damping, hold, max_nfev, dft)
+    a, b = (fitter(h.weighted(data.weights), model.freq_hz, model.damping, hold, max_nfev, settings=dft)
             for h in halves)  # fmt: skip
     chi2 = np.zeros(model.n_modes)
     for i, f in enumerate(model.freq_hz):

@@ -90,7 +90,7 @@ def best_n(state: SelectionState, ctx: SelectionContext) -> SelectionState:
 
 def refit(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     """The frequency-domain refit under the inter-sample behaviour the data choose
-    (:func:`armaxmodal.modes.dft_model.refine_modes`), reported for a band-limited record, with the segment refits
+    (:func:`armaxmodal.modes.state.refine_modes`), reported for a band-limited record, with the segment refits
     of every mode's representative orders run beside it over the worker threads."""
     fitted = refit_and_segment_fits(ctx.diagram, state.modes, ctx.band, True, ctx.segments, ctx.orders, ctx.n_jobs,
                                     ctx.bar, ctx.settings, ctx.fitters)  # fmt: skip

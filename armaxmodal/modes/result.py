@@ -19,9 +19,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from armaxmodal.estimate.dft_model import ModalModel
 from armaxmodal.io.write import finite_or_none
 from armaxmodal.modal import mode_record
-from armaxmodal.modes.dft_model import ModalModel
 from armaxmodal.modes.diagram import StabilisationDiagram
 from armaxmodal.modes.modal_check import ModalCheck
 from armaxmodal.modes.mode_count import ModeCount
@@ -54,7 +54,7 @@ class ModeSelection:
         Eqs. 3.35-3.36: per mode, the mean of the per-sensor values weighted by ``|M_ij|``.
     diagram : StabilisationDiagram
     refinement : ModalModel or None
-        The frequency-domain refit (:func:`armaxmodal.modes.dft_model.refine_modes`); its ``hold`` is the
+        The frequency-domain refit (:func:`armaxmodal.estimate.dft_model.refine_modes`); its ``hold`` is the
         inter-sample behaviour the data chose. ``modes.estimator`` says which values are
         reported: the refit for a band-limited recording, the ARMAX fit (the exact model
         class) for a held input.

@@ -4,7 +4,7 @@ object each stage of ``select_modes`` takes and returns, and
 stage (:mod:`armaxmodal.modes.pipeline` names the stages).
 
 Then the fits run for the selected modes: the frequency-domain refit
-(:func:`armaxmodal.modes.dft_model.refine_modes`) and the segment refits
+(:func:`refine_modes`, which chooses the inter-sample form the data want) and the segment refits
 (``segment_spread`` in :mod:`armaxmodal.modes.intervals`), run together over the worker threads, and the
 refit's values applied within their limits (``refit_and_segment_fits``, ``refined_modes``).
 """
@@ -19,25 +19,25 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
+from armaxmodal._threads import single_blas_thread
+from armaxmodal.estimate.dft_model import HOLDS, DftLines, ModalModel, fit_modal_model
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.clusters import merge_duplicates
 from armaxmodal.modes.count_search import count_modes
-from armaxmodal.modes.dft_model import refine_modes
 from armaxmodal.modes.intervals import segment_jobs, segment_poles
-from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
+from armaxmodal.modes.settings import DEFAULTS, DftSettings, SelectionSettings
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.spectra import excited_band
 
 if TYPE_CHECKING:  # types only: the stages that make them import this module
-    from armaxmodal.modes.dft_model import DftLines, ModalModel
     from armaxmodal.modes.diagram import StabilisationDiagram
     from armaxmodal.modes.modal_check import ModalCheck
     from armaxmodal.modes.mode_count import ModeCount
     from armaxmodal.modes.result import ModeSelection
 
-__all__ = ["Fitters", "SelectionContext", "SelectionState"]
+__all__ = ["Fitters", "SelectionContext", "SelectionState", "refine_modes"]
 
 
 @dataclass(frozen=True)
@@ -118,10 +118,74 @@ class SelectionState:
         return replace(self, warnings=self.warnings + tuple(warnings), **changes)
 
 
+@single_blas_thread
+def refine_modes(recording: Recording, freq_hz, damping, *, band_hz: tuple[float, float], hold: str = "auto",
+                 max_nfev: int = 60, settings: DftSettings = DEFAULTS.dft,
+                 decisive: float = DEFAULTS.count.decisive_bic,
+                 negligible: float = DEFAULTS.count.negligible_bic) -> ModalModel:  # fmt: skip
+    """Refit selected modes to the DFT of a recording, choosing the inter-sample behaviour.
+
+    Both assumptions are fitted a few steps from the same start, with the same lines and the same number of
+    parameters; the one with the lower weighted residual is the data's choice and is iterated to convergence
+    (:mod:`armaxmodal.estimate.dft_model` gives the two forms). Where the few steps leave the two within
+    ``decisive``, both are converged and the lower residual there chooses, unless within ``negligible`` again
+    (a five-segment body's held ride: band-limited led after four steps, held by far converged, and only it
+    gave the exact dampings). Each sensor is weighted by one over its noise level at the start.
+
+    Parameters
+    ----------
+    recording : Recording
+    freq_hz, damping : (n_modes,) array_like
+        Starting modes (Hz, ratio), e.g. from :func:`armaxmodal.select_modes`.
+    band_hz : (lo, hi)
+        Band where the input has power (Hz); only these DFT lines are fitted.
+    hold : {"auto", "bandlimited", "zoh"}
+        Inter-sample assumption; "auto" fits both and keeps the lower residual.
+    max_nfev : int
+        Cap on residual evaluations of the chosen assumption's fit.
+    settings : DftSettings
+        The damping bounds and the stopping tolerance.
+    decisive, negligible : float
+        Differences of weighted residual sums of squares (``-2 ln L`` at unit noise): one that
+        decides, and one that decides nothing (the count's ``decisive_bic`` and ``negligible_bic``).
+
+    Returns
+    -------
+    ModalModel
+        The refit, its modes in the order of ``freq_hz``; ``hold_cost``: each tried assumption's
+        weighted residual sum of squares where it was decided (after the first steps, or converged).
+
+    Examples
+    --------
+    >>> import armaxmodal as am
+    >>> body, exact = am.supine_human(), am.supine_human().modes()  # exact: 5.83, 8.31, 13.50, 16.25 Hz
+    >>> ride = am.simulate_recording(body, am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03, seed=2)
+    >>> from armaxmodal.modes.state import refine_modes
+    >>> model = refine_modes(ride, exact.freq_hz * 1.02, exact.damping, band_hz=(0.5, 28.0))  # from 2 % off
+    >>> model.hold, [round(float(f), 1) for f in model.freq_hz]  # the ride was simulated with a held input
+    ('zoh', [5.8, 8.3, 13.6, 16.2])
+    """
+    if hold not in ("auto", *HOLDS):
+        raise ValueError(f"hold: expected 'auto', 'bandlimited' or 'zoh', got {hold!r}.")
+    data = DftLines.from_recording(recording, band_hz).weighted_at_start(freq_hz, damping, settings)
+    fit = partial(fit_modal_model, data, max_nfev=max_nfev, settings=settings, by_frequency=False)
+    fits = {h: fit(freq_hz, damping, h, **({"max_nfev": 4} if hold == "auto" else {})) for h in HOLDS
+            if hold in (h, "auto")}  # fmt: skip
+    cost = {h: float(np.sum(m.rss * data.weights**2)) for h, m in fits.items()}
+    leader = min(cost, key=cost.get)
+    if hold == "auto":  # a few steps tell the assumptions apart, unless within ``decisive``: then both converge
+        close = abs(cost["zoh"] - cost["bandlimited"]) < decisive
+        fits = {h: fit(m.freq_hz, m.damping, h) for h, m in fits.items() if close or h == leader}
+        if close:  # converged, the lower residual chooses where it is lower by ``negligible`` or more
+            cost = {h: float(np.sum(m.rss * data.weights**2)) for h, m in fits.items()}
+            leader = min(cost, key=cost.get) if abs(cost["zoh"] - cost["bandlimited"]) >= negligible else leader
+    return replace(fits[leader], hold_cost=cost)
+
+
 @dataclass(frozen=True)
 class Fitters:
     """The selection's two fits, handed to the stages by the context, not imported by them: the
-    frequency-domain refit (as :func:`~armaxmodal.modes.dft_model.refine_modes`) and the count (as
+    frequency-domain refit (as :func:`refine_modes`) and the count (as
     :func:`~armaxmodal.modes.count_search.count_modes`). A test hands in one that fails or records."""
 
     refine: Callable = refine_modes
@@ -244,7 +308,7 @@ class RefitFailure:
 def refined_modes(
     diagram, work: SelectionState, refinement, cluster_freq, cluster_damping, merge_mac, relaxed=False
 ) -> SelectionState:
-    """The frequency-domain refit (:func:`armaxmodal.modes.dft_model.refine_modes`, or a
+    """The frequency-domain refit (:func:`refine_modes`, or a
     :class:`RefitFailure` when it could not be made, which leaves the selection without one)
     reported for a band-limited record, and kept as the selection's ``refinement``.
     ``relaxed``: the refit may move a mode by :func:`_refit_reach`, not ``cluster_freq``.

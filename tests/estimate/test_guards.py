@@ -16,8 +16,8 @@ import armaxmodal.estimate.pem as pem_mod
 import armaxmodal.estimate.starts as starts_mod
 from armaxmodal.estimate.orders import default_nb
 from armaxmodal.modal import discrete_modal_parameters, mac, pole_uncertainty
-from armaxmodal.modes.dft_model import refine_modes
 from armaxmodal.modes.poles import Tolerances, rejection_reasons
+from armaxmodal.modes.state import refine_modes
 from armaxmodal.spectra import excited_band
 
 FS = 60.0

@@ -42,8 +42,8 @@ HALVES = (_Half("first"), _Half("second"))
 SEEN = []
 
 
-def _fitter(data, freq_hz, damping, hold, max_nfev, dft):
-    SEEN.append((hold, max_nfev, dft, tuple(freq_hz)))
+def _fitter(data, freq_hz, damping, hold, max_nfev, settings):
+    SEEN.append((hold, max_nfev, settings, tuple(freq_hz)))
     return FITS[data.name]
 
 

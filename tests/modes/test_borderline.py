@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import replace
+from functools import partial
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -18,12 +19,16 @@ import numpy as np
 import pytest
 
 import armaxmodal as am
-from armaxmodal.modes.dft_model import DftLines, fit_modal_model
+from armaxmodal.estimate import dft_model
+from armaxmodal.estimate.dft_model import DftLines
 from armaxmodal.modes.mode_count import ModeCount
 from armaxmodal.modes.notes import count_notes
 from armaxmodal.modes.poles import beyond_band, borderline
-from armaxmodal.modes.settings import ClusterSettings, LineSettings
+from armaxmodal.modes.settings import DEFAULTS, ClusterSettings, LineSettings
 from armaxmodal.stats import MAX_DAMPING, Z95
+
+# the fitter under the selection's default damping bounds and tolerance
+fit_modal_model = partial(dft_model.fit_modal_model, settings=DEFAULTS.dft)
 
 BAND = (1.0, 25.0)
 FLOOR = LineSettings().at_fit_floor

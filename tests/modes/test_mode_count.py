@@ -2,6 +2,7 @@
 own bodies): against exact modes of simulated chains, with over- and under-modelling planted."""
 
 from dataclasses import replace
+from functools import partial
 from types import SimpleNamespace
 
 import numpy as np
@@ -9,17 +10,28 @@ import pandas as pd
 import pytest
 
 import armaxmodal as am
+from armaxmodal.estimate import dft_model
+from armaxmodal.estimate.dft_model import DftLines
 from armaxmodal.modes.count_search import count_modes
 from armaxmodal.modes.counted import _one_where_not_separated
-from armaxmodal.modes.dft_model import DftLines, fit_modal_model
 from armaxmodal.modes.intervals import not_separated, with_intervals
 from armaxmodal.modes.mode_count import ModeCount, Wanted
 from armaxmodal.modes.notes import count_notes as _notes
 from armaxmodal.modes.notes import dropped_where_peaks_remain, not_separated_notes
 from armaxmodal.modes.poles import reported
 from armaxmodal.modes.result import ModeSelection
-from armaxmodal.modes.settings import AgreementSettings, ClusterSettings, CountSettings, LineSettings, SelectionSettings
+from armaxmodal.modes.settings import (
+    DEFAULTS,
+    AgreementSettings,
+    ClusterSettings,
+    CountSettings,
+    LineSettings,
+    SelectionSettings,
+)
 from armaxmodal.stats import Z95, effective_fraction
+
+# the fitter under the selection's default damping bounds and tolerance
+fit_modal_model = partial(dft_model.fit_modal_model, settings=DEFAULTS.dft)
 
 DECISIVE_BIC = CountSettings().decisive_bic  # the count's own level
 SAME_ROW = ClusterSettings().same_row_freq  # the clustering's reach
@@ -404,7 +416,7 @@ def test_a_long_record_is_counted_on_its_start_and_fitted_whole(bundled_diagram)
 def _scripted(table, start=None):
     """A fitter for ``count_modes(fitter=...)`` whose fits are :class:`_Scored` by ``table``, each
     knowing ``start``, the count's starting frequencies (Hz), so that a split of one is told apart."""
-    return lambda data, f, x, hold, n, dft, intervals=True: _Scored(f, x, table, start)
+    return lambda data, f, x, hold, n, settings, intervals=True: _Scored(f, x, table, start)
 
 
 class _Scored:
@@ -506,7 +518,7 @@ def test_a_start_mode_the_free_fit_carries_away_must_be_founded(supine, stable_t
     if not resolved:
         moved.damping_sd = np.array([0.003, 0.003, 0.2])  # 11 Hz: interval reaches below zero
     refits = []
-    search = count_search._Search(data, "zoh", 1.0, 40, fitter=lambda d, f, x, hold, n, dft: refits.append(list(f))
+    search = count_search._Search(data, "zoh", 1.0, 40, fitter=lambda d, f, x, hold, n, settings: refits.append(list(f))
                                   or _Scored(f, x, table))  # fmt: skip
     model, carried, kept = count_search._without_unfounded(search, [5.0, 9.0, 13.0], moved,
                                                          lambda f, x: stable_there or abs(f - 11.0) > 0.5)  # fmt: skip
@@ -551,7 +563,7 @@ def test_with_the_halves_a_moved_pole_is_judged_by_them_not_by_the_diagram(supin
     data = supine[0]
     second = replace(data, y=data.y[:-1], u=data.u[:-1], s=data.s[:-1], z_inv=data.z_inv[:-1])  # told apart by size
 
-    def fitter(d, f, x, hold, n, dft, intervals=True):  # sd 1e-3 f in each half: 10 SD is a shift of 1.41 %
+    def fitter(d, f, x, hold, n, settings, intervals=True):  # sd 1e-3 f in each half: 10 SD is a shift of 1.41 %
         f = np.asarray(f, float)
         moved = np.abs(f - 11.0) < 0.5
         shift = np.where(moved != same_in_halves, 10 * np.sqrt(2) * 1e-3, 0.0) * (d.y.shape[0] == second.y.shape[0])
@@ -974,7 +986,7 @@ def test_an_addition_its_halves_nearly_confirm_is_undecided_not_refused(supine, 
     data, start = supine[0], [5.0, 9.0, 13.0]
     second = replace(data, y=data.y[:-1], u=data.u[:-1], s=data.s[:-1], z_inv=data.z_inv[:-1])  # told apart by size
 
-    def fitter(d, f, x, hold, n, dft, intervals=True):  # sd 1e-3 f in each half: a shift of z sqrt(2) 1e-3 is z apart
+    def fitter(d, f, x, hold, n, settings, intervals=True):  # sd 1e-3 f in each half: z sqrt(2) 1e-3 is z apart
         return _Scored(np.asarray(f) * (1 + z * np.sqrt(2) * 1e-3 * (d.y.shape[0] == second.y.shape[0])), x, table,
                        start)  # fmt: skip
 

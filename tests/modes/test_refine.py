@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import armaxmodal as am
-from armaxmodal.modes.dft_model import refine_modes
+from armaxmodal.modes.state import refine_modes
 from armaxmodal.spectra import excited_band
 
 
@@ -31,6 +31,16 @@ def test_the_data_choose_the_hold_and_the_refit_finds_the_modes(fixtures_dir, na
     # within the issue's targets, and the errors consistent with the reported uncertainty
     assert np.all(np.abs(ref.freq_hz / f - 1) < 0.02) and np.all(np.abs(ref.damping / x - 1) < 0.10)
     assert np.all(np.abs(ref.freq_hz - f) < 4 * ref.freq_sd) and np.all(np.abs(ref.damping - x) < 4 * ref.damping_sd)
+
+
+def test_the_refit_reports_the_modes_in_the_order_they_were_given(fixtures_dir):
+    """The selection's rows and shapes are matched to the refit by position: a start from the
+    highest mode down comes back from the highest mode down, each mode where it belongs."""
+    rec = am.read_recording(fixtures_dir / "supine_random.csv")
+    f, x, f0, x0 = _start(fixtures_dir, "supine_random")
+    ref = refine_modes(rec, f0[::-1], x0[::-1], band_hz=excited_band(rec), hold="bandlimited")
+    np.testing.assert_allclose(ref.freq_hz, f[::-1], rtol=0.02)
+    np.testing.assert_allclose(ref.damping, x[::-1], rtol=0.10)
 
 
 def test_where_a_few_steps_do_not_decide_the_hold_both_are_converged():

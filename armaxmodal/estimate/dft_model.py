@@ -5,14 +5,16 @@ Every sensor's DFT over the excited band is fitted as ``Y = G(Omega) U + T(z) + 
 continuous poles, residues and a direct term, ``T`` the transient (leakage) term with the same poles, exact for
 a finite record (Pintelon & Schoukens, *System Identification: a Frequency Domain Approach*, 2nd ed., Ch. 6-7).
 The method page's "modal model by maximum likelihood" gives the likelihood, why this form and not a fit to the
-H1, and the intervals.
+H1, and the intervals. The fitter estimates; the selection decides (:mod:`armaxmodal.modes`: which inter-sample
+form, how many modes), and hands its damping bounds and tolerance in (``modes.settings.DftSettings``).
 
 **Inter-sample behaviour.** A discrete ARMAX model is the exact model class only when the input is held between
 samples (zero-order hold). Measured signals pass anti-aliasing filters and are band-limited: their discrete
 transfer function equals the continuous one below Nyquist, which no low-order rational function of ``z``
 matches, so the PEM poles carry a model-class bias that depends on where the input has power (measured: a 0.5-20
 Hz sweep puts the 16.2 Hz mode 2.9 % low and mode 3's damping 12 % high). ``G`` is written in ``s = i w`` for a
-band-limited input or in ``z`` for a held one; :func:`refine_modes` fits both and the data choose.
+band-limited input or in ``z`` for a held one; :func:`armaxmodal.modes.state.refine_modes` fits both and
+the data choose.
 
 The residues, direct and transient terms enter linearly and are projected out (the private
 ``armaxmodal._separable``): only the frequencies and damping ratios are iterated, all free.
@@ -21,6 +23,7 @@ The residues, direct and transient terms enter linearly and are projected out (t
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Protocol
 
 import numpy as np
 import scipy.optimize
@@ -28,14 +31,21 @@ import scipy.optimize
 from armaxmodal._separable import GramCompressed, SeparableModel, poles, start_vector, x_bounds
 from armaxmodal._threads import single_blas_thread
 from armaxmodal.exceptions import OrderError
-from armaxmodal.modes.settings import DEFAULTS, DftSettings
 from armaxmodal.recording import Recording
 from armaxmodal.stats import sandwich_sd
 
-__all__ = ["DftLines", "ModalModel", "fit_modal_model", "refine_modes"]
+__all__ = ["DftLines", "FitLimits", "ModalModel", "fit_modal_model"]
 
 HOLDS = ("bandlimited", "zoh")
-COUNT = DEFAULTS.count  # the count's thresholds decide the hold too (refine_modes)
+
+
+class FitLimits(Protocol):
+    """What a fit needs of its settings (``armaxmodal.modes.settings.DftSettings`` is one): every
+    threshold stays in the selection's settings, none is a default here."""
+
+    min_damping: float  #: the lowest damping ratio a free pole may take
+    max_damping: float  #: the highest
+    fit_tol: float  #: relative change of the cost and of the parameters at which a fit stops
 
 
 @dataclass(frozen=True)
@@ -61,7 +71,7 @@ class DftLines:
     Examples
     --------
     >>> import armaxmodal as am
-    >>> from armaxmodal.modes.dft_model import DftLines
+    >>> from armaxmodal.estimate.dft_model import DftLines
     >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, seed=2)
     >>> data = DftLines.from_recording(ride, (0.5, 28.0))  # 60 s: a line every 1/60 Hz
     >>> data.y.shape, data.n_real, data.band_hz
@@ -114,6 +124,27 @@ class DftLines:
         level = np.sqrt(model.rss / model.n_real)
         return self.weighted(1.0 / np.where(level > 0, level, 1.0))
 
+    def weighted_at_start(self, freq_hz, damping, settings: FitLimits) -> DftLines:
+        """The same lines with each sensor weighted by one over its noise level at a start: the
+        RMS of its residual under the held model with these poles, the residues projected out.
+
+        Parameters
+        ----------
+        freq_hz, damping : (n_modes,) array_like
+            The start's frequencies (Hz) and damping ratios, clipped to the fit's bounds.
+        settings : FitLimits
+            The damping bounds.
+
+        Returns
+        -------
+        DftLines
+            The same lines, re-weighted.
+        """
+        start = start_vector(freq_hz, damping)
+        lo, hi = x_bounds(np.abs(self.s[0]), self.dt, start.size // 2, settings.min_damping, settings.max_damping)
+        held = SeparableModel(self.s, self.z_inv, self.u, self.y / self.weights, self.dt, "zoh")
+        return self.weighted(1.0 / held.residual_rms(np.clip(start, lo, hi)))
+
     def weighted(self, weights: np.ndarray) -> DftLines:
         """The same lines with each sensor multiplied by ``weights`` (replacing the old ones).
 
@@ -159,7 +190,7 @@ class ModalModel:
     nyquist_hz : float
         The highest frequency a pole can take (the fit's bound), Hz.
     hold_cost : dict
-        From :func:`refine_modes`: each tried assumption's weighted residual sum of squares from
+        From :func:`armaxmodal.modes.state.refine_modes`: each tried assumption's weighted residual sum of squares from
         the same start, the basis of its choice (empty for a plain fit).
     at_bound : (n_modes,) bool ndarray or None
         The pole's frequency or damping is held at a bound of the fit (the solver's active set):
@@ -170,8 +201,10 @@ class ModalModel:
     >>> import armaxmodal as am
     >>> body, exact = am.supine_human(), am.supine_human().modes()  # exact: 5.83, 8.31, 13.50, 16.25 Hz
     >>> ride = am.simulate_recording(body, am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03, seed=2)
-    >>> from armaxmodal.modes.dft_model import DftLines, fit_modal_model
-    >>> model = fit_modal_model(DftLines.from_recording(ride, (0.5, 28.0)), exact.freq_hz, exact.damping, hold="zoh")
+    >>> from armaxmodal.estimate.dft_model import DftLines, fit_modal_model
+    >>> from armaxmodal.modes.settings import DEFAULTS
+    >>> data = DftLines.from_recording(ride, (0.5, 28.0))
+    >>> model = fit_modal_model(data, exact.freq_hz, exact.damping, hold="zoh", settings=DEFAULTS.dft)
     >>> model.n_modes, model.n_params, [round(float(x), 2) for x in model.damping]  # exact: 0.26, 0.35, 0.30, 0.27
     (4, 72, [0.26, 0.35, 0.3, 0.27])
     """
@@ -259,8 +292,8 @@ class ModalModel:
 
 
 @single_blas_thread
-def fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited", max_nfev: int = 40,
-                    settings: DftSettings = DEFAULTS.dft, intervals: bool = True) -> ModalModel:  # fmt: skip
+def fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited", max_nfev: int = 40, *,
+                    settings: FitLimits, intervals: bool = True, by_frequency: bool = True) -> ModalModel:  # fmt: skip
     """Fit the modal model with every pole free, from a start.
 
     Parameters
@@ -273,32 +306,38 @@ def fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited",
         Inter-sample assumption (see the module notes).
     max_nfev : int
         Cap on residual evaluations.
-    settings : DftSettings
-        The damping bounds and the stopping tolerance.
+    settings : FitLimits
+        The damping bounds and the stopping tolerance (the selection's ``DEFAULTS.dft``).
     intervals : bool
         Compute the standard deviations (False: NaN, for a fit compared by its criterion alone;
         the sandwich's rows are a sixth of a screening fit's time).
+    by_frequency : bool
+        Sort the modes by frequency (False: in the start's order).
 
     Returns
     -------
     ModalModel
-        The fit, its modes by frequency.
+        The fit.
 
     Examples
     --------
     >>> import armaxmodal as am
-    >>> from armaxmodal.modes.dft_model import DftLines, fit_modal_model
+    >>> from armaxmodal.estimate.dft_model import DftLines, fit_modal_model
+    >>> from armaxmodal.modes.settings import DEFAULTS
     >>> body = am.supine_human()
     >>> ride = am.simulate_recording(body, am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03, seed=2)
     >>> exact, data = body.modes(), DftLines.from_recording(ride, (0.5, 28.0))
-    >>> model = fit_modal_model(data, exact.freq_hz * 1.02, exact.damping, hold="zoh")  # from 2 % off
+    >>> model = fit_modal_model(data, exact.freq_hz * 1.02, exact.damping, hold="zoh", settings=DEFAULTS.dft)
     >>> [round(float(f), 1) for f in model.freq_hz]  # exact: 5.83, 8.31, 13.50, 16.25 Hz
     [5.8, 8.3, 13.6, 16.2]
     """
-    return _fit(data, start_vector(freq_hz, damping), hold, max_nfev, settings, intervals).by_frequency()
+    if hold not in HOLDS:
+        raise ValueError(f"hold: expected 'bandlimited' or 'zoh', got {hold!r}.")
+    model = _fit(data, start_vector(freq_hz, damping), hold, max_nfev, settings, intervals)
+    return model.by_frequency() if by_frequency else model
 
 
-def _fit(data: DftLines, start: np.ndarray, hold: str, max_nfev: int, settings: DftSettings,
+def _fit(data: DftLines, start: np.ndarray, hold: str, max_nfev: int, settings: FitLimits,
          intervals: bool = True) -> ModalModel:  # fmt: skip
     """The fit from ``start`` (``(ln omega_n, xi)`` per mode), its modes in the start's order,
     under the caller's BLAS threads."""
@@ -332,69 +371,3 @@ def _fit(data: DftLines, start: np.ndarray, hold: str, max_nfev: int, settings: 
                       converged=bool(res.status > 0),  # 0: stopped at max_nfev
                       band_hz=data.band_hz, nyquist_hz=0.5 / data.dt,
                       at_bound=(res.active_mask != 0).reshape(n, 2).any(axis=1))  # fmt: skip
-
-
-@single_blas_thread
-def refine_modes(recording: Recording, freq_hz, damping, *, band_hz: tuple[float, float], hold: str = "auto",
-                 max_nfev: int = 60, settings: DftSettings = DEFAULTS.dft, decisive: float = COUNT.decisive_bic,
-                 negligible: float = COUNT.negligible_bic) -> ModalModel:  # fmt: skip
-    """Refit selected modes to the DFT of a recording, choosing the inter-sample behaviour.
-
-    Both assumptions are fitted a few steps from the same start, with the same lines and the same number of
-    parameters; the one with the lower weighted residual is the data's choice and is iterated to convergence
-    (see the module notes). Where the few steps leave the two within ``decisive``, both are converged and the
-    lower residual there chooses, unless within ``negligible`` again (a five-segment body's held ride:
-    band-limited led after four steps, held by far converged, and only it gave the exact dampings). Each
-    sensor is weighted by one over its noise level at the start.
-
-    Parameters
-    ----------
-    recording : Recording
-    freq_hz, damping : (n_modes,) array_like
-        Starting modes (Hz, ratio), e.g. from :func:`armaxmodal.select_modes`.
-    band_hz : (lo, hi)
-        Band where the input has power (Hz); only these DFT lines are fitted.
-    hold : {"auto", "bandlimited", "zoh"}
-        Inter-sample assumption; "auto" fits both and keeps the lower residual.
-    max_nfev : int
-        Cap on residual evaluations of the chosen assumption's fit.
-    settings : DftSettings
-        The damping bounds and the stopping tolerance.
-    decisive, negligible : float
-        Differences of weighted residual sums of squares (``-2 ln L`` at unit noise): one that
-        decides, and one that decides nothing (the count's ``decisive_bic`` and ``negligible_bic``).
-
-    Returns
-    -------
-    ModalModel
-        The refit, its modes in the order of ``freq_hz``; ``hold_cost``: each tried assumption's
-        weighted residual sum of squares where it was decided (after the first steps, or converged).
-
-    Examples
-    --------
-    >>> import armaxmodal as am
-    >>> body, exact = am.supine_human(), am.supine_human().modes()  # exact: 5.83, 8.31, 13.50, 16.25 Hz
-    >>> ride = am.simulate_recording(body, am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03, seed=2)
-    >>> from armaxmodal.modes.dft_model import refine_modes
-    >>> model = refine_modes(ride, exact.freq_hz * 1.02, exact.damping, band_hz=(0.5, 28.0))  # from 2 % off
-    >>> model.hold, [round(float(f), 1) for f in model.freq_hz]  # the ride was simulated with a held input
-    ('zoh', [5.8, 8.3, 13.6, 16.2])
-    """
-    if hold not in ("auto", *HOLDS):
-        raise ValueError(f"hold: expected 'auto', 'bandlimited' or 'zoh', got {hold!r}.")
-    data = DftLines.from_recording(recording, band_hz)
-    start = start_vector(freq_hz, damping)
-    held = SeparableModel(data.s, data.z_inv, data.u, data.y, data.dt, "zoh")  # each sensor's noise level at the start
-    lo, hi = x_bounds(np.abs(data.s[0]), data.dt, start.size // 2, settings.min_damping, settings.max_damping)
-    data = data.weighted(1.0 / held.residual_rms(np.clip(start, lo, hi)))
-    fits = {h: _fit(data, start, h, 4 if hold == "auto" else max_nfev, settings) for h in HOLDS if hold in (h, "auto")}
-    cost = {h: float(np.sum(m.rss * data.weights**2)) for h, m in fits.items()}
-    leader = min(cost, key=cost.get)
-    if hold == "auto":  # a few steps tell the assumptions apart, unless within ``decisive``: then both converge
-        close = abs(cost["zoh"] - cost["bandlimited"]) < decisive
-        fits = {h: _fit(data, start_vector(m.freq_hz, m.damping), h, max_nfev, settings) for h, m in fits.items()
-                if close or h == leader}  # fmt: skip
-        if close:  # converged, the lower residual chooses where it is lower by ``negligible`` or more
-            cost = {h: float(np.sum(m.rss * data.weights**2)) for h, m in fits.items()}
-            leader = min(cost, key=cost.get) if abs(cost["zoh"] - cost["bandlimited"]) >= negligible else leader
-    return replace(fits[leader], hold_cost=cost)
