@@ -54,7 +54,7 @@ class ModeSelection:
         Eqs. 3.35-3.36: per mode, the mean of the per-sensor values weighted by ``|M_ij|``.
     diagram : StabilisationDiagram
     refinement : ModalModel or None
-        The frequency-domain refit (:func:`armaxmodal.estimate.dft_model.refine_modes`); its ``hold`` is the
+        The frequency-domain refit (:func:`armaxmodal.modes.state.refine_modes`); its ``hold`` is the
         inter-sample behaviour the data chose. ``modes.estimator`` says which values are
         reported: the refit for a band-limited recording, the ARMAX fit (the exact model
         class) for a held input.
