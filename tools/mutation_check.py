@@ -137,6 +137,39 @@ MUTANTS = [
     ),
     ("armaxmodal/modal.py", "lam = np.log(mu) * fs", "lam = np.log(mu) / fs", "time step inverted"),
     ("armaxmodal/estimate/dft_model.py", "shapes=-r / lam**2,", "shapes=r / lam**2,", "EPFRF modal constant sign"),
+    # the halves ask only where the sensors move near the mode in both (twenty-second session); run with
+    # --match "(excitation)" --tests tests/modes/test_agreement.py tests/modes/test_mode_count.py
+    #   tests/estimate/test_dft_model.py
+    (
+        "armaxmodal/modes/mode_count.py",
+        "if min(power) < agreement.excitation_ratio * max(power):",
+        "if False:",
+        "the halves test a pole one half does not excite (excitation)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "tested = [i for i in new if np.isfinite(chi2[i])]",
+        "tested = list(new)",
+        "an untested pole pooled as a refusal (excitation)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "self.p >= self.agreement.alpha if tested or not new else None)",
+        "self.p >= self.agreement.alpha if tested or not new else True)",
+        "untested halves reported as agreeing (excitation)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "founded = founded and (agree if agree is not None else supported is None or supported(f, x))",
+        "founded = founded and (agree if agree is not None else True)",
+        "an untested moved pole founded without the diagram (excitation)",
+    ),
+    (
+        "armaxmodal/estimate/dft_model.py",
+        "near = np.abs(np.abs(self.s) / (2 * np.pi * freq_hz) - 1) <= reach",
+        "near = np.abs(np.abs(self.s) / (2 * np.pi) - freq_hz) <= reach",
+        "the reach taken in Hz, not relative (excitation)",
+    ),
     # the fitter in estimate/, the refit's choice in modes/state.py (twenty-second session); run with
     # --match "(fitter)" --tests tests/estimate/test_dft_model.py tests/modes/test_refine.py
     (
@@ -597,8 +630,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "founded = x - Z95 * model.damping_sd[i] > 0 and search.in_both_halves(model, [i], halves)",
-        "founded = x - Z95 * model.damping_sd[i] > 0",
+        "agree = search.in_both_halves(model, [i], halves) if founded and len(halves) == 2 else None",
+        "agree = None",
         "a carried-away pole not put to the halves (count)",
     ),
     (

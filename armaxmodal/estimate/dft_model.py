@@ -124,6 +124,24 @@ class DftLines:
         level = np.sqrt(model.rss / model.n_real)
         return self.weighted(1.0 / np.where(level > 0, level, 1.0))
 
+    def response_power(self, freq_hz: float, reach: float) -> float:
+        """The sensors' power near a frequency: what these lines hold to place a pole there.
+
+        Parameters
+        ----------
+        freq_hz : float
+            The frequency, Hz.
+        reach : float
+            The lines within this relative frequency of it are summed.
+
+        Returns
+        -------
+        float
+            The sum of ``|Y|^2`` over those lines and every sensor, in the data's units (unweighted).
+        """
+        near = np.abs(np.abs(self.s) / (2 * np.pi * freq_hz) - 1) <= reach
+        return float(np.sum(np.abs(self.y[near] / self.weights) ** 2))
+
     def weighted_at_start(self, freq_hz, damping, settings: FitLimits) -> DftLines:
         """The same lines with each sensor weighted by one over its noise level at a start: the
         RMS of its residual under the held model with these poles, the residues projected out.

@@ -98,13 +98,14 @@ class _Search:
         new = [i for i in new_poles(current.freq_hz, model.freq_hz) if physical(model, self.data.band_hz)[i]]
         return supported is None or all(supported(model.freq_hz[i], model.damping[i]) for i in new)
 
-    def in_both_halves(self, trial: ModalModel, new: list[int], halves) -> bool:
-        """The new poles of ``trial`` (indices ``new``) agree in the record's two halves at ``agreement.alpha``,
-        pooled (:func:`halves_chi2`; the probability kept in ``self.p``); the answer goes into its row."""
+    def in_both_halves(self, trial: ModalModel, new: list[int], halves) -> bool | None:
+        """Do the new poles of ``trial`` (indices ``new``) that both halves excite agree in them at ``agreement.alpha``,
+        pooled (:func:`halves_chi2`; its probability ``self.p``)? None: none is excited, not asked. Into its row."""
         self.trials += 2
-        chi2 = halves_chi2(self.data, trial, halves, self.hold, self.max_nfev, self.dft, self.fitter)
-        self.p = float(chdtrc(2 * len(new), np.sum(chi2[list(new)]))) if len(new) else 1.0  # no new pole: agreed
-        return self.table.halves(trial, self.p >= self.agreement.alpha)
+        chi2 = halves_chi2(self.data, trial, halves, self.hold, self.max_nfev, self.dft, self.fitter, self.agreement)
+        tested = [i for i in new if np.isfinite(chi2[i])]
+        self.p = float(chdtrc(2 * len(tested), np.sum(chi2[tested]))) if tested else 1.0  # no new pole: agreed
+        return self.table.halves(trial, self.p >= self.agreement.alpha if tested or not new else None)
 
     def removals(self, current: ModalModel) -> list[tuple[str, float, ModalModel | None]]:
         keep = [np.arange(current.n_modes) != m for m in range(current.n_modes)]
@@ -146,7 +147,7 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     """The chosen model without the starting poles the search carried beyond ``settings.same_mode_freq``
     of every start to where no mode is founded, refitted. A pole reported there is a new pole and
     must show what a mode has: a resolved damping, and the same values in both halves of the record
-    (``_Search.in_both_halves``; without ``halves``, stability across the diagram's orders), judged on
+    (``_Search.in_both_halves``; where they do not both excite it, stability across the orders), judged on
     the converged model only (on the way a moved pole may stand in for a mode not yet added). Poles
     the model needs (the criterion rises by ``settings.decisive_bic`` or more without them) stay in
     it, unreported. The method page gives the cases behind both rules (a pelvis stuck for 53 samples,
@@ -159,10 +160,9 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     unfounded = []
     for i, j in moved:
         f, x = model.freq_hz[i], model.damping[i]
-        if len(halves) == 2:
-            founded = x - Z95 * model.damping_sd[i] > 0 and search.in_both_halves(model, [i], halves)
-        else:
-            founded = x - Z95 * model.damping_sd[i] > 0 and (supported is None or supported(f, x))
+        founded = x - Z95 * model.damping_sd[i] > 0
+        agree = search.in_both_halves(model, [i], halves) if founded and len(halves) == 2 else None
+        founded = founded and (agree if agree is not None else supported is None or supported(f, x))
         if not founded:
             unfounded.append((i, (float(start_hz[j]), float(f))))
     keep = np.setdiff1d(np.arange(model.n_modes), [i for i, _ in unfounded])
@@ -286,7 +286,7 @@ def count_modes(
         Cap on residual evaluations per fit.
     halves : tuple of DftLines
         The lines of the record's two halves: an accepted addition's new poles must be the same
-        in each (``_Search.in_both_halves``). Empty: not asked.
+        in each that both excite (``_Search.in_both_halves``). Empty: not asked.
     supported : callable, optional
         ``supported(freq_hz, damping)``: is a pole there stable across the diagram's orders? An
         addition's new poles must be (a ghost soaking up a nonlinearity is not). None: not asked.
@@ -356,7 +356,7 @@ def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev
         search.unsupported = min(lacking, key=lambda t: search.bic(t[2]), default=None)
         if best_addition is not None and search.bic(best_addition[2]) < here and len(halves) == 2:
             new = new_poles(current.freq_hz, best_addition[2].freq_hz)
-            if not search.in_both_halves(best_addition[2], new, halves):  # refused, or undecided if near
+            if search.in_both_halves(best_addition[2], new, halves) is False:  # refused, or undecided if near
                 (unsettled if search.p >= agreement.unsettled_alpha else unconfirmed).append(best_addition[1])
                 best_addition = None
         return here, removed, best_removal, best_addition

@@ -238,7 +238,7 @@ def confirmed_where_incoherent(work: SelectionState, unconfirmed_hz, settings: S
         return (), []
     m, hold, (data, halves) = count.model, work.refinement.hold, work.count_lines  # the count's own lines
     data = data.noise_weighted(m)
-    chi2 = halves_chi2(data, m, halves, hold, count.settings.halves_nfev, count.dft)
+    chi2 = halves_chi2(data, m, halves, hold, count.settings.halves_nfev, count.dft, agreement=settings.agreement)
     agree = chdtrc(2, chi2) >= settings.agreement.alpha  # each pole alone: 2 degrees of freedom
     reach, needed = settings.cluster.same_row_freq, count.verdicts() == "needed"
     confirmed, notes = [], []

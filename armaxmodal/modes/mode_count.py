@@ -73,7 +73,7 @@ class ModelTable:
             self.rows.append(FittedModel(action, float(freq_hz), model.n_modes, *fit, model.converged, None))
         return model
 
-    def halves(self, model: ModalModel, agree: bool) -> bool:
+    def halves(self, model: ModalModel, agree: bool | None) -> bool | None:
         """``agree`` (the halves' test of ``model``'s new poles), written into ``model``'s row."""
         ref, row = self._live.get(id(model), (lambda: None, -1))
         if ref() is model:
@@ -339,11 +339,13 @@ class ModeCount:
 
 
 def halves_chi2(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: int = COUNT.halves_nfev,
-                dft: DftSettings = DEFAULTS.dft, fitter=fit_modal_model) -> np.ndarray:  # fmt: skip
+                dft: DftSettings = DEFAULTS.dft, fitter=fit_modal_model,
+                agreement: AgreementSettings = DEFAULTS.agreement) -> np.ndarray:  # fmt: skip
     """Per pole of ``model``: how far apart the record's two halves (``halves``, lines weighted as
     ``data``; each fitted from ``model``'s poles by ``fitter``) put it: the squared differences of its
     frequency and damping in standard deviations of the difference, summed (each half's pole the one
-    nearest the model's): a chi-square of 2 degrees of freedom where the halves agree.
+    nearest the model's): a chi-square of 2 degrees of freedom where the halves agree. NaN where the
+    sensors hardly move near it in one half (``agreement.excitation_ratio``: a sweep passes it in one).
 
     Returns
     -------
@@ -353,6 +355,10 @@ def halves_chi2(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: 
             for h in halves)  # fmt: skip
     chi2 = np.zeros(model.n_modes)
     for i, f in enumerate(model.freq_hz):
+        power = [h.response_power(f, agreement.match_freq) for h in halves]
+        if min(power) < agreement.excitation_ratio * max(power):
+            chi2[i] = np.nan
+            continue
         j, k = nearest_pole(a.freq_hz, f), nearest_pole(b.freq_hz, f)
         for one, two, sd_one, sd_two in ((a.freq_hz, b.freq_hz, a.freq_sd, b.freq_sd),
                                          (a.damping, b.damping, a.damping_sd, b.damping_sd)):  # fmt: skip

@@ -32,10 +32,9 @@ class Resolution:
 #: the FRF peak search: a peak must stand out over 4 lines either side (a noise bump is a line
 #: or two wide), so the narrowest mode spans 4 lines; 4 segments at least
 PEAK_RESOLUTION = Resolution(lines_per_bandwidth=4, min_segments=4)
-#: the modal-model check: 2 lines per bandwidth (the H1's bias at a peak is about
-#: -(line / bandwidth)^2 / 3 with a Hann window: -8 % at two lines) from 8 segments at least
-#: (with fewer, the coherence of an unrelated line reaches 0.8 by chance: its estimate is
-#: biased by about 1 / segments)
+#: the modal-model check: 2 lines per bandwidth (the H1's bias at a peak is about -(line / bandwidth)^2 / 3 with a Hann
+#: window: -8 % at two lines) from 8 segments at least (with fewer, the coherence of an unrelated line reaches 0.8 by
+#: chance: its estimate is biased by about 1 / segments)
 CHECK_RESOLUTION = Resolution(lines_per_bandwidth=2, min_segments=8)
 #: the record's parts the spread is measured over, when not given (``select_modes(segments=...)``)
 N_SEGMENTS = 3
@@ -44,7 +43,7 @@ N_SEGMENTS = 3
 #: the thresholds that are a probability, a share or a MAC: at most 1
 _AT_MOST_ONE = frozenset({"min_support", "merge_mac", "support_alpha", "likelihood_alpha", "alpha",
                           "unsettled_alpha", "edge_fraction", "oversampled_fraction", "min_damping",
-                          "max_damping"})  # fmt: skip
+                          "max_damping", "excitation_ratio"})  # fmt: skip
 
 
 def _checked(settings) -> None:
@@ -279,6 +278,9 @@ class AgreementSettings:
     unsettled_alpha: float = 1e-6
     #: a segment's pole is the mode's when within this relative frequency of it
     match_freq: float = 0.05
+    #: the halves test a pole where the poorer holds this share of the other's response power within match_freq
+    #: of it (sweeps 3e-5-1e-2 on the F-16 and a ride; at the modes, earthquakes, random 0.021-1, a 2 Hz sine 3e-3-0.4)
+    excitation_ratio: float = 0.01
 
     def __post_init__(self):
         _checked(self)

@@ -46,3 +46,17 @@ def test_an_unknown_inter_sample_form_is_refused_before_a_fit(ride):
     exact, data = ride
     with pytest.raises(ValueError, match="hold: expected 'bandlimited' or 'zoh', got 'foh'"):
         fit_modal_model(data, exact.freq_hz, exact.damping, "foh", settings=DEFAULTS.dft)
+
+
+def test_the_response_power_near_a_frequency_is_the_sum_of_its_lines():
+    """Two sensors on the DFT grid (60 s at 60 Hz): sines of amplitude 2 at 5 Hz and 1 at 5.2 Hz on one,
+    1 at 5 Hz on the other. A line holds ``(N A / 2)^2``, in the data's units whatever the weights;
+    the reach is relative, 5 % of 5 Hz taking both lines, 2 % only the first."""
+    t = np.arange(3600) / 60.0
+    y = np.column_stack([2.0 * np.sin(2 * np.pi * 5.0 * t) + np.sin(2 * np.pi * 5.2 * t), np.sin(2 * np.pi * 5.0 * t)])
+    rec = am.Recording(60.0, np.sin(2 * np.pi * 3.0 * t), y, ("head", "chest"))
+    data = DftLines.from_recording(rec, (0.5, 28.0)).weighted(np.array([3.0, 0.5]))
+    at_5, at_5_2 = (1800 * 2.0) ** 2 + 1800.0**2, 1800.0**2
+    assert data.response_power(5.0, 0.05) == pytest.approx(at_5 + at_5_2, rel=1e-9)
+    assert data.response_power(5.0, 0.02) == pytest.approx(at_5, rel=1e-9)
+    assert data.response_power(10.0, 0.05) < 1e-12 * at_5

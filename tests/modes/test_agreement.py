@@ -15,13 +15,18 @@ from armaxmodal.modes.settings import AgreementSettings, DftSettings, SelectionS
 
 
 class _Half:
-    """A half's lines as the halves' test sees them: weighted (as the record's), then fitted."""
+    """A half's lines as the halves' test sees them: weighted (as the record's), then fitted;
+    ``power``: its sensors' power near each frequency (Hz: power), 1 where not given."""
 
-    def __init__(self, name):
-        self.name = name
+    def __init__(self, name, power=None):
+        self.name, self.power = name, power or {}
 
     def weighted(self, weights):
         return self
+
+    def response_power(self, freq_hz, reach):
+        assert reach == AgreementSettings().match_freq  # where a half's pole is the mode's
+        return self.power.get(float(freq_hz), 1.0)
 
 
 def _fit(freq_hz, damping, freq_sd, damping_sd):
@@ -76,6 +81,24 @@ def test_the_count_pools_a_trials_new_poles_at_the_one_level(new, alpha, statist
     assert {seen[:3] for seen in SEEN} == {("bandlimited", 23, slow)}  # the search's own fits' settings
     search.in_both_halves(MODEL, new, HALVES)
     assert search.trials == 4  # two fits a test
+
+
+def test_a_pole_one_half_does_not_excite_is_not_tested_by_the_halves():
+    """A sweep passes the 10 Hz mode in the first half only: the sensors' power there in the second is
+    0.5 % of the first's, below the 1 % the halves need; at 2 % it is tested again."""
+    swept = (_Half("first"), _Half("second", {10.0: 0.005}))
+    chi2 = halves_chi2(SimpleNamespace(weights=1.0), MODEL, swept, "zoh", 17, fitter=_fitter)
+    assert chi2[0] == pytest.approx(13.0) and np.isnan(chi2[1])
+    search = _Search(SimpleNamespace(weights=1.0), "zoh", 1e4, 40, fitter=_fitter)
+    assert search.in_both_halves(MODEL, [1], swept) is None  # not asked: neither agreed nor refused
+    assert search.p == 1.0
+    assert search.in_both_halves(MODEL, [0, 1], swept) is False  # pooled over the tested pole alone: 13 for 2
+    assert search.p == pytest.approx(chdtrc(2, 13.0))
+    barely = (_Half("first"), _Half("second", {10.0: 0.02}))
+    assert halves_chi2(SimpleNamespace(weights=1.0), MODEL, barely, "zoh", 17, fitter=_fitter)[1] == pytest.approx(2.0)
+    strict = AgreementSettings(excitation_ratio=0.03)
+    assert np.isnan(halves_chi2(SimpleNamespace(weights=1.0), MODEL, barely, "zoh", 17, fitter=_fitter,
+                                agreement=strict)[1])  # fmt: skip
 
 
 def test_a_trial_with_no_new_pole_agrees():

@@ -576,6 +576,29 @@ def test_with_the_halves_a_moved_pole_is_judged_by_them_not_by_the_diagram(supin
     assert (carried == ()) is same_in_halves and model.n_modes == (3 if same_in_halves else 2)
 
 
+@pytest.mark.parametrize("in_diagram", [True, False])
+def test_where_one_half_does_not_excite_a_moved_pole_the_diagram_judges_it(supine, in_diagram):
+    """A sweep passes a mode in one half only: there the halves test nothing (the sensors' power in the
+    second is a millionth of the first's within 5 % of the moved pole, which it puts 10 SD away), and
+    the moved pole is judged as without halves, by the diagram's stability."""
+    import armaxmodal.modes.count_search as count_search
+
+    table, data = {2: 100.0, 3: 100.0}, supine[0]
+    quiet = data.y * np.where(np.abs(np.abs(data.s) / (2 * np.pi * 11.0) - 1) <= 0.05, 1e-3, 1.0)[:, None]
+    second = replace(data, y=quiet[:-1], u=data.u[:-1], s=data.s[:-1], z_inv=data.z_inv[:-1])  # told apart by size
+
+    def fitter(d, f, x, hold, n, settings, intervals=True):
+        f = np.asarray(f, float)
+        shift = np.where(np.abs(f - 11.0) < 0.5, 10 * np.sqrt(2) * 1e-3, 0.0) * (d.y.shape[0] == second.y.shape[0])
+        return _Scored(f * (1 + shift), x, table)
+
+    search = count_search._Search(data, "zoh", 1.0, 40, fitter=fitter)
+    moved = _Scored([5.0, 9.0, 11.0], [0.3, 0.3, 0.3], table)
+    model, carried, _ = count_search._without_unfounded(search, [5.0, 9.0, 13.0], moved, lambda f, x: in_diagram,
+                                                        (data, second))  # fmt: skip
+    assert (carried == ()) is in_diagram and model.n_modes == (3 if in_diagram else 2)
+
+
 @pytest.mark.parametrize("max_samples", [None, "half"])
 def test_the_count_hands_forward_the_lines_it_decided_on(bundled_diagram, max_samples):
     """The count cuts the record once: the lines it decided on (the whole ride, or its first part
