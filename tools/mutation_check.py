@@ -1130,6 +1130,62 @@ MUTANTS = [
         '    disagree = []\n    # where two',
         "the estimators' test not run on the counted modes (estimators)",
     ),
+    # the notes on one screen: what was found and what to do (twenty-third session); run with
+    # --match "(notes)" --tests tests/cli/test_notes.py
+    (
+        "armaxmodal/cli/common.py",
+        'while (shorter := re.sub(r"\\s+\\([^()]*\\)", "", plain)) != plain:',
+        'while (shorter := re.sub(r"\\s*\\([^()]*\\)", "", plain)) != plain:',
+        "a word's '(s)' taken for an aside (notes)",
+    ),
+    (
+        "armaxmodal/cli/common.py",
+        'while (shorter := re.sub(r"\\s+\\([^()]*\\)", "", plain)) != plain:',
+        'if (shorter := re.sub(r"\\s+\\([^()]*\\)", "", plain)) != plain:',
+        "nested asides stripped once, the outer one left (notes)",
+    ),
+    (
+        "armaxmodal/cli/common.py",
+        "if len(kept + piece) > width - 4:",
+        "if len(kept + piece) > width:",
+        "no room kept for the cut's mark (notes)",
+    ),
+    (
+        "armaxmodal/cli/common.py",
+        'return kept if kept.endswith(".") else kept.rstrip(":;,") + " ..."',
+        'return kept.rstrip(":;,.") + " ..."',
+        "a whole sentence marked as cut (notes)",
+    ),
+    (
+        "armaxmodal/cli/common.py",
+        "if len(kept) < width // 2:",
+        "if not kept:",
+        "a short first clause shown where the next one's words would say more (notes)",
+    ),
+    (
+        "armaxmodal/cli/common.py",
+        "blocks = full if sum(map(len, full)) <= NOTE_LINES else compact[:NOTE_LINES]",
+        "blocks = full[:NOTE_LINES]",
+        "too many codes kept at three lines each (notes)",
+    ),
+    (
+        "armaxmodal/cli/common.py",
+        'rows = 1 if level == "info" or compact else 2',
+        "rows = 1",
+        "a warning's finding cut to one line (notes)",
+    ),
+    (
+        "armaxmodal/cli/common.py",
+        'if level != "info" and advice and not compact:',
+        "if advice and not compact:",
+        "information told what to do (notes)",
+    ),
+    (
+        "armaxmodal/cli/common.py",
+        "if len(lines) <= rows or budget <= 20:",
+        "if True:",
+        "a finding wrapped past its rows (notes)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/estimate/test_guards.py",

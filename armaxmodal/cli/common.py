@@ -134,18 +134,21 @@ def order_range(text: str) -> range:
     return range(lo, hi + 1, 2)
 
 
-#: a note's line on the terminal, and how many code lines fit one screen with the header
+#: a note's line on the terminal, and how many lines of codes fit one screen with the header
 NOTE_WIDTH, NOTE_LINES = 100, 23
+#: where a code's second and third lines start (under its name)
+NOTE_INDENT = " " * 10
 
 
 def print_notes(warnings, verbose: bool = False) -> None:
-    """The notes on stderr (even with --quiet), one line per code within ``NOTE_WIDTH`` characters:
-    its severity (:func:`armaxmodal.quality_warnings.severity`), how many, the channels and the
-    frequencies (``QualityWarning.freq_hz``), what to do; problems first, then warnings, then
-    information. ``verbose``: every full text under its code. The JSON and ``--report`` always
+    """The notes on stderr (even with --quiet), on one screen: per code a line within ``NOTE_WIDTH``
+    characters with its severity (:func:`armaxmodal.quality_warnings.severity`), how many, the
+    channels and the frequencies (``QualityWarning.freq_hz``) and what was found (the first note's
+    text without its asides, :func:`headline`, on a second line where a problem's or a warning's
+    needs it); under a problem or a warning a last line says what to do. Problems first, then
+    warnings, then information. Where that takes more than ``NOTE_LINES`` lines, a line a code, as
+    many codes as fit. ``verbose``: every code with its advice and every full text. The JSON and ``--report`` always
     hold the full texts."""
-    import textwrap
-
     from armaxmodal.quality_warnings import CODES, UNCERTAIN_CODES, severity
 
     if not warnings:
@@ -161,23 +164,103 @@ def print_notes(warnings, verbose: bool = False) -> None:
               for level in levels if (n := sum(severity(w.code) == level for w in warnings))]  # fmt: skip
     more = "" if verbose else " (full texts: --verbose, --json, --report)"
     print(f"notes: {', '.join(counts)}{more}", file=sys.stderr)
-    shown = codes if verbose else codes[:NOTE_LINES]
-    for code in shown:
-        notes = groups[code]
-        channels = sorted({c for w in notes for c in w.channels})
-        where = f", {', '.join(channels)}" if channels and len(", ".join(channels)) <= 30 else ""
-        # each frequency once, to 0.01 Hz, or to three digits below 1 Hz (a drift's 0.00417 Hz is not 0)
-        shown_hz = {round(f, 2) if abs(f) >= 1 else float(f"{f:.3g}") for w in notes for f in w.freq_hz}
-        where += _frequencies(sorted(shown_hz))
-        head, text = f"  {severity(code):<8}{code} ({len(notes)}{where}): ", advice.get(code, "")
-        if len(head) + len(text) > NOTE_WIDTH and not verbose:  # cut at a word, marked
-            text = text[: NOTE_WIDTH - len(head) - 4].rsplit(" ", 1)[0] + " ..."
-        print(head + text, file=sys.stderr)
-        for w in notes if verbose else ():
-            print(textwrap.fill(w.message, NOTE_WIDTH, initial_indent="      - ", subsequent_indent="        "),
-                  file=sys.stderr)  # fmt: skip
-    if len(shown) < len(codes):
-        print(f"  ... {len(codes) - len(shown)} more codes (--verbose)", file=sys.stderr)
+    if verbose:
+        blocks = [_verbose_block(code, groups[code], advice.get(code, ""), severity(code)) for code in codes]
+    else:  # what was found and what to do while every code fits the screen so, else a line a code
+        full = [_code_lines(code, groups[code], advice.get(code, ""), severity(code)) for code in codes]
+        compact = [_code_lines(code, groups[code], "", severity(code), compact=True) for code in codes]
+        blocks = full if sum(map(len, full)) <= NOTE_LINES else compact[:NOTE_LINES]
+    print("\n".join(line for block in blocks for line in block), file=sys.stderr)
+    if len(blocks) < len(codes):
+        print(f"  ... {len(codes) - len(blocks)} more codes (--verbose)", file=sys.stderr)
+
+
+def _code_head(code: str, notes: list, level: str) -> str:
+    """``  <severity> <code> (<how many>, <channels>, at <frequencies>): ``."""
+    channels = sorted({c for w in notes for c in w.channels})
+    where = f", {', '.join(channels)}" if channels and len(", ".join(channels)) <= 30 else ""
+    # each frequency once, to 0.01 Hz, or to three digits below 1 Hz (a drift's 0.00417 Hz is not 0)
+    shown_hz = {round(f, 2) if abs(f) >= 1 else float(f"{f:.3g}") for w in notes for f in w.freq_hz}
+    return f"  {level:<8}{code} ({len(notes)}{where}{_frequencies(sorted(shown_hz))}): "
+
+
+def _code_lines(code: str, notes: list, advice: str, level: str, compact: bool = False) -> list[str]:
+    """A code's lines on the screen: what was found (two lines for a problem or a warning, one for
+    information), then for a problem or a warning what to do; ``compact``: the first line alone."""
+    import textwrap
+
+    head = _code_head(code, notes, level)
+    others = f" (+{len(notes) - 1} more)" if len(notes) > 1 else ""
+    rows = 1 if level == "info" or compact else 2
+    budget = rows * NOTE_WIDTH - len(head) - (rows - 1) * len(NOTE_INDENT) - len(others)
+    while True:  # words wrap short of the width: a smaller budget until the finding fits its rows
+        found = head + headline(notes[0].message, budget) + others
+        lines = textwrap.wrap(found, NOTE_WIDTH, subsequent_indent=NOTE_INDENT, break_on_hyphens=False,
+                              break_long_words=False)  # fmt: skip
+        if len(lines) <= rows or budget <= 20:
+            break
+        budget -= 8
+    if level != "info" and advice and not compact:
+        lines.append(NOTE_INDENT + "do: " + headline(advice, NOTE_WIDTH - len(NOTE_INDENT) - 4))
+    return lines[: rows + 1]
+
+
+def _verbose_block(code: str, notes: list, advice: str, level: str) -> list[str]:
+    """A code's advice on its line, every note's full text under it."""
+    import textwrap
+
+    texts = [textwrap.fill(w.message, NOTE_WIDTH, initial_indent="      - ", subsequent_indent="        ")
+             for w in notes]  # fmt: skip
+    return [_code_head(code, notes, level) + advice, *texts]
+
+
+def headline(text: str, width: int) -> str:
+    """What a note found, in at most ``width`` characters: its text without the asides in
+    parentheses, as much of it as fits, cut where a clause or a list item ends (at '.', ':', ';' or
+    ','), or at a word where that would leave less than half the width, marked '...' where a
+    sentence was cut.
+
+    Parameters
+    ----------
+    text : str
+        A note's full text.
+    width : int
+        Characters available.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from armaxmodal.cli.common import headline
+    >>> headline("'head' lags input 'base' by 32.9 ms (95 % interval 32.2 to 33.5 ms). Aligned by 2 samples.", 60)
+    "'head' lags input 'base' by 32.9 ms. Aligned by 2 samples."
+    >>> headline("a stable pole at 1.5 Hz is left out: the measured FRF does not need it", 40)
+    'a stable pole at 1.5 Hz is left out ...'
+    """
+    import re
+
+    plain = text
+    while (shorter := re.sub(r"\s+\([^()]*\)", "", plain)) != plain:  # asides, innermost first; not "sample(s)"
+        plain = shorter
+    plain = re.sub(r"\s+", " ", plain).strip()
+    if len(plain) <= width:
+        return plain
+    kept = ""
+    for piece in re.findall(r".+?(?:[.:;,](?=\s)|$)", plain):
+        if len(kept + piece) > width - 4:
+            break
+        kept += piece
+    if len(kept) < width // 2:  # the next clause is long: as many of its words as fit say more
+        return _cut(plain, width)
+    kept = kept.rstrip()
+    return kept if kept.endswith(".") else kept.rstrip(":;,") + " ..."
+
+
+def _cut(text: str, width: int) -> str:
+    """``text`` within ``width`` characters, cut at a word and marked, where longer."""
+    return text if len(text) <= width else text[: width - 4].rsplit(" ", 1)[0] + " ..."
 
 
 def _frequencies(freqs: list[float], shown: int = 4) -> str:

@@ -270,4 +270,4 @@ def _note_alignment(w: QualityWarning, shifts: dict) -> QualityWarning:
     if w.code != "sensor_delay" or w.channels[0] not in shifts:
         return w
     n = shifts[w.channels[0]]
-    return replace(w, message=w.message + f" Aligned by {abs(n)} sample(s) before fitting.")
+    return replace(w, message=w.message + f" Aligned by {abs(n)} sample{'s' if abs(n) != 1 else ''}.")

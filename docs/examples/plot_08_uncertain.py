@@ -4,8 +4,8 @@ An uncertain verdict: a hum on one sensor
 
 The bundled supine ride with a 0.3 m/s² hum at 12.5 Hz added to the legs' sensor, as mains or a
 pump would put it there. The four modes are still found, but the record holds a line the input
-does not drive, so the verdict is ``uncertain``: the notes say what was seen and what to do, one
-line per code as the command line prints them (``--verbose`` and the JSON give every full text).
+does not drive, so the verdict is ``uncertain``: the notes say what was seen and what to do, per
+code as the command line prints them (``--verbose`` and the JSON give every full text).
 """
 
 from pathlib import Path

@@ -1,10 +1,13 @@
-"""The notes on the terminal: one line per code within 100 characters, labelled by how the code
-moves the verdict, the whole block on one screen; every full text under --verbose."""
+"""The notes on the terminal: per code what was found and, for a problem or a warning, what to do,
+within 100 characters a line, labelled by how the code moves the verdict, the whole block on one
+screen; every full text under --verbose."""
 
 import numpy as np
+from hypothesis import given
+from hypothesis import strategies as st
 
 import armaxmodal as am
-from armaxmodal.cli.common import print_notes
+from armaxmodal.cli.common import NOTE_INDENT, headline, print_notes
 from armaxmodal.cli.main import main
 from armaxmodal.quality_warnings import CODES, PROBLEM_CODES, UNCERTAIN_CODES, severity
 
@@ -15,21 +18,71 @@ def _one_of_each() -> list:
     return [notes[0], *notes]
 
 
-def test_one_line_per_code_on_one_screen_what_moves_the_verdict_first(capsys):
+def test_each_code_says_what_was_found_on_one_screen_what_moves_the_verdict_first(capsys):
     print_notes(_one_of_each())
     lines = capsys.readouterr().err.splitlines()
     assert len(lines) <= 25 and all(len(line) <= 100 for line in lines), max(map(len, lines))
     n_warnings = sum(severity(c.code) == "warning" for c in CODES) + (severity(CODES[0].code) == "warning")
     assert lines[0].startswith(f"notes: {len(PROBLEM_CODES)} problems, {n_warnings} warnings, ")
-    assert lines[-1] == f"  ... {len(CODES) - 23} more codes (--verbose)"
-    shown = [line.split()[1] for line in lines[1:-1]]
-    labels = [line.split()[0] for line in lines[1:-1]]
+    heads = [line for line in lines[1:-1] if not line.startswith(NOTE_INDENT)]
+    shown = [line.split()[1] for line in heads]
+    assert lines[-1] == f"  ... {len(CODES) - len(shown)} more codes (--verbose)"
+    labels = [line.split()[0] for line in heads]
     assert labels == [severity(code) for code in shown]
     assert labels == sorted(labels, key=["problem", "warning", "info"].index)  # problems, then warnings
     n_problems, n_uncertain = len(PROBLEM_CODES), len(UNCERTAIN_CODES)
     assert set(shown[n_problems : n_problems + n_uncertain]) == set(UNCERTAIN_CODES)  # then what makes it uncertain
-    assert f"{CODES[0].code} (2, head): " in lines[1 + shown.index(CODES[0].code)]
-    assert "a long measured sentence" not in "\n".join(lines)  # the full texts are not on the screen
+    first = CODES[0].code
+    assert f"{first} (2, head): {first}: a long measured sentence" in heads[shown.index(first)]  # the finding
+    assert len(heads) == len(lines) - 2  # too many codes for their advice: a line a code
+
+
+def test_a_few_codes_say_what_was_found_and_what_to_do(capsys):
+    advice = {c.code: c.advice for c in CODES}
+    notes = [am.QualityWarning("sensor_delay", ("head",), "'head' lags input 'base' by 32.9 ms (95 % interval 32.2 "
+                               "to 33.5 ms). Aligned by 2 samples."),
+             am.QualityWarning("offset_removed", ("head",), "removed each channel's mean; large offsets: head +9.81"),
+             am.QualityWarning("dropped_packet", (), "2 sample(s) missing at 49.983 s; bridged by linear "
+                               "interpolation. " + "The bridged samples enter the fit as data. " * 5)]  # fmt: skip
+    print_notes(notes)
+    lines = capsys.readouterr().err.splitlines()
+    assert all(len(line) <= 100 for line in lines) and not any("more codes" in line for line in lines)
+    assert lines[1] == ("  warning dropped_packet (1): 2 sample(s) missing at 49.983 s; bridged by linear "
+                        "interpolation. The")  # fmt: skip
+    assert lines[2].startswith(NOTE_INDENT + "bridged samples enter the fit as data.") and lines[2].endswith(".")
+    assert lines[3] == NOTE_INDENT + "do: " + headline(advice["dropped_packet"], 100 - len(NOTE_INDENT) - 4)
+    assert lines[4] == "  warning sensor_delay (1, head): 'head' lags input 'base' by 32.9 ms. Aligned by 2 samples."
+    assert lines[5].startswith(NOTE_INDENT + "do: If the delay is a logger's")
+    assert lines[6:] == ["  info    offset_removed (1, head): removed each channel's mean; large offsets: head +9.81"]
+
+
+def test_a_headline_keeps_the_finding_drops_the_asides_and_says_where_it_was_cut():
+    text = ("'head' lags input 'base' by 32.9 ms (95 % interval 32.2 to 33.5 ms, 1.97 samples; phase slope "
+            "(Hann lines) up to 4.47 Hz). Aligned by 2 samples.")  # fmt: skip
+    assert headline(text, 100) == "'head' lags input 'base' by 32.9 ms. Aligned by 2 samples."  # nested asides too
+    assert headline(text, 40) == "'head' lags input 'base' by 32.9 ms."  # a whole sentence: no mark
+    assert headline("2 sample(s) missing at 49.98 s; bridged by interpolation", 100) == (
+        "2 sample(s) missing at 49.98 s; bridged by interpolation")  # "(s)" is no aside
+    cut = headline("2 sample(s) missing at 49.98 s; bridged by interpolation", 40)
+    assert cut == "2 sample(s) missing at 49.98 s ..."
+    assert headline("offsets: head +9.81, chest +9.81, pelvis +9.81, legs +9.81", 40) == (
+        "offsets: head +9.81, chest +9.81 ...")  # a list cut between its items
+    assert headline("one long clause without any stop in it at all", 20) == "one long clause ..."
+    assert headline("abcdefgh, ijkl mnop qrst", 10) == "abcdef ..."  # the mark fits the width too
+
+
+def test_a_finding_of_long_words_keeps_to_its_two_lines_and_its_advice(capsys):
+    """Words wrap short of the width: the finding is shortened until it fits its two lines, and the
+    advice keeps its own."""
+    print_notes([am.QualityWarning("drift", ("pelvis",), " ".join(["a-measured-quantity-named"] * 40))])
+    lines = capsys.readouterr().err.splitlines()[1:]
+    assert len(lines) == 3 and lines[2].startswith(NOTE_INDENT + "do: Rerun with `--detrend linear`"), lines
+    assert lines[1].endswith(" ...") and all(len(line) <= 100 for line in lines)
+
+
+@given(st.text(alphabet=st.sampled_from(list("ab .,:;()")), max_size=300), st.integers(10, 120))
+def test_a_headline_never_exceeds_its_width(text, width):
+    assert len(headline(text, width)) <= width
 
 
 def test_verbose_shows_every_full_text(capsys):
@@ -47,10 +100,10 @@ def test_a_code_line_names_its_notes_frequencies(capsys):
 
     print_notes([note("count_undecided", 28.4838), note("count_undecided", 4.4, 28.4838), note("mode_count"),
                  *(note("unexplained_peak", f) for f in (3.0, 5.5, 7.25, 9.0, 11.75))])  # fmt: skip
-    lines = capsys.readouterr().err.splitlines()
-    assert lines[1].startswith("  warning count_undecided (2, at 4.4, 28.48 Hz): ")  # each once, in order
-    assert lines[2].startswith("  warning unexplained_peak (5, at 5 frequencies 3-11.75 Hz): ")  # more: the range
-    assert lines[3].startswith("  info    mode_count (1): ")
+    lines = [line for line in capsys.readouterr().err.splitlines() if not line.startswith(NOTE_INDENT)]
+    assert lines[1] == "  warning count_undecided (2, at 4.4, 28.48 Hz): text (+1 more)"  # each once, in order
+    assert lines[2] == "  warning unexplained_peak (5, at 5 frequencies 3-11.75 Hz): text (+4 more)"  # more: the range
+    assert lines[3] == "  info    mode_count (1): text"
     print_notes([note("unexplained_peak", f) for f in (3.0, 5.5, 7.25, 9.0)])  # four: each named
     assert capsys.readouterr().err.splitlines()[1].startswith("  warning unexplained_peak (4, at 3, 5.5, 7.25, 9 Hz): ")
     print_notes([note("mode_count", 0.0041667, 15.7291), note("mode_count", 0.0041667)])  # a drift's pole: not "0"
@@ -74,7 +127,8 @@ def test_stabilise_prints_the_verdict_then_the_notes(fixtures_dir, tmp_path, cap
     lines = out.strip().splitlines()  # the read, the modes, the check, the verdict: one screen, with the notes
     assert any(line.startswith("quality: UNCERTAIN") for line in lines[-2:]) and "drift" in out
     err = err[err.index("notes: "):]  # after the progress bars
-    assert "\n  warning drift (1, pelvis): Rerun with `--detrend linear`" in err
+    assert "\n  warning drift (1, pelvis): a linear drift remains after the mean was removed: pelvis +" in err
+    assert f"\n{NOTE_INDENT}do: Rerun with `--detrend linear`" in err
     shown = lines + err.strip().splitlines()
     assert len(shown) <= 25 and max(map(len, shown)) <= 100, shown
     assert main(["--quiet", "--verbose", "stabilise", str(path), "--orders", "2:16"]) == 0
