@@ -152,10 +152,11 @@ def _input_in_other_units(recording: Recording, lines: np.ndarray, gains: np.nda
         QualityWarning(
             "unit_mismatch",
             (recording.input_name,),
-            f"every output reads {ratio:.4g} times the input '{recording.input_name}' below the first mode "
-            f"({gains.min():.4g}-{gains.max():.4g}), where a base-excited structure moves with its base: the "
-            f"outputs are in {meaning}. Frequencies, damping and shapes do not change; residues and the masses "
-            "drawn from them are off by that factor. Convert one side and rerun.",
+            # the finding first: the terminal shows a note's first clauses
+            f"the outputs are in {meaning}: every output reads {ratio:.4g} times the input "
+            f"'{recording.input_name}' below the first mode ({gains.min():.4g}-{gains.max():.4g}), where a "
+            "base-excited structure moves with its base. Frequencies, damping and shapes do not change; residues "
+            "and the masses drawn from them are off by that factor. Convert one side and rerun.",
             ratio,
         )
     ]
