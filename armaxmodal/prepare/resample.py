@@ -41,8 +41,9 @@ def resample_to_band(rec: Recording, band) -> tuple[Recording, QualityWarning | 
     note = QualityWarning(
         "resampled",
         (),
-        f"{source} ends at {hi:.3g} Hz, far below the Nyquist frequency {rec.fs / 2:g} Hz: resampled by "
-        f"1/{factor} to {new_fs:g} Hz (anti-alias filtered) for the analysis.",
+        # the finding first: the terminal shows a note's first clauses
+        f"resampled by 1/{factor} to {new_fs:g} Hz (anti-alias filtered) for the analysis: {source} ends at "
+        f"{hi:.3g} Hz, far below the Nyquist frequency {rec.fs / 2:g} Hz.",
         new_fs,
     )
     return out, note
