@@ -112,8 +112,8 @@ def _step_notes(count: ModeCount, same_row_freq: float) -> list[QualityWarning]:
         where = f" (its new pole settled at {step.settled_hz:.3f} Hz)" if moved else ""
         notes.append(QualityWarning(
             "mode_count", (),
-            f"the maximum-likelihood modal model with every pole free: the mode at {step.freq_hz:.3f} Hz "
-            f"{words[step.action]}{where}, the information criterion (BIC) falls by {step.bic_fall:.1f}",
+            f"the mode at {step.freq_hz:.3f} Hz {words[step.action]}{where}: the information criterion (BIC) of "
+            f"the maximum-likelihood modal model, every pole free, falls by {step.bic_fall:.1f}",
             float(step.freq_hz), (step.freq_hz,),
         ))  # fmt: skip
     return notes

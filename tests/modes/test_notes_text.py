@@ -55,11 +55,11 @@ def test_every_count_note_says_its_numbers_in_their_places():
     model, stand-ins beyond and inside the band, and a pole outside it."""
     assert _said(notes.count_notes(_count(), KEEP, BAND, SAME_ROW)) == [
         ('mode_count', 12.5,
-            'the maximum-likelihood modal model with every pole free: the mode at 12.500 Hz added '
-            '(its new pole settled at 13.500 Hz), the information criterion (BIC) falls by 44.2'),
+            'the mode at 12.500 Hz added (its new pole settled at 13.500 Hz): the information criterion (BIC) '
+            'of the maximum-likelihood modal model, every pole free, falls by 44.2'),
         ('mode_count', 17.0,
-            'the maximum-likelihood modal model with every pole free: the mode at 17.000 Hz left '
-            'out, the information criterion (BIC) falls by 12.5'),
+            'the mode at 17.000 Hz left out: the information criterion (BIC) of the maximum-likelihood modal '
+            'model, every pole free, falls by 12.5'),
         ('count_undecided', 4.5,
             'the record does not decide the number of modes: with one mode fewer (the rest refitted '
             "free) the criterion rises by only 4.5 (under 10, Kass & Raftery's 'very strong'); treat "
@@ -203,10 +203,10 @@ def test_the_edges_of_each_rule():
                    carried_away=(), wanted=(), stand_ins=((24.0, 25.0, 15.0), (2.0, 1.0, 12.0)), unsettled_hz=())
     said = _said(notes.count_notes(count, np.array([False, True, False, False]), BAND, SAME_ROW))
     assert [text for _, _, text in said[:2]] == [
-        "the maximum-likelihood modal model with every pole free: the mode at 12.500 Hz added, the information "
-        "criterion (BIC) falls by 20.0",
-        "the maximum-likelihood modal model with every pole free: the mode at 8.000 Hz split in two (its new pole "
-        "settled at 7.000 Hz), the information criterion (BIC) falls by 15.0",
+        "the mode at 12.500 Hz added: the information criterion (BIC) of the maximum-likelihood modal model, "
+        "every pole free, falls by 20.0",
+        "the mode at 8.000 Hz split in two (its new pole settled at 7.000 Hz): the information criterion (BIC) of "
+        "the maximum-likelihood modal model, every pole free, falls by 15.0",
     ]
     # 5 Hz is undecided but not reported: no note of the count's doubt; an addition at exactly -10 is decided
     assert not any("does not decide the number" in t or "rule out" in t for _, _, t in said)
