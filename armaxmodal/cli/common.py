@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -147,8 +149,8 @@ def print_notes(warnings, verbose: bool = False) -> None:
     text without its asides, :func:`headline`, on a second line where a problem's or a warning's
     needs it); under a problem or a warning a last line says what to do. Problems first, then
     warnings, then information. Where that takes more than ``NOTE_LINES`` lines, a line a code, as
-    many codes as fit. ``verbose``: every code with its advice and every full text. The JSON and ``--report`` always
-    hold the full texts."""
+    many codes as fit. ``verbose``: every code with its advice and every full text. The JSON and
+    ``--report`` always hold the full texts."""
     from armaxmodal.quality_warnings import CODES, UNCERTAIN_CODES, severity
 
     if not warnings:
@@ -167,9 +169,9 @@ def print_notes(warnings, verbose: bool = False) -> None:
     if verbose:
         blocks = [_verbose_block(code, groups[code], advice.get(code, ""), severity(code)) for code in codes]
     else:  # what was found and what to do while every code fits the screen so, else a line a code
-        full = [_code_lines(code, groups[code], advice.get(code, ""), severity(code)) for code in codes]
-        compact = [_code_lines(code, groups[code], "", severity(code), compact=True) for code in codes]
-        blocks = full if sum(map(len, full)) <= NOTE_LINES else compact[:NOTE_LINES]
+        blocks = [_code_lines(code, groups[code], advice.get(code, ""), severity(code)) for code in codes]
+        if sum(map(len, blocks)) > NOTE_LINES:
+            blocks = [_code_lines(code, groups[code], "", severity(code), compact=True) for code in codes[:NOTE_LINES]]
     print("\n".join(line for block in blocks for line in block), file=sys.stderr)
     if len(blocks) < len(codes):
         print(f"  ... {len(codes) - len(blocks)} more codes (--verbose)", file=sys.stderr)
@@ -187,8 +189,6 @@ def _code_head(code: str, notes: list, level: str) -> str:
 def _code_lines(code: str, notes: list, advice: str, level: str, compact: bool = False) -> list[str]:
     """A code's lines on the screen: what was found (two lines for a problem or a warning, one for
     information), then for a problem or a warning what to do; ``compact``: the first line alone."""
-    import textwrap
-
     head = _code_head(code, notes, level)
     others = f" (+{len(notes) - 1} more)" if len(notes) > 1 else ""
     rows = 1 if level == "info" or compact else 2
@@ -207,8 +207,6 @@ def _code_lines(code: str, notes: list, advice: str, level: str, compact: bool =
 
 def _verbose_block(code: str, notes: list, advice: str, level: str) -> list[str]:
     """A code's advice on its line, every note's full text under it."""
-    import textwrap
-
     texts = [textwrap.fill(w.message, NOTE_WIDTH, initial_indent="      - ", subsequent_indent="        ")
              for w in notes]  # fmt: skip
     return [_code_head(code, notes, level) + advice, *texts]
@@ -225,11 +223,16 @@ def headline(text: str, width: int) -> str:
     text : str
         A note's full text.
     width : int
-        Characters available.
+        Characters available, at least 10.
 
     Returns
     -------
     str
+
+    Raises
+    ------
+    ValueError
+        ``width`` below 10: no cut with its mark fits.
 
     Examples
     --------
@@ -239,8 +242,8 @@ def headline(text: str, width: int) -> str:
     >>> headline("a stable pole at 1.5 Hz is left out: the measured FRF does not need it", 40)
     'a stable pole at 1.5 Hz is left out ...'
     """
-    import re
-
+    if width < 10:
+        raise ValueError(f"width: expected at least 10 characters, got {width}.")
     plain = text
     while (shorter := re.sub(r"\s+\([^()]*\)", "", plain)) != plain:  # asides, innermost first; not "sample(s)"
         plain = shorter

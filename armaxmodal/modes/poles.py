@@ -210,15 +210,11 @@ def disturbance_lines(
         seen = f"sensors whose own sweep shows it: {', '.join(channels)}" if channels else "no sensor alone shows it"
         prominence = _input_prominence(recording, freq)
         if prominence >= lines.input_ratio:
-            what = "a line on the input sensor or on every channel"
-            where = (
-                f"the input carries the line too ({10 * np.log10(prominence):.0f} dB above its neighbouring lines) "
-                "but the outputs do not follow it as a response (electrical pickup, a disturbance on the input "
-                "sensor)"
-            )
+            what = "a line on the input sensor or on every channel (electrical pickup)"
+            level = f"{10 * np.log10(prominence):.0f} dB above its neighbouring lines"
+            why = f": the input carries the line too ({level}) but the outputs do not follow it as a response"
         else:
-            what = "a periodic disturbance in the outputs"
-            where = "a disturbance in the outputs (mains hum, a rotating machine, a harmonic the input does not carry)"
+            what, why = "a periodic disturbance in the outputs (mains hum, a rotating machine, a harmonic)", ""
         warnings.append(
             QualityWarning(
                 "periodic_disturbance",
@@ -226,7 +222,7 @@ def disturbance_lines(
                 # the finding first: the terminal shows a note's first clauses
                 f"{what} at {freq:.3f} Hz, not a mode; {seen}: a pole with damping at most "
                 f"{float(line.damping.abs().max()):.1e} (undamped) at {count} of {n_orders} orders, which the "
-                f"input does not drive (residue under {100 * min_energy:g} % of the strongest pole's): {where}. The "
+                f"input does not drive (residue under {100 * min_energy:g} % of the strongest pole's){why}. The "
                 "modes near it were fitted with it in the data: run 'armaxmodal diagnose', which fits the line and "
                 "refits.",
                 freq,

@@ -3,6 +3,7 @@ within 100 characters a line, labelled by how the code moves the verdict, the wh
 screen; every full text under --verbose."""
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -69,6 +70,8 @@ def test_a_headline_keeps_the_finding_drops_the_asides_and_says_where_it_was_cut
         "offsets: head +9.81, chest +9.81 ...")  # a list cut between its items
     assert headline("one long clause without any stop in it at all", 20) == "one long clause ..."
     assert headline("abcdefgh, ijkl mnop qrst", 10) == "abcdef ..."  # the mark fits the width too
+    with pytest.raises(ValueError, match="at least 10"):
+        headline("text", 9)
 
 
 def test_a_finding_of_long_words_keeps_to_its_two_lines_and_its_advice(capsys):
