@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-__all__ = ["CHOLESKY_QR_MAX_CONDITION", "ONE_PASS_MAX_CONDITION", "hermitian_from_upper", "orthonormal_basis",
-           "ridged_cholesky"]
+__all__ = ["CHOLESKY_QR_MAX_CONDITION", "ONE_PASS_MAX_CONDITION", "basis_factor", "hermitian_from_upper",
+           "orthonormal_basis", "ridged_cholesky"]
 
 #: a basis is made orthonormal through its Gram matrix, twice (CholeskyQR2: Fukaya et al. 2014;
 #: Yamamoto et al. 2015, a half of a Householder QR's time here), while its columns, scaled to unit
@@ -55,6 +55,31 @@ def orthonormal_basis(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     >>> bool(np.allclose(q.T @ q, np.eye(4))), bool(np.allclose(q @ r, a))
     (True, True)
     """
+    b, r, formed = basis_factor(a)
+    return (b, r) if formed else (scipy.linalg.blas.dtrsm(1.0, r, b, side=1, overwrite_b=1), r)
+
+
+def basis_factor(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
+    """:func:`orthonormal_basis`'s ``R``, with ``Q`` formed only where one pass of the Gram matrix
+    does not suffice.
+
+    Parameters
+    ----------
+    a : (m, k) float64, F-ordered, m >= k
+        Full column rank; its memory may be overwritten (it holds ``Q`` where ``formed``).
+
+    Returns
+    -------
+    b : (m, k) ndarray
+        ``Q`` where ``formed``; else ``a`` itself, unchanged, and ``Q = a R^-1`` is left to the
+        caller, who applies ``R^-1`` to its products with the basis instead (a triangular solve
+        of the whole basis was a seventh of a modal-model evaluation; the products are as exact,
+        since ``Q`` of one pass is ``a R^-1`` to the same rounding).
+    r : (k, k) ndarray
+        Upper triangular, ``a = Q @ r``.
+    formed : bool
+        Whether ``b`` is ``Q``.
+    """
     gram = scipy.linalg.blas.dsyrk(1.0, a, trans=1)  # the upper triangle of a' a
     scale = 1.0 / np.sqrt(np.diag(gram))
     try:
@@ -63,14 +88,14 @@ def orthonormal_basis(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     except np.linalg.LinAlgError:  # not positive definite in floating point: Householder's
         condition = np.inf
     if not condition <= CHOLESKY_QR_MAX_CONDITION:
-        return scipy.linalg.qr(a, mode="economic", overwrite_a=True, check_finite=False)
+        return (*scipy.linalg.qr(a, mode="economic", overwrite_a=True, check_finite=False), True)
     r = unit / scale  # a D = Q U for the column scaling D, so a = Q (U D^-1)
-    q = scipy.linalg.blas.dtrsm(1.0, r, a, side=1, overwrite_b=1)
     if condition <= ONE_PASS_MAX_CONDITION:
-        return q, r
+        return a, r, False
+    q = scipy.linalg.blas.dtrsm(1.0, r, a, side=1, overwrite_b=1)
     # the second pass: Q is orthonormal to condition^2 x 1e-16, so its Gram matrix is I to that
     again = scipy.linalg.cholesky(scipy.linalg.blas.dsyrk(1.0, q, trans=1), lower=False, check_finite=False)
-    return scipy.linalg.blas.dtrsm(1.0, again, q, side=1, overwrite_b=1), again @ r
+    return scipy.linalg.blas.dtrsm(1.0, again, q, side=1, overwrite_b=1), again @ r, True
 
 
 def hermitian_from_upper(upper: np.ndarray) -> np.ndarray:

@@ -16,7 +16,7 @@ import numpy as np
 import scipy.linalg
 
 from armaxmodal._kernels import modal_basis, modal_moved
-from armaxmodal._linalg import hermitian_from_upper, orthonormal_basis, ridged_cholesky
+from armaxmodal._linalg import basis_factor, hermitian_from_upper, ridged_cholesky
 
 #: the normal equations take ``|P_perp M|^2`` as ``|M|^2 - |Q'M|^2``, which keeps about
 #: 16 + log10 of this ratio of the two digits; below it the Jacobian's rows are formed (a light
@@ -60,11 +60,11 @@ class SeparableModel:
     def __init__(self, s, z_inv, u, y_weighted, dt, hold):
         self.s, self.z_inv, self.u, self.dt, self.hold = s, z_inv, u, dt, hold
         self.b = np.vstack([y_weighted.real, y_weighted.imag])
-        self._x = self.q = self.slopes = self._q_conj = None
+        self._x = self.basis = self.slopes = self._basis_conj = None
 
     def release(self) -> None:
         """Let go of the factors of the last point (the size of the data)."""
-        self._x = self.q = self.resid = self.slopes = self._q_conj = None
+        self._x = self.basis = self.resid = self.slopes = self._basis_conj = None
 
     def _solve(self, x):
         if self._x is not None and np.array_equal(x, self._x):
@@ -75,11 +75,25 @@ class SeparableModel:
         # QR); the last point's arrays are filled again where they fit
         a, slopes = self._buffers(lam.size)
         modal_basis(self.s, self.z_inv, self.u, lam, self.dt, self.hold == "bandlimited", a, slopes)
-        q, r = orthonormal_basis(a)
-        qtb = q.T @ self.b
-        self._x, self.lam, self.q, self.r, self.slopes = x.copy(), lam, q, r, slopes
+        # the basis itself where one pass of its Gram matrix gives R (Q = basis R^-1, applied to
+        # the products below), else Q (basis_factor)
+        basis, r, self.formed = basis_factor(a)
+        self._x, self.lam, self.basis, self.r, self.slopes = x.copy(), lam, basis, r, slopes
+        qtb = self.q_t(self.b)
         self.coef = scipy.linalg.solve_triangular(r, qtb, check_finite=False)
-        self.resid = self.b - q @ qtb
+        self.resid = self.b - basis @ (qtb if self.formed else self.coef)
+
+    def q_t(self, m: np.ndarray) -> np.ndarray:
+        """``Q' m`` for a matrix ``m`` of the basis's rows."""
+        product = self.basis.T @ m
+        return product if self.formed else self._r_inv_t(product)
+
+    def q_times(self, z: np.ndarray) -> np.ndarray:
+        """``Q z`` for a matrix ``z`` of the basis's columns."""
+        return self.basis @ (z if self.formed else scipy.linalg.solve_triangular(self.r, z, check_finite=False))
+
+    def _r_inv_t(self, m: np.ndarray) -> np.ndarray:
+        return scipy.linalg.solve_triangular(self.r, m, trans="T", check_finite=False)
 
     def _buffers(self, n_modes: int) -> tuple[np.ndarray, np.ndarray]:
         """The basis and slope arrays of a point with ``n_modes`` poles: the last point's where they
@@ -87,20 +101,21 @@ class SeparableModel:
         size, and fresh arrays of that size cost as much as the point's products: the allocator
         hands megabytes back to the system when they are freed, and takes them again zeroed."""
         shape, lines = (2 * self.s.size, 4 * n_modes + 2), self.s.size
-        a, slopes = self.q, self.slopes
+        a, slopes = self.basis, self.slopes
         self.release()
         if a is None or a.shape != shape or not a.flags.f_contiguous or not a.flags.writeable:
             a, slopes = np.empty(shape, order="F"), np.empty((4, n_modes, lines), complex)
         return a, slopes
 
-    def _conj_q(self) -> np.ndarray:
-        """``conj(Q_c)`` (L, 4 n + 2) of the current point, in an array kept from point to point."""
-        lines, width = self.s.size, self.q.shape[1]
-        if self._q_conj is None or self._q_conj.shape != (lines, width):
-            self._q_conj = np.empty((lines, width), complex)
-        self._q_conj.real[...] = self.q[:lines]
-        np.negative(self.q[lines:], out=self._q_conj.imag)
-        return self._q_conj
+    def _conj_basis(self) -> np.ndarray:
+        """The conjugate of the current basis as complex lines, ``(L, 4 n + 2)``, in an array kept from
+        point to point: its real rows minus i its imaginary rows."""
+        lines, width = self.s.size, self.basis.shape[1]
+        if self._basis_conj is None or self._basis_conj.shape != (lines, width):
+            self._basis_conj = np.empty((lines, width), complex)
+        self._basis_conj.real[...] = self.basis[:lines]
+        np.negative(self.basis[lines:], out=self._basis_conj.imag)
+        return self._basis_conj
 
     def residual(self, x):
         self._solve(x)
@@ -136,8 +151,7 @@ class SeparableModel:
         back = _basis_slopes_times(seen, d_lam, coef.shape[0])
         moved = moved.reshape(2 * lines, -1)
         # every column at once: two passes over Q
-        moved -= self.q @ (self.q.T @ moved + scipy.linalg.solve_triangular(
-            self.r, back.reshape(coef.shape[0], -1), trans="T", check_finite=False))  # fmt: skip
+        moved -= self.q_times(self.q_t(moved) + self._r_inv_t(back.reshape(coef.shape[0], -1)))
         return moved.reshape(resid.size, x.size)
 
     def normal_equations(self, x, rows: bool = False):
@@ -162,8 +176,11 @@ class SeparableModel:
         # no conjugate copy of the slopes S, nor a new complex copy of Q: each is as large as the basis
         slopes = self.slopes.reshape(4 * n, lines)
         seen = np.conj(slopes @ (self.resid[:lines] - 1j * self.resid[lines:]))  # conj(S) r
-        # Q' M = Re(Q_c^H slopes w) = Re((S conj(Q_c))' w), Q_c = Q's real rows + i its imaginary rows
-        on_basis = ((slopes @ self._conj_q()).T @ w.reshape(4 * n, -1)).real
+        # Q' M = Re(Q_c^H slopes w) = Re((S conj(Q_c))' w), Q_c = Q's real rows + i its imaginary rows;
+        # S conj(Q_c) = (S conj(basis_c)) R^-1 where Q is not formed
+        seen_basis = slopes @ self._conj_basis()
+        seen_basis = seen_basis.T if self.formed else self._r_inv_t(seen_basis.T)
+        on_basis = (seen_basis @ w.reshape(4 * n, -1)).real
         on_basis = on_basis.reshape(-1, width, 2 * n)
         e = scipy.linalg.solve_triangular(self.r, _basis_slopes_times(seen, d_lam, coef.shape[0]).reshape(
             coef.shape[0], -1), trans="T", check_finite=False).reshape(-1, width, 2 * n)  # fmt: skip

@@ -222,18 +222,24 @@ def test_the_modal_kernels_equal_their_column_by_column_references(hold):
     np.testing.assert_allclose(moved, want, rtol=1e-12, atol=1e-12 * np.abs(want).max())
 
 
-@pytest.mark.parametrize("at_nyquist", [False, True])
-def test_the_normal_equations_equal_those_of_the_jacobians_rows(fixtures_dir, at_nyquist):
-    """``J'J``, ``J'r`` and ``|r|^2`` without the rows equal those of the formed Jacobian, also
-    where a fit has put an undamped pole at the Nyquist frequency (30 Hz for this 60 Hz ride, as a
-    count's fit did): its slope lies almost in the basis and the difference of squares alone kept
-    no digit of its diagonal."""
+@pytest.mark.parametrize(("case", "formed"), [("plain", False), ("at_nyquist", False), ("close pair", True)])
+def test_the_normal_equations_equal_those_of_the_jacobians_rows(fixtures_dir, case, formed):
+    """``J'J``, ``J'r`` and ``|r|^2`` without the rows equal those of the formed Jacobian, with the
+    basis left implicit (``Q = basis R^-1``) and, where two poles 2 % apart condition it past one
+    pass of its Gram matrix, with ``Q`` formed; also where a fit has put an undamped pole at the
+    Nyquist frequency (30 Hz for this 60 Hz ride, as a count's fit did): its slope lies almost in
+    the basis and the difference of squares alone kept no digit of its diagonal, so the rows are
+    formed there, and only there."""
     model = _supine_model(fixtures_dir, "bandlimited")
-    freq = np.array([5.8, 8.3, 13.5, 16.2] + ([30.0] if at_nyquist else []))
-    damping = np.array([0.26, 0.35, 0.3, 0.27] + ([1e-4] if at_nyquist else []))
-    x = np.ravel(np.column_stack([np.log(2 * np.pi * freq), damping]))
+    freq, damping = {"plain": ([5.8, 8.3, 13.5, 16.2], [0.26, 0.35, 0.3, 0.27]),
+                     "at_nyquist": ([5.8, 8.3, 13.5, 16.2, 30.0], [0.26, 0.35, 0.3, 0.27, 1e-4]),
+                     "close pair": ([5.8, 5.9, 13.5], [0.26, 0.26, 0.3])}[case]  # fmt: skip
+    x = np.ravel(np.column_stack([np.log(2 * np.pi * np.array(freq)), damping]))
     j, r = model.jacobian(x), model.residual(x).copy()
+    rows, sensor_rows = [], model.sensor_rows
+    model.sensor_rows = lambda at: rows.append(at) or sensor_rows(at)
     gram, grad, power = model.normal_equations(x)
+    assert model.formed == formed and bool(rows) == (case == "at_nyquist")
     np.testing.assert_allclose(gram, j.T @ j, rtol=1e-8, atol=1e-10 * np.abs(j.T @ j).max())
     np.testing.assert_allclose(grad, j.T @ r, rtol=1e-6, atol=1e-9 * np.abs(j.T @ r).max())
     assert power == pytest.approx(r @ r, rel=1e-12)
