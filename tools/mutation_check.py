@@ -196,6 +196,38 @@ MUTANTS = [
         "fit = partial(fit_modal_model, data, max_nfev=max_nfev, settings=settings)",
         "the refit's modes by frequency, not in the start's order (fitter)",
     ),
+    # the basis left implicit where one pass of its Gram matrix gives R (twenty-fourth session); run with
+    # --match "(implicit)" --tests tests/modes/test_refine.py tests/estimate/test_dft_model.py
+    (
+        "armaxmodal/_separable.py",
+        "self.resid = self.b - basis @ (qtb if self.formed else self.coef)",
+        "self.resid = self.b - basis @ qtb",
+        "the residual through Q' b where Q is not formed (implicit)",
+    ),
+    (
+        "armaxmodal/_separable.py",
+        "seen_basis = seen_basis.T if self.formed else self._r_inv_t(seen_basis.T)",
+        "seen_basis = seen_basis.T",
+        "the slopes' projections on the basis, not on Q (implicit)",
+    ),
+    (
+        "armaxmodal/_separable.py",
+        "return self.basis @ (z if self.formed else scipy.linalg.solve_triangular(self.r, z, check_finite=False))",
+        "return self.basis @ z",
+        "Q z taken as basis z (implicit)",
+    ),
+    (
+        "armaxmodal/_separable.py",
+        "return product if self.formed else self._r_inv_t(product)",
+        "return product",
+        "Q' m taken as basis' m (implicit)",
+    ),
+    (
+        "armaxmodal/_linalg.py",
+        "    if condition <= ONE_PASS_MAX_CONDITION:\n        return a, r, False",
+        "    if condition <= ONE_PASS_MAX_CONDITION:\n        return a, r, True",
+        "the basis called Q (implicit)",
+    ),
     # continuing a capped fit (issue 13's performance round)
     (
         "armaxmodal/estimate/_gauss_newton.py",
@@ -977,8 +1009,8 @@ MUTANTS = [
         "orders_damping_unresolved=0,",
         "the neighbour's energy kept (row-facts)",
     ),
-    # every reported mode split once after the search, for the likelihood's flag (run with
-    #   --match "(split-wanted)" --tests tests/modes/test_mode_count.py)
+    # the mode nearest the residual's peak split once after the search, for the likelihood's flag (run
+    #   with --match "(split-wanted)" --tests tests/modes/test_mode_count.py)
     (
         "armaxmodal/modes/count_search.py",
         "        wanted, split = _split_wanted(search, current, halves, supported)\n",
@@ -987,9 +1019,15 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "m, best = min(tried, key=lambda t: search.bic(t[1]))",
-        "m, best = max(tried, key=lambda t: search.bic(t[1]))",
-        "the worst split judged (split-wanted)",
+        "m = int(shown[nearest_pole(current.freq_hz[shown], residual_peak(current, search.data)[0])])",
+        "m = int(shown[-1])",
+        "the top mode split wherever the residual peaks (split-wanted)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "m = int(shown[nearest_pole(current.freq_hz[shown], residual_peak(current, search.data)[0])])",
+        "m = int(nearest_pole(current.freq_hz, residual_peak(current, search.data)[0]))",
+        "the peak's nearest pole split though it is not reported (split-wanted)",
     ),
     (
         "armaxmodal/modes/count_search.py",

@@ -229,19 +229,19 @@ def _unsupported_wanted(search: _Search, current: ModalModel, halves) -> tuple:
 
 
 def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) -> tuple[tuple, ModalModel | None]:
-    """A split the likelihood wants (``()`` if none) and its converged model (None if no split
-    converged resolved): every reported mode split, the best converged and judged as :func:`_wanted`
-    judges an addition; it needs no diagram column (two close modes stand as one column there)."""
+    """A split the likelihood wants (``()`` if none) and its converged model (None if none converged
+    resolved): the reported mode nearest the residual's peak split (as the search's additions split one),
+    converged and judged as :func:`_wanted` judges an addition; it needs no diagram column (two close
+    modes stand as one column there)."""
     shown = np.flatnonzero(physical(current, search.data.band_hz))
     if len(halves) != 2 or shown.size == 0:
         return (), None
-    screened = search.screened([split_start(current, m) for m in shown],  # the best is converged
-                               [("split", float(current.freq_hz[m])) for m in shown], intervals=False)  # fmt: skip
-    tried = [(m, fit) for m, fit in zip(shown, screened, strict=True) if fit is not None]
-    if not tried:
+    m = int(shown[nearest_pole(current.freq_hz[shown], residual_peak(current, search.data)[0])])
+    label = ("split", float(current.freq_hz[m]))
+    best = search.screened([split_start(current, m)], [label], intervals=False)[0]
+    if best is None:
         return (), None
-    m, best = min(tried, key=lambda t: search.bic(t[1]))
-    model = search.fit(best.freq_hz, best.damping, search.cfg.final_nfev, label=("split", float(current.freq_hz[m])))
+    model = search.fit(best.freq_hz, best.damping, search.cfg.final_nfev, label=label)
     new = new_poles(current.freq_hz, model.freq_hz) if model is not None else []
     if not resolved(model, search.data.band_hz) or not new:
         return (), None

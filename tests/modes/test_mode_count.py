@@ -413,10 +413,18 @@ def test_a_long_record_is_counted_on_its_start_and_fitted_whole(bundled_diagram)
     np.testing.assert_allclose(width(part), width(whole), rtol=0.05)
 
 
-def _scripted(table, start=None):
+def _scripted(table, start=None, peak_hz=None):
     """A fitter for ``count_modes(fitter=...)`` whose fits are :class:`_Scored` by ``table``, each
-    knowing ``start``, the count's starting frequencies (Hz), so that a split of one is told apart."""
-    return lambda data, f, x, hold, n, settings, intervals=True: _Scored(f, x, table, start)
+    knowing ``start``, the count's starting frequencies (Hz), so that a split of one is told apart;
+    ``peak_hz(n)``: their residual, over the data's lines, peaks there in a fit capped at ``n`` evaluations."""
+    def fit(data, f, x, hold, n, settings, intervals=True):
+        residual = None
+        if peak_hz is not None:
+            residual = np.random.default_rng(0).standard_normal((data.s.size, 2)) + 0j
+            residual[np.argmin(np.abs(np.abs(data.s) / (2 * np.pi) - peak_hz(n)))] += 10.0
+        return _Scored(f, x, table, start, residual)
+
+    return fit
 
 
 class _Scored:
@@ -426,12 +434,12 @@ class _Scored:
     two poles either side of a mode, 15 % off at damping 0.3); ``table["split"]``, or
     ``table[("split", f)]`` for the split of ``f``, is then its criterion where given."""
 
-    def __init__(self, freq_hz, damping, table, start=None):
+    def __init__(self, freq_hz, damping, table, start=None, residual=None):
         order = np.argsort(freq_hz)
         self.freq_hz, self.damping = np.asarray(freq_hz, float)[order], np.asarray(damping, float)[order]
         self.freq_sd, self.damping_sd = 1e-3 * self.freq_hz, 1e-3 * np.ones_like(self.freq_hz)
         self.n_real, self.rss, self.table = 100, np.ones(4), table  # the supine ride: 4 sensors
-        self.residual = np.random.default_rng(0).standard_normal((50, 2)) + 0j
+        self.residual = np.random.default_rng(0).standard_normal((50, 2)) + 0j if residual is None else residual
         lost = [f for f in (start if start is not None else ()) if np.min(np.abs(np.log(self.freq_hz / f))) > 0.05]
         self.split_of = lost[0] if len(lost) == 1 and self.n_modes > len(start) else None
 
@@ -917,47 +925,64 @@ def test_a_close_pair_reported_as_one_leaves_the_count_undecided_where_the_recor
         assert row.damping_ci95_lo <= exact.damping[k] <= row.damping_ci95_hi, (row.damping, exact.damping[k])
 
 
-@pytest.mark.parametrize("best_resolved", [True, False])
-def test_the_split_of_lowest_criterion_is_the_one_judged(best_resolved):
-    """Of the reported modes' splits, the one of lowest criterion is converged and judged; one
-    whose damping the record does not resolve is no mode, and no other split stands in for it."""
+def _peaked(at_hz: float):
+    """Lines over 1-30 Hz (0.1 Hz apart) and a one-sensor residual whose power peaks at ``at_hz``."""
+    freq_hz = np.linspace(1.0, 30.0, 291)
+    residual = (1.0 + 100.0 * np.exp(-(((freq_hz - at_hz) / 0.3) ** 2)))[:, None].astype(complex)
+    return 2j * np.pi * freq_hz, residual
+
+
+@pytest.mark.parametrize(("peak_hz", "top_hz", "best_resolved", "split_hz"), [
+    (14.0, 100.0, True, 15.0), (14.0, 100.0, False, 15.0), (5.5, 100.0, True, 6.0), (10.6, 100.0, True, 15.0),
+    (14.0, 12.0, True, 6.0)])  # fmt: skip
+def test_the_split_judged_is_that_of_the_mode_nearest_the_residuals_peak(peak_hz, top_hz, best_resolved, split_hz):
+    """The reported mode nearest the line where the model misses most is split, screened, converged and
+    judged (a mode that hides two leaves its largest residual in its band); a pole past the band's top
+    (``top_hz``) is no reported mode; a split whose damping the record does not resolve is no mode,
+    and no other split stands in for it."""
     from armaxmodal.modes.count_search import _split_wanted
 
-    n_eff = 1e5
+    n_eff, s = 1e5, _peaked(peak_hz)[0]
     current = SimpleNamespace(n_params=44, freq_hz=np.array([6.0, 15.0]), damping=np.array([0.2, 0.3]),
-                              neg2_loglik_on=lambda n: 1000.0)  # fmt: skip
+                              neg2_loglik_on=lambda n: 1000.0, residual=_peaked(peak_hz)[1])  # fmt: skip
 
     def split(at, ratio, damping_sd=0.01):  # an sd of 0.2 leaves a damping of 0.25 unresolved
         f = np.sort(np.r_[current.freq_hz, at])
         return SimpleNamespace(n_params=66, freq_hz=f, damping=np.full(3, 0.25), damping_sd=np.full(3, damping_sd),
                                neg2_loglik_on=lambda n: 1000.0 - ratio)  # fmt: skip
 
-    low = split(14.0, 200.0, 0.01 if best_resolved else 0.2)  # beyond the 1e-6 quantile of 22 (68.9)
-    high = split(5.0, 80.0)  # so is this one
-    bic = {id(m): m.neg2_loglik_on(n_eff) + m.n_params * np.log(n_eff) for m in (current, low, high)}
+    upper = split(14.0, 200.0, 0.01 if best_resolved else 0.2)  # beyond the 1e-6 quantile of 22 (68.9)
+    lower = split(5.0, 80.0)  # so is this one
+    screened = []
+    bic = {id(m): m.neg2_loglik_on(n_eff) + m.n_params * np.log(n_eff) for m in (current, upper, lower)}
     search = SimpleNamespace(
-        n_eff=n_eff, bic=lambda m: bic[id(m)], data=SimpleNamespace(band_hz=(1.0, 100.0)),
-        screened=lambda starts, labels, intervals=True: [high, low],
-        fit=lambda f, x, nfev, label=None: low if f[1] == 14.0 else high,
+        n_eff=n_eff, bic=lambda m: bic[id(m)], data=SimpleNamespace(band_hz=(1.0, top_hz), s=s),
+        screened=lambda starts, labels, intervals=True: screened.extend(labels) or [
+            upper if labels[0][1] == 15.0 else lower],
+        fit=lambda f, x, nfev, label=None: upper if 14.0 in f else lower,
         in_both_halves=lambda m, new, halves: True, cfg=CountSettings(),
     )  # fmt: skip
     got, model = _split_wanted(search, current, ("first half", "second half"))
-    if best_resolved:
-        assert got[0] == 14.0 and np.isclose(got[1], 200.0) and model is low, got
-    else:
+    assert screened == [("split", split_hz)]
+    if not best_resolved:
         assert got == () and model is None
+    else:
+        want = upper if split_hz == 15.0 else lower
+        assert got[0] == (14.0 if split_hz == 15.0 else 5.0) and model is want, got
 
 
 @pytest.mark.parametrize(("rise", "joins"), [(-2.9, True), (6.0, True), (40.0, False), (-40.0, False)])
 def test_a_wanted_split_as_good_as_the_chosen_model_is_one_of_the_equally_good(supine, rise, joins):
     """A wanted split whose criterion stays within the decisive 10 of the chosen model's is a model
     the record cannot tell from it: the intervals cover its modes. Beyond that, either way, it is
-    not (a decisive rise is BIC's verdict; a decisive fall the search would have taken had it tried).
-    Criterion 100 for the three modes, 1000 for any addition or split but that of 13 Hz, 100 + rise."""
+    not (a decisive rise is BIC's verdict; a decisive fall the search would have taken had the diagram
+    a column there). Criterion 100 for the three modes, 1000 for any addition or split but that of
+    13 Hz, 100 + rise; the models miss most at 13 Hz, and the diagram has no column at 11-15 Hz."""
     data, start = supine[0], [5.0, 9.0, 13.0]
     table = {2: 200.0, 3: 100.0, 4: 1000.0, "split": 1000.0, ("split", 13.0): 100.0 + rise}
-    count = count_modes(data, start, [0.3, 0.3, 0.3], hold="zoh", halves=(data, data), supported=lambda f, x: True,
-                        fitter=_scripted(table, start))  # fmt: skip
+    count = count_modes(data, start, [0.3, 0.3, 0.3], hold="zoh", halves=(data, data),
+                        supported=lambda f, x: not 11.0 < f < 15.0,
+                        fitter=_scripted(table, start, peak_hz=lambda n: 13.0))  # fmt: skip
     assert count.model.n_modes == 3 and count.wanted.rise == pytest.approx(rise) and not count.wanted.unsupported
     assert 11.0 < count.wanted.freq_hz < 15.0  # a pole of the 13 Hz split
     split = [alt for _, alt in count.alternatives if alt.split_of == 13.0]
@@ -1029,14 +1054,15 @@ def test_a_record_of_one_mode_has_its_split_tried():
     from armaxmodal.modes.count_search import _split_wanted
 
     n_eff = 1e5
+    s, residual = _peaked(25.0)  # the only reported mode is split wherever the model misses most
     current = SimpleNamespace(n_params=22, freq_hz=np.array([10.0]), damping=np.array([0.05]),
-                              neg2_loglik_on=lambda n: 1000.0)  # fmt: skip
+                              neg2_loglik_on=lambda n: 1000.0, residual=residual)  # fmt: skip
     split = SimpleNamespace(n_params=44, freq_hz=np.array([9.8, 10.2]), damping=np.full(2, 0.03),
                             damping_sd=np.full(2, 0.002), neg2_loglik_on=lambda n: 800.0)  # fmt: skip
     screened = []
     search = SimpleNamespace(
         n_eff=n_eff, bic=lambda m: m.neg2_loglik_on(n_eff) + m.n_params * np.log(n_eff),
-        data=SimpleNamespace(band_hz=(1.0, 100.0)), cfg=CountSettings(),
+        data=SimpleNamespace(band_hz=(1.0, 100.0), s=s), cfg=CountSettings(),
         screened=lambda starts, labels, intervals=True: screened.extend(labels) or [split],
         fit=lambda f, x, nfev, label=None: split, in_both_halves=lambda m, new, halves: True,
     )  # fmt: skip
