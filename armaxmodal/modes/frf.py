@@ -179,9 +179,12 @@ def refit_with_added(diagram, work: SelectionState, band, settings: SelectionSet
     """The frequency-domain refit again, of every mode once the check has added some: a mode
     missing from a refit biases its neighbours (a five-segment chain's 13.5 Hz mode came out
     at 12.5 Hz while the 24.8 Hz one was missing, and its refit was refused as too far; now
-    13.3 Hz for the exact 13.54). A refit that cannot be made (by ``refine``) leaves the modes, said."""
+    13.3 Hz for the exact 13.54). The inter-sample form is the record's, chosen once by the first
+    refit: re-chosen here, a held ride whose first refit was held by 258 went band-limited by 8
+    (both converged) and lost its top mode. A refit that cannot be made (by ``refine``) leaves the modes, said."""
+    hold = work.refinement.hold if work.refinement is not None else "auto"
     refit = selection_job(diagram.recording, [], work.modes, ("refit", refit_band(diagram.recording, band)),
-                          settings, refine)  # fmt: skip
+                          settings, refine, hold)  # fmt: skip
     if isinstance(refit, RefitFailure):
         work = work.warned(*refit.notes("the modes with those the check added", uncounted=False))
     else:  # the first refit's start lacked these modes: its refusals may not stand

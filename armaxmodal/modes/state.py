@@ -272,14 +272,14 @@ def refit_band(recording: Recording, band) -> tuple[float, float]:
 
 
 def selection_job(recording: Recording, parts: list, modes: pd.DataFrame, job, settings: SelectionSettings = DEFAULTS,
-                  refine: Callable = refine_modes):  # fmt: skip
+                  refine: Callable = refine_modes, hold: str = "auto"):  # fmt: skip
     """One job of :func:`refit_and_segment_fits`: a segment's refit, or the frequency-domain refit by
-    ``refine`` (a :class:`RefitFailure` where it cannot be made)."""
+    ``refine`` under ``hold`` (a :class:`RefitFailure` where it cannot be made)."""
     kind, what = job
     if kind == "segment":
         return segment_poles(parts, what)
     try:
-        return refine(recording, modes.freq_hz, modes.damping, band_hz=what, settings=settings.dft,
+        return refine(recording, modes.freq_hz, modes.damping, band_hz=what, hold=hold, settings=settings.dft,
                       decisive=settings.count.decisive_bic, negligible=settings.count.negligible_bic)  # fmt: skip
     except (OrderError, np.linalg.LinAlgError) as exc:
         return RefitFailure(str(exc))  # too few lines or a degenerate basis: the ARMAX values stand, said

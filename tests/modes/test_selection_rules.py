@@ -434,9 +434,10 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     lo, hi = excited_band(rec)
     seen = []
 
-    def refit(recording, freq_hz, damping, band_hz, settings=None, decisive=None, negligible=None):
+    def refit(recording, freq_hz, damping, band_hz, hold, settings=None, decisive=None, negligible=None):
         seen.append(band_hz)
-        # the hold is decided at the count's levels
+        # the hold is decided by the data, at the count's levels
+        assert hold == "auto"
         assert (decisive, negligible) == (CountSettings().decisive_bic, CountSettings().negligible_bic)
         return SimpleNamespace(hold="zoh")
 
@@ -451,7 +452,7 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     # a held input: the ARMAX values are reported
     assert out.refinement is ref and out.modes is modes and out.shapes is shapes
 
-    def failing(recording, freq_hz, damping, band_hz, settings=None, decisive=None, negligible=None):
+    def failing(recording, freq_hz, damping, band_hz, hold, settings=None, decisive=None, negligible=None):
         raise OrderError("too few lines")
 
     failed = st.selection_job(rec, [], modes, ("refit", (lo, hi)), refine=failing)
@@ -460,6 +461,27 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     assert note.code == "refit_failed" and "too few lines" in note.message
     out = st.refined_modes(diagram, work, failed, 0.05, 0.5, 0.8)
     assert out.refinement is None and out.modes is modes and out.shapes is shapes  # the ARMAX values stand
+
+
+@pytest.mark.parametrize("first", [None, "zoh", "bandlimited"])
+def test_the_refit_with_the_checks_additions_keeps_the_records_inter_sample_form(first):
+    """The inter-sample form is the record's: the first refit chooses it, and the refit of every mode
+    once the check has added some keeps it (a held ride, held by 258 at the first refit, went
+    band-limited by 8 when chosen again and lost its top mode); chosen by the data where the first
+    refit could not be made."""
+    from armaxmodal.modes.frf import refit_with_added
+
+    rec, seen = _recording(2000), []
+
+    def refit(recording, freq_hz, damping, band_hz, hold, settings=None, decisive=None, negligible=None):
+        seen.append(hold)
+        raise OrderError("too few lines")  # the modes stand, said
+
+    modes = _modes([5.0, 9.0], [0.1, 0.05], [1.0, 1.0])
+    first_refit = None if first is None else SimpleNamespace(hold=first)
+    work = SelectionState(modes, np.eye(2, dtype=complex), refinement=first_refit)
+    out = refit_with_added(SimpleNamespace(recording=rec), work, None, refine=refit)
+    assert seen == [first or "auto"] and [w.code for w in out.warnings] == ["refit_failed"]
 
 
 def _band_limited_refit(freq_hz, damping, shapes):
