@@ -61,6 +61,7 @@ class SeparableModel:
         self.s, self.z_inv, self.u, self.dt, self.hold = s, z_inv, u, dt, hold
         self.b = np.vstack([y_weighted.real, y_weighted.imag])
         self._x = self.basis = self.slopes = self._basis_conj = None
+        self.formed = True  # whether ``basis`` is Q (set by each point's factorisation)
 
     def release(self) -> None:
         """Let go of the factors of the last point (the size of the data)."""
