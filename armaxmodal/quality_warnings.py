@@ -320,6 +320,18 @@ CODES: tuple[WarningCode, ...] = (
         uncertain=True,
     ),
     WarningCode(
+        "model_inadequate", "selection",
+        "the modal model the criterion and the halves chose misfits the record beyond its noise: some output's "
+        "residual power exceeds 1.25 times the noise the local polynomial method measures in that residual "
+        "(0.97–1.02 on simulated bodies and light chains; 1.5–35 on shake-table and bridge records, 600 and more on "
+        "the F-16's multisine)",
+        "the count runs again under one stated rule: a mode it adds must also stand in a stable column of the "
+        "diagram (the likelihood of a wrong model buys ghost modes); what that rule refused is named; a reported "
+        "mode without a column is `count_undecided`",
+        "Read the modes as those the record and the diagram agree on; look for what the model lacks with "
+        "`armaxmodal diagnose` (a second input, a delay, a nonlinearity).",
+    ),
+    WarningCode(
         "mode_beyond_band", "selection",
         "a pole of the maximum-likelihood modal model whose removal raises BIC by 10 or more, whose 95 % intervals "
         "lie wholly outside the band and below Nyquist in frequency and above zero in damping (at most 0.6), and whose "

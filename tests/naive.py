@@ -124,3 +124,22 @@ def modal_moved(slopes, alpha, beta, d_lam):
             m = -(g * own + np.conj(g) * partner)
             out[:lines, :, 2 * j + i], out[lines:, :, 2 * j + i] = m.real, m.imag
     return out
+
+
+def local_polynomial_noise(u, y, half_width: int, degree: int):
+    """The local polynomial method one line at a time: each line's window (shifted inwards at the
+    ends), the FRF and transient polynomials fitted by ``numpy.linalg.lstsq``, the residual's power
+    over its degrees of freedom."""
+    u, y = np.asarray(u, complex), np.asarray(y, complex)
+    n, width = u.size, 2 * half_width + 1
+    var = np.empty(y.shape)
+    for k in range(n):
+        centre = min(max(k, half_width), n - 1 - half_width)
+        rows = np.arange(centre - half_width, centre + half_width + 1)
+        r = (rows - k) / half_width
+        columns = [r**p * u[rows] for p in range(degree + 1)] + [r**p + 0j for p in range(degree + 1)]
+        a = np.column_stack(columns)
+        for j in range(y.shape[1]):
+            coef = np.linalg.lstsq(a, y[rows, j], rcond=None)[0]
+            var[k, j] = np.sum(np.abs(y[rows, j] - a @ coef) ** 2) / (width - 2 * (degree + 1))
+    return var

@@ -9,6 +9,7 @@ the chosen model is converged, carried-away starts judged, equally good models f
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from functools import partial
 
 import numpy as np
@@ -24,6 +25,7 @@ from armaxmodal.modes.mode_count import (
     Step,
     Wanted,
     halves_chi2,
+    model_adequacy,
     residual_peak,
     split_start,
 )
@@ -269,6 +271,7 @@ def count_modes(
     dft: DftSettings = DEFAULTS.dft,
     fitter: Callable = fit_modal_model,
     agreement: AgreementSettings = DEFAULTS.agreement,
+    adequacy: Callable | None = None,
 ) -> ModeCount:
     """Choose the number of modes by nested tests of free refits (see the module notes).
 
@@ -301,6 +304,10 @@ def count_modes(
         Which poles are lines, not modes; the modal model's fits; the halves' test's level.
     fitter : callable
         The fit, as :func:`~armaxmodal.estimate.dft_model.fit_modal_model` (a test's stands in for it).
+    adequacy : callable, optional
+        ``adequacy(model, data) -> Adequacy``: the adequacy test (default
+        :func:`~armaxmodal.modes.mode_count.model_adequacy` at ``settings.adequacy_ratio``; a test's
+        stands in for it beside a scripted fitter).
 
     Returns
     -------
@@ -321,12 +328,39 @@ def count_modes(
     """
     return _count_modes(data, freq_hz, damping, candidates, hold=hold, max_nfev=max_nfev, halves=halves,
                         supported=supported, search=search, n_jobs=n_jobs, settings=settings, lines=lines, dft=dft,
-                        fitter=fitter, agreement=agreement)  # fmt: skip
+                        fitter=fitter, agreement=agreement, adequacy=adequacy)  # fmt: skip
 
 
-def _count_modes(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev, halves, supported, search, n_jobs,
-                 settings: CountSettings, lines, dft, fitter, agreement) -> ModeCount:  # fmt: skip
-    """:func:`count_modes` itself (its parameters), under the caller's BLAS threads (the public one holds one)."""
+def _count_modes(data: DftLines, freq_hz, damping, candidates, *, supported, search, settings: CountSettings,
+                 adequacy: Callable | None = None, **options) -> ModeCount:  # fmt: skip
+    """:func:`count_modes` itself (its parameters), under the caller's BLAS threads (the public one holds one).
+
+    The world first (:func:`armaxmodal.modes.mode_count.model_adequacy`): the search runs with the criterion and the
+    halves alone, and where its model explains the record to its noise, that model is the count's.
+    Where it does not, the likelihood is no judge of what a mode is: the search runs again under the
+    one stated rule (an added mode also stands in a stable diagram column, ``supported``), both
+    searches' fits in the table, and ``rule_refused`` keeps what the first chose where its criterion is lower."""
+    free = _searched(data, freq_hz, damping, candidates, supported=None, search=search, settings=settings, **options)
+    test = (adequacy or _adequacy_at(settings.adequacy_ratio))(free.model, data)
+    if test.adequate or supported is None or not search:
+        return replace(free, adequacy=test)
+    ruled = _searched(data, freq_hz, damping, candidates, supported=supported, search=search, settings=settings,
+                      **options)  # fmt: skip
+    n_eff = free.effective_fraction * data.n_real * data.y.shape[1]  # both searches start from one model
+    fall = float(ruled.model.bic(n_eff) - free.model.bic(n_eff))
+    refused = (fall, tuple(np.sort(free.model.freq_hz))) if fall > 0 else ()  # what the criterion preferred
+    return replace(ruled, adequacy=test, rule_refused=refused, trials=free.trials + ruled.trials,
+                   models=free.models + ruled.models)  # fmt: skip
+
+
+def _adequacy_at(level: float) -> Callable:
+    """The package's adequacy test at ``level``, as :func:`count_modes` calls one: ``(model, data)``."""
+    return lambda model, data: model_adequacy(model, data.u, level)
+
+
+def _searched(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev, halves, supported, search, n_jobs,
+              settings: CountSettings, lines, dft, fitter, agreement) -> ModeCount:  # fmt: skip
+    """One search from the starting set, an addition admitted where ``supported`` says (None: always)."""
     start_model = fitter(data, freq_hz, damping, hold, max_nfev, settings=dft)
     # each sensor weighted by its noise level as the fitted start leaves it (the likelihood is
     # concentrated over those levels; the weights only steer the fits)

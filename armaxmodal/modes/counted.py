@@ -38,6 +38,7 @@ from armaxmodal.modes.notes import (
     pick_moved_note,
     pick_notes,
     reported_as_one_note,
+    rule_notes,
 )
 from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
 from armaxmodal.modes.state import SelectionState
@@ -148,7 +149,8 @@ def counted_modes(
     if picked:
         return replace(_picked_result(_doubts_said(work, ()), count, keep, verdicts, hold, settings), **lines)
     if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
-        return _doubts_said(work, ()).warned(no_mode_kept_note(count, modes, data.band_hz), **lines)
+        return _doubts_said(work, ()).warned(no_mode_kept_note(count, modes, data.band_hz),
+                                             *rule_notes(count, keep, rec.sensors, supported), **lines)
     rows = pd.DataFrame([_row(modes, count, i, hold, same_row, verdicts[i]) for i in np.flatnonzero(keep)])
     rows, shapes, merged = _one_where_not_separated(rows, count.model.shapes[:, keep], count, keep, whole, hold,
                                                     settings)  # fmt: skip
@@ -157,7 +159,8 @@ def counted_modes(
     poles = tuple(zip(count.model.freq_hz[keep].tolist(), count.model.damping[keep].tolist(), strict=True))
     work = work.with_modes(rows, shapes, check_poles=poles if merged else None, counted=True, **lines)
     work = _doubts_said(work, count.model.freq_hz[keep], same_row)
-    return work.warned(*count_notes(count, keep, data.band_hz, same_row), *merged, *disagree)
+    return work.warned(*count_notes(count, keep, data.band_hz, same_row), *merged, *disagree,
+                       *rule_notes(count, keep, rec.sensors, supported))
 
 
 def _doubts_said(work: SelectionState, reported_hz, reach: float = 0.0) -> SelectionState:

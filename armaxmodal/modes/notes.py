@@ -398,3 +398,49 @@ def not_needed_note(f: float, x: float, neighbour_hz: float | None, level: float
         f"a stable pole at {f:.3f} Hz (damping {x:.3f}) is left out: the measured FRF does not need it, {evidence}: "
         "a spurious pole of the model (noise, a nonlinearity, leakage), not a mode of the record", float(f), (f,),
     )  # fmt: skip
+
+
+def rule_notes(count: ModeCount, keep: np.ndarray, sensors, stable) -> list[QualityWarning]:
+    """Where the counted model misfits the record beyond its noise (``count.adequacy``), the rule the
+    count then ran by, in one ``model_inadequate`` note that says what it refused; and a
+    ``count_undecided`` note for each reported mode that does not pass it (``stable(f, x)``: no stable
+    column of the diagram there). Nothing where the model is adequate.
+
+    Parameters
+    ----------
+    count : ModeCount
+        The count's result.
+    keep : (n_poles,) bool ndarray
+        The poles reported as modes.
+    sensors : sequence of str
+        The outputs, in the order of ``count.adequacy.ratio``.
+    stable : callable
+        ``stable(freq_hz, damping)``: does the diagram hold a stable column there?
+
+    Returns
+    -------
+    list of QualityWarning
+    """
+    test = count.adequacy
+    if test is None or test.adequate:
+        return []
+    worst = int(np.nanargmax(test.ratio))
+    text = (f"the modal model misfits the record beyond its noise (on '{sensors[worst]}' its residual holds "
+            f"{test.ratio[worst]:.2f} times the noise the record shows, at most {test.level:g} where a model explains "
+            f"it), so the criterion, which assumes a right model, cannot count the modes alone: a mode the count adds "
+            "must also stand in a stable column of the diagram")  # fmt: skip
+    if count.rule_refused:
+        fall, freqs = count.rule_refused
+        text += (f"; the criterion alone chose {len(freqs)} modes ({', '.join(f'{f:.2f}' for f in freqs)} Hz, lower "
+                 f"by {fall:.1f}), refused by that rule")  # fmt: skip
+    notes = [QualityWarning("model_inadequate", (sensors[worst],), text, float(test.ratio[worst]))]
+    m = count.model
+    for i in np.flatnonzero(keep):
+        if not stable(m.freq_hz[i], m.damping[i]):
+            notes.append(QualityWarning(
+                "count_undecided", (),
+                f"the mode at {m.freq_hz[i]:.3f} Hz stands in no stable column of the diagram, which the count's rule "
+                "asks of a mode where the model misfits the record: treat it as tentative",
+                float(m.freq_hz[i]), (float(m.freq_hz[i]),),
+            ))  # fmt: skip
+    return notes

@@ -256,6 +256,11 @@ class CountSettings:
     #: two modes closer than this many standard deviations of their difference are not separated
     #: by the record (a difference 3 SD from zero is the usual resolution rule)
     separation_sd: float = 3.0
+    #: the counted model is adequate where no sensor's residual power exceeds this multiple of the
+    #: noise the local polynomial method measures in it (:func:`armaxmodal.modes.mode_count.model_adequacy`): 0.97-1.02
+    #: on 16 simulated bodies and light chains (one in a hundred would pass 1.1 at 1,000 lines); 1.5-35
+    #: on the shake-table and bridge records the count refused ghost modes on, 600-2,200 on the F-16
+    adequacy_ratio: float = 1.25
 
     def __post_init__(self):
         _checked(self)
