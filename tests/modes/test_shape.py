@@ -1,5 +1,7 @@
-"""The shape the one-pipeline issue asks of ``modes/``: every threshold in ``settings.py``, and
-no module a reader cannot hold (at most 400 lines)."""
+"""The shape the one-pipeline issue asks of ``modes/``: every threshold in ``settings.py``. The
+selection system's size is measured by ``tools/selection_shape.py`` (branches, characters, named
+thresholds, formatting), which CI prints; the 400-line limit per module is retired (issue 67: a
+module may be longer where its one job needs it, and says so in its docstring)."""
 
 import ast
 from pathlib import Path
@@ -27,11 +29,6 @@ def test_no_numeric_module_constant_outside_the_settings(path):
     bound = [node for node in tree.body if isinstance(node, ast.Assign | ast.AnnAssign) and node.value is not None]
     found = [(node.lineno, _numbers(node.value)) for node in bound if _numbers(node.value)]
     assert not found, f"{path.name}: numeric module constants at lines {found}"
-
-
-@pytest.mark.parametrize("path", MODULES, ids=lambda p: p.name)
-def test_no_module_of_modes_is_over_400_lines(path):
-    assert len(path.read_text().splitlines()) <= 400
 
 
 def test_modes_holds_at_most_fourteen_modules():
