@@ -323,8 +323,8 @@ CODES: tuple[WarningCode, ...] = (
         "model_inadequate", "selection",
         "the modal model the criterion and the halves chose misfits the record beyond its noise: some output's "
         "residual power exceeds 1.25 times the noise the local polynomial method measures in that residual "
-        "(0.97–1.02 on simulated bodies and light chains; 1.5–35 on shake-table and bridge records, 600 and more on "
-        "the F-16's multisine)",
+        "(0.97–1.02 on simulated bodies and light chains; 1.3–35 on the bridge and shake-table records that "
+        "misfit, 32–2,056 on the F-16's multisine)",
         "the count runs again under one stated rule: a mode it adds must also stand in a stable column of the "
         "diagram (the likelihood of a wrong model buys ghost modes); what that rule refused is named; a reported "
         "mode without a column is `count_undecided`",

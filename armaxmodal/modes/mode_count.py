@@ -17,7 +17,7 @@ residual with the noise the record holds by itself: the local polynomial method
 (:func:`armaxmodal.spectra.local_polynomial_noise`) applied to the residual on the count's own
 lines. Where the model is right the residual is the noise and each sensor's ratio of the two powers
 is 1 (0.97-1.02 over bodies and light chains); what the model lacks that is smooth over a few lines
-stays in it (1.5-35 on the shake-table and bridge records, 600-2,200 on the F-16's multisine).
+stays in it (1.3-35 on the bridge and shake-table records that misfit, 32-2,056 on the F-16).
 Noise the input does not explain (another input, a cubic spring's distortion under a random input)
 is noise to both, and leaves the ratio at 1.
 

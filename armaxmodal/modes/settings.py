@@ -258,8 +258,8 @@ class CountSettings:
     separation_sd: float = 3.0
     #: the counted model is adequate where no sensor's residual power exceeds this multiple of the
     #: noise the local polynomial method measures in it (:func:`armaxmodal.modes.mode_count.model_adequacy`): 0.97-1.02
-    #: on 16 simulated bodies and light chains (one in a hundred would pass 1.1 at 1,000 lines); 1.5-35
-    #: on the shake-table and bridge records the count refused ghost modes on, 600-2,200 on the F-16
+    #: on 11 simulated bodies and light chains; 1.3-35 on the bridge and shake-table records that misfit
+    #: (Painter Street's 2021 event 9-35), 32-2,056 on the F-16's four levels; 0.79-1.22 on the others
     adequacy_ratio: float = 1.25
 
     def __post_init__(self):
