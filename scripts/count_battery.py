@@ -227,7 +227,7 @@ def main() -> None:
               f" quality {sel.quality} {because}{f' estimators disagree ({disagree[0]:.0f})' if disagree else ''}"
               f" | {'right' if ok else 'WRONG: ' + '; '.join(why)}"
               f"{f' | beyond the band: {named} named, {held} an exact mode' if named else ''}"
-              f" | {cpu:.1f} CPU-s", flush=True)  # fmt: skip
+              f"{_table_best(sel)} | {cpu:.1f} CPU-s", flush=True)  # fmt: skip
     wrong = tally["cases"] - tally["right"]
     print(f"\n{tally['right']}/{tally['cases']} right; of {wrong} wrong, {tally['wrong_flagged']} say poor or "
           f"uncertain; {tally['right_flagged']} right ones say poor or uncertain")  # fmt: skip
@@ -236,6 +236,23 @@ def main() -> None:
     print(f"{tally['disagree']} of {tally['cases']} rides say their two estimators disagree (estimators_disagree)")
     print(f"{tally['beyond']} modes named beyond the band (mode_beyond_band), {tally['beyond_held']} of them holding "
           "an exact mode in their interval")
+
+
+def _table_best(sel) -> str:
+    """The reported model's criterion beside the best converged model of the count's table whose
+    halves did not refuse it (issue 67: the count reports its best model), and the world it ran in."""
+    count = getattr(sel, "count", None)
+    if count is None:
+        return ""
+    n_eff = count.effective_fraction * count.model.n_real * count.model.rss.size
+    here = count.model.bic(n_eff)
+    rows = [m for m in count.models if m.converged and m.halves_agree is not False]
+    best = min(rows, key=lambda m: m.bic, default=None)
+    adequacy = getattr(count, "adequacy", None)  # absent before issue 67
+    world = "" if adequacy is None else f", ratio {max(adequacy.ratio):.2f}"
+    if best is None:
+        return f" | BIC {here:.1f}{world}"
+    return f" | BIC {here:.1f}, table's best {best.bic:.1f} ({best.n_modes} modes){world}"
 
 
 def _interval_coverage(truth, sel) -> tuple[int, int]:

@@ -148,7 +148,8 @@ SEVERITIES = {
                 "periodic_disturbance", "stuck_samples", "oversampled", "held_samples", "refit_failed",
                 "count_undecided", "modes_not_separated", "pick_not_supported", "mode_beyond_band"],
     "info": ["gap_filled", "empty_columns_dropped", "time_rounded", "offset_removed", "trend_removed", "resampled",
-             "split_merged", "mode_not_needed", "orders_capped", "check_not_run", "mode_count", "estimators_disagree"],
+             "split_merged", "mode_not_needed", "orders_capped", "check_not_run", "mode_count", "estimators_disagree",
+             "model_inadequate"],
 }  # fmt: skip
 
 

@@ -88,8 +88,9 @@ def test_the_earlier_estimate_is_the_diagrams_not_the_modal_models():
 def test_a_cubic_spring_makes_the_estimators_disagree_and_its_linear_twin_does_not(ratio):
     """The supine human with a cubic spring between chest and pelvis (its force 0.3 of the linear
     spring's at the RMS deflection) and without it: only the nonlinear ride's modal model and ARMAX
-    fit disagree beyond their noise (statistic 77 for its three modes), and there every reported
-    interval holds the ARMAX value its mode was counted from."""
+    fit disagree beyond their noise (statistic 20 for the three modes both estimate; the fourth, near
+    13.8 Hz, is the count's split, which the ARMAX fits merge), and there every reported interval
+    holds the ARMAX value its mode was counted from."""
     import armaxmodal as am
     from armaxmodal.diagnosis.inject import cubic_spring_ride
 
@@ -100,8 +101,10 @@ def test_a_cubic_spring_makes_the_estimators_disagree_and_its_linear_twin_does_n
     if ratio == 0.0:
         assert not notes and not m.estimator_widened.any()
         return
-    assert len(notes) == 1 and notes[0].value > scipy.stats.chi2.isf(0.01, 2 * len(m))
-    assert m.estimator_widened.all()
-    assert ((m.freq_ci95_lo <= m.freq_earlier) & (m.freq_earlier <= m.freq_ci95_hi)).all()
-    assert ((m.damping_ci95_lo <= m.damping_earlier) & (m.damping_earlier <= m.damping_ci95_hi)).all()
-    assert all(r["interval_covers_other_estimator"] for r in selection.to_dict()["modes"])
+    both = m[np.isfinite(m.freq_earlier.to_numpy(float))]  # the modes both estimators give
+    assert len(both) >= 3 and len(notes) == 1 and notes[0].value > scipy.stats.chi2.isf(0.01, 2 * len(both))
+    assert both.estimator_widened.any()
+    assert ((both.freq_ci95_lo <= both.freq_earlier) & (both.freq_earlier <= both.freq_ci95_hi)).all()
+    assert ((both.damping_ci95_lo <= both.damping_earlier) & (both.damping_earlier <= both.damping_ci95_hi)).all()
+    flags = [r["interval_covers_other_estimator"] for r in selection.to_dict()["modes"]]
+    assert flags == m.estimator_widened.tolist()  # the JSON says which intervals were widened to cover it
