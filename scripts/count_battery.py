@@ -239,14 +239,16 @@ def main() -> None:
 
 
 def _table_best(sel) -> str:
-    """The reported model's criterion beside the best converged model of the count's table whose
-    halves did not refuse it (issue 67: the count reports its best model), and the world it ran in."""
+    """The reported model's criterion beside the best converged model of the count's table that holds
+    no more modes than it or whose halves confirmed its new poles (issue 67: the count reports the best
+    model whose new modes the halves confirm; a larger model's row whose halves were not asked is a
+    copy of one they were asked of, or was never the best), and the world it ran in."""
     count = getattr(sel, "count", None)
     if count is None:
         return ""
     n_eff = count.effective_fraction * count.model.n_real * count.model.rss.size
     here = count.model.bic(n_eff)
-    rows = [m for m in count.models if m.converged and m.halves_agree is not False]
+    rows = [m for m in count.models if m.converged and (m.halves_agree or m.n_modes <= count.model.n_modes)]
     best = min(rows, key=lambda m: m.bic, default=None)
     adequacy = getattr(count, "adequacy", None)  # absent before issue 67
     world = "" if adequacy is None else f", ratio {max(adequacy.ratio):.2f}"

@@ -16,7 +16,7 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
-from count_battery import beyond_named, bound, judge, ride  # scripts/ is on the path when a script runs
+from count_battery import _table_best, beyond_named, bound, judge, ride  # scripts/ is on the path when a script runs
 
 import armaxmodal as am
 from armaxmodal.modes.state import refit_band
@@ -66,7 +66,8 @@ def main() -> None:
         verdict = "right" if ok else "WRONG: " + "; ".join(why)
         print(f"{args.seed}#{i}: exact {np.round(truth.freq_hz, 2).tolist()}, found "
               f"{np.round(sel.modes.freq_hz, 2).tolist()} {sel.quality} | {verdict}"
-              f"{f' | beyond the band: {named} named, {held} an exact mode' if named else ''}", flush=True)  # fmt: skip
+              f"{f' | beyond the band: {named} named, {held} an exact mode' if named else ''}{_table_best(sel)}",
+              flush=True)  # fmt: skip
     print(f"\n{tally['right']}/{args.bodies} right; {tally['wrong_good']} wrong ones say good; "
           f"{tally['right_flagged']} right ones say uncertain or poor; "
           f"{tally['lost_good']} lose a mode of the ride's band under good; {tally['beyond']} modes named beyond "

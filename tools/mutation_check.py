@@ -1224,6 +1224,74 @@ MUTANTS = [
         "if True:",
         "a finding wrapped past its rows (notes)",
     ),
+    # which world the record is in: the adequacy test and the count by it (issue 67; run with
+    #   --match "(adequacy)" --tests tests/modes/test_adequacy.py tests/modes/test_mode_count.py)
+    (
+        "armaxmodal/spectra.py",
+        "    return np.sum(np.abs(residual) ** 2, axis=1) / (width - unknowns)",
+        "    return np.sum(np.abs(residual) ** 2, axis=1) / width",
+        "the noise over the window's lines, not its degrees of freedom (adequacy)",
+    ),
+    (
+        "armaxmodal/spectra.py",
+        "basis, _ = np.linalg.qr(np.concatenate([powers * u[rows][..., None], powers], axis=-1))",
+        "basis, _ = np.linalg.qr(powers * u[rows][..., None])",
+        "no transient polynomial (adequacy)",
+    ),
+    (
+        "armaxmodal/spectra.py",
+        "centres = np.clip(np.arange(n), half_width, n - 1 - half_width)",
+        "centres = np.clip(np.arange(n), 0, n - 1)",
+        "windows run past the band's ends (adequacy)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "    noise = local_polynomial_noise(u, model.residual).sum(axis=0)",
+        "    noise = local_polynomial_noise(u, model.residual).mean(axis=0)",
+        "the noise's mean against the residual's sum (adequacy)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "        return bool(np.all(self.ratio <= self.level))",
+        "        return bool(np.any(self.ratio <= self.level))",
+        "one sensor explained makes the model adequate (adequacy)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "    if test.adequate or supported is None or not search:",
+        "    if supported is None or not search:",
+        "the column rule everywhere (adequacy)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "free = _searched(data, freq_hz, damping, candidates, supported=None,",
+        "free = _searched(data, freq_hz, damping, candidates, supported=supported,",
+        "the first search under the column rule (adequacy)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "    refused = (fall, tuple(np.sort(free.model.freq_hz))) if fall > 0 else ()",
+        "    refused = (fall, tuple(np.sort(free.model.freq_hz)))",
+        "a worse model said to be refused (adequacy)",
+    ),
+    (
+        "armaxmodal/modes/notes.py",
+        "        if not stable(m.freq_hz[i], m.damping[i]):",
+        "        if stable(m.freq_hz[i], m.damping[i]):",
+        "the modes with a column said undecided (adequacy)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "        if wanted and supported is None and wanted.rise <= -settings.decisive_bic:",
+        "        if wanted and wanted.rise <= -settings.decisive_bic:",
+        "a wanted split taken under the column rule too (adequacy)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "        if wanted and supported is None and wanted.rise <= -settings.decisive_bic:",
+        "        if False:",
+        "no split taken after the search (adequacy)",
+    ),
 ]
 DEFAULT_TESTS = [
     "tests/estimate/test_guards.py",
