@@ -39,7 +39,7 @@ from armaxmodal.modal import matched_poles, nearest_pole
 from armaxmodal.modes.intervals import interval
 from armaxmodal.modes.poles import beyond_band, borderline, reported
 from armaxmodal.modes.settings import DEFAULTS, AgreementSettings, CountSettings, DftSettings, LineSettings
-from armaxmodal.spectra import local_polynomial_noise
+from armaxmodal.spectra import LPM_HALF_WIDTH, local_polynomial_noise
 from armaxmodal.stats import Z95
 
 __all__ = ["Adequacy", "Alternative", "FittedModel", "LeftOut", "ModeCount", "ModelTable", "StandIn", "Step", "Wanted",
@@ -116,6 +116,8 @@ def model_adequacy(model: ModalModel, u: np.ndarray, level: float) -> Adequacy:
     Returns
     -------
     Adequacy
+        Each sensor's ratio; NaN for all where the band holds fewer lines than the method's window
+        (13), which is not shown adequate.
 
     Examples
     --------
@@ -130,6 +132,8 @@ def model_adequacy(model: ModalModel, u: np.ndarray, level: float) -> Adequacy:
     >>> model_adequacy(model, data.u, 1.25).adequate
     True
     """
+    if np.size(u) < 2 * LPM_HALF_WIDTH + 1:  # too few lines to measure the noise: not shown adequate
+        return Adequacy(np.full(model.residual.shape[1], np.nan), float(level))
     noise = local_polynomial_noise(u, model.residual).sum(axis=0)
     power = np.sum(np.abs(model.residual) ** 2, axis=0)
     return Adequacy(power / np.where(noise > 0, noise, np.nan), float(level))

@@ -424,11 +424,15 @@ def rule_notes(count: ModeCount, keep: np.ndarray, sensors, stable) -> list[Qual
     test = count.adequacy
     if test is None or test.adequate:
         return []
-    worst = int(np.nanargmax(test.ratio))
-    text = (f"the modal model misfits the record beyond its noise (on '{sensors[worst]}' its residual holds "
-            f"{test.ratio[worst]:.2f} times the noise the record shows, at most {test.level:g} where a model explains "
-            f"it), so the criterion, which assumes a right model, cannot count the modes alone: a mode the count adds "
-            "must also stand in a stable column of the diagram")  # fmt: skip
+    if np.all(np.isnan(test.ratio)):
+        worst, found = 0, "the band holds too few lines to measure the record's noise"
+    else:
+        worst = int(np.nanargmax(test.ratio))
+        found = (f"the modal model misfits the record beyond its noise (on '{sensors[worst]}' its residual holds "
+                 f"{test.ratio[worst]:.2f} times the noise the record shows, at most {test.level:g} where a model "
+                 "explains it)")  # fmt: skip
+    text = (f"{found}, so the criterion, which assumes a right model, cannot count the modes alone: a mode the "
+            "count adds must also stand in a stable column of the diagram")  # fmt: skip
     if count.rule_refused:
         fall, freqs = count.rule_refused
         text += (f"; the criterion alone chose {len(freqs)} modes ({', '.join(f'{f:.2f}' for f in freqs)} Hz, lower "

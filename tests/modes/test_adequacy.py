@@ -3,6 +3,8 @@ reference and a known noise level, the adequacy test on a right, a short and a w
 count that runs by the criterion and the halves where its model is adequate and by the stated rule
 (a stable diagram column as well) where it is not."""
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -133,3 +135,16 @@ def test_where_it_is_not_the_stated_rule_decides(ride):
     assert [n.code for n in notes] == ["model_inadequate"] and "stable column" in notes[0].message
     undecided = rule_notes(count, reported, led.sensors, lambda f, x: False)
     assert [n.code for n in undecided].count("count_undecided") == int(reported.sum()) > 0
+
+
+def test_a_band_of_too_few_lines_is_not_shown_adequate_and_says_why(ride):
+    """Ten lines, fewer than the method's window of 13: no noise to measure, so no ratio, the model is
+    not shown adequate (the column rule holds), and the note says why instead of naming a sensor."""
+    exact = am.supine_human().modes()
+    data = DftLines.from_recording(ride, (10.0, 10.08))  # a line every 1/120 Hz: 10 lines
+    model = fit_modal_model(data, exact.freq_hz[2:3], exact.damping[2:3], "zoh", 5, settings=DEFAULTS.dft)
+    test = model_adequacy(model, data.u, LEVEL)
+    assert data.u.size < 13 and np.all(np.isnan(test.ratio)) and not test.adequate
+    count = SimpleNamespace(adequacy=test, rule_refused=(), model=model)
+    notes = rule_notes(count, np.zeros(1, bool), ride.sensors, lambda f, x: True)
+    assert len(notes) == 1 and notes[0].message.startswith("the band holds too few lines")
