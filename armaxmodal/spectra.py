@@ -286,9 +286,10 @@ LPM_HALF_WIDTH, LPM_DEGREE = 6, 2
 
 def local_polynomial_noise(u: np.ndarray, y: np.ndarray, half_width: int = LPM_HALF_WIDTH,
                            degree: int = LPM_DEGREE) -> np.ndarray:  # fmt: skip
-    """The noise variance of each output's DFT line, measured without a parametric model: the local
-    polynomial method (Pintelon, Schoukens, Vandersteen & Barbé, *Mech. Syst. Signal Process.* 24,
-    2010, 573-595). Around each line ``k``, ``Y(k+r) = G(r) U(k+r) + T(r) + V(k+r)`` for
+    """The noise variance of each output's DFT line, measured without a parametric model.
+
+    The local polynomial method (Pintelon, Schoukens, Vandersteen and Barbé, Mechanical Systems and
+    Signal Processing 24, 2010, 573-595). Around each line ``k``, ``Y(k+r) = G(r) U(k+r) + T(r) + V(k+r)`` for
     ``r = -R..R``, with ``G`` (the FRF) and ``T`` (the leakage of a finite record) polynomials of
     ``degree`` in ``r``, fitted by least squares; the residual's power over its degrees of freedom is
     the variance at ``k``. Windows at the band's ends are shifted inwards. No package for Python

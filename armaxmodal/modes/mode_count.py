@@ -7,7 +7,8 @@ verdicts derived from it, and the tests the search applies: the halves' agreemen
 two pole sets and the residual's peak (the lines' effective share: :func:`armaxmodal.stats.effective_fraction`).
 The criterion is Schwarz's BIC on the effective lines (the method page's "how many modes").
 
-**Which world the record is in** (:class:`Adequacy`, :func:`model_adequacy`). The criterion
+**Which world the record is in** (:class:`~armaxmodal.modes.mode_count.Adequacy`,
+:func:`~armaxmodal.modes.mode_count.model_adequacy`). The criterion
 and the halves' test assume the model is right. Where it is, they decide the number of modes
 alone; where the model misfits far beyond the noise (a bridge moved at several supports by one
 measured input, outputs that lead the input, a nonlinearity under a periodic input), the
@@ -123,6 +124,7 @@ def model_adequacy(model: ModalModel, u: np.ndarray, level: float) -> Adequacy:
     --------
     >>> import armaxmodal as am
     >>> from armaxmodal.estimate.dft_model import DftLines, fit_modal_model
+    >>> from armaxmodal.modes.mode_count import model_adequacy
     >>> from armaxmodal.modes.settings import DEFAULTS
     >>> exact = am.supine_human().modes()
     >>> ride = am.simulate_recording(am.supine_human(), am.random_vibration(60.0, 60.0, seed=1), 60.0, noise=0.03,
