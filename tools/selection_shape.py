@@ -56,7 +56,7 @@ def named_thresholds() -> int:
 def reformatted(files: list[Path]) -> int:
     done = subprocess.run([sys.executable, "-m", "ruff", "format", "--check", "--output-format", "concise",
                            *map(str, files)], capture_output=True, text=True)  # fmt: skip
-    return len({line.split(":")[0] for line in done.stdout.splitlines() if "would be reformatted" in line})
+    return len({line.split(":")[0] for line in done.stdout.splitlines() if "File would be reformatted" in line})
 
 
 def main() -> int:
