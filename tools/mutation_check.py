@@ -1275,10 +1275,16 @@ MUTANTS = [
         "a worse model said to be refused (adequacy)",
     ),
     (
-        "armaxmodal/modes/notes.py",
-        "        if not stable(m.freq_hz[i], m.damping[i]):",
-        "        if stable(m.freq_hz[i], m.damping[i]):",
+        "armaxmodal/modes/counted.py",
+        "for i in np.flatnonzero(keep) if not supported(m.freq_hz[i], m.damping[i])]",
+        "for i in np.flatnonzero(keep) if supported(m.freq_hz[i], m.damping[i])]",
         "the modes with a column said undecided (adequacy)",
+    ),
+    (
+        "armaxmodal/modes/counted.py",
+        "    if count.adequacy is None or count.adequacy.adequate:\n        return []\n    m = count.model",
+        "    if count.adequacy is None:\n        return []\n    m = count.model",
+        "the rule's refusals said where the model is adequate (adequacy)",
     ),
     (
         "armaxmodal/modes/count_search.py",

@@ -44,7 +44,7 @@ from armaxmodal.modes.settings import DEFAULTS, SelectionSettings
 from armaxmodal.modes.state import SelectionState
 from armaxmodal.stats import MAX_DAMPING, Z95
 
-__all__ = ["confirmed_where_incoherent", "counted_modes"]
+__all__ = ["confirmed_where_incoherent", "counted_modes", "without_column"]
 
 #: the sweep's rejection that leaves a stable cluster a candidate still (poles/rejection_reasons)
 WEAK_RESIDUE = "negligible residue"
@@ -150,7 +150,7 @@ def counted_modes(
         return replace(_picked_result(_doubts_said(work, ()), count, keep, verdicts, hold, settings), **lines)
     if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
         return _doubts_said(work, ()).warned(no_mode_kept_note(count, modes, data.band_hz),
-                                             *rule_notes(count, keep, rec.sensors, supported), **lines)
+                                             *rule_notes(count, rec.sensors), **lines)
     rows = pd.DataFrame([_row(modes, count, i, hold, same_row, verdicts[i]) for i in np.flatnonzero(keep)])
     rows, shapes, merged = _one_where_not_separated(rows, count.model.shapes[:, keep], count, keep, whole, hold,
                                                     settings)  # fmt: skip
@@ -160,7 +160,31 @@ def counted_modes(
     work = work.with_modes(rows, shapes, check_poles=poles if merged else None, counted=True, **lines)
     work = _doubts_said(work, count.model.freq_hz[keep], same_row)
     return work.warned(*count_notes(count, keep, data.band_hz, same_row), *merged, *disagree,
-                       *rule_notes(count, keep, rec.sensors, supported))
+                       *rule_notes(count, rec.sensors, without_column(count, keep, supported)))
+
+
+def without_column(count: ModeCount, keep: np.ndarray, supported) -> list[float]:
+    """The reported modes the count's rule refuses where its model is not adequate: those the diagram
+    holds no stable column for; none where the model is adequate.
+
+    Parameters
+    ----------
+    count : ModeCount
+        The count's result (its ``adequacy`` and ``model``).
+    keep : (n_poles,) bool ndarray
+        The poles reported as modes.
+    supported : callable
+        ``supported(freq_hz, damping)``: does the diagram hold a stable column there?
+
+    Returns
+    -------
+    list of float
+        Their frequencies, Hz.
+    """
+    if count.adequacy is None or count.adequacy.adequate:
+        return []
+    m = count.model
+    return [float(m.freq_hz[i]) for i in np.flatnonzero(keep) if not supported(m.freq_hz[i], m.damping[i])]
 
 
 def _doubts_said(work: SelectionState, reported_hz, reach: float = 0.0) -> SelectionState:

@@ -400,22 +400,20 @@ def not_needed_note(f: float, x: float, neighbour_hz: float | None, level: float
     )  # fmt: skip
 
 
-def rule_notes(count: ModeCount, keep: np.ndarray, sensors, stable) -> list[QualityWarning]:
+def rule_notes(count: ModeCount, sensors, without_column=()) -> list[QualityWarning]:
     """Where the counted model misfits the record beyond its noise (``count.adequacy``), the rule the
     count then ran by, in one ``model_inadequate`` note that says what it refused; and a
-    ``count_undecided`` note for each reported mode that does not pass it (``stable(f, x)``: no stable
-    column of the diagram there). Nothing where the model is adequate.
+    ``count_undecided`` note for each reported mode that does not pass it (``without_column``, Hz:
+    no stable column of the diagram there). Nothing where the model is adequate.
 
     Parameters
     ----------
     count : ModeCount
         The count's result.
-    keep : (n_poles,) bool ndarray
-        The poles reported as modes.
     sensors : sequence of str
         The outputs, in the order of ``count.adequacy.ratio``.
-    stable : callable
-        ``stable(freq_hz, damping)``: does the diagram hold a stable column there?
+    without_column : sequence of float
+        The reported modes the rule refuses (Hz), as :mod:`armaxmodal.modes.counted` finds them.
 
     Returns
     -------
@@ -428,23 +426,19 @@ def rule_notes(count: ModeCount, keep: np.ndarray, sensors, stable) -> list[Qual
         worst, found = 0, "the band holds too few lines to measure the record's noise"
     else:
         worst = int(np.nanargmax(test.ratio))
-        found = (f"the modal model misfits the record beyond its noise (on '{sensors[worst]}' its residual holds "
-                 f"{test.ratio[worst]:.2f} times the noise the record shows, at most {test.level:g} where a model "
-                 "explains it)")  # fmt: skip
-    text = (f"{found}, so the criterion, which assumes a right model, cannot count the modes alone: a mode the "
+        found = (f"the modal model's residual holds {test.ratio[worst]:.2f} times the record's own noise on "
+                 f"'{sensors[worst]}' (at most {test.level:g} where a model explains the record)")  # fmt: skip
+    text = (f"{found}: the criterion, which assumes a right model, cannot count the modes alone, so a mode the "
             "count adds must also stand in a stable column of the diagram")  # fmt: skip
     if count.rule_refused:
         fall, freqs = count.rule_refused
         text += (f"; the criterion alone chose {len(freqs)} modes ({', '.join(f'{f:.2f}' for f in freqs)} Hz, lower "
                  f"by {fall:.1f}), refused by that rule")  # fmt: skip
     notes = [QualityWarning("model_inadequate", (sensors[worst],), text, float(test.ratio[worst]))]
-    m = count.model
-    for i in np.flatnonzero(keep):
-        if not stable(m.freq_hz[i], m.damping[i]):
-            notes.append(QualityWarning(
-                "count_undecided", (),
-                f"the mode at {m.freq_hz[i]:.3f} Hz stands in no stable column of the diagram, which the count's rule "
-                "asks of a mode where the model misfits the record: treat it as tentative",
-                float(m.freq_hz[i]), (float(m.freq_hz[i]),),
-            ))  # fmt: skip
+    for f in without_column:
+        notes.append(QualityWarning(
+            "count_undecided", (),
+            f"the mode at {f:.3f} Hz stands in no stable column of the diagram, which the count's rule asks of a "
+            "mode where the model misfits the record: treat it as tentative", float(f), (float(f),),
+        ))  # fmt: skip
     return notes

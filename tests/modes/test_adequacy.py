@@ -11,6 +11,7 @@ import pytest
 import armaxmodal as am
 from armaxmodal.estimate.dft_model import DftLines, fit_modal_model
 from armaxmodal.modes.count_search import count_modes
+from armaxmodal.modes.counted import without_column
 from armaxmodal.modes.mode_count import COLUMN_RULE, LIKELIHOOD_RULE, Adequacy, model_adequacy
 from armaxmodal.modes.notes import rule_notes
 from armaxmodal.modes.settings import DEFAULTS
@@ -131,10 +132,21 @@ def test_where_it_is_not_the_stated_rule_decides(ride):
     if count.rule_refused:  # only a model the criterion preferred is said to be refused
         assert count.rule_refused[0] > 0
     reported = count.reported()
-    notes = rule_notes(count, reported, led.sensors, lambda f, x: True)
+    assert without_column(count, reported, lambda f, x: True) == []
+    refused = without_column(count, reported, lambda f, x: False)
+    assert refused == count.model.freq_hz[reported].tolist() and refused
+    notes = rule_notes(count, led.sensors)
     assert [n.code for n in notes] == ["model_inadequate"] and "stable column" in notes[0].message
-    undecided = rule_notes(count, reported, led.sensors, lambda f, x: False)
-    assert [n.code for n in undecided].count("count_undecided") == int(reported.sum()) > 0
+    undecided = rule_notes(count, led.sensors, refused)
+    assert [n.code for n in undecided] == ["model_inadequate"] + ["count_undecided"] * len(refused)
+    assert [n.value for n in undecided[1:]] == refused
+
+
+def test_where_the_model_is_adequate_the_rule_refuses_no_reported_mode(ride):
+    count = _count(ride, 4)
+    assert count.adequacy.adequate
+    assert without_column(count, count.reported(), lambda f, x: False) == []
+    assert rule_notes(count, ride.sensors, [5.0]) == []
 
 
 def test_a_band_of_too_few_lines_is_not_shown_adequate_and_says_why(ride):
@@ -146,5 +158,5 @@ def test_a_band_of_too_few_lines_is_not_shown_adequate_and_says_why(ride):
     test = model_adequacy(model, data.u, LEVEL)
     assert data.u.size < 13 and np.all(np.isnan(test.ratio)) and not test.adequate
     count = SimpleNamespace(adequacy=test, rule_refused=(), model=model)
-    notes = rule_notes(count, np.zeros(1, bool), ride.sensors, lambda f, x: True)
+    notes = rule_notes(count, ride.sensors)
     assert len(notes) == 1 and notes[0].message.startswith("the band holds too few lines")
