@@ -1286,18 +1286,6 @@ MUTANTS = [
         "    if count.adequacy is None:\n        return []\n    m = count.model",
         "the rule's refusals said where the model is adequate (adequacy)",
     ),
-    (
-        "armaxmodal/modes/count_search.py",
-        "        if wanted and supported is None and wanted.rise <= -settings.decisive_bic:",
-        "        if wanted and wanted.rise <= -settings.decisive_bic:",
-        "a wanted split taken under the column rule too (adequacy)",
-    ),
-    (
-        "armaxmodal/modes/count_search.py",
-        "        if wanted and supported is None and wanted.rise <= -settings.decisive_bic:",
-        "        if False:",
-        "no split taken after the search (adequacy)",
-    ),
 ]
 DEFAULT_TESTS = [
     "tests/estimate/test_guards.py",

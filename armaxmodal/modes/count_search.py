@@ -422,18 +422,8 @@ def _searched(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev, h
     wanted = _wanted(search, current, best_addition, gain, new_hz, halves) if searching else ()
     if searching and not wanted and close is None:  # one mode more is already undecided: said once
         wanted, split = _split_wanted(search, current, halves, supported)
-        if wanted and supported is None and wanted.rise <= -settings.decisive_bic:
-            # the criterion and the halves deciding alone, a split both take is the count's, as a step of the
-            # search would have been (the search screens its splits short of convergence)
-            split_hz = next(row.freq_hz for row in reversed(search.table.rows) if row.action == "split")
-            steps.append(Step("split", split_hz, -wanted.rise, wanted.freq_hz))
-            current = split
-            here, removed, best_removal, best_addition = neighbours()
-            rise, gain, new_hz = _margins(search, here, current, removed, best_removal, best_addition)
-            close = best_addition[2] if best_addition is not None and gain > -settings.decisive_bic else None
-            alternatives = _equally_good(search, current, rise, close)
-            wanted = _wanted(search, current, best_addition, gain, new_hz, halves)
-        elif wanted and abs(wanted.rise) < settings.decisive_bic:  # as good as the chosen model: its modes too
+        # as good as the chosen model: its modes are the record's too
+        if wanted and abs(wanted.rise) < settings.decisive_bic:
             alternatives += ((wanted.rise, split),)
     if searching and not wanted and close is None:
         wanted = _unsupported_wanted(search, current, halves)

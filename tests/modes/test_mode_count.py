@@ -419,18 +419,16 @@ def _world(adequate: bool):
     return lambda model, data: Adequacy(np.array([1.0 if adequate else 3.0]), 1.25)
 
 
-def _scripted(table, start=None, peak_hz=None, screened=None):
+def _scripted(table, start=None, peak_hz=None):
     """A fitter for ``count_modes(fitter=...)`` whose fits are :class:`_Scored` by ``table``, each
     knowing ``start``, the count's starting frequencies (Hz), so that a split of one is told apart;
-    ``peak_hz(n)``: their residual, over the data's lines, peaks there in a fit capped at ``n`` evaluations;
-    ``screened``: the table of every fit short of the count's last (``final_nfev``), where given."""
+    ``peak_hz(n)``: their residual, over the data's lines, peaks there in a fit capped at ``n`` evaluations."""
     def fit(data, f, x, hold, n, settings, intervals=True):
         residual = None
         if peak_hz is not None:
             residual = np.random.default_rng(0).standard_normal((data.s.size, 2)) + 0j
             residual[np.argmin(np.abs(np.abs(data.s) / (2 * np.pi) - peak_hz(n)))] += 10.0
-        scores = screened if screened is not None and n < CountSettings().final_nfev else table
-        return _Scored(f, x, scores, start, residual)
+        return _Scored(f, x, table, start, residual)
 
     return fit
 
@@ -1007,28 +1005,6 @@ def test_a_wanted_split_as_good_as_the_chosen_model_is_one_of_the_equally_good(s
     assert 11.0 < count.wanted.freq_hz < 15.0  # a pole of the 13 Hz split
     split = [alt for _, alt in count.alternatives if alt.split_of == 13.0]
     assert len(split) == joins and all(d == pytest.approx(rise) for d, alt in count.alternatives if alt in split)
-
-
-@pytest.mark.parametrize("adequate", [True, False])
-def test_a_split_the_criterion_and_the_halves_take_after_the_search_is_the_counts_where_they_decide(
-        supine, adequate):  # fmt: skip
-    """Criterion 100 for the three modes; the split of 13 Hz fits badly short of convergence (1000, so
-    the search's steps pass it by) but converges to 60, the same in both halves. Where the record's
-    model is adequate the criterion and the halves decide alone, and the split is the count's; where
-    it is not, the split has no diagram column, and it is named as wanted, not taken."""
-    data, start = supine[0], [5.0, 9.0, 13.0]
-    table = {2: 200.0, 3: 100.0, 4: 1000.0, 5: 2000.0, "split": 1000.0, ("split", 13.0): 60.0}
-    screened = {**table, ("split", 13.0): 1000.0}
-    count = count_modes(data, start, [0.3, 0.3, 0.3], hold="zoh", halves=(data, data),
-                        supported=lambda f, x: not 11.0 < f < 15.0, adequacy=_world(adequate),
-                        fitter=_scripted(table, start, peak_hz=lambda n: 13.0, screened=screened))  # fmt: skip
-    if adequate:
-        assert count.model.n_modes == 4 and count.wanted == ()
-        assert [(s.action, s.freq_hz) for s in count.steps] == [("split", 13.0)]
-        assert count.steps[0].bic_fall == pytest.approx(40.0)
-    else:
-        assert count.model.n_modes == 3 and count.steps == ()
-        assert count.wanted.rise == pytest.approx(-40.0) and not count.wanted.in_diagram
 
 
 def test_a_doubt_the_count_takes_back_goes_unsaid_and_one_it_leaves_out_is_said():
