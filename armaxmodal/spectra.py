@@ -312,6 +312,11 @@ def local_polynomial_noise(u: np.ndarray, y: np.ndarray, half_width: int = LPM_H
     (n_lines, n_outputs) ndarray
         ``E |V(k)|^2`` of each line, in the units of ``y`` squared.
 
+    Raises
+    ------
+    ValueError
+        Arrays of other shapes, or fewer lines than a window holds.
+
     Examples
     --------
     >>> import numpy as np
@@ -325,6 +330,9 @@ def local_polynomial_noise(u: np.ndarray, y: np.ndarray, half_width: int = LPM_H
     0.02
     """
     u, y = np.asarray(u, complex), np.asarray(y, complex)
+    if u.ndim != 1 or y.ndim != 2 or y.shape[0] != u.size:
+        raise ValueError(f"local_polynomial_noise: expected u of shape (n_lines,) and y of shape (n_lines, n_outputs), "
+                         f"got {u.shape} and {y.shape}: give one output per column, on the input's lines.")  # fmt: skip
     n, width, unknowns = u.size, 2 * half_width + 1, 2 * (degree + 1)
     if n < width or width <= unknowns:
         raise ValueError(f"local_polynomial_noise: {n} lines, window of {width} for {unknowns} unknowns: "

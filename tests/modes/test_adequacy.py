@@ -54,9 +54,13 @@ def test_lpm_measures_a_known_noise_that_varies_with_frequency():
         assert abs(var[half].mean() / truth - 1) < NOISE_TOL
 
 
-def test_lpm_refuses_too_few_lines():
+def test_lpm_refuses_too_few_lines_and_arrays_of_other_shapes():
     with pytest.raises(ValueError, match="lines"):
         local_polynomial_noise(np.ones(5), np.ones((5, 1)))
+    with pytest.raises(ValueError, match=r"got \(40,\) and \(39, 1\)"):  # not the input's lines
+        local_polynomial_noise(np.ones(40), np.ones((39, 1)))
+    with pytest.raises(ValueError, match="one output per column"):  # one output given as a vector
+        local_polynomial_noise(np.ones(40), np.ones(40))
 
 
 @pytest.fixture(scope="module")
