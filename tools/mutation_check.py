@@ -734,9 +734,45 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "(unsettled if search.p >= agreement.unsettled_alpha else unconfirmed)",
-        "(unconfirmed if search.p >= agreement.unsettled_alpha else unconfirmed)",
-        "an addition the halves nearly confirm refused as a change in time, the verdict good (count)",
+        "                if column is None and search.p >= agreement.unsettled_alpha:  # see _without_unfounded",
+        "                if False:",
+        "an addition the halves nearly confirm refused as a change in time (count)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        '                verdict[at] = "undecided"',
+        "                pass",
+        "an addition the halves nearly confirm reported as decided (count)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "        if agree is False and supported is None and search.p >= search.agreement.unsettled_alpha:",
+        "        if agree is False and supported is None and search.p >= search.agreement.alpha:",
+        "a moved pole the halves nearly confirm left out (count)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "        if agree is False and supported is None and search.p >= search.agreement.unsettled_alpha:",
+        "        if agree is False and search.p >= search.agreement.unsettled_alpha:",
+        "a moved pole the halves nearly confirm taken under the rule (count)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "                if column is None and search.p >= agreement.unsettled_alpha:  # see _without_unfounded",
+        "                if search.p >= agreement.unsettled_alpha:",
+        "an addition the halves nearly confirm taken under the rule (count)",
+    ),
+    (
+        "armaxmodal/modes/notes.py",
+        "    ruled = count.adequacy is not None and not count.adequacy.adequate",
+        "    ruled = False",
+        "an addition the rule refuses called a change during the record (count)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "        return at if abs(np.log(self.model.freq_hz[at] / f)) <= self.settings.same_mode_freq else None",
+        "        return at",
+        "a stand-in or unsettled pole matched at any distance (count)",
     ),
     (
         "armaxmodal/modes/count_search.py",
@@ -953,8 +989,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/mode_count.py",
-        'verdict[np.abs(np.log(self.model.freq_hz / stand_in.went_hz)) <= self.settings.same_mode_freq] = "stand_in"',
-        "pass",
+        '                verdict[at] = "stand_in"',
+        "                pass",
         "a stand-in reported (stand-in)",
     ),
     (
@@ -1043,15 +1079,9 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "        wanted = _unsupported_wanted(search, current, halves)",
-        "        wanted = ()",
-        "an addition the diagram has no column for never named (split-wanted)",
-    ),
-    (
-        "armaxmodal/notes.py".replace("armaxmodal/", "armaxmodal/modes/"),
-        "    if unsupported:\n        return (f\"the diagram holds no stable column there",
-        "    if False:\n        return (f\"the diagram holds no stable column there",
-        "an unsupported addition explained as one the search did not try (split-wanted)",
+        "    in_diagram = supported is not None and bool(supported(model.freq_hz[at], model.damping[at]))",
+        "    in_diagram = True",
+        "a wanted mode with no column to pick advised to be picked (split-wanted)",
     ),
     (
         'armaxmodal/modes/count_search.py',
@@ -1065,12 +1095,6 @@ MUTANTS = [
         'return f"the criterion (BIC) rises by {rise_bic:.1f}, so it is not reported"',
         'return f"the criterion (BIC) falls by {rise_bic:.1f}, so it is not reported"',
         "a rise said to be a fall (split-wanted)",
-    ),
-    (
-        "armaxmodal/modes/count_search.py",
-        "in_diagram = supported is not None and bool(supported(f, x))",
-        "in_diagram = True",
-        "a split's pole said to be a column to pick (split-wanted)",
     ),
     (
         "armaxmodal/modes/notes.py",
@@ -1264,10 +1288,11 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "free = _searched(data, freq_hz, damping, candidates, supported=None,",
-        "free = _searched(data, freq_hz, damping, candidates, supported=supported,",
+        "free = _searched(data, freq_hz, damping, candidates, supported=supported, rule=False,",
+        "free = _searched(data, freq_hz, damping, candidates, supported=supported, rule=True,",
         "the first search under the column rule (adequacy)",
     ),
+
     (
         "armaxmodal/modes/count_search.py",
         "    refused = (fall, tuple(np.sort(free.model.freq_hz))) if fall > 0 else ()",

@@ -45,7 +45,7 @@ class _Search:
                  agreement: AgreementSettings = DEFAULTS.agreement):  # fmt: skip
         self.data, self.hold, self.n_eff, self.max_nfev, self.n_jobs = data, hold, n_effective, max_nfev, n_jobs
         self.cfg, self.lines, self.dft, self.trials, self.table = settings, lines, dft, 0, ModelTable(n_effective)
-        self.fitter, self.agreement, self.logged, self.unsupported = fitter, agreement, self.table.add, None
+        self.fitter, self.agreement, self.logged = fitter, agreement, self.table.add
 
     def screened(self, starts: list[tuple[np.ndarray, np.ndarray]], labels: list[tuple[str, float]],
                  intervals: bool = True) -> list[ModalModel | None]:  # fmt: skip
@@ -152,30 +152,37 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     (``_Search.in_both_halves``; where they do not both excite it, stability across the orders), judged on
     the converged model only (on the way a moved pole may stand in for a mode not yet added). Poles
     the model needs (the criterion rises by ``settings.decisive_bic`` or more without them) stay in
-    it, unreported. The method page gives the cases behind both rules (a pelvis stuck for 53 samples,
-    a bridge's start carried to 4.40 Hz, a body's top mode the model needs). Returns
-    ``(model, left out: ((start Hz, Hz), ...), kept unreported: ((start Hz, Hz, rise), ...))``."""
+    it, unreported. The halves judge as they judge an addition: where no column is asked (the model
+    is adequate), a pole they refuse at ``agreement.alpha`` but not at ``agreement.unsettled_alpha`` is
+    founded, tentative; under the rule its standard deviations, from a model that misfits, are no
+    judge of a near agreement, and the halves refuse at ``alpha``. The method page gives the cases
+    behind these rules (a pelvis stuck for 53 samples, a bridge's start carried to 4.40 Hz, a body's
+    top mode the model needs, a body's close pair at 14.40 and 15.62 Hz). Returns ``(model, left out:
+    ((start Hz, Hz), ...), kept unreported: ((start Hz, Hz, rise), ...), tentative: (Hz, ...))``."""
     start_hz = np.atleast_1d(np.asarray(start_hz, float))
     shown = reported(model, search.data.band_hz, search.lines)
     moved = [(i, j) for i, j in matched_poles(start_hz, model.freq_hz)
              if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > search.cfg.same_mode_freq]  # fmt: skip
-    unfounded = []
+    unfounded, tentative = [], []
     for i, j in moved:
         f, x = model.freq_hz[i], model.damping[i]
         founded = x - Z95 * model.damping_sd[i] > 0
         agree = search.in_both_halves(model, [i], halves) if founded and len(halves) == 2 else None
+        if agree is False and supported is None and search.p >= search.agreement.unsettled_alpha:
+            tentative.append(float(f))
+            agree = True
         founded = founded and (agree if agree is not None else supported is None or supported(f, x))
         if not founded:
             unfounded.append((i, (float(start_hz[j]), float(f))))
     keep = np.setdiff1d(np.arange(model.n_modes), [i for i, _ in unfounded])
     if not unfounded or keep.size == 0:  # nothing else to stand on: the search's model stays
-        return model, (), ()
+        return model, (), (), tuple(tentative)
     without = search.fit(model.freq_hz[keep], model.damping[keep], search.cfg.final_nfev,
                          label=("leave out", unfounded[0][1][1]))
     rise = search.bic(without) - search.bic(model)
     if rise >= search.cfg.decisive_bic:  # the model needs them: they stay in it, unreported
-        return model, (), tuple((*moved, float(rise)) for _, moved in unfounded)
-    return without, tuple(moved for _, moved in unfounded), ()
+        return model, (), tuple((*moved, float(rise)) for _, moved in unfounded), tuple(tentative)
+    return without, tuple(moved for _, moved in unfounded), (), tuple(tentative)
 
 
 def _equally_good(search: _Search, chosen: ModalModel, rise: np.ndarray, addition: ModalModel | None):
@@ -192,42 +199,30 @@ def _equally_good(search: _Search, chosen: ModalModel, rise: np.ndarray, additio
     return tuple(out)
 
 
-def _wanted(search: _Search, current: ModalModel, addition, gain: float, new_hz: float, halves) -> tuple:
+def _wanted(search: _Search, current: ModalModel, addition, gain: float, new_hz: float, halves,
+            supported=None) -> tuple:  # fmt: skip
     """The refused addition the likelihood wants (see :attr:`ModeCount.wanted`), or ``()``. The
     likelihood ratio is ``-2 ln L`` of the current model less the addition's, on the effective
     lines; it is a chi-square of the parameters one mode adds where the record holds no more."""
     if addition is None or addition[2] is None or gain > -search.cfg.decisive_bic or len(halves) != 2:
         return ()
-    return _likelihood_wants(search, current, addition[2], new_hz, gain, halves, in_diagram=True)
+    return _likelihood_wants(search, current, addition[2], new_hz, gain, halves, supported)
 
 
 def _likelihood_wants(search: _Search, current: ModalModel, model: ModalModel, new_hz: float, gain: float,
-                      halves, in_diagram: bool) -> tuple:  # fmt: skip
+                      halves, supported) -> tuple:  # fmt: skip
     """A :class:`Wanted` when ``model``'s likelihood ratio over ``current`` is beyond
-    ``settings.likelihood_alpha`` and its new poles are the same in both halves, else ``()``."""
+    ``settings.likelihood_alpha`` and its new poles are the same in both halves, else ``()``;
+    ``supported(Hz, ratio)``: does the diagram hold a column at its new pole (``new_hz``) to pick?"""
     dof = model.n_params - current.n_params
     ratio = current.neg2_loglik_on(search.n_eff) - model.neg2_loglik_on(search.n_eff)
     if dof <= 0 or not chdtrc(dof, ratio) < search.cfg.likelihood_alpha:  # NaN below 0
         return ()
     if not search.in_both_halves(model, new_poles(current.freq_hz, model.freq_hz), halves):
         return ()
-    return Wanted(new_hz, float(ratio), int(dof), float(-gain), bool(in_diagram))
-
-
-def _unsupported_wanted(search: _Search, current: ModalModel, halves) -> tuple:
-    """The best addition that lowers the criterion but was refused for want of a stable diagram
-    column, converged and judged as :func:`_wanted` judges one: the ARMAX fits may miss a mode the
-    record holds (a six-mass chain at 400 Hz: no order resolved its three top modes)."""
-    trial = search.unsupported
-    if trial is None or len(halves) != 2:
-        return ()
-    model = search.fit(trial[2].freq_hz, trial[2].damping, search.cfg.final_nfev, label=("add", trial[1]))
-    new = new_poles(current.freq_hz, model.freq_hz) if model is not None else []
-    if not resolved(model, search.data.band_hz) or not new:
-        return ()
-    gain, f = search.bic(current) - search.bic(model), float(model.freq_hz[new[0]])
-    wanted = _likelihood_wants(search, current, model, f, gain, halves, in_diagram=False)
-    return wanted._replace(unsupported=True) if wanted else ()
+    at = nearest_pole(model.freq_hz, new_hz)
+    in_diagram = supported is not None and bool(supported(model.freq_hz[at], model.damping[at]))
+    return Wanted(new_hz, float(ratio), int(dof), float(-gain), in_diagram)
 
 
 def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) -> tuple[tuple, ModalModel | None]:
@@ -248,9 +243,7 @@ def _split_wanted(search: _Search, current: ModalModel, halves, supported=None) 
     if not resolved(model, search.data.band_hz) or not new:
         return (), None
     gain = search.bic(current) - search.bic(model)
-    f, x = float(model.freq_hz[new[0]]), float(model.damping[new[0]])
-    in_diagram = supported is not None and bool(supported(f, x))
-    return _likelihood_wants(search, current, model, f, gain, halves, in_diagram), model
+    return _likelihood_wants(search, current, model, float(model.freq_hz[new[0]]), gain, halves, supported), model
 
 
 @single_blas_thread
@@ -331,21 +324,25 @@ def count_modes(
                         fitter=fitter, agreement=agreement, adequacy=adequacy)  # fmt: skip
 
 
-def _count_modes(data: DftLines, freq_hz, damping, candidates, *, supported, search, settings: CountSettings,
-                 adequacy: Callable | None = None, **options) -> ModeCount:  # fmt: skip
+def _count_modes(
+    data: DftLines, freq_hz, damping, candidates, *, supported, search, settings: CountSettings,
+    adequacy: Callable | None = None, **options,
+) -> ModeCount:
     """:func:`count_modes` itself (its parameters), under the caller's BLAS threads (the public one holds one).
 
     The world first (:func:`armaxmodal.modes.mode_count.model_adequacy`): the search runs with the criterion and the
     halves alone, and where its model explains the record to its noise, that model is the count's.
     Where it does not, the likelihood is no judge of what a mode is: the search runs again under the
     one stated rule (an added mode also stands in a stable diagram column, ``supported``), both
-    searches' fits in the table, and ``rule_refused`` keeps what the first chose where its criterion is lower."""
-    free = _searched(data, freq_hz, damping, candidates, supported=None, search=search, settings=settings, **options)
+    searches' fits in the table, and ``rule_refused`` keeps what the first chose where its criterion
+    is lower."""
+    free = _searched(data, freq_hz, damping, candidates, supported=supported, rule=False, search=search,
+                     settings=settings, **options)  # fmt: skip
     test = (adequacy or _adequacy_at(settings.adequacy_ratio))(free.model, data)
     if test.adequate or supported is None or not search:
         return replace(free, adequacy=test)
-    ruled = _searched(data, freq_hz, damping, candidates, supported=supported, search=search, settings=settings,
-                      **options)  # fmt: skip
+    ruled = _searched(data, freq_hz, damping, candidates, supported=supported, rule=True, search=search,
+                      settings=settings, **options)  # fmt: skip
     n_eff = free.effective_fraction * data.n_real * data.y.shape[1]  # both searches start from one model
     fall = float(ruled.model.bic(n_eff) - free.model.bic(n_eff))
     refused = (fall, tuple(np.sort(free.model.freq_hz))) if fall > 0 else ()  # what the criterion preferred
@@ -358,9 +355,13 @@ def _adequacy_at(level: float) -> Callable:
     return lambda model, data: model_adequacy(model, data.u, level)
 
 
-def _searched(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev, halves, supported, search, n_jobs,
-              settings: CountSettings, lines, dft, fitter, agreement) -> ModeCount:  # fmt: skip
-    """One search from the starting set, an addition admitted where ``supported`` says (None: always)."""
+def _searched(
+    data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev, halves, supported, rule: bool, search, n_jobs,
+    settings: CountSettings, lines, dft, fitter, agreement,
+) -> ModeCount:
+    """One search from the starting set; ``rule``: an addition is admitted only where ``supported`` says
+    (which also says whether a wanted mode has a column to pick)."""
+    column = supported if rule else None
     start_model = fitter(data, freq_hz, damping, hold, max_nfev, settings=dft)
     # each sensor weighted by its noise level as the fitted start leaves it (the likelihood is
     # concentrated over those levels; the weights only steer the fits)
@@ -383,16 +384,16 @@ def _searched(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev, h
         peak = residual_peak(current, search.data)
         added = search.additions(current, candidates + [peak], peak[0])
         best_removal, best_addition = search.best_of_each(
-            removed, added, lambda model: search.admissible(model, current, supported)
+            removed, added, lambda model: search.admissible(model, current, column)
         )
-        lacking = [t for t in added if search.bic(t[2]) < here and resolved(t[2], data.band_hz)
-                   and not search.admissible(t[2], current, supported)]  # better, but no diagram column
-        search.unsupported = min(lacking, key=lambda t: search.bic(t[2]), default=None)
         if best_addition is not None and search.bic(best_addition[2]) < here and len(halves) == 2:
             new = new_poles(current.freq_hz, best_addition[2].freq_hz)
-            if search.in_both_halves(best_addition[2], new, halves) is False:  # refused, or undecided if near
-                (unsettled if search.p >= agreement.unsettled_alpha else unconfirmed).append(best_addition[1])
-                best_addition = None
+            if search.in_both_halves(best_addition[2], new, halves) is False:  # refused, or taken undecided if near
+                if column is None and search.p >= agreement.unsettled_alpha:  # see _without_unfounded
+                    unsettled.append(float(best_addition[2].freq_hz[new[0]]))
+                else:
+                    unconfirmed.append(best_addition[1])
+                    best_addition = None
         return here, removed, best_removal, best_addition
 
     while True:
@@ -412,21 +413,21 @@ def _searched(data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev, h
     final = search.fit(current.freq_hz, current.damping, settings.final_nfev)
     if search.bic(final) < here:
         rise, gain, current = rise + here - search.bic(final), gain - (here - search.bic(final)), final
-    current, carried_away, stand_ins = (_without_unfounded(search, freq_hz, current, supported, halves)
-                                        if searching else (current, (), ()))  # fmt: skip
+    current, carried_away, stand_ins, tentative = (_without_unfounded(search, freq_hz, current, column, halves)
+                                                   if searching else (current, (), (), ()))  # fmt: skip
+    unsettled += [f for f in tentative  # one note a pole: the search may have taken it so already
+                  if not any(abs(np.log(f / u)) <= settings.same_mode_freq for u in unsettled)]
     if carried_away:  # the model lost a pole: its neighbours are judged again, from where it stands
         here, removed, best_removal, best_addition = neighbours()
         rise, gain, new_hz = _margins(search, here, current, removed, best_removal, best_addition)
     close = best_addition[2] if best_addition is not None and gain > -settings.decisive_bic else None
     alternatives = _equally_good(search, current, rise, close)
-    wanted = _wanted(search, current, best_addition, gain, new_hz, halves) if searching else ()
+    wanted = _wanted(search, current, best_addition, gain, new_hz, halves, supported) if searching else ()
     if searching and not wanted and close is None:  # one mode more is already undecided: said once
         wanted, split = _split_wanted(search, current, halves, supported)
         # as good as the chosen model: its modes are the record's too
         if wanted and abs(wanted.rise) < settings.decisive_bic:
             alternatives += ((wanted.rise, split),)
-    if searching and not wanted and close is None:
-        wanted = _unsupported_wanted(search, current, halves)
     return ModeCount(model=current, start=start_model, steps=tuple(steps), removal_rise=rise, best_addition=float(gain),
                      best_addition_hz=new_hz, effective_fraction=fraction, trials=search.trials, wanted=wanted,
                      unconfirmed_hz=tuple(unconfirmed), unsettled_hz=tuple(unsettled), alternatives=alternatives,

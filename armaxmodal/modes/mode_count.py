@@ -221,7 +221,6 @@ class Wanted(NamedTuple):
     dof: int  #: the parameters one mode adds
     rise: float  #: the criterion's rise with it (negative: a fall)
     in_diagram: bool  #: the diagram holds a stable column there to pick
-    unsupported: bool = False  #: an addition refused only for want of a stable diagram column
 
 
 @dataclass(frozen=True)
@@ -272,8 +271,9 @@ class ModeCount:
     band_hz : (float, float)
         The band of the lines the count decided on (Hz): which poles are modes of it.
     unsettled_hz : tuple of float
-        Additions the criterion and the diagram take whose halves differ beyond the halves test's
-        level ``agreement.alpha`` but not beyond ``agreement.unsettled_alpha``: undecided (Hz, the start).
+        Additions the criterion takes whose halves differ beyond the halves test's level
+        ``agreement.alpha`` but not beyond ``agreement.unsettled_alpha``: taken, undecided (Hz, where
+        the new pole settled).
     agreement : AgreementSettings
         The level of the halves' test.
     adequacy : Adequacy or None
@@ -373,7 +373,8 @@ class ModeCount:
 
         * ``"needed"``: a mode of the band whose removal (the rest refitted free) raises the
           criterion decisively (``settings.decisive_bic``);
-        * ``"undecided"``: a mode of the band the record holds less firmly (the rise is smaller):
+        * ``"undecided"``: a mode of the band the record holds less firmly (the rise is smaller, or
+          its halves differ beyond chance but not beyond ``agreement.unsettled_alpha``: ``unsettled_hz``):
           reported, and said tentative;
         * ``"stand_in"``: a start the search carried where no mode is founded but which the
           model needs (``stand_ins``, matched within ``settings.same_mode_freq``): kept in the
@@ -401,9 +402,23 @@ class ModeCount:
         verdict[~reported(self.model, band, self.lines)] = "not_a_mode"
         verdict[borderline(self.model, band, self.lines)] = "borderline"
         verdict[needed & beyond_band(self.model, band, self.lines)] = "beyond_band"
+        for f in self.unsettled_hz:  # taken, though its halves differ beyond chance
+            at = self._pole_at(f)
+            if at is not None and verdict[at] == "needed":
+                verdict[at] = "undecided"
         for stand_in in self.stand_ins:
-            verdict[np.abs(np.log(self.model.freq_hz / stand_in.went_hz)) <= self.settings.same_mode_freq] = "stand_in"
+            at = self._pole_at(stand_in.went_hz)
+            if at is not None:
+                verdict[at] = "stand_in"
         return verdict
+
+    def _pole_at(self, f: float) -> int | None:
+        """The model's pole nearest ``f`` (Hz) if within ``settings.same_mode_freq`` of it, else None:
+        one pole, not every pole near (a close pair's other mode is a mode of its own)."""
+        if not self.model.n_modes:
+            return None
+        at = nearest_pole(self.model.freq_hz, f)
+        return at if abs(np.log(self.model.freq_hz[at] / f)) <= self.settings.same_mode_freq else None
 
     def reported(self, band_hz=None) -> np.ndarray:
         """Which of the model's poles are reported as modes of the band (bool per pole): those

@@ -57,20 +57,14 @@ def pick_notes(count: ModeCount, keep: np.ndarray) -> list[QualityWarning]:
     return notes
 
 
-def _why_not_reported(rise_bic: float, unsupported: bool = False) -> str:
-    if unsupported:
-        return (f"the diagram holds no stable column there, which a mode the search adds must have (with it the "
-                f"criterion falls by {-rise_bic:.1f}), so it is not reported")
+def _why_not_reported(rise_bic: float) -> str:
     if rise_bic > 0:
         return f"the criterion (BIC) rises by {rise_bic:.1f}, so it is not reported"
     return ("the search, which splits only the mode nearest the residual's peak, did not try it (with it the "
             f"criterion falls by {-rise_bic:.1f}), so it is not reported")
 
 
-def _what_to_do(in_diagram: bool, unsupported: bool = False) -> str:
-    if unsupported:  # the ARMAX fits miss it: at a lower rate their poles crowd z = 1 less
-        return ("fit a narrower band that holds it (--band), so the record is fitted at a lower rate, or use higher "
-                "orders, and look for its column; the modes reported may be too few")
+def _what_to_do(in_diagram: bool) -> str:
     if in_diagram:
         return "pick it (--pick) to see what the record says of it"
     # a split's pole: the ARMAX fits merge it with its neighbour, and a pick takes a diagram's column
@@ -122,7 +116,7 @@ def _step_notes(count: ModeCount, same_row_freq: float) -> list[QualityWarning]:
 def _undecided_notes(count: ModeCount, keep: np.ndarray, verdicts: np.ndarray) -> list[QualityWarning]:
     """Where the criterion does not decide: a reported mode, one mode more, a mode the likelihood wants."""
     decisive, notes = count.settings.decisive_bic, []
-    undecided = keep & (verdicts == "undecided")  # of the reported modes only
+    undecided = keep & (verdicts == "undecided") & (count.removal_rise < decisive)  # reported, the criterion's
     if undecided.any():
         rise = float(count.removal_rise[undecided].min())
         weakest = count.model.freq_hz[np.flatnonzero(undecided)[np.argmin(count.removal_rise[undecided])]]
@@ -140,13 +134,13 @@ def _undecided_notes(count: ModeCount, keep: np.ndarray, verdicts: np.ndarray) -
             f"{-count.best_addition:+.1f}, less than {decisive:g} either way", f, (f,),
         ))  # fmt: skip
     if count.wanted:
-        f, ratio, dof, rise_bic, in_diagram, unsupported = count.wanted  # a Wanted
+        f, ratio, dof, rise_bic, in_diagram = count.wanted  # a Wanted
         notes.append(QualityWarning(
             "count_undecided", (),
             f"the record may hold one mode more near {f:.3f} Hz: adding it raises the likelihood far beyond chance "
             f"(likelihood ratio {ratio:.1f} for its {dof} parameters, p < {count.settings.likelihood_alpha:g}) and the "
-            f"mode is the same in both halves of the record, but {_why_not_reported(rise_bic, unsupported)}; "
-            f"{_what_to_do(in_diagram, unsupported)}", f, (f,),
+            f"mode is the same in both halves of the record, but {_why_not_reported(rise_bic)}; "
+            f"{_what_to_do(in_diagram)}", f, (f,),
         ))  # fmt: skip
     return notes
 
@@ -163,18 +157,20 @@ def _left_out_notes(count: ModeCount) -> list[QualityWarning]:
     for f in count.unsettled_hz:
         notes.append(QualityWarning(
             "count_undecided", (),
-            f"one mode more near {f:.3f} Hz lowers the criterion decisively and the diagram holds a stable column "
-            f"there, but its frequency and damping in the record's two halves differ by more than chance allows at "
-            f"the {100 * count.agreement.alpha:g} % level, though not by enough ({count.agreement.unsettled_alpha:g}) "
-            "to call it a change during the record: the record does not settle whether it is a mode; compare another "
-            "record of the structure, or pick it ('--pick') to see what the record says of it", f, (f,),
+            f"the mode at {f:.3f} Hz lowers the criterion decisively, but its frequency and damping in the record's "
+            f"two halves differ by more than chance allows at the {100 * count.agreement.alpha:g} % level, though not "
+            f"by enough ({count.agreement.unsettled_alpha:g}) to call it a change during the record: it is reported, "
+            "tentative; compare another record of the structure", f, (f,),
         ))  # fmt: skip
+    ruled = count.adequacy is not None and not count.adequacy.adequate  # the halves refuse at alpha, not below
     for f in count.unconfirmed_hz:
-        notes.append(QualityWarning(
-            "mode_count", (),
-            f"one mode more near {f:.3f} Hz fits the whole record better but not each of its halves: a change "
-            "during the record (a drifting frequency, a transient, a nonlinearity), not a mode; left out", f, (f,),
-        ))  # fmt: skip
+        why = (f"its frequency and damping in the record's two halves differ beyond chance at the "
+               f"{100 * count.agreement.alpha:g} % level, which refuses it where the model misfits the record (the "
+               "count's rule): a change during the record or a mode the misfit disturbs; left out") if ruled else (
+               "not each of its halves: a change during the record (a drifting frequency, a transient, a "
+               "nonlinearity), not a mode; left out")  # fmt: skip
+        notes.append(QualityWarning("mode_count", (), f"one mode more near {f:.3f} Hz fits the whole record better "
+                                    f"but {why}", f, (f,)))  # fmt: skip
     return notes
 
 

@@ -278,8 +278,9 @@ class AgreementSettings:
     #: each test's false-alarm rate (the estimators' test: 30-59 on the F-16's levels for 12 values, 77
     #: for 6 on a ride with a cubic spring, none on its linear twin; the 1 % points are 26.2 and 16.8)
     alpha: float = 0.01
-    #: a new pole the halves refuse at ``alpha`` but not at this rate is undecided, not refused (a weak
-    #: mode's damping 3.6 standard deviations apart in its halves; 1e-6: one value 5.3 apart)
+    #: where the count's model is adequate, a new pole the halves refuse at ``alpha`` but not at this rate
+    #: is taken, tentative (a weak mode's damping 3.6 standard deviations apart in its halves; 1e-6: one
+    #: value 5.3 apart); where it misfits, its standard deviations are no judge and ``alpha`` refuses
     unsettled_alpha: float = 1e-6
     #: a segment's pole is the mode's when within this relative frequency of it
     match_freq: float = 0.05
