@@ -116,7 +116,8 @@ CODES: tuple[WarningCode, ...] = (
         "none` and in `diagnose`. Before, +0.8 on the supine pelvis from 60 s moved the 13.5 Hz mode to 14.66 Hz "
         "outside its interval, with a drift warning whose advice (`--detrend linear`) left it at 14.56 Hz; +0.28 lost "
         "that mode",
-        "Find what happened at that time (re-zeroing, a knock); with `--detrend none`, run `diagnose`.",
+        "Find what happened at that time (re-zeroing, a knock); `diagnose` names the step (`level_shift`) with its "
+        "time and size and their intervals, and takes it out.",
     ),
     WarningCode(
         "drift", "preparation",

@@ -18,6 +18,62 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 # (file, original text, mutated text, what it models)
 MUTANTS = [
+    # the level shift (issue 70); run with --match "(level shift)" --tests tests/diagnosis/test_level_shift.py
+    #   tests/diagnosis/test_diagnose.py::test_offset_and_drift_are_named_measured_and_removed
+    (
+        "armaxmodal/diagnosis/level_shift.py",
+        "    matched = fftconvolve(e, g[::-1], mode=\"full\")[n - 1 :]",
+        "    matched = fftconvolve(e, g[::-1], mode=\"full\")[n - 2 : -1]",
+        "the matched filter a sample early (level shift)",
+    ),
+    (
+        "armaxmodal/diagnosis/level_shift.py",
+        "    energy = np.cumsum(g**2)[::-1]",
+        "    energy = np.cumsum(g**2)",
+        "the pattern's energy from the wrong end (level shift)",
+    ),
+    (
+        "armaxmodal/diagnosis/level_shift.py",
+        "        sd = max(np.sqrt(_robust_variance(e, g, at, size[at])), sigma * np.sqrt(energy)) / energy",
+        "        sd = sigma / np.sqrt(energy)",
+        "a coloured residual judged as white (level shift)",
+    ),
+    (
+        "armaxmodal/diagnosis/level_shift.py",
+        "    r = e[at:] - size * g[: e.size - at]",
+        "    r = e[at:]",
+        "the step's own pattern counted as noise (level shift)",
+    ),
+    (
+        "armaxmodal/diagnosis/level_shift.py",
+        "        lo = max(edge, int(np.argmax(mask)) + _start_up(model.c, s.n))",
+        "        lo = edge",
+        "the predictor's start-up searched as a step (level shift)",
+    ),
+    (
+        "armaxmodal/diagnosis/level_shift.py",
+        "CHANGE_POINT_LR_95 = float(-2 * np.log(1 - np.sqrt(0.95)))",
+        "CHANGE_POINT_LR_95 = 3.841",
+        "the change point's interval at the chi-square level (level shift)",
+    ),
+    (
+        "armaxmodal/diagnosis/model.py",
+        "    shifted = apply_shifts(replace(signals, y=signals.y - step_levels(signals, spec.steps)), spec.shifts)",
+        "    shifted = apply_shifts(replace(signals, y=signals.y + step_levels(signals, spec.steps)), spec.shifts)",
+        "the step added, not taken out (level shift)",
+    ),
+    (
+        "armaxmodal/diagnosis/acceptance.py",
+        "        if abs(left) < sd:",
+        "        if True:",
+        "the step's size never completed (level shift)",
+    ),
+    (
+        "armaxmodal/diagnosis/level_shift.py",
+        "    return float(size[at]), spread / energy",
+        "    return float(size[at]), spread / energy / 10",
+        "the completed size's interval ten times too narrow (level shift)",
+    ),
     # the modal-model check and the selection by it (issue 26); run with
     # --match "(check)" --tests tests/modes/test_modal_check.py tests/modes/test_frf.py
     #   tests/modes/test_stabilisation.py::test_a_split_the_frf_does_not_need_is_merged_and_said

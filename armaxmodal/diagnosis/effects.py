@@ -24,6 +24,7 @@ from armaxmodal.diagnosis import acceptance, evidence, fixes
 from armaxmodal.diagnosis.delays import delay_findings, late_start, lead_findings
 from armaxmodal.diagnosis.finding import Finding
 from armaxmodal.diagnosis.joint_forces import joint_force_findings
+from armaxmodal.diagnosis.level_shift import level_shift_findings
 from armaxmodal.diagnosis.missing_mode import mode_findings
 from armaxmodal.diagnosis.model import FittedModel, counted
 
@@ -89,6 +90,10 @@ def _modes(ev: Evidence) -> list[Finding]:
     return mode_findings(ev.fitted, ev.n_tests, ev.table)
 
 
+def _level_shifts(ev: Evidence) -> list[Finding]:
+    return level_shift_findings(ev.fitted, ev.eps, ev.mask, ev.n_tests, ev.table)
+
+
 def _trends(ev: Evidence) -> list[Finding]:
     return evidence.trend_findings(ev.fitted, ev.eps, ev.mask, ev.n_tests, ev.table)
 
@@ -132,6 +137,8 @@ REGISTRY: tuple[EffectKind, ...] = (
     EffectKind("sensor_fault", _faults, 0, fixes.add_fault, keep=acceptance.fault_kept),
     EffectKind("input_delay", _delays, 0, fixes.add_delay, refit=acceptance.refit_moved, keep=acceptance.delay_kept),
     EffectKind("unmodelled_mode", _modes, 1, fixes.add_mode, fixes.mode_parameters, "simulation"),
+    EffectKind("level_shift", _level_shifts, 1, fixes.add_level_shift, fixes.level_shift_parameters, "simulation",
+               refit=acceptance.refit_level_shift),  # fmt: skip
     EffectKind("offset_drift", _trends, 1, fixes.add_trend, fixes.trend_parameters, "simulation"),
     EffectKind("periodic_disturbance", _lines, 1, fixes.add_line, fixes.line_parameters, "simulation"),
     EffectKind("coloured_noise", _whiteness, 2, fixes.add_noise_model, fixes.noise_model_parameters),

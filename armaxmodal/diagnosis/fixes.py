@@ -9,6 +9,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from armaxmodal.diagnosis.finding import Finding
+from armaxmodal.diagnosis.level_shift import remaining_step
 from armaxmodal.diagnosis.model import FittedModel, ModelSpec, response_free_of, usable
 from armaxmodal.stats import MAX_DAMPING, Z95
 
@@ -34,6 +35,14 @@ def add_delay(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSp
 def add_trend(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
     """One more polynomial degree of the output's trend (at most a quadratic)."""
     return replace(spec, trend_degree=min(2, max(1, spec.trend_degree + 1)))
+
+
+def add_level_shift(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
+    """The step taken out of the channel from its sample on (the size the test measured; added to
+    a step already taken out there)."""
+    at, size = (finding.channels[0], int(finding.parameters["sample"])), float(finding.parameters["size"])
+    others = tuple(step for step in spec.steps if step[:2] != at)
+    return replace(spec, steps=others + ((*at, size + sum(v for c, t, v in spec.steps if (c, t) == at)),))
 
 
 def add_line(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
@@ -109,6 +118,17 @@ def finding_parameters(finding: Finding, fitted) -> dict:
 def time_change_parameters(finding: Finding, fitted) -> dict:
     """The change's time and each mode before and after it."""
     return {**finding.parameters, "modes_each_side": _modes_each_side(fitted)}
+
+
+def level_shift_parameters(finding: Finding, fitted) -> dict:
+    """The step's time (s, with the test's 95 % interval) and its size as the refit completed it (the
+    channel's units, with a 95 % interval from what remains in the refitted model's residual)."""
+    name, first = finding.channels[0], int(finding.parameters["sample"])
+    (size,) = [v for c, t, v in fitted.spec.steps if (c, t) == (name, first)]
+    left, sd = remaining_step(fitted, name, first)
+    size += left
+    return {**finding.parameters, "size_first": finding.parameters["size"], "size": size,
+            "size_ci95": [size - Z95 * sd, size + Z95 * sd]}  # fmt: skip
 
 
 def trend_parameters(finding: Finding, fitted) -> dict:

@@ -90,6 +90,9 @@ class ModelSpec:
     inputs_from : tuple of str
         Recorded channels that are inputs, not outputs (a second excitation): taken out of the
         outputs and entered as extra inputs (also listed in ``terms``).
+    steps : tuple of (str, int, float)
+        Level shifts taken out of an output: from this sample on (recorded frame) its offset is
+        larger by this much (the channel's units), as a sensor knocked or re-zeroed leaves it.
     """
 
     orders: tuple[int, int, int, int]
@@ -103,6 +106,7 @@ class ModelSpec:
     #: (output, sample indices) a sensor fault spoiled: filled and left out likewise.
     faults: tuple[tuple[str, tuple[int, ...]], ...] = ()
     inputs_from: tuple[str, ...] = ()
+    steps: tuple[tuple[str, int, float], ...] = ()
 
     @property
     def n_disturbance(self) -> int:
@@ -149,6 +153,14 @@ def as_inputs(signals: Signals, names) -> Signals:
     keep = [k for k, name in enumerate(signals.sensors) if name not in move]
     extra = {**signals.extra, **{name: signals.y[:, signals.sensors.index(name)].copy() for name in move}}
     return replace(signals, y=signals.y[:, keep], sensors=tuple(signals.sensors[k] for k in keep), extra=extra)
+
+
+def step_levels(signals: Signals, steps) -> np.ndarray:
+    """The level shifts ``steps`` ((output, first sample, size), ...) as they sit on each output, (n, K)."""
+    levels = np.zeros_like(signals.y)
+    for name, first, size in steps:
+        levels[first:, signals.sensors.index(name)] += size
+    return levels
 
 
 def apply_shifts(signals: Signals, shifts) -> Signals:
@@ -320,6 +332,7 @@ def _filled(model: FittedModel, signals: Signals, masks: dict) -> Signals:
     prediction (:func:`~.clipping.fill_by_prediction`) in the model's (shifted) time frame,
     then moved back to the recorded frame."""
     y = signals.y.copy()
+    levels = step_levels(signals, model.spec.steps)  # the fill is made without them: put back
     shifts = dict(model.spec.shifts)
     s = model.signals
     u, dist = s.inputs(model.spec), model.disturbance()
@@ -327,12 +340,13 @@ def _filled(model: FittedModel, signals: Signals, masks: dict) -> Signals:
         shift = shifts.get(signals.sensors[k], 0.0)
         missing = fractional_shift(gone.astype(float), shift) > 0.5 if shift else gone
         filled = fill_by_prediction(s.y[:, k] - dist[:, k], u, model.fit.models[k], missing) + dist[:, k]
-        y[gone, k] = (fractional_shift(filled, -shift) if shift else filled)[gone]
+        y[gone, k] = (fractional_shift(filled, -shift) if shift else filled)[gone] + levels[gone, k]
     return replace(signals, y=y)
 
 
 def _fit_once(spec: ModelSpec, signals: Signals, window, start: FittedModel | None) -> FittedModel:
-    shifted = apply_shifts(signals, spec.shifts)
+    # a level shift is the recorded channel's: taken out before any shift moves the channel
+    shifted = apply_shifts(replace(signals, y=signals.y - step_levels(signals, spec.steps)), spec.shifts)
     lo, hi = window or (0, signals.n)
     na, nb, nc, nk = spec.orders
     phi = disturbance_columns(spec, signals)
