@@ -49,12 +49,23 @@ def two_regimes(stiffening: float, seed: int) -> am.Recording:
     return am.Recording(60.0, np.concatenate([a.base, b.base]), np.vstack([a.response, b.response]), a.sensors)
 
 
+def stepped(rec: am.Recording, name: str, rms_share: float, time_s: float) -> tuple:
+    """``rec`` with ``name``'s offset stepping by ``rms_share`` of its RMS at ``time_s``: a case with its time."""
+    size = rms_share * float(np.std(rec.response[:, rec.sensors.index(name)]))
+    return inject(rec, "level_shift", [name], time_s=time_s, size=size), "level_shift", name, time_s
+
+
 def cases(seed: int) -> dict:
-    """label -> (recording, effect expected, channel expected); None effect: the clean twin."""
+    """label -> (recording, effect expected, channel expected[, time expected (s)]); None effect:
+    the clean twin."""
     sup, ch2 = ride("supine", seed), ride("chapter2", seed)
     m = ch2.sensors
     u = am.random_vibration(60.0, 120.0, band=(0.5, 28.0), seed=seed)
     return {
+        "supine: pelvis offset steps 0.3 x RMS at 70 s": stepped(sup, "pelvis", 0.3, 70.0),
+        "supine: head offset steps 0.1 x RMS at 33.25 s": stepped(sup, "head", 0.1, 33.25),
+        "chapter2: m2 offset steps 0.3 x RMS at 50 s": stepped(ch2, m[1], 0.3, 50.0),
+        "chapter2: m3 offset steps 0.1 x RMS at 91.75 s": stepped(ch2, m[2], 0.1, 91.75),
         "supine: every output 3 samples late": (inject(sup, "input_delay", list(sup.sensors), samples=3.0),
                                                 "input_delay", "base"),
         "chapter2: every output 4 samples late": (inject(ch2, "input_delay", list(m), samples=4.0),
@@ -78,7 +89,7 @@ def cases(seed: int) -> dict:
     }  # fmt: skip
 
 
-def judge(d, effect: str | None, channel: str | None) -> tuple[bool, str]:
+def judge(d, effect: str | None, channel: str | None, time_s: float | None = None) -> tuple[bool, str]:
     named = [(e.finding.effect, e.finding.channels) for e in d.effects]
     if effect is None:
         return not named, f"named {named}" if named else "clean"
@@ -90,7 +101,11 @@ def judge(d, effect: str | None, channel: str | None) -> tuple[bool, str]:
             before = e.parameters.get("sim_error_before", e.error_before) if "simulation" in crit else e.error_before
             after = e.parameters.get("sim_error_after", e.error_after) if "simulation" in crit else e.error_after
             ok = after <= before * 1.01  # a delay the B taps absorbed need only be no worse
-            return ok, f"named ({'first' if e is d.effects[0] else 'kept'}), error {before:.4g} -> {after:.4g}"
+            how = f"named ({'first' if e is d.effects[0] else 'kept'}), error {before:.4g} -> {after:.4g}"
+            if time_s is not None:  # a step's time within its interval
+                lo, hi = e.parameters["time_ci95_s"]
+                ok, how = ok and lo <= time_s <= hi, f"{how}, time {time_s} s in [{lo:.3f}, {hi:.3f}]"
+            return ok, how
     return False, f"named {named}; unconfirmed {[(u['effect'], u['channels']) for u in d.unconfirmed]}"
 
 
@@ -100,11 +115,11 @@ def main() -> None:
     parser.add_argument("--only", default="")
     args = parser.parse_args()
     passed = total = 0
-    for label, (rec, effect, channel) in cases(args.seed).items():
+    for label, (rec, *expected) in cases(args.seed).items():
         if args.only not in label:
             continue
         t0 = time.perf_counter()
-        ok, how = judge(diagnose(rec), effect, channel)
+        ok, how = judge(diagnose(rec), *expected)
         passed, total = passed + ok, total + 1
         print(f"{'ok  ' if ok else 'MISS'} {label}: {how} ({time.perf_counter() - t0:.0f} s)", flush=True)
     print(f"{passed} of {total}")
