@@ -21,11 +21,16 @@ def add_parser(sub, parents) -> None:
                    help="the input between samples: held (zoh) or band-limited, as an anti-aliased logger records "
                         "it; default bandlimited")
     p.add_argument("--seed", type=NONNEG_INT, default=0, help="seed of the excitation and the noise; default 0")
+    from armaxmodal.diagnosis.inject import PARAMETERS  # numba is loaded already: no cost to the CLI's start
+
+    effects = "; ".join(f"{name} ({', '.join(need + tuple(f'[{k}]' for k in optional)) or 'no parameter'})"
+                        for name, (need, optional) in PARAMETERS.items())  # fmt: skip
     p.add_argument(
         "--effect",
         action="append",
         help="plant an effect the diagnosis is not told: EFFECT[:CH1+CH2][:key=value,...], e.g. "
-        "periodic_disturbance:head:freq_hz=11.7,amp=0.1 or input_delay:legs:samples=2.5 (repeatable)",
+        "periodic_disturbance:head:freq_hz=11.7,amp=0.1 or input_delay:legs:samples=2.5 (repeatable). "
+        f"Effects and their parameters ([optional]): {effects}",
     )
     p.add_argument("--out", required=True, help="CSV file to write")
     p.set_defaults(func=run)

@@ -320,6 +320,13 @@ def test_simulate_cli_plants_effects_and_refuses_bad_ones(tmp_path, capsys):
     assert rec.response[:, 1].mean() == pytest.approx(0.5, abs=0.05)
     assert main([*args, "--effect", "periodic_disturbance:head"]) == 2
     assert "freq_hz, amp" in capsys.readouterr().err
+    # -h names every effect it can plant, with its parameters
+    from armaxmodal.diagnosis.inject import INJECTABLE
+
+    with pytest.raises(SystemExit):
+        main(["simulate", "-h"])
+    shown = " ".join(capsys.readouterr().out.split())
+    assert all(name in shown for name in INJECTABLE) and "level_shift (time_s, size)" in shown
 
 
 def test_a_mode_the_baseline_lacks_is_named_and_found(clean):
