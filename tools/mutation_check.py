@@ -57,6 +57,12 @@ MUTANTS = [
         "the change point's interval at the chi-square level (level shift)",
     ),
     (
+        "armaxmodal/diagnosis/level_shift.py",
+        "        first = int(round(at + lag))",
+        "        first = int(round(at - lag))",
+        "a late sensor's step placed in the moved frame's wrong direction (level shift)",
+    ),
+    (
         "armaxmodal/diagnosis/model.py",
         "    shifted = apply_shifts(replace(signals, y=signals.y - step_levels(signals, spec.steps)), spec.shifts)",
         "    shifted = apply_shifts(replace(signals, y=signals.y + step_levels(signals, spec.steps)), spec.shifts)",

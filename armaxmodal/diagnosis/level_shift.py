@@ -120,7 +120,7 @@ def level_shift_findings(fitted, eps: np.ndarray, mask: np.ndarray, n_tests: int
         half = Z95 * sd
         out.append(Finding("level_shift", (name,), "step_z", float(abs(z)), p, {
             "sample": first, "time_s": first / s.fs,
-            "time_ci95_s": [float((inside.min() + lag) / s.fs), float((inside.max() + lag) / s.fs)],
+            "time_ci95_s": [round(inside.min() + lag) / s.fs, round(inside.max() + lag) / s.fs],
             "size": float(size[at]), "size_ci95": [float(size[at] - half), float(size[at] + half)],
         }))  # fmt: skip
     return out

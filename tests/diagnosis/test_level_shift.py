@@ -136,3 +136,15 @@ def test_a_small_late_step_on_a_100_hz_record_is_found_past_the_start_up():
     # the size's interval is conditional on the time found (here two samples late): 0.0846-0.0895
     # for a planted 0.0841, so held to 10 % only
     assert effect.parameters["size"] == pytest.approx(size, rel=0.1)
+
+
+def test_a_step_on_a_late_sensor_is_placed_in_the_recorded_time(clean):
+    """Pelvis 2 samples late and stepped at 45 s: the delay is moved first, then the step found in
+    the moved frame is placed and taken out in the recorded one (sample 2700), its interval too."""
+    late = inject(clean, "input_delay", ["pelvis"], samples=2.0)
+    rec = inject(late, "level_shift", ["pelvis"], time_s=45.0, size=0.3)
+    d = diagnose(rec, baseline=am.fit_armax(rec, *ORDERS, shared_poles=True, warn=False), max_rounds=2)
+    assert [e.finding.effect for e in d.effects] == ["input_delay", "level_shift"]
+    step = d.effects[1].parameters
+    assert step["sample"] == 2700 and step["time_ci95_s"][0] <= 45.0 <= step["time_ci95_s"][1]
+    assert d.final.model.spec.steps[0][:2] == ("pelvis", 2700)
