@@ -18,6 +18,37 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 # (file, original text, mutated text, what it models)
 MUTANTS = [
+    # the gain change (issue 70); run with --match "(gain change)" --tests tests/diagnosis/test_gain_change.py
+    (
+        "armaxmodal/diagnosis/gain_change.py",
+        "    matched = np.cumsum((zm * e)[::-1])[::-1]",
+        "    matched = np.cumsum(zm * e)",
+        "the sums from the wrong end (gain change)",
+    ),
+    (
+        "armaxmodal/diagnosis/gain_change.py",
+        "    z = np.where(mask, lfilter(model.a, model.c, y) - eps, 0.0)",
+        "    z = np.where(mask, lfilter(model.a, model.c, y), 0.0)",
+        "the residual left in the regressor (gain change)",
+    ),
+    (
+        "armaxmodal/diagnosis/gain_change.py",
+        "        if _seen_by_others(scans, k, at):",
+        "        if False:",
+        "a change every sensor shows named one sensor's gain (gain change)",
+    ),
+    (
+        "armaxmodal/diagnosis/model.py",
+        "    true = (signals.y - step_levels(signals, spec.steps)) / gain_factors(signals, spec.gains)",
+        "    true = (signals.y - step_levels(signals, spec.steps)) * gain_factors(signals, spec.gains)",
+        "the gain change applied, not taken out (gain change)",
+    ),
+    (
+        "armaxmodal/diagnosis/acceptance.py",
+        "        if abs(left) < sd:\n            break\n        spec = replace(spec, gains=",
+        "        if True:\n            break\n        spec = replace(spec, gains=",
+        "the gain's factor never completed (gain change)",
+    ),
     # the level shift (issue 70); run with --match "(level shift)" --tests tests/diagnosis/test_level_shift.py
     #   tests/diagnosis/test_diagnose.py::test_offset_and_drift_are_named_measured_and_removed
     (
@@ -40,14 +71,14 @@ MUTANTS = [
     ),
     (
         "armaxmodal/diagnosis/level_shift.py",
-        "    r = e[at:] - size * g[: e.size - at]",
-        "    r = e[at:]",
+        "    return newey_west_sum(g[: e.size - at] * (e[at:] - size * g[: e.size - at]))",
+        "    return newey_west_sum(g[: e.size - at] * e[at:])",
         "the step's own pattern counted as noise (level shift)",
     ),
     (
         "armaxmodal/diagnosis/level_shift.py",
-        "        lo = max(edge, int(np.argmax(mask)) + _start_up(model.c, s.n))",
-        "        lo = edge",
+        "    return max(edge, int(np.argmax(mask)) + start_up)",
+        "    return edge",
         "the predictor's start-up searched as a step (level shift)",
     ),
     (
@@ -64,14 +95,14 @@ MUTANTS = [
     ),
     (
         "armaxmodal/diagnosis/model.py",
-        "    shifted = apply_shifts(replace(signals, y=signals.y - step_levels(signals, spec.steps)), spec.shifts)",
-        "    shifted = apply_shifts(replace(signals, y=signals.y + step_levels(signals, spec.steps)), spec.shifts)",
+        "    true = (signals.y - step_levels(signals, spec.steps)) / gain_factors(signals, spec.gains)",
+        "    true = (signals.y + step_levels(signals, spec.steps)) / gain_factors(signals, spec.gains)",
         "the step added, not taken out (level shift)",
     ),
     (
         "armaxmodal/diagnosis/acceptance.py",
-        "        if abs(left) < sd:",
-        "        if True:",
+        "        if abs(left) < sd:\n            break\n        spec = replace(spec, steps=",
+        "        if True:\n            break\n        spec = replace(spec, steps=",
         "the step's size never completed (level shift)",
     ),
     (

@@ -23,6 +23,7 @@ import numpy as np
 from armaxmodal.diagnosis import acceptance, evidence, fixes
 from armaxmodal.diagnosis.delays import delay_findings, late_start, lead_findings
 from armaxmodal.diagnosis.finding import Finding
+from armaxmodal.diagnosis.gain_change import gain_change_findings
 from armaxmodal.diagnosis.joint_forces import joint_force_findings
 from armaxmodal.diagnosis.level_shift import level_shift_findings
 from armaxmodal.diagnosis.missing_mode import mode_findings
@@ -94,6 +95,10 @@ def _level_shifts(ev: Evidence) -> list[Finding]:
     return level_shift_findings(ev.fitted, ev.eps, ev.mask, ev.n_tests, ev.table)
 
 
+def _gain_changes(ev: Evidence) -> list[Finding]:
+    return gain_change_findings(ev.fitted, ev.eps, ev.mask, ev.n_tests, ev.table)
+
+
 def _trends(ev: Evidence) -> list[Finding]:
     return evidence.trend_findings(ev.fitted, ev.eps, ev.mask, ev.n_tests, ev.table)
 
@@ -139,6 +144,8 @@ REGISTRY: tuple[EffectKind, ...] = (
     EffectKind("unmodelled_mode", _modes, 1, fixes.add_mode, fixes.mode_parameters, "simulation"),
     EffectKind("level_shift", _level_shifts, 1, fixes.add_level_shift, fixes.level_shift_parameters, "simulation",
                refit=acceptance.refit_level_shift),  # fmt: skip
+    EffectKind("gain_change", _gain_changes, 1, fixes.add_gain_change, fixes.gain_change_parameters, "simulation",
+               refit=acceptance.refit_gain_change),  # fmt: skip
     EffectKind("offset_drift", _trends, 1, fixes.add_trend, fixes.trend_parameters, "simulation"),
     EffectKind("periodic_disturbance", _lines, 1, fixes.add_line, fixes.line_parameters, "simulation"),
     EffectKind("coloured_noise", _whiteness, 2, fixes.add_noise_model, fixes.noise_model_parameters),

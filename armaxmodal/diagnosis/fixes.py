@@ -9,6 +9,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from armaxmodal.diagnosis.finding import Finding
+from armaxmodal.diagnosis.gain_change import remaining_gain
 from armaxmodal.diagnosis.level_shift import remaining_step
 from armaxmodal.diagnosis.model import FittedModel, ModelSpec, response_free_of, usable
 from armaxmodal.stats import MAX_DAMPING, Z95
@@ -43,6 +44,13 @@ def add_level_shift(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> M
     at, size = (finding.channels[0], int(finding.parameters["sample"])), float(finding.parameters["size"])
     others = tuple(step for step in spec.steps if step[:2] != at)
     return replace(spec, steps=others + ((*at, size + sum(v for c, t, v in spec.steps if (c, t) == at)),))
+
+
+def add_gain_change(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
+    """The gain change taken out of the channel from its sample on (combined with one already there)."""
+    at, factor = (finding.channels[0], int(finding.parameters["sample"])), float(finding.parameters["factor"])
+    before = np.prod([v for c, t, v in spec.gains if (c, t) == at])
+    return replace(spec, gains=tuple(g for g in spec.gains if g[:2] != at) + ((*at, factor * before),))
 
 
 def add_line(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
@@ -129,6 +137,17 @@ def level_shift_parameters(finding: Finding, fitted) -> dict:
     size += left
     return {**finding.parameters, "size_first": finding.parameters["size"], "size": size,
             "size_ci95": [size - Z95 * sd, size + Z95 * sd]}  # fmt: skip
+
+
+def gain_change_parameters(finding: Finding, fitted) -> dict:
+    """The change's time (s, with the test's 95 % interval) and its factor as the refit completed it,
+    with a 95 % interval from what remains in the refitted model's residual."""
+    name, first = finding.channels[0], int(finding.parameters["sample"])
+    (factor,) = [v for c, t, v in fitted.spec.gains if (c, t) == (name, first)]
+    left, sd = remaining_gain(fitted, name, first)
+    factor *= 1 + left
+    return {**finding.parameters, "factor_first": finding.parameters["factor"], "factor": factor,
+            "factor_ci95": [factor * (1 - Z95 * sd), factor * (1 + Z95 * sd)]}  # fmt: skip
 
 
 def trend_parameters(finding: Finding, fitted) -> dict:

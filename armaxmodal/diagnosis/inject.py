@@ -19,6 +19,7 @@ INJECTABLE = (
     "input_delay",
     "offset_drift",
     "level_shift",
+    "gain_change",
     "periodic_disturbance",
     "coloured_noise",
     "clipping",
@@ -30,6 +31,7 @@ PARAMETERS = {
     "input_delay": (("samples",), ()),
     "offset_drift": ((), ("offset", "drift_per_s")),
     "level_shift": (("time_s", "size"), ()),
+    "gain_change": (("time_s", "factor"), ()),
     "periodic_disturbance": (("freq_hz", "amp"), ()),
     "coloured_noise": (("level",), ("pole", "freq_hz")),
     "clipping": (("fraction",), ()),
@@ -116,9 +118,11 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, stru
         if len(names) != 1:
             raise DataError(f"effect 'second_input': one channel (where the force acts), got {names}.")
         return add_second_input(recording, structure, names[0], float(params["level"]), seed)
-    if effect == "level_shift" and not 0 < float(params["time_s"]) < recording.duration:
-        raise DataError(f"effect 'level_shift': time_s must lie inside the record (0-{recording.duration:g} s), "
+    if effect in ("level_shift", "gain_change") and not 0 < float(params["time_s"]) < recording.duration:
+        raise DataError(f"effect {effect!r}: time_s must lie inside the record (0-{recording.duration:g} s), "
                         f"got {params['time_s']}.")  # fmt: skip
+    if effect == "gain_change" and not float(params["factor"]) > 0:
+        raise DataError(f"effect 'gain_change': factor must be > 0, got {params['factor']}.")
     default = [recording.input_name] if effect == "input_delay" else list(recording.sensors)
     names = list(channels) if channels is not None else default
     base, y = recording.base.copy(), np.array(recording.response, dtype=float)
@@ -134,6 +138,8 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, stru
             x += float(params.get("offset", 0.0)) + float(params.get("drift_per_s", 0.0)) * (t - t.mean())
         elif effect == "level_shift":
             x[t >= float(params["time_s"])] += float(params["size"])
+        elif effect == "gain_change":
+            x[t >= float(params["time_s"])] *= float(params["factor"])
         elif effect == "sensor_fault":
             at = rng.choice(np.arange(10, t.size - 10), int(params.get("spikes", 0)), replace=False)
             x[at] += float(params.get("spike_size", 8.0)) * rms * rng.choice([-1.0, 1.0], at.size)

@@ -29,11 +29,13 @@ from armaxmodal.diagnosis.finding import Finding
 from armaxmodal.prepare.detrend import STEP_EDGE
 from armaxmodal.stats import Z95
 
-__all__ = ["level_shift_findings", "remaining_step", "step_scan"]
+__all__ = ["CHANGE_POINT_LR_95", "level_shift_findings", "newey_west_sum", "remaining_step", "search_start",
+           "step_scan"]
 
 #: the change point's 95 % likelihood-ratio level: its ratio is not chi-square(1) but has
 #: P(LR <= x) = (1 - exp(-x / 2))^2 (Hansen 2000, threshold estimation), so -2 ln(1 - sqrt(0.95));
-#: at 3.84 a 0.1 x RMS step's interval was one sample wide, the sample beside the truth
+#: at 3.84 (with the spread then allowed below the white-noise one) a 0.1 x RMS step's interval
+#: was one sample wide, the sample beside the truth
 CHANGE_POINT_LR_95 = float(-2 * np.log(1 - np.sqrt(0.95)))
 
 
@@ -56,18 +58,22 @@ def _scan(eps: np.ndarray, model, mask: np.ndarray):
     return matched / (sigma * np.sqrt(energy)), matched / energy, sigma, e, g
 
 
-def _robust_variance(e: np.ndarray, g: np.ndarray, at: int, size: float) -> float:
-    """Newey-West variance of the matched filter's sum ``sum_j g_j e(at + j)`` under the step
-    (the residual with it taken out): a coloured or heteroscedastic residual (an earthquake's
-    strong phase) spreads the sum more than ``sigma^2 sum g^2`` says, and a white-noise bound
-    names a step in nearly every measured record."""
-    r = e[at:] - size * g[: e.size - at]
-    w = g[: e.size - at] * r
-    lag = int(4 * e.size ** (1 / 3))  # as the disturbances' covariance (model._disturbance_ls)
+def newey_west_sum(w: np.ndarray) -> float:
+    """Newey-West variance of ``sum w`` (Bartlett weights, ``4 n^(1/3)`` lags, as the disturbances'
+    covariance in ``model._disturbance_ls``): a coloured or heteroscedastic residual (an
+    earthquake's strong phase) spreads a matched filter's sum more than the white-noise
+    ``sigma^2 sum g^2`` says, and a white-noise bound named a step in most measured records."""
+    lag = int(4 * w.size ** (1 / 3))
     var = float(w @ w)
     for j in range(1, min(lag, w.size - 1) + 1):
         var += 2 * (1 - j / (lag + 1)) * float(w[j:] @ w[:-j])
     return max(var, 1e-300)
+
+
+def _robust_variance(e: np.ndarray, g: np.ndarray, at: int, size: float) -> float:
+    """:func:`newey_west_sum` of the matched filter's sum ``sum_j g_j e(at + j)`` under the step
+    (the residual with it taken out)."""
+    return newey_west_sum(g[: e.size - at] * (e[at:] - size * g[: e.size - at]))
 
 
 def remaining_step(fitted, name: str, first: int) -> tuple[float, float]:
@@ -84,11 +90,13 @@ def remaining_step(fitted, name: str, first: int) -> tuple[float, float]:
     return float(size[at]), spread / energy
 
 
-def _start_up(c: np.ndarray, n: int) -> int:
-    """Samples the predictor's start from unknown initial values lasts: until 1/C's impulse
-    response holds ``PI_ENERGY`` of its energy (as the glitch test cuts its filter)."""
-    h = lfilter([1.0], c, np.r_[1.0, np.zeros(n - 1)])
-    return int(np.searchsorted(np.cumsum(h**2) / np.sum(h**2), PI_ENERGY)) + 1
+def search_start(model, mask: np.ndarray, edge: int) -> int:
+    """The first sample a change is searched at: past ``edge`` and past the predictor's start from
+    unknown initial values, which lasts until 1/C's impulse response holds ``PI_ENERGY`` of its
+    energy (as the glitch test cuts its filter) and otherwise reads as a change near the start."""
+    h = lfilter([1.0], model.c, np.r_[1.0, np.zeros(mask.size - 1)])
+    start_up = int(np.searchsorted(np.cumsum(h**2) / np.sum(h**2), PI_ENERGY)) + 1
+    return max(edge, int(np.argmax(mask)) + start_up)
 
 
 def level_shift_findings(fitted, eps: np.ndarray, mask: np.ndarray, n_tests: int, table: dict) -> list[Finding]:
@@ -100,7 +108,7 @@ def level_shift_findings(fitted, eps: np.ndarray, mask: np.ndarray, n_tests: int
     shifts = dict(fitted.spec.shifts)
     out, table["step_p"] = [], []
     for k, (name, model) in enumerate(zip(s.sensors, fitted.fit.models, strict=True)):
-        lo = max(edge, int(np.argmax(mask)) + _start_up(model.c, s.n))
+        lo = search_start(model, mask, edge)
         searched, settled = slice(lo, s.n - edge), mask & (np.arange(s.n) >= lo)
         lam, size, sigma, e, g = _scan(eps[:, k], model, settled)
         at = lo + int(np.argmax(np.abs(lam[searched])))

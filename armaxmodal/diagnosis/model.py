@@ -93,6 +93,9 @@ class ModelSpec:
     steps : tuple of (str, int, float)
         Level shifts taken out of an output: from this sample on (recorded frame) its offset is
         larger by this much (the channel's units), as a sensor knocked or re-zeroed leaves it.
+    gains : tuple of (str, int, float)
+        Gain changes taken out of an output: from this sample on it reads this factor times what
+        reaches it (a range switch, a loosening mount). Recorded = factor x true + step.
     """
 
     orders: tuple[int, int, int, int]
@@ -107,6 +110,7 @@ class ModelSpec:
     faults: tuple[tuple[str, tuple[int, ...]], ...] = ()
     inputs_from: tuple[str, ...] = ()
     steps: tuple[tuple[str, int, float], ...] = ()
+    gains: tuple[tuple[str, int, float], ...] = ()
 
     @property
     def n_disturbance(self) -> int:
@@ -161,6 +165,14 @@ def step_levels(signals: Signals, steps) -> np.ndarray:
     for name, first, size in steps:
         levels[first:, signals.sensors.index(name)] += size
     return levels
+
+
+def gain_factors(signals: Signals, gains) -> np.ndarray:
+    """The gain changes ``gains`` ((output, first sample, factor), ...) as they scale each output, (n, K)."""
+    factors = np.ones_like(signals.y)
+    for name, first, factor in gains:
+        factors[first:, signals.sensors.index(name)] *= factor
+    return factors
 
 
 def apply_shifts(signals: Signals, shifts) -> Signals:
@@ -333,6 +345,7 @@ def _filled(model: FittedModel, signals: Signals, masks: dict) -> Signals:
     then moved back to the recorded frame."""
     y = signals.y.copy()
     levels = step_levels(signals, model.spec.steps)  # the fill is made without them: put back
+    factors = gain_factors(signals, model.spec.gains)
     shifts = dict(model.spec.shifts)
     s = model.signals
     u, dist = s.inputs(model.spec), model.disturbance()
@@ -340,13 +353,15 @@ def _filled(model: FittedModel, signals: Signals, masks: dict) -> Signals:
         shift = shifts.get(signals.sensors[k], 0.0)
         missing = fractional_shift(gone.astype(float), shift) > 0.5 if shift else gone
         filled = fill_by_prediction(s.y[:, k] - dist[:, k], u, model.fit.models[k], missing) + dist[:, k]
-        y[gone, k] = (fractional_shift(filled, -shift) if shift else filled)[gone] + levels[gone, k]
+        filled = fractional_shift(filled, -shift) if shift else filled
+        y[gone, k] = filled[gone] * factors[gone, k] + levels[gone, k]
     return replace(signals, y=y)
 
 
 def _fit_once(spec: ModelSpec, signals: Signals, window, start: FittedModel | None) -> FittedModel:
-    # a level shift is the recorded channel's: taken out before any shift moves the channel
-    shifted = apply_shifts(replace(signals, y=signals.y - step_levels(signals, spec.steps)), spec.shifts)
+    # a level shift and a gain change are the recorded channel's: taken out before any shift moves it
+    true = (signals.y - step_levels(signals, spec.steps)) / gain_factors(signals, spec.gains)
+    shifted = apply_shifts(replace(signals, y=true), spec.shifts)
     lo, hi = window or (0, signals.n)
     na, nb, nc, nk = spec.orders
     phi = disturbance_columns(spec, signals)
