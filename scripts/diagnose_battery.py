@@ -55,6 +55,11 @@ def stepped(rec: am.Recording, name: str, rms_share: float, time_s: float) -> tu
     return inject(rec, "level_shift", [name], time_s=time_s, size=size), "level_shift", name, time_s
 
 
+def gained(rec: am.Recording, name: str, factor: float, time_s: float) -> tuple:
+    """``rec`` with ``name`` reading ``factor`` times more from ``time_s``: a case with its time."""
+    return inject(rec, "gain_change", [name], time_s=time_s, factor=factor), "gain_change", name, time_s
+
+
 def cases(seed: int) -> dict:
     """label -> (recording, effect expected, channel expected[, time expected (s)]); None effect:
     the clean twin."""
@@ -66,6 +71,10 @@ def cases(seed: int) -> dict:
         "supine: head offset steps 0.1 x RMS at 33.25 s": stepped(sup, "head", 0.1, 33.25),
         "chapter2: m2 offset steps 0.3 x RMS at 50 s": stepped(ch2, m[1], 0.3, 50.0),
         "chapter2: m3 offset steps 0.1 x RMS at 91.75 s": stepped(ch2, m[2], 0.1, 91.75),
+        "supine: pelvis gain x 1.2 from 70 s": gained(sup, "pelvis", 1.2, 70.0),
+        "supine: head gain x 1.05 from 33.25 s": gained(sup, "head", 1.05, 33.25),
+        "chapter2: m2 gain x 0.8 from 50 s": gained(ch2, m[1], 0.8, 50.0),
+        "chapter2: m3 gain x 0.95 from 91.75 s": gained(ch2, m[2], 0.95, 91.75),
         "supine: every output 3 samples late": (inject(sup, "input_delay", list(sup.sensors), samples=3.0),
                                                 "input_delay", "base"),
         "chapter2: every output 4 samples late": (inject(ch2, "input_delay", list(m), samples=4.0),
