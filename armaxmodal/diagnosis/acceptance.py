@@ -109,37 +109,32 @@ def refit_spec(stage: Stage, finding: Finding, entry) -> Stage:
     return Stage(model, held_out(model.spec, s, model))
 
 
-def refit_level_shift(stage: Stage, finding: Finding, entry) -> Stage:
-    """A level shift taken out of the channel, refitted, and its size completed from the refitted
-    model's residual (``STEP_PASSES`` times): the model fitted with the step in the data carried
-    part of it, so the first size falls short."""
-    s, name = stage.model.raw, finding.channels[0]
-    spec = entry.add(stage.model.spec, finding, stage.model)
-    model = fit_model(spec, s, start=widened_start(stage.model, spec))
-    first = int(finding.parameters["sample"])
-    for _ in range(STEP_PASSES):
-        left, sd = remaining_step(model, name, first)
-        if abs(left) < sd:
-            break
-        spec = replace(spec, steps=tuple((c, t, v + left if (c, t) == (name, first) else v) for c, t, v in spec.steps))
-        model = fit_model(spec, s, start=model)
-    return Stage(model, held_out(model.spec, s, model))
-
-
-def refit_gain_change(stage: Stage, finding: Finding, entry) -> Stage:
-    """A gain change taken out of the channel, refitted, and its factor completed from the refitted
-    model's residual, as a level shift's size is (:func:`refit_level_shift`)."""
+def _refit_completed(stage: Stage, finding: Finding, entry, remaining, key: str, as_value) -> Stage:
+    """A sensor's change taken out of its channel (``entry.add``), refitted, and completed from the
+    refitted model's residual at most ``STEP_PASSES`` times while what remains exceeds its SD: the
+    model fitted with the change in the data carried part of it, so the first reading falls short.
+    ``remaining(model, name, sample)`` gives ``(left, sd)``; ``entry.add`` combines the rest, its
+    parameter ``key`` set to ``as_value(left)``, with what is taken out at that sample already."""
     s, name, first = stage.model.raw, finding.channels[0], int(finding.parameters["sample"])
     spec = entry.add(stage.model.spec, finding, stage.model)
     model = fit_model(spec, s, start=widened_start(stage.model, spec))
     for _ in range(STEP_PASSES):
-        left, sd = remaining_gain(model, name, first)
+        left, sd = remaining(model, name, first)
         if abs(left) < sd:
             break
-        spec = replace(spec, gains=tuple((c, t, v * (1 + left) if (c, t) == (name, first) else v)
-                                         for c, t, v in spec.gains))  # fmt: skip
+        spec = entry.add(spec, replace(finding, parameters={**finding.parameters, key: as_value(left)}), model)
         model = fit_model(spec, s, start=model)
     return Stage(model, held_out(model.spec, s, model))
+
+
+def refit_level_shift(stage: Stage, finding: Finding, entry) -> Stage:
+    """A level shift taken out and its size completed (:func:`_refit_completed`)."""
+    return _refit_completed(stage, finding, entry, remaining_step, "size", float)
+
+
+def refit_gain_change(stage: Stage, finding: Finding, entry) -> Stage:
+    """A gain change taken out and its factor completed (:func:`_refit_completed`)."""
+    return _refit_completed(stage, finding, entry, remaining_gain, "factor", lambda left: 1 + left)
 
 
 def refit_moved(stage: Stage, finding: Finding, entry) -> Stage:
