@@ -33,6 +33,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import fftconvolve, lfilter
 from scipy.special import ndtr, ndtri
+from scipy.stats import median_abs_deviation
 
 from armaxmodal.diagnosis.clipping import clipped_mask
 from armaxmodal.prepare.quality import STUCK_MIN_RUN, stuck_runs  # noqa: F401  (shared with the pre-fit check
@@ -73,7 +74,7 @@ def outlier_scores(eps: np.ndarray, model, mask: np.ndarray) -> np.ndarray:
     """``|lambda(t)|`` of one channel's one-step residual ``eps`` (n,), zero outside ``mask``."""
     pi = _matched_filter(model)
     e = np.where(mask, eps, 0.0)
-    sigma = 1.4826 * float(np.median(np.abs(eps[mask] - np.median(eps[mask]))))
+    sigma = float(median_abs_deviation(eps[mask], scale="normal"))
     lam = fftconvolve(e, pi[::-1], mode="full")[pi.size - 1 :] / (sigma * float(np.sqrt(pi @ pi)))
     return np.where(mask, np.abs(lam), 0.0)
 
@@ -99,7 +100,7 @@ def glitches(eps: np.ndarray, model, mask: np.ndarray, alpha: float = FAULT_ALPH
     ``mask``: ``(samples, sizes, largest |lambda|)``; sizes in the channel's units."""
     pi = _matched_filter(model)
     e = np.where(mask, eps, 0.0)
-    sigma = 1.4826 * float(np.median(np.abs(eps[mask] - np.median(eps[mask]))))
+    sigma = float(median_abs_deviation(eps[mask], scale="normal"))
     norm = float(np.sqrt(pi @ pi))
     n = int(mask.sum())
     bound = float(ndtri(1 - alpha / (2 * n)))

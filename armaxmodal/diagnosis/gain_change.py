@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import lfilter
 from scipy.special import ndtr
+from scipy.stats import median_abs_deviation
 
 from armaxmodal.diagnosis.finding import Finding
 from armaxmodal.diagnosis.level_shift import CHANGE_POINT_LR_95, newey_west_sum, search_start
@@ -38,7 +39,7 @@ def gain_scan(eps: np.ndarray, z: np.ndarray, mask: np.ndarray) -> tuple[np.ndar
     least-squares relative change and ``sum_{t >= t0} z^2``, from the one-step residual ``eps`` and
     the filtered output ``z`` (n,), counted where ``mask``."""
     e, zm = np.where(mask, eps, 0.0), np.where(mask, z, 0.0)
-    sigma = 1.4826 * float(np.median(np.abs(eps[mask] - np.median(eps[mask]))))
+    sigma = float(median_abs_deviation(eps[mask], scale="normal"))
     matched = np.cumsum((zm * e)[::-1])[::-1]
     energy = np.maximum(np.cumsum((zm**2)[::-1])[::-1], 1e-300)
     return matched / (sigma * np.sqrt(energy)), matched / energy, energy
@@ -59,7 +60,7 @@ def _filtered(fitted, k: int, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     y = fitted.signals.y[:, k] - fitted.disturbance()[:, k]
     eps = fitted.one_step_errors()[:, k]
     z = np.where(mask, lfilter(model.a, model.c, y) - eps, 0.0)
-    sigma = 1.4826 * float(np.median(np.abs(eps[mask] - np.median(eps[mask]))))
+    sigma = float(median_abs_deviation(eps[mask], scale="normal"))
     return z, np.where(mask, eps, 0.0), sigma
 
 

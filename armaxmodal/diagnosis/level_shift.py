@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import fftconvolve, lfilter
 from scipy.special import ndtr
+from scipy.stats import median_abs_deviation
 
 from armaxmodal.diagnosis.faults import PI_ENERGY
 from armaxmodal.diagnosis.finding import Finding
@@ -52,7 +53,7 @@ def _scan(eps: np.ndarray, model, mask: np.ndarray):
     n = eps.size
     g = lfilter(model.a, model.c, np.ones(n))
     e = np.where(mask, eps, 0.0)
-    sigma = 1.4826 * float(np.median(np.abs(eps[mask] - np.median(eps[mask]))))
+    sigma = float(median_abs_deviation(eps[mask], scale="normal"))
     matched = fftconvolve(e, g[::-1], mode="full")[n - 1 :]  # sum_j g_j e(t0 + j), t0 = 0..n-1
     energy = np.cumsum(g**2)[::-1]  # sum of g_j^2 over j < n - t0
     return matched / (sigma * np.sqrt(energy)), matched / energy, sigma, e, g
