@@ -30,6 +30,9 @@ def _runs(real: Path) -> dict[str, list[str]]:
     for event in ("elcentro1", "northridge1"):  # the top IMU lags the table by about 2.3 samples
         folder = real / "mini_shake_table_imu" / "stiff1"
         runs[f"stiff1 {event}"] = [*(str(folder / f"{event}__{s}.csv.gz") for s in ("g", "f1")), "--input", "g"]
+    for bridge in sorted(real.glob("bridge_*")):  # the column base or free field in, the deck out
+        for record in sorted(bridge.glob("*.csv*")):
+            runs[record.name.split(".")[0].replace("_", " ")] = [str(record)]
     return runs
 
 

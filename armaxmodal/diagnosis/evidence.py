@@ -33,6 +33,7 @@ from armaxmodal.diagnosis.finding import Finding
 from armaxmodal.diagnosis.model import LINE_MERGE_HZ, UNDAMPED, FittedModel, usable
 from armaxmodal.diagnosis.model import lagged as _lag
 from armaxmodal.diagnosis.spectral import harmonic_f_test
+from armaxmodal.estimate.fit import record_supports
 from armaxmodal.prepare.quality import input_coherence
 from armaxmodal.stats import MAX_DAMPING, SECOND_INPUT_COHERENCE
 
@@ -327,7 +328,13 @@ def time_findings(fitted, mask, n_tests, table) -> list[Finding]:
     the parameters say so."""
     from armaxmodal.diagnosis.model import PiecewiseModel
 
-    if isinstance(fitted, PiecewiseModel) or fitted.signals.n < N_WINDOWS * 200:
+    spec, s = fitted.spec, fitted.signals
+    if isinstance(fitted, PiecewiseModel) or s.n < N_WINDOWS * 200:
+        return []
+    window = int(mask.sum()) // N_WINDOWS
+    if not record_supports(window, spec.orders, 1 + len(spec.terms), len(s.sensors), True):
+        table["time_varying_not_run"] = (f"{N_WINDOWS} windows of {window} samples cannot hold the model's orders "
+                                         f"{spec.orders}: the record is too short for this test")  # fmt: skip
         return []
     ref, freq, sd, rms, edges = _window_modes(fitted, mask)
     best = (0.0, None, None)
@@ -353,7 +360,6 @@ def time_findings(fitted, mask, n_tests, table) -> list[Finding]:
     confounded = abs(np.corrcoef(order, rms)[0, 1]) > 0.8 if np.std(rms) > 0 else False
     if r_amp > r_time and not confounded:
         return []
-    s = fitted.signals
     params = {
         "change_time_s": float(edges[b] / s.fs),
         "mode_hz": float(ref[m, 0]),

@@ -25,7 +25,7 @@ from armaxmodal.estimate.result import ArmaxFit
 from armaxmodal.exceptions import ConvergenceWarning, DataError, OrderError
 from armaxmodal.recording import Recording
 
-__all__ = ["fit_armax", "fit_resumable", "covariance_at", "load_kernels"]
+__all__ = ["fit_armax", "fit_resumable", "covariance_at", "load_kernels", "record_supports"]
 
 # At least this many samples per estimated parameter in the fit window.
 _MIN_SAMPLES_PER_PARAMETER = 5
@@ -177,11 +177,41 @@ def fit_resumable(
     return fit, checkpoint
 
 
+def record_supports(n: int, orders: tuple[int, int, int, int], n_in: int, n_out: int, shared_poles: bool) -> bool:
+    """Can ``n`` samples hold a fit of ``orders``? The rule :func:`fit_armax` refuses by: at least
+    5 samples per parameter, and twice one sensor's parameters, in the samples its start-up leaves.
+
+    Parameters
+    ----------
+    n : int
+        Samples of the window fitted.
+    orders : (na, nb, nc, nk)
+    n_in, n_out : int
+        Inputs and outputs.
+    shared_poles : bool
+        One A for every output (its parameters counted once).
+
+    Returns
+    -------
+    bool
+    """
+    na, nb, nc, nk = orders
+    lead = max(0, -nk)
+    return _supported(n - lead - max(na, nc, nk + lead + nb - 1, 0), orders, n_in, n_out, shared_poles)
+
+
+def _supported(n_eff, orders, n_in, n_out, shared_poles) -> bool:
+    na, nb, nc, _ = orders
+    p_single = na + n_in * nb + nc
+    p_needed = p_single if not shared_poles else na + n_out * (n_in * nb + nc)
+    return n_eff * (n_out if shared_poles else 1) >= _MIN_SAMPLES_PER_PARAMETER * p_needed and n_eff >= 2 * p_single
+
+
 def _check_record_supports(n, n_eff, orders, n_in, n_out, shared_poles) -> None:
     na, nb, nc, nk = orders
     p_single = na + n_in * nb + nc
     p_needed = p_single if not shared_poles else na + n_out * (n_in * nb + nc)
-    if n_eff * (n_out if shared_poles else 1) < _MIN_SAMPLES_PER_PARAMETER * p_needed or n_eff < 2 * p_single:
+    if not _supported(n_eff, orders, n_in, n_out, shared_poles):
         raise OrderError(
             f"orders na={na}, nb={nb}, nc={nc}, nk={nk} give {p_needed} parameters; the record has "
             f"{n} samples ({n_eff} usable), too few (need about "
