@@ -51,7 +51,8 @@ CODES: tuple[WarningCode, ...] = (
         "standard deviation: Hann-windowed lines are correlated, and the fit's alone was 1.3–1.6× narrow over 40 "
         "rides); reported from ¾ sample (a held input shows ½)",
         "whole samples aligned",
-        "If the delay is a logger's, fix the time stamps at the source; `diagnose` times it to a fraction of a sample.",
+        "If the delay is a logger's, fix the time stamps at the source; `diagnose` times it to a fraction of a sample, "
+        "and names a delay that grows through the record (`clock_drift`: the logger's clock runs off) with its rate.",
     ),
     WarningCode(
         "narrowband_input", "preparation",
@@ -145,7 +146,7 @@ CODES: tuple[WarningCode, ...] = (
         "family-wise)",
         "the 95 % interval widened to the thirds' t-interval",
         "The record's thirds disagree about the mode: run `diagnose` to find the effect (a nonlinearity, a change in "
-        "time).",
+        "time, a sensor's gain change or clock drift).",
     ),
     WarningCode(
         "nk_at_search_edge", "preparation",

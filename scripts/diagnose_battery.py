@@ -52,17 +52,22 @@ def two_regimes(stiffening: float, seed: int) -> am.Recording:
 def stepped(rec: am.Recording, name: str, rms_share: float, time_s: float) -> tuple:
     """``rec`` with ``name``'s offset stepping by ``rms_share`` of its RMS at ``time_s``: a case with its time."""
     size = rms_share * float(np.std(rec.response[:, rec.sensors.index(name)]))
-    return inject(rec, "level_shift", [name], time_s=time_s, size=size), "level_shift", name, time_s
+    return inject(rec, "level_shift", [name], time_s=time_s, size=size), "level_shift", name, {"time_s": time_s}
 
 
 def gained(rec: am.Recording, name: str, factor: float, time_s: float) -> tuple:
     """``rec`` with ``name`` reading ``factor`` times more from ``time_s``: a case with its time."""
-    return inject(rec, "gain_change", [name], time_s=time_s, factor=factor), "gain_change", name, time_s
+    return inject(rec, "gain_change", [name], time_s=time_s, factor=factor), "gain_change", name, {"time_s": time_s}
+
+
+def drifting(rec: am.Recording, name: str, rate_ppm: float) -> tuple:
+    """``rec`` with ``name``'s clock drifting by ``rate_ppm``: a case with its rate."""
+    return inject(rec, "clock_drift", [name], rate_ppm=rate_ppm), "clock_drift", name, {"rate_ppm": rate_ppm}
 
 
 def cases(seed: int) -> dict:
-    """label -> (recording, effect expected, channel expected[, time expected (s)]); None effect:
-    the clean twin."""
+    """label -> (recording, effect expected, channel expected[, {parameter: value expected}]); None
+    effect: the clean twin."""
     sup, ch2 = ride("supine", seed), ride("chapter2", seed)
     m = ch2.sensors
     u = am.random_vibration(60.0, 120.0, band=(0.5, 28.0), seed=seed)
@@ -75,6 +80,11 @@ def cases(seed: int) -> dict:
         "supine: head gain x 1.05 from 33.25 s": gained(sup, "head", 1.05, 33.25),
         "chapter2: m2 gain x 0.8 from 50 s": gained(ch2, m[1], 0.8, 50.0),
         "chapter2: m3 gain x 0.95 from 91.75 s": gained(ch2, m[2], 0.95, 91.75),
+        "supine: chest clock drifts 278 ppm (2 samples in 120 s)": drifting(sup, "chest", 278.0),
+        "supine: legs clock drifts 40 ppm": drifting(sup, "legs", 40.0),
+        "chapter2: m3 clock drifts -150 ppm": drifting(ch2, m[2], -150.0),
+        "chapter2: m2 clock drifts 25 ppm (0.3 samples in 120 s)": drifting(ch2, m[1], 25.0),
+        "supine: the input's clock drifts 100 ppm": drifting(sup, "base", 100.0),
         "supine: every output 3 samples late": (inject(sup, "input_delay", list(sup.sensors), samples=3.0),
                                                 "input_delay", "base"),
         "chapter2: every output 4 samples late": (inject(ch2, "input_delay", list(m), samples=4.0),
@@ -98,7 +108,11 @@ def cases(seed: int) -> dict:
     }  # fmt: skip
 
 
-def judge(d, effect: str | None, channel: str | None, time_s: float | None = None) -> tuple[bool, str]:
+#: where each expected parameter's 95 % interval is
+INTERVALS = {"time_s": "time_ci95_s", "rate_ppm": "rate_ci95_ppm"}
+
+
+def judge(d, effect: str | None, channel: str | None, expected: dict | None = None) -> tuple[bool, str]:
     named = [(e.finding.effect, e.finding.channels) for e in d.effects]
     if effect is None:
         return not named, f"named {named}" if named else "clean"
@@ -111,9 +125,10 @@ def judge(d, effect: str | None, channel: str | None, time_s: float | None = Non
             after = e.parameters.get("sim_error_after", e.error_after) if "simulation" in crit else e.error_after
             ok = after <= before * 1.01  # a delay the B taps absorbed need only be no worse
             how = f"named ({'first' if e is d.effects[0] else 'kept'}), error {before:.4g} -> {after:.4g}"
-            if time_s is not None:  # a step's time within its interval
-                lo, hi = e.parameters["time_ci95_s"]
-                ok, how = ok and lo <= time_s <= hi, f"{how}, time {time_s} s in [{lo:.3f}, {hi:.3f}]"
+            for key, truth in (expected or {}).items():  # a step's time, a drift's rate within its interval
+                lo, hi = e.parameters[INTERVALS[key]]
+                found = e.parameters[key]
+                ok, how = ok and lo <= truth <= hi, f"{how}, {key} {truth}: {found:.3f} in [{lo:.3f}, {hi:.3f}]"
             return ok, how
     return False, f"named {named}; unconfirmed {[(u['effect'], u['channels']) for u in d.unconfirmed]}"
 

@@ -4,9 +4,12 @@ each effect planted with a known size; an interval counts when it holds the plan
 
 - offset 0.3 and drift 0.004 /s on chest: ``offset_ci95``, ``drift_ci95_per_s``;
 - a line at 11.3 Hz of RMS 10 % of head's: ``amp_ci95`` (peak amplitude, ``sqrt(2)`` x RMS);
-- legs recorded 2.4 samples late: ``delay_ci95_ms`` (40 ms).
+- legs recorded 2.4 samples late: ``delay_ci95_ms`` (40 ms);
+- chest's clock drifting 120 ppm: ``rate_ci95_ppm``;
+- pelvis reading 1.1 times more from 70.5 s: ``factor_ci95``, ``time_ci95_s``;
+- head's offset stepping by 0.15 x its RMS at 45.25 s: ``size_ci95``, ``time_ci95_s``.
 
-    python scripts/diagnose_coverage.py --seeds 40
+    python scripts/diagnose_coverage.py --seeds 40 [--only TEXT]
 """
 
 from __future__ import annotations
@@ -60,17 +63,42 @@ def planted_cases(rec: am.Recording):
         "legs",
         [(("delay_ci95_ms",), 1e3 * 2.4 / FS)],
     )
+    yield (
+        "chest clock 120 ppm",
+        inject(rec, "clock_drift", ["chest"], rate_ppm=120.0),
+        "clock_drift",
+        "chest",
+        [(("rate_ci95_ppm",), 120.0)],
+    )
+    yield (
+        "pelvis gain 1.1 at 70.5 s",
+        inject(rec, "gain_change", ["pelvis"], time_s=70.5, factor=1.1),
+        "gain_change",
+        "pelvis",
+        [(("factor_ci95",), 1.1), (("time_ci95_s",), 70.5)],
+    )
+    step = 0.15 * head_rms
+    yield (
+        "head step 0.15 x RMS at 45.25 s",
+        inject(rec, "level_shift", ["head"], time_s=45.25, size=step),
+        "level_shift",
+        "head",
+        [(("size_ci95",), step), (("time_ci95_s",), 45.25)],
+    )
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=40)
+    parser.add_argument("--only", default="", help="the cases whose label holds this text")
     args = parser.parse_args()
     held: dict[str, list[bool]] = {}
     named: dict[str, int] = {}
     t0 = time.perf_counter()
     for seed in range(args.seeds):
         for label, rec, effect, channel, checks in planted_cases(ride(seed)):
+            if args.only not in label:
+                continue
             e = _effect(diagnose(rec), effect, channel)
             named[label] = named.get(label, 0) + (e is not None)
             if e is None:

@@ -13,6 +13,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy import stats
 
+from armaxmodal.diagnosis.clock_drift import remaining_drift
 from armaxmodal.diagnosis.finding import Finding
 from armaxmodal.diagnosis.gain_change import remaining_gain
 from armaxmodal.diagnosis.level_shift import remaining_step
@@ -30,18 +31,33 @@ from armaxmodal.diagnosis.model import (
 )
 from armaxmodal.diagnosis.result import Effect, Stage
 
-__all__ = ["NK_REACH", "NO_WORSE", "STEP_PASSES", "Judgement", "delay_kept", "fact_kept", "fault_kept",
-           "refit_gain_change", "refit_level_shift", "refit_moved", "refit_piecewise", "refit_spec", "significant_drop",
-           "try_fix"]  # fmt: skip
+__all__ = [
+    "Judgement",
+    "NK_REACH",
+    "NO_WORSE",
+    "STEP_PASSES",
+    "delay_kept",
+    "fact_kept",
+    "fault_kept",
+    "refit_clock_drift",
+    "refit_gain_change",
+    "refit_level_shift",
+    "refit_moved",
+    "refit_piecewise",
+    "refit_spec",
+    "significant_drop",
+    "try_fix",
+]
 
 #: A fix that must only not hurt (a delay the B taps absorbed, a clipped or stuck run filled)
 #: may raise the held-out error by this fraction: the refit's own scatter.
 NO_WORSE = 0.01
 #: nk candidates either side of where a delay's move puts the baseline's (and the baseline's).
 NK_REACH = 1
-#: refits at most that complete a level shift's size or a gain change's factor, each while what
-#: remains exceeds its SD (a 0.8 step on the supine ride's pelvis: 0.791 at first, and a second 0.009
-#: step found the next round; a gain of 1.2 read 1.073 at first and 1.190 after three passes)
+#: refits at most that complete a level shift's size, a gain change's factor or a clock's drift, each
+#: while what remains exceeds its SD (a 0.8 step on the supine ride's pelvis: 0.791 at first, and a
+#: second 0.009 step found the next round; a gain of 1.2 read 1.073 at first and 1.190 after three
+#: passes; a drift of 278 ppm read 322 at first, its first-order pattern outgrown by a sample's drift)
 STEP_PASSES = 8
 
 
@@ -110,16 +126,16 @@ def refit_spec(stage: Stage, finding: Finding, entry) -> Stage:
 
 
 def _refit_completed(stage: Stage, finding: Finding, entry, remaining, key: str, as_value) -> Stage:
-    """A sensor's change taken out of its channel (``entry.add``), refitted, and completed from the
+    """A channel's change taken out of it (``entry.add``), refitted, and completed from the
     refitted model's residual at most ``STEP_PASSES`` times while what remains exceeds its SD: the
     model fitted with the change in the data carried part of it, so the first reading falls short.
-    ``remaining(model, name, sample)`` gives ``(left, sd)``; ``entry.add`` combines the rest, its
-    parameter ``key`` set to ``as_value(left)``, with what is taken out at that sample already."""
-    s, name, first = stage.model.raw, finding.channels[0], int(finding.parameters["sample"])
+    ``remaining(model, finding)`` gives ``(left, sd)``; ``entry.add`` combines the rest, its
+    parameter ``key`` set to ``as_value(left)``, with what is taken out there already."""
+    s = stage.model.raw
     spec = entry.add(stage.model.spec, finding, stage.model)
     model = fit_model(spec, s, start=widened_start(stage.model, spec))
     for _ in range(STEP_PASSES):
-        left, sd = remaining(model, name, first)
+        left, sd = remaining(model, finding)
         if abs(left) < sd:
             break
         spec = entry.add(spec, replace(finding, parameters={**finding.parameters, key: as_value(left)}), model)
@@ -127,14 +143,25 @@ def _refit_completed(stage: Stage, finding: Finding, entry, remaining, key: str,
     return Stage(model, held_out(model.spec, s, model))
 
 
+def _at_sample(remaining):
+    """``remaining(model, name, sample)`` read at the finding's channel and sample."""
+    return lambda model, f: remaining(model, f.channels[0], int(f.parameters["sample"]))
+
+
 def refit_level_shift(stage: Stage, finding: Finding, entry) -> Stage:
     """A level shift taken out and its size completed (:func:`_refit_completed`)."""
-    return _refit_completed(stage, finding, entry, remaining_step, "size", float)
+    return _refit_completed(stage, finding, entry, _at_sample(remaining_step), "size", float)
 
 
 def refit_gain_change(stage: Stage, finding: Finding, entry) -> Stage:
     """A gain change taken out and its factor completed (:func:`_refit_completed`)."""
-    return _refit_completed(stage, finding, entry, remaining_gain, "factor", lambda left: 1 + left)
+    return _refit_completed(stage, finding, entry, _at_sample(remaining_gain), "factor", lambda left: 1 + left)
+
+
+def refit_clock_drift(stage: Stage, finding: Finding, entry) -> Stage:
+    """A clock's drift taken out and its rate completed (:func:`_refit_completed`)."""
+    remaining = lambda model, f: remaining_drift(model, f.channels[0])  # noqa: E731
+    return _refit_completed(stage, finding, entry, remaining, "rate_ppm", lambda left: 1e6 * left)
 
 
 def refit_moved(stage: Stage, finding: Finding, entry) -> Stage:

@@ -21,6 +21,7 @@ from functools import cached_property
 import numpy as np
 
 from armaxmodal.diagnosis import acceptance, evidence, fixes
+from armaxmodal.diagnosis.clock_drift import drift_findings
 from armaxmodal.diagnosis.delays import delay_findings, late_start, lead_findings
 from armaxmodal.diagnosis.finding import Finding
 from armaxmodal.diagnosis.gain_change import gain_change_findings
@@ -99,6 +100,10 @@ def _gain_changes(ev: Evidence) -> list[Finding]:
     return gain_change_findings(ev.fitted, ev.eps, ev.mask, ev.n_tests, ev.table)
 
 
+def _clock_drifts(ev: Evidence) -> list[Finding]:
+    return drift_findings(ev.fitted, ev.mask, ev.n_tests, ev.table)
+
+
 def _trends(ev: Evidence) -> list[Finding]:
     return evidence.trend_findings(ev.fitted, ev.eps, ev.mask, ev.n_tests, ev.table)
 
@@ -146,6 +151,8 @@ REGISTRY: tuple[EffectKind, ...] = (
                refit=acceptance.refit_level_shift),  # fmt: skip
     EffectKind("gain_change", _gain_changes, 1, fixes.add_gain_change, fixes.gain_change_parameters, "simulation",
                refit=acceptance.refit_gain_change),  # fmt: skip
+    EffectKind("clock_drift", _clock_drifts, 0, fixes.add_clock_drift, fixes.clock_drift_parameters, "simulation",
+               refit=acceptance.refit_clock_drift),  # fmt: skip
     EffectKind("offset_drift", _trends, 1, fixes.add_trend, fixes.trend_parameters, "simulation"),
     EffectKind("periodic_disturbance", _lines, 1, fixes.add_line, fixes.line_parameters, "simulation"),
     EffectKind("coloured_noise", _whiteness, 2, fixes.add_noise_model, fixes.noise_model_parameters),

@@ -8,6 +8,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from armaxmodal.diagnosis.clock_drift import remaining_drift
 from armaxmodal.diagnosis.finding import Finding
 from armaxmodal.diagnosis.gain_change import remaining_gain
 from armaxmodal.diagnosis.level_shift import remaining_step
@@ -15,11 +16,27 @@ from armaxmodal.diagnosis.model import FittedModel, ModelSpec, response_free_of,
 from armaxmodal.stats import MAX_DAMPING, Z95
 
 __all__ = [
-    "add_clipped", "add_delay", "add_fault", "add_joint_force", "add_line", "add_mode", "add_noise_model",
-    "add_second_input", "add_trend", "finding_parameters", "joint_force_parameters", "line_parameters",
-    "mode_parameters", "noise_model_parameters", "refine_line", "second_input_parameters", "time_change_parameters",
+    "add_clipped",
+    "add_clock_drift",
+    "add_delay",
+    "add_fault",
+    "add_joint_force",
+    "add_line",
+    "add_mode",
+    "add_noise_model",
+    "add_second_input",
+    "add_trend",
+    "clock_drift_parameters",
+    "finding_parameters",
+    "joint_force_parameters",
+    "line_parameters",
+    "mode_parameters",
+    "noise_model_parameters",
+    "refine_line",
+    "second_input_parameters",
+    "time_change_parameters",
     "trend_parameters",
-]  # fmt: skip
+]
 
 #: C coefficients a richer noise model adds.
 EXTRA_NC_STEP = 6
@@ -51,6 +68,14 @@ def add_gain_change(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> M
     at, factor = (finding.channels[0], int(finding.parameters["sample"])), float(finding.parameters["factor"])
     before = np.prod([v for c, t, v in spec.gains if (c, t) == at])
     return replace(spec, gains=tuple(g for g in spec.gains if g[:2] != at) + ((*at, factor * before),))
+
+
+def add_clock_drift(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
+    """The channel resampled on its own clock (added to a drift already taken out of it)."""
+    drifts = dict(spec.drifts)
+    name = finding.channels[0]
+    drifts[name] = drifts.get(name, 0.0) + 1e-6 * float(finding.parameters["rate_ppm"])
+    return replace(spec, drifts=tuple(sorted(drifts.items())))
 
 
 def add_line(spec: ModelSpec, finding: Finding, fitted: FittedModel) -> ModelSpec:
@@ -148,6 +173,21 @@ def gain_change_parameters(finding: Finding, fitted) -> dict:
     factor *= 1 + left
     return {**finding.parameters, "factor_first": finding.parameters["factor"], "factor": factor,
             "factor_ci95": [factor * (1 - Z95 * sd), factor * (1 + Z95 * sd)]}  # fmt: skip
+
+
+def clock_drift_parameters(finding: Finding, fitted) -> dict:
+    """The drift's rate (ppm: microseconds a second) as the refit completed it, with a 95 % interval
+    from what remains in the refitted model's residual, and the delay it adds over the record (ms)."""
+    name, s = finding.channels[0], fitted.signals
+    left, sd = remaining_drift(fitted, name)
+    rate = dict(fitted.spec.drifts)[name] + left
+    return {
+        **finding.parameters,
+        "rate_first_ppm": finding.parameters["rate_ppm"],
+        "rate_ppm": 1e6 * rate,
+        "rate_ci95_ppm": [1e6 * (rate - Z95 * sd), 1e6 * (rate + Z95 * sd)],
+        "delay_change_ms": 1e3 * rate * s.n / s.fs,
+    }
 
 
 def trend_parameters(finding: Finding, fitted) -> dict:

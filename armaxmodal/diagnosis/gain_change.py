@@ -27,7 +27,7 @@ from armaxmodal.diagnosis.level_shift import CHANGE_POINT_LR_95, newey_west_sum,
 from armaxmodal.prepare.detrend import STEP_EDGE
 from armaxmodal.stats import Z95
 
-__all__ = ["SHARED_Z", "gain_change_findings", "gain_scan", "remaining_gain"]
+__all__ = ["SHARED_Z", "gain_change_findings", "gain_scan", "predicted_part", "remaining_gain"]
 
 #: another sensor's relative change at a gain change's time, in its own SDs, beyond which the change
 #: is the structure's: the 1 % two-sided level over the other sensors of a four-sensor record
@@ -51,7 +51,7 @@ def _spread(e: np.ndarray, z: np.ndarray, at: int, d: float, sigma: float, energ
     return max(np.sqrt(newey_west_sum(z[at:] * (e[at:] - d * z[at:]))), sigma * np.sqrt(energy)) / energy
 
 
-def _filtered(fitted, k: int, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+def predicted_part(fitted, k: int, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """Output ``k``'s predicted part through its predictor's filter, ``(A / C) y - e = (B / C) u``
     (disturbance taken out), its masked residual and the residual's SD. Not ``(A / C) y`` itself:
     it holds the residual, whose sum of squares then reads as a gain (1.207 for a planted 1.2,
@@ -81,7 +81,7 @@ def remaining_gain(fitted, name: str, first: int) -> tuple[float, float]:
 
     k = fitted.signals.sensors.index(name)
     at = first - int(round(dict(fitted.spec.shifts).get(name, 0.0)))
-    z, e, sigma = _filtered(fitted, k, counted(fitted))
+    z, e, sigma = predicted_part(fitted, k, counted(fitted))
     _, d, energy = gain_scan(e, z, counted(fitted))
     return float(d[at]), float(_spread(e, z, at, d[at], sigma, energy[at]))
 
@@ -95,7 +95,7 @@ def gain_change_findings(fitted, eps: np.ndarray, mask: np.ndarray, n_tests: int
     out, table["gain_p"] = [], []
     lo = max(search_start(model, mask, edge) for model in fitted.fit.models)
     settled = mask & (np.arange(s.n) >= lo)
-    scans = [(*_filtered(fitted, k, settled),) for k in range(len(s.sensors))]
+    scans = [(*predicted_part(fitted, k, settled),) for k in range(len(s.sensors))]
     scans = [(z, e, sigma, *gain_scan(e, z, settled)) for z, e, sigma in scans]
     for k, name in enumerate(s.sensors):
         z, e, sigma, lam, d, energy = scans[k]

@@ -9,7 +9,7 @@ import numba
 import numpy as np
 from scipy.signal import lfilter
 
-from armaxmodal.diagnosis.model import fractional_shift
+from armaxmodal.diagnosis.model import fractional_shift, moved
 from armaxmodal.exceptions import DataError
 from armaxmodal.recording import Recording
 
@@ -20,18 +20,22 @@ INJECTABLE = (
     "offset_drift",
     "level_shift",
     "gain_change",
+    "clock_drift",
     "periodic_disturbance",
     "coloured_noise",
     "clipping",
     "sensor_fault",
     "second_input",
 )
+#: a clock that runs off by 1 % or more is a wrong sampling rate, not a drift
+MAX_RATE_PPM = 1e4
 #: Each effect's parameters: required, then optional.
 PARAMETERS = {
     "input_delay": (("samples",), ()),
     "offset_drift": ((), ("offset", "drift_per_s")),
     "level_shift": (("time_s", "size"), ()),
     "gain_change": (("time_s", "factor"), ()),
+    "clock_drift": (("rate_ppm",), ()),
     "periodic_disturbance": (("freq_hz", "amp"), ()),
     "coloured_noise": (("level",), ("pole", "freq_hz")),
     "clipping": (("fraction",), ()),
@@ -87,6 +91,10 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, stru
     effect : str
         ``"input_delay"`` (``samples``, may be fractional: the channel is recorded that late),
         ``"offset_drift"`` (``offset`` in signal units, ``drift_per_s``),
+        ``"level_shift"`` (``time_s``, ``size`` in signal units: the offset steps then),
+        ``"gain_change"`` (``time_s``, ``factor``: the channel reads that much more from then on),
+        ``"clock_drift"`` (``rate_ppm``: the channel's delay grows by that many microseconds a
+        second, from none at the start, as on a recorder synchronised when it started),
         ``"periodic_disturbance"`` (``freq_hz``; ``amp``, the line's RMS as a fraction of
         each channel's RMS),
         ``"coloured_noise"`` (``level`` as a fraction of RMS; AR(1) ``pole``, or with
@@ -123,6 +131,9 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, stru
                         f"got {params['time_s']}.")  # fmt: skip
     if effect == "gain_change" and not float(params["factor"]) > 0:
         raise DataError(f"effect 'gain_change': factor must be > 0, got {params['factor']}.")
+    if effect == "clock_drift" and not abs(float(params["rate_ppm"])) < MAX_RATE_PPM:
+        raise DataError(f"effect 'clock_drift': rate_ppm must lie within +-{MAX_RATE_PPM:g} (a clock off by more is "
+                        f"a wrong sampling rate, not a drift), got {params['rate_ppm']}.")  # fmt: skip
     default = [recording.input_name] if effect == "input_delay" else list(recording.sensors)
     names = list(channels) if channels is not None else default
     base, y = recording.base.copy(), np.array(recording.response, dtype=float)
@@ -136,6 +147,9 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, stru
             x[:] = fractional_shift(x, -float(params["samples"]))
         elif effect == "offset_drift":
             x += float(params.get("offset", 0.0)) + float(params.get("drift_per_s", 0.0)) * (t - t.mean())
+        elif effect == "clock_drift":
+            rate = 1e-6 * float(params["rate_ppm"])
+            x[:] = moved(x, -rate * (x.size - 1) / 2, -rate)  # x[t - rate t]: no delay at the start
         elif effect == "level_shift":
             x[t >= float(params["time_s"])] += float(params["size"])
         elif effect == "gain_change":

@@ -3,7 +3,8 @@
 An effect is added without touching the numba fitter:
 
 * channel shifts (a late sensor or input) move that channel by a fractional number of
-  samples before the fit (Fourier shift: the data are band-limited);
+  samples before the fit (Fourier shift: the data are band-limited), and a clock's drift
+  resamples it on its own time axis (the same interpolation, evaluated by a chirp-z transform);
 * additive output disturbances ``y = G u + H e + phi theta`` (offset, drift, sinusoids) are
   estimated by backfitting: ``theta`` from least squares of the output on the regressors,
   ARMAX fitted to ``y - phi theta``, ``theta`` again from the simulation residual, three
@@ -27,7 +28,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.signal import lfilter
+from scipy.signal import czt, lfilter
 
 from armaxmodal.diagnosis.clipping import IMPUTE_PASSES, clipped_mask, fill_by_prediction
 from armaxmodal.estimate.fit import fit_armax
@@ -96,6 +97,10 @@ class ModelSpec:
     gains : tuple of (str, int, float)
         Gain changes taken out of an output: from this sample on it reads this factor times what
         reaches it (a range switch, a loosening mount). Recorded = factor x true + step.
+    drifts : tuple of (str, float)
+        Clock drifts taken out of a channel (an output or the input): its delay grows by this many
+        samples per sample (its clock runs slow by that fraction), taken out about the record's
+        middle so the mean delay stays where the shifts and ``nk`` put it.
     """
 
     orders: tuple[int, int, int, int]
@@ -111,6 +116,7 @@ class ModelSpec:
     inputs_from: tuple[str, ...] = ()
     steps: tuple[tuple[str, int, float], ...] = ()
     gains: tuple[tuple[str, int, float], ...] = ()
+    drifts: tuple[tuple[str, float], ...] = ()
 
     @property
     def n_disturbance(self) -> int:
@@ -148,6 +154,28 @@ def fractional_shift(x: np.ndarray, samples: float) -> np.ndarray:
     return np.fft.irfft(np.fft.rfft(ext) * np.exp(2j * np.pi * f * samples), ext.size)[:n]
 
 
+def moved(x: np.ndarray, samples: float = 0.0, rate: float = 0.0) -> np.ndarray:
+    """``x`` moved earlier by ``samples`` and its clock's drift ``rate`` taken out:
+    ``out[t] = x[t + samples + rate (t - c)]``, ``c`` the record's middle.
+
+    The band-limited (Fourier) interpolation of the mirrored record, as :func:`fractional_shift`,
+    evaluated on the new times by a chirp-z transform: they are equally spaced, ``1 + rate`` apart,
+    which an FFT cannot evaluate and a windowed-sinc filter would only approximate near Nyquist.
+    """
+    if rate == 0:
+        return fractional_shift(x, samples)
+    n = x.size
+    ext = np.concatenate([x, x[::-1]])
+    m = ext.size
+    spectrum = np.fft.fftshift(np.fft.fft(ext))  # bin j is frequency (j - m // 2) / m
+    step, first = 1.0 + rate, samples - rate * (n - 1) / 2
+    weights = spectrum * np.exp(2j * np.pi * np.arange(m) * first / m)
+    times = step * np.arange(n) + first
+    # sum_j weights_j w^(j t), w = exp(2 pi i step / m); the factor puts the bins at j - m // 2
+    series = czt(weights, n, w=np.exp(2j * np.pi * step / m), a=1.0)
+    return np.real(np.exp(-2j * np.pi * (m // 2) * times / m) * series) / m
+
+
 def as_inputs(signals: Signals, names) -> Signals:
     """``signals`` with the recorded channels ``names`` moved from the outputs to the extra
     inputs (a channel moved already is left as it is)."""
@@ -175,15 +203,18 @@ def gain_factors(signals: Signals, gains) -> np.ndarray:
     return factors
 
 
-def apply_shifts(signals: Signals, shifts) -> Signals:
-    """Signals with each named channel (an output or the input) moved by its shift."""
+def apply_shifts(signals: Signals, shifts, drifts=()) -> Signals:
+    """Signals with each named channel (an output or the input) moved by its shift and its clock's
+    drift taken out (:func:`moved`)."""
     u, y = signals.u, signals.y.copy()
-    for name, s in shifts:
+    shift, drift = dict(shifts), dict(drifts)
+    for name in sorted(set(shift) | set(drift)):
+        samples, rate = shift.get(name, 0.0), drift.get(name, 0.0)
         if name == signals.input_name:
-            u = fractional_shift(u, s)
+            u = moved(u, samples, rate)
         else:
             k = signals.sensors.index(name)
-            y[:, k] = fractional_shift(y[:, k], s)
+            y[:, k] = moved(y[:, k], samples, rate)
     return replace(signals, u=u, y=y)
 
 
@@ -255,7 +286,8 @@ def usable(n: int, spec: ModelSpec) -> np.ndarray:
     """Samples where every error is meaningful: away from start-up, non-causal taps and shift
     edges, (n,) bool."""
     na, nb, nc, nk = spec.orders
-    shift = max((abs(s) for _, s in spec.shifts), default=0.0)
+    drift = max((abs(r) * n / 2 for _, r in spec.drifts), default=0.0)  # the move at either end
+    shift = max((abs(s) for _, s in spec.shifts), default=0.0) + drift
     head = max(na, nc + spec.extra_nc, nk + nb - 1, n // 50) + int(np.ceil(shift)) + 8
     tail = max(0, -nk) + int(np.ceil(shift)) + 8
     mask = np.zeros(n, bool)
@@ -275,7 +307,7 @@ def model_bic(model, kind: str = "one_step", channels=None, mask: np.ndarray | N
     e = errors[mask][:, [s.sensors.index(c) for c in (s.sensors if channels is None else channels)]]
     n, k = e.shape
     pieces = 2 if isinstance(model, PiecewiseModel) else 1
-    p = pieces * model.spec.n_parameters(k) + len(model.spec.shifts)
+    p = pieces * model.spec.n_parameters(k) + len(model.spec.shifts) + len(model.spec.drifts)
     return float(n * np.sum(np.log(np.mean(e**2, axis=0))) + p * np.log(n * k))
 
 
@@ -346,14 +378,15 @@ def _filled(model: FittedModel, signals: Signals, masks: dict) -> Signals:
     y = signals.y.copy()
     levels = step_levels(signals, model.spec.steps)  # the fill is made without them: put back
     factors = gain_factors(signals, model.spec.gains)
-    shifts = dict(model.spec.shifts)
+    shifts, drifts = dict(model.spec.shifts), dict(model.spec.drifts)
     s = model.signals
     u, dist = s.inputs(model.spec), model.disturbance()
     for k, gone in masks.items():
-        shift = shifts.get(signals.sensors[k], 0.0)
-        missing = fractional_shift(gone.astype(float), shift) > 0.5 if shift else gone
+        shift, rate = shifts.get(signals.sensors[k], 0.0), drifts.get(signals.sensors[k], 0.0)
+        timed = shift or rate
+        missing = moved(gone.astype(float), shift, rate) > 0.5 if timed else gone
         filled = fill_by_prediction(s.y[:, k] - dist[:, k], u, model.fit.models[k], missing) + dist[:, k]
-        filled = fractional_shift(filled, -shift) if shift else filled
+        filled = moved(filled, -shift, -rate) if timed else filled  # back, to first order in the rate
         y[gone, k] = filled[gone] * factors[gone, k] + levels[gone, k]
     return replace(signals, y=y)
 
@@ -361,7 +394,7 @@ def _filled(model: FittedModel, signals: Signals, masks: dict) -> Signals:
 def _fit_once(spec: ModelSpec, signals: Signals, window, start: FittedModel | None) -> FittedModel:
     # a level shift and a gain change are the recorded channel's: taken out before any shift moves it
     true = (signals.y - step_levels(signals, spec.steps)) / gain_factors(signals, spec.gains)
-    shifted = apply_shifts(replace(signals, y=true), spec.shifts)
+    shifted = apply_shifts(replace(signals, y=true), spec.shifts, spec.drifts)
     lo, hi = window or (0, signals.n)
     na, nb, nc, nk = spec.orders
     phi = disturbance_columns(spec, signals)
