@@ -18,6 +18,86 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 # (file, original text, mutated text, what it models)
 MUTANTS = [
+    # the clock drift (issue 70); run with --match "(clock drift)" --tests tests/diagnosis/test_clock_drift.py
+    (
+        "armaxmodal/diagnosis/clock_drift.py",
+        "    x = ramp - slope * (slope @ ramp) / max(slope @ slope, 1e-300)  # the constant delay partialled out",
+        "    x = ramp  # the constant delay partialled out",
+        "the constant delay not partialled out (clock drift)",
+    ),
+    (
+        "armaxmodal/diagnosis/clock_drift.py",
+        "    return -coef, float(spread / energy)  # the residual is -(delta - delta_0) dz/dt",
+        "    return coef, float(spread / energy)  # the residual is -(delta - delta_0) dz/dt",
+        "the rate's sign flipped (clock drift)",
+    ),
+    (
+        "armaxmodal/diagnosis/clock_drift.py",
+        "    spread = max(np.sqrt(newey_west_sum(x * (e - coef * ramp - delay * slope))), sigma * np.sqrt(energy))",
+        "    spread = np.sqrt(newey_west_sum(x * e))",
+        "the spread without the white-noise floor and under no drift (clock drift)",
+    ),
+    (
+        "armaxmodal/diagnosis/clock_drift.py",
+        "        if spread_p < SPREAD_ALPHA:",
+        "        if False:",
+        "outputs that drift unalike named a clock (clock drift)",
+    ),
+    (
+        "armaxmodal/diagnosis/clock_drift.py",
+        "            return [_finding(s.input_name, -mean, sd, p, s, {\"per_output_rate_ppm\"",
+        "            return [_finding(s.input_name, mean, sd, p, s, {\"per_output_rate_ppm\"",
+        "the input's rate with the outputs' sign (clock drift)",
+    ),
+    (
+        "armaxmodal/diagnosis/model.py",
+        "    step, first = 1.0 + rate, samples - rate * (n - 1) / 2",
+        "    step, first = 1.0 + rate, samples - rate * n / 2",
+        "the resampling's centre half a sample off (clock drift)",
+    ),
+    (
+        "armaxmodal/diagnosis/model.py",
+        "    return np.real(np.exp(-2j * np.pi * (m // 2) * times / m) * series) / m",
+        "    return np.real(series) / m",
+        "the bins not moved to their frequencies (clock drift)",
+    ),
+    (
+        "armaxmodal/diagnosis/fixes.py",
+        '    rate = dict(fitted.spec.drifts)[name] + left',
+        '    rate = dict(fitted.spec.drifts)[name]',
+        "the remaining rate left out of the report (clock drift)",
+    ),
+    (
+        "armaxmodal/diagnosis/model.py",
+        "    drift = max((abs(r) * n / 2 for _, r in spec.drifts), default=0.0)  # the move at either end",
+        "    drift = 0.0  # the move at either end",
+        "the resampled ends counted in every error (clock drift)",
+    ),
+    # a diverging simulation judges nothing; --match "(divergence)" --tests tests/diagnosis/test_divergence.py
+    (
+        "armaxmodal/diagnosis/acceptance.py",
+        '    if entry.criterion == "simulation" and not (stage.held.simulates and new.held.simulates):',
+        '    if entry.criterion == "simulation" and not new.held.simulates:',
+        "only the refit's folds looked at (divergence)",
+    ),
+    (
+        "armaxmodal/diagnosis/model.py",
+        "        return self.growth <= DIVERGENT_GROWTH",
+        "        return self.growth < 1.0",
+        "any growth read as divergence (divergence)",
+    ),
+    (
+        "armaxmodal/diagnosis/model.py",
+        "    span = simulated.stop - simulated.start",
+        "    span = simulated.stop",
+        "the span counted from the record's start (divergence)",
+    ),
+    (
+        "armaxmodal/diagnosis/result.py",
+        '                ) if not held.simulates else ""  # fmt: skip',
+        '                ) if False else ""  # fmt: skip',
+        "the verdict silent on a diverging baseline (divergence)",
+    ),
     # the gain change (issue 70); run with --match "(gain change)" --tests tests/diagnosis/test_gain_change.py
     (
         "armaxmodal/diagnosis/gain_change.py",

@@ -85,6 +85,12 @@ def try_fix(stage: Stage, finding: Finding, alpha: float, entry) -> tuple[tuple[
     if refused:
         return None, refused
     new = entry.refit(stage, finding, entry)
+    if entry.criterion == "simulation" and not (stage.held.simulates and new.held.simulates):
+        return None, (
+            f"judged on the held-out simulation, which diverges: a half-record model has a mode that grows "
+            f"{max(stage.held.growth, new.held.growth):.3g} times over the half it simulates, so its simulation "
+            "errors cannot judge the fix"
+        )
     affected = entry.judged_on(finding) if entry.judged_on else _affected(finding, s)
     idx = [s.sensors.index(c) for c in affected]
     idx_new = [new.model.signals.sensors.index(c) for c in affected]  # a second input leaves the outputs

@@ -185,6 +185,16 @@ def _verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float = 0.01) 
     and its held-out error before and after), then what is left; "unsure" only where nothing was
     confirmed and a test fired (a dry friction confirmed as a damping nonlinearity read "unsure",
     for two side tests whose fixes did not help)."""
+    held = diagnosis.baseline.held
+    diverges = (f" The baseline's held-out simulation diverges (a half-record model has a mode that grows "
+                f"{held.growth:.3g} times over the half it simulates: the record is too short or too nonstationary "
+                "for the model's order), so no fix judged on simulation can be confirmed."
+                ) if not held.simulates else ""  # fmt: skip
+    return _findings_verdict(diagnosis, whiteness, alpha) + diverges
+
+
+def _findings_verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float) -> str:
+    """What was found and confirmed, then what is left (:func:`_verdict`)."""
     coloured = [s for s, p in zip(diagnosis.sensors, whiteness, strict=True) if p is not None and p < alpha]
     left = (f"the residual of {', '.join(coloured)} is still not white after the fixes; an effect the fixes do not "
             "capture (a non-smooth nonlinearity such as friction or a clearance, a time change, a missing mode) may "
