@@ -53,3 +53,27 @@ def test_growth_is_the_fastest_unstable_mode_over_the_span_simulated():
     empty = np.zeros((1, 1))
     assert HeldOut(empty, empty, np.ones(1, bool), 4.5).simulates
     assert not HeldOut(empty, empty, np.ones(1, bool), 788.0).simulates
+
+
+def test_a_fix_is_not_judged_against_a_diverging_baseline(fixtures_dir):
+    """A refit that simulates beside a baseline that diverges: its simulation error is far lower
+    for a reason that is not the fix, so the fix is refused all the same."""
+    from dataclasses import replace
+
+    from armaxmodal.diagnosis.acceptance import try_fix
+    from armaxmodal.diagnosis.effects import entry_of, run_tests
+    from armaxmodal.diagnosis.model import ModelSpec, Signals, fit_model, held_out
+    from armaxmodal.diagnosis.result import Stage
+
+    rec = inject(am.read_recording(fixtures_dir / "supine_random.csv"), "periodic_disturbance", ["head"],
+                 freq_hz=11.3, amp=0.1)  # fmt: skip
+    signals = Signals(rec.base, rec.response, rec.fs, rec.sensors, rec.input_name)
+    spec = ModelSpec((10, 16, 10, -5))
+    model = fit_model(spec, signals)
+    stage = Stage(model, held_out(spec, signals, model))
+    (line,) = [f for f in run_tests(model)[0] if f.effect == "periodic_disturbance"]
+    entry = entry_of("periodic_disturbance")
+    assert try_fix(stage, line, 0.01, entry)[0] is not None  # kept where the baseline simulates
+    diverging = Stage(model, replace(stage.held, growth=10 * DIVERGENT_GROWTH))
+    kept, reason = try_fix(diverging, line, 0.01, entry)
+    assert kept is None and "diverges" in reason
