@@ -82,7 +82,7 @@ def joint_force_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
         q, _ = np.linalg.qr(gradient_columns(m, s.y[:, k] - dist[:, k], s.inputs(fitted.spec), eps[:, k])[mask])
         bases.append(q)
         resid.append(eps[mask, k] - q @ (q.T @ eps[mask, k]))
-    best, best_sum, best_ps = None, -np.inf, None
+    best, best_sum, best_ps, places = None, -np.inf, None, {}
     for kind, pair in candidates:
         effect, quantity, force = JOINT_TERMS[kind]
         term = force(motion[quantity][pair])
@@ -94,6 +94,8 @@ def joint_force_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
             f, p = projected_f(resid[k], cols - bases[k] @ (bases[k].T @ cols), bases[k].shape[1])
             fs_.append(f)
             ps.append(p)
+        place = "-".join(pair)
+        places[place] = max(places.get(place, 0.0), float(sum(fs_)))
         if sum(fs_) > best_sum:
             best, best_sum, best_ps = (kind, pair, term), sum(fs_), ps
     if best is None:
@@ -105,7 +107,18 @@ def joint_force_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
     channels = tuple(name for name, p in zip(s.sensors, ps, strict=True) if p < 0.01)
     if not channels:
         return []
-    params = {"term": kind, "between": list(pair)}
+    params = {"term": kind, "between": list(pair), **_place_evidence(places)}
     return [Finding(JOINT_TERMS[kind][0], channels, "score_F", best_sum, min(ps), params, payload=term)]
+
+
+def _place_evidence(places: dict[str, float]) -> dict:
+    """How sure the test is of the joint: the summed score F of the best term at every candidate
+    place (``place_score_F``, largest first), and the runner-up place with the ratio of the chosen
+    place's F to its (``place_margin``; near 1: the record cannot tell the two joints apart; None
+    where there is one place)."""
+    ranked = sorted(places.items(), key=lambda item: -item[1])
+    second, f2 = ranked[1] if len(ranked) > 1 else (None, 0.0)
+    margin = ranked[0][1] / f2 if f2 > 0 else None  # one place (a single sensor): nothing to tell apart
+    return {"place_score_F": dict(ranked), "runner_up_place": second, "place_margin": margin}
 
 

@@ -223,6 +223,12 @@ def test_a_cubic_spring_is_named_between_the_right_segments(nonlinear_rides):
     assert {"chest", "pelvis"} <= set(effect.finding.channels)
     assert effect.parameters["sim_error_after"] < 0.95 * effect.parameters["sim_error_before"]
     assert effect.error_after < effect.error_before
+    # the place's evidence: every joint's best F, the chosen one first, the runner-up behind it
+    places = effect.parameters["place_score_F"]
+    assert len(places) == 10 and next(iter(places)) == "chest-pelvis"  # 4 to the base, 6 pairs
+    ranked = list(places.values())
+    assert ranked == sorted(ranked, reverse=True) and effect.parameters["runner_up_place"] == list(places)[1]
+    assert effect.parameters["place_margin"] == pytest.approx(ranked[0] / ranked[1]) and ranked[0] / ranked[1] > 1
 
 
 @pytest.mark.parametrize("seed", [1, 3])
