@@ -34,3 +34,16 @@ def test_windows_too_short_for_the_model_skip_the_time_test_and_say_so():
     findings, table = run_tests(fit_model(ModelSpec((20, 27, 20, -6)), s))
     assert "cannot hold the model's orders" in table["time_varying_not_run"]
     assert "time_varying_p" not in table and "time_varying" not in {f.effect for f in findings}
+
+
+def test_a_record_the_band_would_leave_too_short_is_analysed_at_its_own_rate():
+    """9 s at 240 Hz (2,160 samples) of a ride whose band ends at 28 Hz: resampled to the band it
+    would keep about 600, too few to hold half out, so it is analysed as recorded."""
+    from armaxmodal.diagnosis import diagnose
+
+    ride = am.simulate_recording(am.supine_human(), am.random_vibration(240.0, 9.0, band=(0.5, 28.0), seed=5),
+                                 240.0, noise=0.05, seed=6)  # fmt: skip
+    d = diagnose(ride, max_rounds=0)
+    assert d.recording.fs == 240.0 and d.recording.n_samples == ride.n_samples
+    with pytest.raises(am.DataError, match="holding out half"):
+        diagnose(am.Recording(240.0, ride.base[:700], ride.response[:700], ride.sensors))  # short as recorded
