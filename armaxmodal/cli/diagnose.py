@@ -70,12 +70,13 @@ def _diagnosis_text(name: str, report: dict) -> str:
              "verdict: " + report["verdict"]]  # what was found first; the numbers and the side tests after
     lines.append(f"{'sensor':>12} {'fit before %':>13} {'fit after %':>12} {'resid RMS':>10} {'H1 floor':>12}")
     for k, s in enumerate(sensors):
-        if final["fit_val_pct"][k] is None:
-            lines.append(f"{s:>12} {base['fit_val_pct'][k]:13.1f}   now an input (a second excitation)")
+        if s in final["inputs_added"]:
+            lines.append(f"{s:>12} {_fit(base['fit_val_pct'][k]):>13}   now an input (a second excitation)")
             continue
+        rms = "diverges" if final["sim_resid_rms"][k] is None else f"{final['sim_resid_rms'][k]:.4g}"
         lines.append(
-            f"{s:>12} {base['fit_val_pct'][k]:13.1f} {final['fit_val_pct'][k]:12.1f} "
-            f"{final['sim_resid_rms'][k]:10.4g} {_or_unresolved(final['noise_floor_rms'][k]):>12}"
+            f"{s:>12} {_fit(base['fit_val_pct'][k]):>13} {_fit(final['fit_val_pct'][k]):>12} "
+            f"{rms:>10} {_or_unresolved(final['noise_floor_rms'][k]):>12}"
         )
     if not report["effects"]:
         lines.append("no effect kept (the tests' p-values are in the JSON's 'tests').")
@@ -91,6 +92,11 @@ def _diagnosis_text(name: str, report: dict) -> str:
     for u in report["unconfirmed"]:
         lines.append(f"note: unconfirmed {u['effect']} on {', '.join(u['channels'])}: {u['reason']}")
     return "\n".join(lines)
+
+
+def _fit(value) -> str:
+    """A held-out simulation fit (%), or "diverges" where the simulation does (the verdict says why)."""
+    return "diverges" if value is None else f"{value:.1f}"
 
 
 def _or_unresolved(value) -> str:

@@ -43,9 +43,16 @@ def effects_table(report: dict) -> pd.DataFrame:
 
 def _fits_table(report: dict) -> pd.DataFrame:
     base, final = report["baseline"], report["final"]
+    inputs = set(final["inputs_added"])
+
+    def shown(values, after=True):  # null: an output made an input (after), or a diverging simulation
+        return [("now an input" if after and name in inputs else "diverges") if v is None else v
+                for name, v in zip(report["outputs"], values, strict=True)]  # fmt: skip
+
     return pd.DataFrame({
-        "output": report["outputs"], "fit before (%)": base["fit_val_pct"], "fit after (%)": final["fit_val_pct"],
-        "residual RMS after": final["sim_resid_rms"], "H1 noise floor": final["noise_floor_rms"],
+        "output": report["outputs"], "fit before (%)": shown(base["fit_val_pct"], after=False),
+        "fit after (%)": shown(final["fit_val_pct"]), "residual RMS after": shown(final["sim_resid_rms"]),
+        "H1 noise floor": final["noise_floor_rms"],
     })  # fmt: skip
 
 

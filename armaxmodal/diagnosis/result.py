@@ -33,11 +33,13 @@ class Stage:
         y = s.y
         e1 = self.held.one_step[self.held.mask]
         yy = y[self.held.mask] - y[self.held.mask].mean(axis=0)
+        sim_rms = np.sqrt(np.mean(self.held.simulation[self.held.mask] ** 2, axis=0)).tolist()
+        diverged = [None] * len(s.sensors)  # a diverging simulation's error is its growth, not a fit
         return {
-            "fit_val_pct": self.held.fit_percent(y).tolist(),
+            "fit_val_pct": self.held.fit_percent(y).tolist() if self.held.simulates else diverged,
             "one_step_fit_pct": (100 * (1 - np.linalg.norm(e1, axis=0) / np.linalg.norm(yy, axis=0))).tolist(),
             "resid_rms": self.held.rms().tolist(),
-            "sim_resid_rms": np.sqrt(np.mean(self.held.simulation[self.held.mask] ** 2, axis=0)).tolist(),
+            "sim_resid_rms": sim_rms if self.held.simulates else diverged,
             "noise_floor_rms": [noise_floor.get(name) for name in s.sensors],
             "whiteness_p": whiteness_p(self.model),
         }
@@ -148,6 +150,9 @@ class Diagnosis:
             "outputs": list(self.sensors),
             "orders": {"na": na, "nb": nb, "nc": nc, "nk": nk, "shared_poles": True},
             "validation": "two blocked folds: each half predicted by the model fitted on the other half",
+            # how much a fold model's fastest mode grows over the half it simulates; beyond 100 the
+            # simulation diverges and its fits are null
+            "simulation_growth": {"baseline": self.baseline.held.growth, "final": self.final.held.growth},
             "baseline": self.baseline.summary(self.noise_floor),
             "effects": [e.to_dict() for e in self.effects],
             "unconfirmed": list(self.unconfirmed),

@@ -35,6 +35,14 @@ def test_a_diverging_simulation_confirms_no_fix_judged_on_it():
     assert not [e for e in d.effects if e.parameters["criterion"] == "held-out simulation error"]
     refused = [u for u in d.unconfirmed if "simulation, which diverges" in u["reason"]]
     assert any(u["effect"] == "periodic_disturbance" for u in refused)
+    # the fits a diverging simulation would give are no fits: null in the JSON, "diverges" where read
+    from armaxmodal.cli.diagnose import _diagnosis_text
+    from armaxmodal.diagnosis.report import _fits_table
+
+    report = d.to_dict()
+    assert report["baseline"]["fit_val_pct"] == [None, None] and report["simulation_growth"]["baseline"] > 100
+    assert _diagnosis_text("ride", report).count("diverges") >= 2
+    assert set(_fits_table(report)["fit before (%)"]) == {"diverges"}
 
 
 def test_growth_is_the_fastest_unstable_mode_over_the_span_simulated():
