@@ -148,3 +148,16 @@ def test_a_step_on_a_late_sensor_is_placed_in_the_recorded_time(clean):
     step = d.effects[1].parameters
     assert step["sample"] == 2700 and step["time_ci95_s"][0] <= 45.0 <= step["time_ci95_s"][1]
     assert d.final.model.spec.steps[0][:2] == ("pelvis", 2700)
+
+
+def test_a_change_of_the_structure_is_no_level_shift():
+    """Springs 12 % stiffer half way change every sensor's dynamics at 60 s, not one sensor's
+    level: no step is named (the time-change test names it), and no gain change or clock drift."""
+    from armaxmodal.diagnosis.effects import run_tests
+    from armaxmodal.diagnosis.model import ModelSpec, Signals, fit_model
+    from tests.diagnosis.test_diagnose import _two_regimes
+
+    rec = _two_regimes(1.12)
+    fitted = fit_model(ModelSpec(ORDERS), Signals(rec.base, rec.response, rec.fs, rec.sensors, rec.input_name))
+    named = {f.effect for f in run_tests(fitted)[0]}
+    assert "time_varying" in named and not named & {"level_shift", "gain_change", "clock_drift"}
