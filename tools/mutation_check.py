@@ -608,8 +608,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/diagnosis/acceptance.py",
-        "if j.p >= j.alpha or j.delta_bic >= 0:",
-        "if j.p >= j.alpha and j.delta_bic >= 0:",
+        "    if j.delta_bic >= 0:\n        return False, (\n            f\"named by its test; the held-out",
+        "    if False:\n        return False, (\n            f\"named by its test; the held-out",
         "either criterion keeps a fix (loop delay)",
     ),
     (

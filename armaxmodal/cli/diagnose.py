@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 from armaxmodal.cli.common import (
@@ -41,7 +42,7 @@ def run(args) -> int:
     if args.report:
         check_report_path(args.report)
     rec = load_recording(args)
-    result = diagnose(rec, band=band, max_rounds=args.max_rounds, progress=not args.quiet)
+    result = diagnose(rec, band=band, max_rounds=args.max_rounds, progress=args.verbose and not args.quiet)
     print_notes(result.warnings, args.verbose)
     report = result.to_dict()
     print(_diagnosis_text(args.data, report))
@@ -62,12 +63,31 @@ def run(args) -> int:
     return 0
 
 
+#: a line of the printed diagnosis at most (a terminal's width beside another window)
+WIDTH = 100
+
+
 def _diagnosis_text(name: str, report: dict) -> str:
-    """The diagnosis as a person reads it: fits before and after, each effect with its numbers."""
+    """The diagnosis as a person reads it, at most :data:`WIDTH` characters a line: the verdict
+    first, each effect kept with the held-out error that judged it, the fits before and after,
+    then each effect named and refused with why (the rounds are printed only with ``--verbose``)."""
     sensors = report["outputs"]
     base, final = report["baseline"], report["final"]
-    lines = [f"{name}: {len(sensors)} sensors at {report['analysis_fs']:g} Hz; baseline orders {report['orders']}",
-             "verdict: " + report["verdict"]]  # what was found first; the numbers and the side tests after
+    orders = report["orders"]
+    lines = _wrapped(f"{name}: {len(sensors)} sensors at {report['analysis_fs']:g} Hz; baseline ARMAX "
+                     f"({orders['na']}, {orders['nb']}, {orders['nc']}, {orders['nk']})")  # fmt: skip
+    lines += _wrapped("verdict: " + report["verdict"])
+    for e in report["effects"]:
+        judged = e["judged_by"]
+        lines += _wrapped(f"kept {e['effect']} on {', '.join(e['channels'])}: held-out {judged['error']} error "
+                          f"{judged['before']:.4g} -> {judged['after']:.4g} ({e['evidence']['statistic']} p = "
+                          f"{e['evidence']['p']:.2g})")  # fmt: skip
+        params = {k: v for k, v in e["parameters"].items() if not isinstance(v, dict) and k not in _SHOWN}
+        lines += _wrapped(short_parameters(params), first="  ")
+        if e.get("note"):
+            lines += _wrapped(f"note: {e['note']}", first="  ")
+    if not report["effects"]:
+        lines.append("no effect kept (the tests' p-values are in the JSON's 'tests').")
     lines.append(f"{'sensor':>12} {'fit before %':>13} {'fit after %':>12} {'resid RMS':>10} {'H1 floor':>12}")
     for k, s in enumerate(sensors):
         if s in final["inputs_added"]:
@@ -78,20 +98,18 @@ def _diagnosis_text(name: str, report: dict) -> str:
             f"{s:>12} {_fit(base['fit_val_pct'][k]):>13} {_fit(final['fit_val_pct'][k]):>12} "
             f"{rms:>10} {_or_unresolved(final['noise_floor_rms'][k]):>12}"
         )
-    if not report["effects"]:
-        lines.append("no effect kept (the tests' p-values are in the JSON's 'tests').")
-    for e in report["effects"]:
-        params = {k: v for k, v in e["parameters"].items() if not isinstance(v, dict)}
-        lines.append(
-            f"effect {e['effect']} on {', '.join(e['channels'])}: "
-            f"{e['evidence']['statistic']} p = {e['evidence']['p']:.2g}; "
-            f"held-out one-step RMS {e['error_before']:.4g} -> {e['error_after']:.4g}; {short_parameters(params)}"
-        )
-        if e.get("note"):
-            lines.append(f"  note: {e['note']}")
     for u in report["unconfirmed"]:
-        lines.append(f"note: unconfirmed {u['effect']} on {', '.join(u['channels'])}: {u['reason']}")
+        lines += _wrapped(f"refused {u['effect']} on {', '.join(u['channels'])}: {u['reason']}")
     return "\n".join(lines)
+
+
+#: parameters the effect's line already shows
+_SHOWN = ("criterion", "sim_error_before", "sim_error_after")
+
+
+def _wrapped(text: str, first: str = "") -> list[str]:
+    """``text`` in lines of at most :data:`WIDTH` characters, the continuations indented."""
+    return textwrap.wrap(text, WIDTH, initial_indent=first, subsequent_indent=first + "  ", break_on_hyphens=False)
 
 
 def _fit(value) -> str:

@@ -190,12 +190,26 @@ def refit_piecewise(stage: Stage, finding: Finding, entry) -> Stage:
 
 def significant_drop(j: Judgement) -> tuple[bool, str]:
     """The general rule: the held-out error falls significantly and BIC falls."""
-    if j.p >= j.alpha or j.delta_bic >= 0:
+    kind, before, after = _judged_errors(j)
+    if j.p >= j.alpha:
         return False, (
-            f"named by its test, but the fix did not lower the held-out error significantly "
-            f"({j.before:.4g} -> {j.after:.4g}, p = {j.p:.2g}, change in BIC {j.delta_bic:+.1f})"
+            f"named by its test, but the fix did not lower the held-out {kind} error significantly "
+            f"({before:.4g} -> {after:.4g}, p = {j.p:.2g}, change in BIC {j.delta_bic:+.1f})"
+        )
+    if j.delta_bic >= 0:
+        return False, (
+            f"named by its test; the held-out {kind} error fell ({before:.4g} -> {after:.4g}, p = {j.p:.2g}) but "
+            f"BIC rose by {j.delta_bic:.1f}: the fix's parameters cost more than it explains"
         )
     return True, ""
+
+
+def _judged_errors(j: Judgement) -> tuple[str, float, float]:
+    """The held-out error the p and BIC read (one-step or simulation), before and after: a refusal
+    quotes the numbers its test judged (it quoted the one-step error beside a simulation p)."""
+    if "sim_error_before" in j.parameters:
+        return "simulation", j.parameters["sim_error_before"], j.parameters["sim_error_after"]
+    return "one-step", j.before, j.after
 
 
 def delay_kept(j: Judgement) -> tuple[bool, str]:

@@ -57,6 +57,14 @@ class Effect:
     delta_bic: float
     note: str = ""
 
+    def judged_by(self) -> dict:
+        """The held-out error that judged the fix (``"one-step"`` or ``"simulation"``), before and
+        after: the one the keep rule read, which falls for every effect kept."""
+        if "simulation" in self.parameters.get("criterion", ""):
+            return {"error": "simulation", "before": self.parameters["sim_error_before"],
+                    "after": self.parameters["sim_error_after"]}  # fmt: skip
+        return {"error": "one-step", "before": self.error_before, "after": self.error_after}
+
     def to_dict(self) -> dict:
         out = {
             "effect": self.finding.effect,
@@ -65,6 +73,7 @@ class Effect:
             "parameters": self.parameters,
             "error_before": self.error_before,
             "error_after": self.error_after,
+            "judged_by": self.judged_by(),
             "held_out_p": self.dm_p,
             "delta_bic": self.delta_bic,
         }
@@ -205,8 +214,9 @@ def _findings_verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float
             "capture (a non-smooth nonlinearity such as friction or a clearance, a time change, a missing mode) may "
             "remain. Look at the figure.") if coloured else ""  # fmt: skip
     if diagnosis.effects:
-        found = "; ".join(f"{e.finding.effect} on {', '.join(e.finding.channels)} (held-out error {e.error_before:.3g}"
-                          f" -> {e.error_after:.3g})" for e in diagnosis.effects)  # fmt: skip
+        found = "; ".join(f"{e.finding.effect} on {', '.join(e.finding.channels)} (held-out {e.judged_by()['error']} "
+                          f"error {e.judged_by()['before']:.3g} -> {e.judged_by()['after']:.3g})"
+                          for e in diagnosis.effects)  # fmt: skip
         if left:
             return f"found and confirmed: {found}. But {left}"
         if diagnosis.unconfirmed:

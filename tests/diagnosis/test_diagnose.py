@@ -25,6 +25,25 @@ from tests.conftest import open_in_headless_chromium
 ORDERS = (10, 16, 10, -5)  # the supine fixture's orders chosen by BIC (README)
 
 
+def test_cli_leads_with_the_verdict_on_one_screen(tmp_path, clean, capsys):
+    """The verdict first, the kept effect with the error that judged it falling, every line within
+    100 characters, at most 25 lines; the rounds only under --verbose."""
+    from armaxmodal.io.write import write_recording_csv
+
+    data = tmp_path / "ride.csv"
+    write_recording_csv(inject(clean, "clock_drift", ["chest"], rate_ppm=150.0), data)
+    assert main(["diagnose", str(data), "--max-rounds", "1"]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    first = next(i for i, line in enumerate(lines) if line.startswith("verdict:"))  # after the file's name
+    assert first <= 2 and lines[first].startswith("verdict: found and confirmed: clock_drift on chest (held-out")
+    assert max(map(len, lines)) <= 100 and len(lines) <= 25 and not any(x.startswith("round") for x in lines)
+    (kept,) = [x for x in lines if x.startswith("kept ")]
+    before, after = (float(v) for v in kept.split("error ")[1].split(" (")[0].split(" -> "))
+    assert after < before
+    assert main(["diagnose", str(data), "--max-rounds", "1", "--verbose"]) == 0
+    assert "round 1: clock_drift ['chest']" in capsys.readouterr().out
+
+
 @pytest.fixture(scope="module")
 def clean(fixtures_dir):
     return am.read_recording(fixtures_dir / "supine_random.csv")
@@ -314,8 +333,9 @@ def test_two_effects_are_named_in_turn_without_undoing_each_other(clean):
     assert named == [("input_delay", ("legs",)), ("periodic_disturbance", ("head",))]
     assert d.effects[0].parameters["delay_samples"] == pytest.approx(2.0, abs=0.2)
     verdict = d.to_dict()["verdict"]
-    assert verdict.startswith("found and confirmed: input_delay on legs (held-out error ")
-    assert "; periodic_disturbance on head (held-out error " in verdict and "the effects listed explain" in verdict
+    assert verdict.startswith("found and confirmed: input_delay on legs (held-out one-step error ")
+    assert "; periodic_disturbance on head (held-out simulation error " in verdict
+    assert "the effects listed explain" in verdict
 
 
 def test_simulate_cli_plants_effects_and_refuses_bad_ones(tmp_path, capsys):
