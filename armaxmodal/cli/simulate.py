@@ -21,15 +21,17 @@ def add_parser(sub, parents) -> None:
                    help="the input between samples: held (zoh) or band-limited, as an anti-aliased logger records "
                         "it; default bandlimited")
     p.add_argument("--seed", type=NONNEG_INT, default=0, help="seed of the excitation and the noise; default 0")
-    from armaxmodal.diagnosis.inject import PARAMETERS  # numba is loaded already: no cost to the CLI's start
+    from armaxmodal.diagnosis.inject import PARAMETERS, RIDE_EFFECTS  # numba is loaded already: no cost
 
     effects = "; ".join(f"{name} ({', '.join(need + tuple(f'[{k}]' for k in optional)) or 'no parameter'})"
-                        for name, (need, optional) in PARAMETERS.items())  # fmt: skip
+                        for name, (need, optional) in {**PARAMETERS, **RIDE_EFFECTS}.items())  # fmt: skip
     p.add_argument(
         "--effect",
         action="append",
         help="plant an effect the diagnosis is not told: EFFECT[:CH1+CH2][:key=value,...], e.g. "
-        "periodic_disturbance:head:freq_hz=11.7,amp=0.1 or input_delay:legs:samples=2.5 (repeatable). "
+        "periodic_disturbance:head:freq_hz=11.7,amp=0.1, input_delay:legs:samples=2.5 or "
+        "stiffness_nonlinearity:chest+pelvis:ratio=0.3 (a cubic spring in that joint; one channel: to the base; "
+        "damping_nonlinearity: dry friction) (repeatable; one effect in the structure a ride). "
         f"Effects and their parameters ([optional]): {effects}",
     )
     p.add_argument("--out", required=True, help="CSV file to write")
@@ -41,8 +43,8 @@ MAX_SIMULATED_SAMPLES = 10_000_000
 
 
 def run(args) -> int:
-    from armaxmodal.diagnosis.inject import check_effect
-    from armaxmodal.systems.simulation import random_vibration, simulate_recording, sine_sweep
+    from armaxmodal.diagnosis.inject import RIDE_EFFECTS, check_effect, inject
+    from armaxmodal.systems.simulation import random_vibration, sine_sweep
 
     effects = [_parse_effect(text) for text in args.effect or ()]
     for effect, _, params in effects:  # before the simulation
@@ -61,15 +63,61 @@ def run(args) -> int:
         u = random_vibration(args.fs, args.duration, (0.5, min(28.0, 0.47 * args.fs)), seed=args.seed)
     else:
         u = sine_sweep(args.fs, args.duration)
-    rec = simulate_recording(structure, u, args.fs, noise=args.noise, seed=args.seed, hold=args.hold)
+    in_structure = [e for e in effects if e[0] in RIDE_EFFECTS]
+    if len(in_structure) > 1:
+        raise DataError(f"--effect: one effect in the structure a ride, got {[e[0] for e in in_structure]}.")
+    rec = _ride(structure, u, args, in_structure[0] if in_structure else None)
     for effect, channels, params in effects:
-        from armaxmodal.diagnosis.inject import inject
-
-        rec = inject(rec, effect, channels, seed=args.seed, structure=structure, **params)
+        if effect not in RIDE_EFFECTS:
+            rec = inject(rec, effect, channels, seed=args.seed, structure=structure, **params)
     write_recording_csv(rec, args.out)
     if not args.quiet:
         print(f"wrote {args.out}: {rec.n_samples} samples, outputs {', '.join(rec.sensors)}")
     return 0
+
+
+def _ride(structure, u, args, effect):
+    """The simulated ride, with ``effect`` (``(name, channels, params)`` of
+    :data:`~armaxmodal.diagnosis.inject.RIDE_EFFECTS`, or None) in the structure: a joint force by
+    :func:`~armaxmodal.diagnosis.inject.nonlinear_joint_ride`, or a stiffening (:func:`_stiffened`)."""
+    from armaxmodal.diagnosis.inject import nonlinear_joint_ride
+    from armaxmodal.systems.simulation import simulate_recording
+
+    if effect is None:
+        return simulate_recording(structure, u, args.fs, noise=args.noise, seed=args.seed, hold=args.hold)
+    name, channels, params = effect
+    if name == "time_varying":
+        return _stiffened(structure, u, args, params)
+    names = list(structure.names)
+    if not channels or len(channels) > 2 or any(c not in names for c in channels) or not params["ratio"] > 0:
+        raise DataError(f"--effect {name}: name the joint, one or two of {names} (one: to the base), and ratio > 0; "
+                        f"got {channels} and {params}.")  # fmt: skip
+    if args.hold != "bandlimited":
+        raise DataError(f"--effect {name}: a joint force is simulated with the band-limited input; drop --hold zoh.")
+    between = (names.index(channels[0]), names.index(channels[1]) if len(channels) == 2 else -1)
+    force = "cubic" if name == "stiffness_nonlinearity" else "friction"
+    return nonlinear_joint_ride(structure, u, args.fs, between, params["ratio"], force=force, noise=args.noise,
+                                seed=args.seed)  # fmt: skip
+
+
+def _stiffened(structure, u, args, params):
+    """Every spring ``stiffening`` times stiffer from ``time_s`` on: the stiffer structure's ride to
+    the same input and noise from then on (the state jumps there, as in an instant change)."""
+    import numpy as np
+
+    from armaxmodal.recording import Recording
+    from armaxmodal.systems.simulation import simulate_recording
+    from armaxmodal.systems.structure import Structure
+
+    if not (0 < params["time_s"] < args.duration and params["stiffening"] > 0):
+        raise DataError(f"--effect time_varying: time_s inside the ride (0-{args.duration:g} s) and stiffening > 0; "
+                        f"got {params}.")  # fmt: skip
+    stiffer = Structure(structure.M, structure.C, structure.K * params["stiffening"], structure.names)
+    before, after = (simulate_recording(s, u, args.fs, noise=args.noise, seed=args.seed, hold=args.hold)
+                     for s in (structure, stiffer))  # fmt: skip
+    later = (np.arange(before.n_samples) / args.fs >= params["time_s"])[:, None]
+    meta = {"injected": {"effect": "time_varying", **params}}
+    return Recording(args.fs, before.base, np.where(later, after.response, before.response), before.sensors, meta=meta)
 
 
 def _parse_effect(text: str):

@@ -13,7 +13,7 @@ from armaxmodal.diagnosis.model import fractional_shift, moved
 from armaxmodal.exceptions import DataError
 from armaxmodal.recording import Recording
 
-__all__ = ["inject", "INJECTABLE", "add_second_input"]
+__all__ = ["inject", "INJECTABLE", "RIDE_EFFECTS", "add_second_input"]
 
 INJECTABLE = (
     "input_delay",
@@ -44,11 +44,23 @@ PARAMETERS = {
 }
 
 
+#: Effects in the structure itself, planted as the ride is simulated (``armaxmodal simulate``), not
+#: in a recording: a joint force between the channels given (one channel: to the base), its size
+#: ``ratio`` times the linear spring's (or damper's) force at the linear ride's RMS deflection (or
+#: velocity); every spring stiffer by the factor ``stiffening`` from ``time_s`` on.
+RIDE_EFFECTS = {
+    "stiffness_nonlinearity": (("ratio",), ()),
+    "damping_nonlinearity": (("ratio",), ()),
+    "time_varying": (("time_s", "stiffening"), ()),
+}
+
+
 def check_effect(effect: str, params: dict) -> None:
-    """Raise :class:`DataError` unless ``effect`` is injectable with exactly these parameters."""
-    if effect not in INJECTABLE:
-        raise DataError(f"effect: expected one of {INJECTABLE}, got {effect!r}.")
-    required, optional = PARAMETERS[effect]
+    """Raise :class:`DataError` unless ``effect`` is injectable (in a recording, or in the structure
+    as a ride is simulated: :data:`RIDE_EFFECTS`) with exactly these parameters."""
+    if effect not in INJECTABLE and effect not in RIDE_EFFECTS:
+        raise DataError(f"effect: expected one of {INJECTABLE + tuple(RIDE_EFFECTS)}, got {effect!r}.")
+    required, optional = {**PARAMETERS, **RIDE_EFFECTS}[effect]
     missing = [k for k in required if k not in params]
     unknown = [k for k in params if k not in required + optional]
     if missing or unknown:
@@ -119,6 +131,9 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, stru
         With ``meta["injected"]`` recording what was planted.
     """
     check_effect(effect, params)
+    if effect in RIDE_EFFECTS:
+        raise DataError(f"effect {effect!r} acts in the structure, not on a recorded channel: plant it as the ride is "
+                        "simulated (armaxmodal simulate --effect, or nonlinear_joint_ride).")  # fmt: skip
     if effect == "second_input":
         if structure is None:
             raise DataError("effect 'second_input' needs the structure the force acts on: pass structure=.")

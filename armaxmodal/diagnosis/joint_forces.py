@@ -21,7 +21,7 @@ from armaxmodal.diagnosis.model import lagged as _lag
 from armaxmodal.recording import Recording
 from armaxmodal.stats import MAX_DAMPING
 
-__all__ = ["JOINT_TERMS", "deflections", "joint_force_findings"]
+__all__ = ["JOINT_TERMS", "TERM_WORDS", "deflections", "joint_force_findings"]
 
 #: candidate joint forces: ``kind -> (effect, motion, force of that motion)``. A stiffness
 #: nonlinearity is a function of a deflection, a damping nonlinearity of a relative velocity
@@ -34,6 +34,11 @@ JOINT_TERMS = {
     "dry_friction": ("damping_nonlinearity", "velocity", np.sign),
     "quadratic_damping": ("damping_nonlinearity", "velocity", lambda v: np.abs(v) * v),
 }
+
+
+#: each term as a person reads it (the verdict's words)
+TERM_WORDS = {"cubic": "a cubic spring", "quadratic": "a quadratic spring", "abs_times": "a |d| d spring",
+              "dry_friction": "dry friction", "quadratic_damping": "quadratic damping"}  # fmt: skip
 
 
 def deflections(fitted: FittedModel, integrations: int = 2) -> dict[tuple[str, str], np.ndarray]:

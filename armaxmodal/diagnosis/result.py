@@ -207,6 +207,21 @@ def _verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float = 0.01) 
     return _findings_verdict(diagnosis, whiteness, alpha) + diverges
 
 
+def _found(effect: Effect) -> str:
+    """An effect kept, as the verdict names it: where, and the held-out error that judged it."""
+    judged = effect.judged_by()
+    return (f"{effect.finding.effect}{_place(effect)} on {', '.join(effect.finding.channels)} (held-out "
+            f"{judged['error']} error {judged['before']:.3g} -> {judged['after']:.3g})")  # fmt: skip
+
+
+def _place(effect: Effect) -> str:
+    """A joint force's term and joint, as the verdict names it ("" for other effects)."""
+    from armaxmodal.diagnosis.joint_forces import TERM_WORDS
+
+    p = effect.parameters
+    return f" ({TERM_WORDS[p['term']]} between {' and '.join(p['between'])})" if "between" in p else ""
+
+
 def _findings_verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float) -> str:
     """What was found and confirmed, then what is left (:func:`_verdict`)."""
     coloured = [s for s, p in zip(diagnosis.sensors, whiteness, strict=True) if p is not None and p < alpha]
@@ -214,9 +229,7 @@ def _findings_verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float
             "capture (a non-smooth nonlinearity such as friction or a clearance, a time change, a missing mode) may "
             "remain. Look at the figure.") if coloured else ""  # fmt: skip
     if diagnosis.effects:
-        found = "; ".join(f"{e.finding.effect} on {', '.join(e.finding.channels)} (held-out {e.judged_by()['error']} "
-                          f"error {e.judged_by()['before']:.3g} -> {e.judged_by()['after']:.3g})"
-                          for e in diagnosis.effects)  # fmt: skip
+        found = "; ".join(_found(e) for e in diagnosis.effects)
         if left:
             return f"found and confirmed: {found}. But {left}"
         if diagnosis.unconfirmed:

@@ -353,6 +353,37 @@ def test_simulate_cli_plants_effects_and_refuses_bad_ones(tmp_path, capsys):
         main(["simulate", "-h"])
     shown = " ".join(capsys.readouterr().out.split())
     assert all(name in shown for name in INJECTABLE) and "level_shift (time_s, size)" in shown
+    assert "stiffness_nonlinearity (ratio)" in shown and "time_varying (time_s, stiffening)" in shown
+
+
+def test_simulate_cli_plants_an_effect_in_the_structure(tmp_path, capsys):
+    """A joint force is the ride nonlinear_joint_ride integrates, a stiffening the stiffer
+    structure's ride from its time on; either is refused on a recording or where it cannot be."""
+    from armaxmodal.diagnosis.inject import nonlinear_joint_ride
+
+    out = tmp_path / "ride.csv"
+    args = ["simulate", "--duration", "20", "--out", str(out), "--quiet", "--seed", "3"]
+    u = am.random_vibration(60.0, 20.0, (0.5, 28.0), seed=3)
+    assert main([*args, "--effect", "damping_nonlinearity:chest+pelvis:ratio=2"]) == 0
+    truth = nonlinear_joint_ride(am.supine_human(), u, 60.0, (1, 2), 2.0, force="friction", noise=0.05, seed=3)
+    assert np.allclose(am.read_recording(out).response, truth.response, atol=1e-6 * np.abs(truth.response).max())
+    assert main([*args, "--effect", "time_varying::time_s=12,stiffening=1.2"]) == 0
+    s = am.supine_human()
+    stiffer = am.simulate_recording(am.Structure(s.M, s.C, s.K * 1.2, s.names), u, 60.0, noise=0.05, seed=3,
+                                    hold="bandlimited")  # fmt: skip
+    plain = am.simulate_recording(s, u, 60.0, noise=0.05, seed=3, hold="bandlimited")
+    got, at = am.read_recording(out).response, 12 * 60
+    scale = np.abs(plain.response).max()
+    assert np.allclose(got[:at], plain.response[:at], atol=1e-6 * scale)
+    assert np.allclose(got[at:], stiffer.response[at:], atol=1e-6 * scale)
+    for bad in ("stiffness_nonlinearity:chest+hip:ratio=0.3", "stiffness_nonlinearity::ratio=0.3",
+                "time_varying::time_s=30,stiffening=1.1"):  # fmt: skip
+        assert main([*args, "--effect", bad]) == 2
+    assert main([*args, "--effect", "time_varying::time_s=5,stiffening=1.1", "--effect",
+                 "damping_nonlinearity:chest:ratio=1"]) == 2  # fmt: skip
+    assert "one effect in the structure" in capsys.readouterr().err
+    with pytest.raises(DataError, match="acts in the structure"):
+        inject(truth, "stiffness_nonlinearity", ["chest"], ratio=0.3)
 
 
 def test_a_mode_the_baseline_lacks_is_named_and_found(clean):
