@@ -59,6 +59,9 @@ NK_REACH = 1
 #: second 0.009 step found the next round; a gain of 1.2 read 1.073 at first and 1.190 after three
 #: passes; a drift of 278 ppm read 322 at first, its first-order pattern outgrown by a sample's drift)
 STEP_PASSES = 8
+#: what may remain of a change, in its SD, when the refits stop: the residual shows only part of
+#: what remains (half of a gain change), so stopping at one SD left a factor 1.5 SD short
+COMPLETED = 0.1
 
 
 @dataclass
@@ -142,7 +145,7 @@ def _refit_completed(stage: Stage, finding: Finding, entry, remaining, key: str,
     model = fit_model(spec, s, start=widened_start(stage.model, spec))
     for _ in range(STEP_PASSES):
         left, sd = remaining(model, finding)
-        if abs(left) < sd:
+        if abs(left) < COMPLETED * sd:
             break
         spec = entry.add(spec, replace(finding, parameters={**finding.parameters, key: as_value(left)}), model)
         model = fit_model(spec, s, start=model)

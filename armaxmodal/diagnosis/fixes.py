@@ -171,8 +171,19 @@ def gain_change_parameters(finding: Finding, fitted) -> dict:
     (factor,) = [v for c, t, v in fitted.spec.gains if (c, t) == (name, first)]
     left, sd = remaining_gain(fitted, name, first)
     factor *= 1 + left
+    sd /= seen_share(finding.parameters["factor"] - 1, factor - 1)
     return {**finding.parameters, "factor_first": finding.parameters["factor"], "factor": factor,
             "factor_ci95": [factor * (1 - Z95 * sd), factor * (1 + Z95 * sd)]}  # fmt: skip
+
+
+def seen_share(first: float, total: float) -> float:
+    """The share of a change the residual shows: its first reading over the total the refits
+    completed (a model fitted with the change in the data carries the rest: 0.054 of a planted
+    gain change of 0.1). The residual's SD of what remains is the SD of the total over that share;
+    read as the total's, the factor's interval held 1.1 in 13 of 20 rides. 1 where the first
+    reading is not a part of the total (a drift's first-order reading overshoots)."""
+    share = first / total if total else 1.0
+    return share if 0 < share < 1 else 1.0
 
 
 def clock_drift_parameters(finding: Finding, fitted) -> dict:

@@ -73,3 +73,15 @@ def test_a_change_every_sensor_shows_is_the_structure_not_a_gain():
     fitted = fit_model(ModelSpec(ORDERS), Signals(rec.base, rec.response, rec.fs, rec.sensors, rec.input_name))
     findings, table = run_tests(fitted)
     assert min(table["gain_p"]) < 0.01 and not [f for f in findings if f.effect == "gain_change"]
+
+
+def test_the_interval_widens_by_the_share_of_the_change_the_residual_shows():
+    """A model fitted with the change in the data carries part of it, so the residual shows only a
+    share of what remains: the first reading over the completed total (0.054 of 0.1). A first
+    reading past the total (a drift's first-order overshoot), of the other sign or of no total
+    leaves the SD as it is."""
+    from armaxmodal.diagnosis.fixes import seen_share
+
+    assert seen_share(0.054, 0.1) == pytest.approx(0.54)
+    assert seen_share(-0.046, -0.1) == pytest.approx(0.46)
+    assert seen_share(322.0, 278.0) == 1.0 and seen_share(-0.01, 0.1) == 1.0 and seen_share(0.01, 0.0) == 1.0
