@@ -100,6 +100,18 @@ MUTANTS = [
     ),
     # the gain change (issue 70); run with --match "(gain change)" --tests tests/diagnosis/test_gain_change.py
     (
+        "armaxmodal/diagnosis/fixes.py",
+        '    sd /= seen_share(finding.parameters["factor"] - 1, factor - 1)',
+        "    pass",
+        "the factor's SD read as the total's (gain change)",
+    ),
+    (
+        "armaxmodal/diagnosis/fixes.py",
+        "    return share if 0 < share < 1 else 1.0",
+        "    return share if 0 < share else 1.0",
+        "an overshooting first reading narrows the interval (gain change)",
+    ),
+    (
         "armaxmodal/diagnosis/gain_change.py",
         "    matched = np.cumsum((zm * e)[::-1])[::-1]",
         "    matched = np.cumsum(zm * e)",
@@ -175,7 +187,7 @@ MUTANTS = [
     ),
     (
         "armaxmodal/diagnosis/acceptance.py",
-        "        if abs(left) < sd:",
+        "        if abs(left) < COMPLETED * sd:",
         "        if True:",
         "the step's size never completed (level shift)",
     ),

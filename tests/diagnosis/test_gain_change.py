@@ -34,6 +34,15 @@ def test_a_gain_change_is_named_placed_and_taken_out(clean, channel, time_s, fac
     assert abs(p["factor_first"] - 1) < abs(factor - 1)
     ((_, first, taken_out),) = d.final.model.spec.gains
     assert first == p["sample"] and abs(taken_out - p["factor"]) < p["factor_ci95"][1] - p["factor_ci95"][0]
+    # the interval: the SD of what the residual still shows, over the share of a change it shows
+    from armaxmodal.diagnosis.fixes import seen_share
+    from armaxmodal.diagnosis.gain_change import remaining_gain
+    from armaxmodal.stats import Z95
+
+    _, sd = remaining_gain(d.final.model, channel, first)
+    share = seen_share(p["factor_first"] - 1, p["factor"] - 1)
+    assert 0.3 < share < 0.9  # about half of the change is carried by the model fitted with it
+    assert np.ptp(p["factor_ci95"]) / 2 == pytest.approx(p["factor"] * Z95 * sd / share, rel=1e-9)
     assert p["sim_error_after"] < 0.9 * p["sim_error_before"]
 
 
