@@ -35,12 +35,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="armaxmodal", description="Time-domain modal analysis of base-excited systems."
     )
-    parser.add_argument("--quiet", action="store_true", help="no progress or chatter")
+    parser.add_argument("--quiet", action="store_true", help="no progress bars (the results still print)")
     # --quiet is accepted after the command too; SUPPRESS keeps a subcommand's unset default
     # from overwriting the top-level flag
     parser.add_argument("--verbose", action="store_true", help="every note's full text, not one line per code")
     quiet = argparse.ArgumentParser(add_help=False)
-    quiet.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS, help="no progress or chatter")
+    quiet.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS,
+                       help="no progress bars (the results still print)")  # fmt: skip
     quiet.add_argument("--verbose", action="store_true", default=argparse.SUPPRESS,
                        help="every note's full text, not one line per code")  # fmt: skip
     sub = parser.add_subparsers(dest="command", required=True)

@@ -84,10 +84,9 @@ def run(args) -> int:
         from armaxmodal.io.report.shape_plot import check_positions
 
         check_positions(positions, list(rec.sensors))
-    if not args.quiet:
-        outputs = ", ".join(rec.sensors)
-        read = f"{rec.n_samples} samples at {rec.fs:g} Hz"
-        print(_fill(f"{args.data}: input {rec.input_name}; outputs {outputs}; {read}"))
+    outputs = ", ".join(rec.sensors)  # what was read, the modes and the check print under --quiet too: it
+    read = f"{rec.n_samples} samples at {rec.fs:g} Hz"  # turns the progress off, not the result
+    print(_fill(f"{args.data}: input {rec.input_name}; outputs {outputs}; {read}"))
     diagram = stabilisation_diagram(rec, orders, band=band, detrend=args.detrend, progress=not args.quiet)
     try:
         selection = select_modes(diagram, args.modes, band, progress=not args.quiet, picks=picks)
@@ -96,13 +95,12 @@ def run(args) -> int:
         print_notes(diagram.warnings, args.verbose)
         write_outputs(_diagram_outputs(args, diagram, None, plot_format))
         raise
-    if not args.quiet:
-        prep = diagram.preparation
-        if prep is not None and prep.analysis_fs != prep.original_fs:
-            print(f"analysis at {prep.analysis_fs:g} Hz (resampled from {prep.original_fs:g} Hz)")
-        print_modes(selection.modes, selection.picks is not None)
-        if selection.check is not None:
-            print_check(selection.check)
+    prep = diagram.preparation
+    if prep is not None and prep.analysis_fs != prep.original_fs:
+        print(f"analysis at {prep.analysis_fs:g} Hz (resampled from {prep.original_fs:g} Hz)")
+    print_modes(selection.modes, selection.picks is not None)
+    if selection.check is not None:
+        print_check(selection.check)
     outputs = _diagram_outputs(args, diagram, selection, plot_format)
     if args.shapes_plot:
         from armaxmodal.io.report.shape_plot import plot_shapes

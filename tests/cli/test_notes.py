@@ -156,3 +156,11 @@ SEVERITIES = {
 def test_each_code_has_its_one_severity():
     pinned = {code: level for level, codes in SEVERITIES.items() for code in codes}
     assert {c.code: severity(c.code) for c in CODES} == pinned
+
+
+def test_quiet_turns_the_progress_off_not_the_result(fixtures_dir, capsys):
+    """Under --quiet the mode table, the check and the verdict print; no progress bar does."""
+    assert main(["stabilise", str(fixtures_dir / "supine_random.csv"), "--orders", "2:12", "--quiet"]) == 0
+    out, err = capsys.readouterr()
+    assert "mode    f (Hz)" in out and "modal-model check" in out and "quality: " in out
+    assert "fit/s" not in err and "%|" not in err
