@@ -20,10 +20,9 @@ supine ride's four sensors): nothing is named, and the time-change test takes it
 from __future__ import annotations
 
 import numpy as np
-from scipy import stats
 from scipy.special import ndtr
 
-from armaxmodal.diagnosis.delays import SPREAD_ALPHA
+from armaxmodal.diagnosis.delays import SPREAD_ALPHA, pooled
 from armaxmodal.diagnosis.finding import Finding
 from armaxmodal.diagnosis.gain_change import SHARED_Z, predicted_part
 from armaxmodal.diagnosis.level_shift import newey_west_sum
@@ -66,11 +65,9 @@ def _rates(fitted, mask: np.ndarray) -> list[tuple[float, float]]:
 
 
 def _common(rates: list[tuple[float, float]]) -> tuple[float, float, float]:
-    """``(r, sd, spread_p)``: the inverse-variance mean rate and Cochran's Q p of their spread."""
-    r, sd = np.array(rates).T
-    w = 1.0 / sd**2
-    mean = float(w @ r / w.sum())
-    return mean, float(1.0 / np.sqrt(w.sum())), float(stats.chi2.sf(w @ (r - mean) ** 2, r.size - 1))
+    """``(r, sd, spread_p)``: the outputs' rates pooled as the delays are (:func:`.delays.pooled`)."""
+    mean, sd, _, spread_p = pooled(*np.array(rates).T)
+    return mean, sd, spread_p
 
 
 def remaining_drift(fitted, name: str) -> tuple[float, float]:

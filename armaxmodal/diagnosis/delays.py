@@ -20,7 +20,7 @@ from armaxmodal.diagnosis.model import FittedModel, usable
 from armaxmodal.prepare.delay import MIN_DELAY_SAMPLES, DelayEstimate, estimate_delays, jackknife_sd
 from armaxmodal.recording import Recording
 
-__all__ = ["delay_findings", "lead_findings", "cross_correlation", "late_start", "SPREAD_ALPHA"]
+__all__ = ["delay_findings", "lead_findings", "cross_correlation", "late_start", "pooled", "SPREAD_ALPHA"]
 
 #: Outputs whose delays scatter no more than this test's chance (chi-square of their spread
 #: about the common delay, each by its own interval) lag alike.
@@ -103,9 +103,7 @@ def _common_delay(estimates: list[DelayEstimate], fs: float) -> dict | None:
     (the outputs share the input's noise, so their errors correlate)."""
     d = np.array([e.delay_s for e in estimates])
     w = 1.0 / np.array([max(e.delay_sd_s, 1e-300) for e in estimates]) ** 2
-    fixed = float(w @ d / w.sum())
-    q = float(w @ (d - fixed) ** 2)
-    spread_p = float(stats.chi2.sf(q, d.size - 1))
+    _, _, q, spread_p = pooled(d, np.sqrt(1.0 / w))
     if spread_p < SPREAD_ALPHA and np.ptp(d) * fs >= MIN_DELAY_SAMPLES:
         return None
     tau2 = max(0.0, (q - (d.size - 1)) / (w.sum() - (w @ w) / w.sum()))
@@ -127,6 +125,16 @@ def _common_delay(estimates: list[DelayEstimate], fs: float) -> dict | None:
         "per_output_s": {e.channel: e.delay_s for e in estimates},
         "spread_p": spread_p,
     }
+
+
+def pooled(values: np.ndarray, sds: np.ndarray) -> tuple[float, float, float, float]:
+    """``(mean, sd, q, spread_p)``: the inverse-variance mean of estimates ``values`` (k,) with SDs
+    ``sds`` (k,), its SD, and Cochran's Q of their spread about it with its chi-square p (k - 1
+    degrees of freedom): are they one quantity measured k times?"""
+    w = 1.0 / np.asarray(sds, float) ** 2
+    mean = float(w @ values / w.sum())
+    q = float(w @ (np.asarray(values, float) - mean) ** 2)
+    return mean, float(1.0 / np.sqrt(w.sum())), q, float(stats.chi2.sf(q, len(values) - 1))
 
 
 def late_start(fitted: FittedModel, findings: list[Finding]) -> dict[str, int]:
