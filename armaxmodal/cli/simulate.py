@@ -79,15 +79,20 @@ def run(args) -> int:
 def _ride(structure, u, args, effect):
     """The simulated ride, with ``effect`` (``(name, channels, params)`` of
     :data:`~armaxmodal.diagnosis.inject.RIDE_EFFECTS`, or None) in the structure: a joint force by
-    :func:`~armaxmodal.diagnosis.inject.nonlinear_joint_ride`, or a stiffening (:func:`_stiffened`)."""
-    from armaxmodal.diagnosis.inject import nonlinear_joint_ride
+    :func:`~armaxmodal.diagnosis.inject.nonlinear_joint_ride`, or a stiffening
+    (:func:`~armaxmodal.diagnosis.inject.stiffened_ride`)."""
+    from armaxmodal.diagnosis.inject import nonlinear_joint_ride, stiffened_ride
     from armaxmodal.systems.simulation import simulate_recording
 
     if effect is None:
         return simulate_recording(structure, u, args.fs, noise=args.noise, seed=args.seed, hold=args.hold)
     name, channels, params = effect
     if name == "time_varying":
-        return _stiffened(structure, u, args, params)
+        if not 0 < params["time_s"] < args.duration:
+            raise DataError(f"--effect time_varying: time_s must lie inside the ride (0-{args.duration:g} s), "
+                            f"got {params['time_s']}.")  # fmt: skip
+        return stiffened_ride(structure, u, args.fs, params["time_s"], params["stiffening"], noise=args.noise,
+                              seed=args.seed, hold=args.hold)  # fmt: skip
     names = list(structure.names)
     if not channels or len(channels) > 2 or any(c not in names for c in channels) or not params["ratio"] > 0:
         raise DataError(f"--effect {name}: name the joint, one or two of {names} (one: to the base), and ratio > 0; "
@@ -98,26 +103,6 @@ def _ride(structure, u, args, effect):
     force = "cubic" if name == "stiffness_nonlinearity" else "friction"
     return nonlinear_joint_ride(structure, u, args.fs, between, params["ratio"], force=force, noise=args.noise,
                                 seed=args.seed)  # fmt: skip
-
-
-def _stiffened(structure, u, args, params):
-    """Every spring ``stiffening`` times stiffer from ``time_s`` on: the stiffer structure's ride to
-    the same input and noise from then on (the state jumps there, as in an instant change)."""
-    import numpy as np
-
-    from armaxmodal.recording import Recording
-    from armaxmodal.systems.simulation import simulate_recording
-    from armaxmodal.systems.structure import Structure
-
-    if not (0 < params["time_s"] < args.duration and params["stiffening"] > 0):
-        raise DataError(f"--effect time_varying: time_s inside the ride (0-{args.duration:g} s) and stiffening > 0; "
-                        f"got {params}.")  # fmt: skip
-    stiffer = Structure(structure.M, structure.C, structure.K * params["stiffening"], structure.names)
-    before, after = (simulate_recording(s, u, args.fs, noise=args.noise, seed=args.seed, hold=args.hold)
-                     for s in (structure, stiffer))  # fmt: skip
-    later = (np.arange(before.n_samples) / args.fs >= params["time_s"])[:, None]
-    meta = {"injected": {"effect": "time_varying", **params}}
-    return Recording(args.fs, before.base, np.where(later, after.response, before.response), before.sensors, meta=meta)
 
 
 def _parse_effect(text: str):

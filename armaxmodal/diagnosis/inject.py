@@ -13,7 +13,7 @@ from armaxmodal.diagnosis.model import fractional_shift, moved
 from armaxmodal.exceptions import DataError
 from armaxmodal.recording import Recording
 
-__all__ = ["inject", "INJECTABLE", "RIDE_EFFECTS", "add_second_input"]
+__all__ = ["inject", "INJECTABLE", "RIDE_EFFECTS", "add_second_input", "stiffened_ride"]
 
 INJECTABLE = (
     "input_delay",
@@ -300,6 +300,44 @@ def _rk4_joint(m_inv, c, k, fine, h, i, j, size, kind, scale):
         z = z + h / 6 * (k1z + 2 * k2z + 2 * k3z + k4z)
         v = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)
     return out
+
+
+def stiffened_ride(structure, base: np.ndarray, fs: float, time_s: float, stiffening: float, *,
+                   noise: float = 0.05, seed: int = 0, hold: str = "bandlimited") -> Recording:  # fmt: skip
+    """A ride of ``structure`` whose every spring is ``stiffening`` times stiffer from ``time_s`` on
+    (the truth for ``time_varying``): the stiffer structure's ride to the same input and noise from
+    then on, so the state jumps there as in an instant change.
+
+    Parameters
+    ----------
+    structure : Structure
+    base : (n,) ndarray
+        Base acceleration.
+    fs : float
+        Sampling rate, Hz.
+    time_s : float
+        When the springs stiffen, s from the start (inside the ride).
+    stiffening : float
+        Factor on every spring (> 0).
+    noise, seed, hold
+        As :func:`armaxmodal.simulate_recording`.
+
+    Returns
+    -------
+    Recording
+        With ``meta["injected"]`` recording the change.
+    """
+    from armaxmodal.systems.simulation import simulate_recording
+    from armaxmodal.systems.structure import Structure
+
+    if not (0 < time_s < base.size / fs and stiffening > 0):
+        raise DataError(f"time_varying: time_s inside the ride (0-{base.size / fs:g} s) and stiffening > 0; got "
+                        f"{time_s}, {stiffening}.")  # fmt: skip
+    stiffer = Structure(structure.M, structure.C, structure.K * stiffening, structure.names)
+    before, after = (simulate_recording(s, base, fs, noise=noise, seed=seed, hold=hold) for s in (structure, stiffer))
+    later = (np.arange(before.n_samples) / fs >= time_s)[:, None]
+    meta = {"injected": {"effect": "time_varying", "time_s": time_s, "stiffening": stiffening}}
+    return Recording(fs, before.base, np.where(later, after.response, before.response), before.sensors, meta=meta)
 
 
 def add_second_input(recording: Recording, structure, at: str, level: float, seed: int = 0) -> Recording:
