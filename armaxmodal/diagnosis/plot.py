@@ -116,12 +116,21 @@ def _traces(ax, diagnosis):
     ax.legend(fontsize=7)
 
 
+def _fits(stage) -> dict[str, str]:
+    """Each output's held-out simulation fit (%), or "diverges" where the simulation does."""
+    s = stage.model.signals
+    if not stage.held.simulates:
+        return dict.fromkeys(s.sensors, "diverges")
+    return {name: f"{v:.1f}" for name, v in zip(s.sensors, stage.held.fit_percent(s.y), strict=True)}
+
+
 def _summary(ax, diagnosis):
     ax.set_axis_off()
-    lines = ["effects kept:"] if diagnosis.effects else ["no effect: the residual is consistent with the model"]
+    # what was kept, not the verdict's reading of the residual: that is the report's and the text's
+    lines = ["effects kept:"] if diagnosis.effects else ["no effect kept"]
     for e in diagnosis.effects:
-        where = ", ".join(e.finding.channels)
-        lines.append(f"  {e.finding.effect} {where}: one-step {e.error_before:.4g} -> {e.error_after:.4g}")
+        where, judged = ", ".join(e.finding.channels), e.judged_by()
+        lines.append(f"  {e.finding.effect} {where}: {judged['error']} {judged['before']:.4g} -> {judged['after']:.4g}")
         if "outputs_lag_ms" in e.parameters:
             lo, hi = e.parameters["outputs_lag_ci95_ms"]
             lines.append(f"    every output lags by {e.parameters['outputs_lag_ms']:.3g} ms ({lo:.3g} to {hi:.3g})")
@@ -130,10 +139,8 @@ def _summary(ax, diagnosis):
             lines.append(f"    late by {e.parameters['delay_ms']:.3g} ms ({lo:.3g} to {hi:.3g})")
     for u in diagnosis.unconfirmed:
         lines.append(f"unconfirmed: {u['effect']} {', '.join(u['channels'])}")
-    before, after = (stage.model.signals for stage in (diagnosis.baseline, diagnosis.final))
-    base = dict(zip(before.sensors, diagnosis.baseline.held.fit_percent(before.y), strict=True))
-    final = dict(zip(after.sensors, diagnosis.final.held.fit_percent(after.y), strict=True))
+    base, final = (_fits(stage) for stage in (diagnosis.baseline, diagnosis.final))
     # an output a second input took has no fit after
-    pairs = [f"{base[name]:.1f} -> " + (f"{final[name]:.1f}" if name in final else "input") for name in base]
+    pairs = [f"{base[name]} -> {final.get(name, 'input')}" for name in base]
     lines.append("held-out simulation fit %:\n  " + ", ".join(pairs))
     ax.text(0, 1, "\n".join(lines), va="top", family="monospace", fontsize=8, wrap=True)

@@ -43,6 +43,9 @@ def test_a_diverging_simulation_confirms_no_fix_judged_on_it():
     assert report["baseline"]["fit_val_pct"] == [None, None] and report["simulation_growth"]["baseline"] > 100
     assert _diagnosis_text("ride", report).count("diverges") >= 2
     assert set(_fits_table(report)["fit before (%)"]) == {"diverges"}
+    from armaxmodal.diagnosis.plot import _fits
+
+    assert set(_fits(d.baseline).values()) == {"diverges"}  # the figure's summary, too
 
 
 def test_growth_is_the_fastest_unstable_mode_over_the_span_simulated():
