@@ -61,6 +61,8 @@ _LATER = {
     "Diagnosis": ("armaxmodal.diagnosis", "Diagnosis"),
     "run_study": ("armaxmodal.study", "run_study"),
     "write_study": ("armaxmodal.study", "write_study"),
+    "track_modes": ("armaxmodal.study", "track_modes"),
+    "write_track": ("armaxmodal.study", "write_track"),
     "lump_check": ("armaxmodal.lumping", "lump_check"),
     "model_update": ("armaxmodal.inverse", "model_update"),
     "evphc": ("armaxmodal.inverse", "evphc"),

@@ -57,7 +57,7 @@ def check_output_paths(args) -> None:
     seen = {}
     for option in OUTPUT_OPTIONS:
         value = getattr(args, option, None)
-        if value is None or (option == "out" and args.command == "study"):  # a study's --out is a folder
+        if value is None or (option == "out" and args.command in ("study", "track")):  # their --out is a folder
             continue
         path = Path(value).resolve()
         flag = f"--{option}"

@@ -9,6 +9,7 @@ armaxmodal info DATA [--input COL] [--fs HZ]
 armaxmodal modes --system supine|chapter2 [--json OUT]
 armaxmodal simulate --system supine --excitation random|sweep --out DATA.csv
 armaxmodal study MANIFEST_OR_FOLDER --out DIR [--report FILE] [--jobs N] [--scheduler ADDRESS]
+armaxmodal track MANIFEST_OR_FOLDER --out DIR [--jobs N] [--scheduler ADDRESS] [--input-scale F --input-unit U]
 armaxmodal lump DATA A B [--json OUT] [--plot OUT]
 
 Every command that reads a recording takes --input COL, --fs HZ, --outputs A,B and --fill-gaps SECONDS.
@@ -23,12 +24,12 @@ import os
 import sys
 from collections.abc import Sequence
 
-from armaxmodal.cli import diagnose, identify, info, invert, lump, modes, simulate, stabilise, study
+from armaxmodal.cli import diagnose, identify, info, invert, lump, modes, simulate, stabilise, study, track
 from armaxmodal.cli.common import check_output_paths
 from armaxmodal.exceptions import ArmaxModalError
 
 #: the commands in the order ``--help`` lists them
-COMMANDS = (stabilise, invert, identify, diagnose, info, modes, simulate, study, lump)
+COMMANDS = (stabilise, invert, identify, diagnose, info, modes, simulate, study, track, lump)
 
 
 def build_parser() -> argparse.ArgumentParser:

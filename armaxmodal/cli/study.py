@@ -36,7 +36,8 @@ def add_parser(sub, parents) -> None:
     p.set_defaults(func=run)
 
 
-def _settings(args):
+def study_settings(args):
+    """The StudySettings the command line asks for (also ``track``'s)."""
     from armaxmodal.prepare.preparation import check_band
     from armaxmodal.study.job import StudySettings
 
@@ -77,7 +78,7 @@ def run(args) -> int:
     from armaxmodal.study.output import write_study
     from armaxmodal.study.run import run_study
 
-    settings = _settings(args)
+    settings = study_settings(args)
     _check_paths(args)
     study = run_study(
         args.source,

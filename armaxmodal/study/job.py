@@ -88,7 +88,8 @@ def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[st
     dict
         ``sensors``, ``fs``, ``analysis_fs``, ``nk``, ``modes`` (one dict per mode: frequency in
         Hz, damping ratio, 95 % intervals, Eq. 3.35-3.36 weighted values and the normalised shape
-        per sensor), ``per_sensor`` (Table 3.2 rows), ``warnings``, ``reconstruction_error`` and
+        per sensor), ``peak_input`` (the input's largest departure from its mean, in its own units),
+        ``per_sensor`` (Table 3.2 rows), ``warnings``, ``reconstruction_error`` and
         ``quality`` (the modal-model check's misfit and verdict), ``lump`` and ``figure_png``
         (base64).
 
@@ -132,6 +133,7 @@ def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[st
         "fs": report["fs"],
         "analysis_fs": report["analysis_fs"],
         "n_samples": rec.n_samples,
+        "peak_input": float(np.max(np.abs(rec.base - rec.base.mean()))),  # about its mean: gravity is no shaking
         "nk": report["nk"],
         "modes": report["modes"],
         "per_sensor": report["per_sensor"],

@@ -330,9 +330,10 @@ def _cache_path(cache: Path, digest: str, settings: StudySettings, sensors) -> P
 def _read_cache(cache: Path, digest, settings, sensors) -> dict | None:
     path = _cache_path(cache, digest, settings, sensors)
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
+        cached = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None  # absent or half-written by a crash: analyse again
+    return cached if "peak_input" in cached else None  # written before results carried it
 
 
 def _record(entry: Entry, digest: str, result: dict) -> dict:

@@ -47,3 +47,4 @@ def test_the_schema_rejects_a_broken_output():
     bad_mode = {"freq_ci95": [1, 2], "damping_ci95": [0, 1], "damping": 0.1, "shape": {}}
     assert list(_validator("identify").iter_errors({"modes": [bad_mode]}))
     assert list(_validator("diagnose").iter_errors({"effects": [{"effect": "gremlins"}]}))
+    assert list(_validator("track").iter_errors({"events": [{"quality": "great"}]}))
