@@ -50,6 +50,12 @@ import report as _benchmark_report  # noqa: E402
 
 _benchmark_report.write()
 
+# the bridges' validation page and its figures, from the saved track results (scripts/track_bridges.py)
+sys.path.insert(0, str(ROOT / "scripts"))
+import track_bridges as _track_bridges  # noqa: E402
+
+_track_bridges.write_page()
+
 _page = Path(__file__).parent / "user_guide" / "warnings.md"
 if not _page.exists() or _page.read_text() != _warning_page():
     _page.write_text(_warning_page())

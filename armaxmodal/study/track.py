@@ -120,7 +120,7 @@ class Track:
         One row per event: file, date, peak_input, quality, modes found.
     settings : TrackSettings
     study : Study
-        The per-event analyses (:func:`~armaxmodal.run_study`).
+        The per-event analyses (:func:`~armaxmodal.study.run_study`).
     notes : list of str
 
     See Also
@@ -347,13 +347,13 @@ def track_modes(
         A manifest CSV (``file`` and optionally ``date``, ISO 8601, and any labels) or a folder of
         the structure's records.
     out : path
-        Folder for the per-event cache (as :func:`~armaxmodal.run_study`'s).
+        Folder for the per-event cache (as :func:`~armaxmodal.study.run_study`'s).
     settings : StudySettings, optional
         What every event goes through.
     track : TrackSettings, optional
         The matching and departure rules (see the module's docstring).
     jobs, scheduler, progress
-        As :func:`~armaxmodal.run_study`'s: local processes, a dask.distributed cluster, a tqdm bar.
+        As :func:`~armaxmodal.study.run_study`'s: local processes, a dask.distributed cluster, a tqdm bar.
 
     Returns
     -------
@@ -362,7 +362,7 @@ def track_modes(
     See Also
     --------
     armaxmodal.study.write_track : Write the table, the figure and the report.
-    armaxmodal.run_study : The per-event analyses.
+    armaxmodal.study.run_study : The per-event analyses.
 
     Examples
     --------

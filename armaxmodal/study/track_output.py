@@ -58,7 +58,7 @@ def plot_track(track: Track):
     fig, axes = plt.subplots(2, 2 if dated else 1, figsize=(11 if dated else 6.5, 7), squeeze=False)
     unit = track.settings.input_unit
     for (mode, group), colour in zip(rows.groupby("mode"), plt.cm.tab10.colors * 10, strict=False):
-        label = f"mode {mode} ({group.freq_hz.median():.2f} Hz, {len(group)} events)"
+        label = f"mode {mode} ({group.freq_hz.median():.2f} Hz, {len(group)} event{'s' * (len(group) > 1)})"
         for col, x in enumerate(["peak_input", "date"][: 1 + dated]):
             if x == "date":
                 group = group[group.date.notna()]
