@@ -138,19 +138,15 @@ def order_range(text: str) -> range:
 
 #: a note's line on the terminal, and how many lines of codes fit one screen with the header
 NOTE_WIDTH, NOTE_LINES = 100, 23
-#: where a code's second and third lines start (under its name)
-NOTE_INDENT = " " * 10
 
 
 def print_notes(warnings, verbose: bool = False) -> None:
-    """The notes on stderr (even with --quiet), on one screen: per code a line within ``NOTE_WIDTH``
-    characters with its severity (:func:`armaxmodal.quality_warnings.severity`), how many, the
-    channels and the frequencies (``QualityWarning.freq_hz``) and what was found (the first note's
-    text without its asides, :func:`headline`, on a second line where a problem's or a warning's
-    needs it); under a problem or a warning a last line says what to do. Problems first, then
-    warnings, then information. Where that takes more than ``NOTE_LINES`` lines, a line a code, as
-    many codes as fit. ``verbose``: every code with its advice and every full text. The JSON and
-    ``--report`` always hold the full texts."""
+    """The notes on stderr (even with --quiet), on one screen: per code one line within
+    ``NOTE_WIDTH`` characters with its severity (:func:`armaxmodal.quality_warnings.severity`), how
+    many, the channels and the frequencies (``QualityWarning.freq_hz``) and what was found (the first
+    note's text without its asides, :func:`headline`). Problems first, then warnings, then
+    information; at most ``NOTE_LINES`` codes. ``verbose``: every code with its advice and every full
+    text. The JSON and ``--report`` always hold the full texts and what to do."""
     from armaxmodal.quality_warnings import CODES, UNCERTAIN_CODES, severity
 
     if not warnings:
@@ -164,17 +160,16 @@ def print_notes(warnings, verbose: bool = False) -> None:
     codes = sorted(groups, key=lambda c: (levels.index(severity(c)), c not in UNCERTAIN_CODES, order.get(c, 99)))
     counts = [f"{n} {level}{'s' if n > 1 and level != 'info' else ''}"  # notes, of each severity
               for level in levels if (n := sum(severity(w.code) == level for w in warnings))]  # fmt: skip
-    more = "" if verbose else " (full texts: --verbose, --json, --report)"
+    more = "" if verbose else " (what to do, full texts: --verbose, --json, --report)"
     print(f"notes: {', '.join(counts)}{more}", file=sys.stderr)
     if verbose:
-        blocks = [_verbose_block(code, groups[code], advice.get(code, ""), severity(code)) for code in codes]
-    else:  # what was found and what to do while every code fits the screen so, else a line a code
-        blocks = [_code_lines(code, groups[code], advice.get(code, ""), severity(code)) for code in codes]
-        if sum(map(len, blocks)) > NOTE_LINES:
-            blocks = [_code_lines(code, groups[code], "", severity(code), compact=True) for code in codes[:NOTE_LINES]]
-    print("\n".join(line for block in blocks for line in block), file=sys.stderr)
-    if len(blocks) < len(codes):
-        print(f"  ... {len(codes) - len(blocks)} more codes (--verbose)", file=sys.stderr)
+        lines = [line for code in codes for line in _verbose_block(code, groups[code], advice.get(code, ""),
+                                                                    severity(code))]  # fmt: skip
+    else:
+        lines = [_code_line(code, groups[code], severity(code)) for code in codes[:NOTE_LINES]]
+    print("\n".join(lines), file=sys.stderr)
+    if not verbose and len(codes) > NOTE_LINES:
+        print(f"  ... {len(codes) - NOTE_LINES} more codes (--verbose)", file=sys.stderr)
 
 
 def _code_head(code: str, notes: list, level: str) -> str:
@@ -186,23 +181,12 @@ def _code_head(code: str, notes: list, level: str) -> str:
     return f"  {level:<8}{code} ({len(notes)}{where}{_frequencies(sorted(shown_hz))}): "
 
 
-def _code_lines(code: str, notes: list, advice: str, level: str, compact: bool = False) -> list[str]:
-    """A code's lines on the screen: what was found (two lines for a problem or a warning, one for
-    information), then for a problem or a warning what to do; ``compact``: the first line alone."""
+def _code_line(code: str, notes: list, level: str) -> str:
+    """A code's line on the screen: its head and what was found, within ``NOTE_WIDTH``."""
     head = _code_head(code, notes, level)
     others = f" (+{len(notes) - 1} more)" if len(notes) > 1 else ""
-    rows = 1 if level == "info" or compact else 2
-    budget = rows * NOTE_WIDTH - len(head) - (rows - 1) * len(NOTE_INDENT) - len(others)
-    while True:  # words wrap short of the width: a smaller budget until the finding fits its rows
-        found = head + headline(notes[0].message, budget) + others
-        lines = textwrap.wrap(found, NOTE_WIDTH, subsequent_indent=NOTE_INDENT, break_on_hyphens=False,
-                              break_long_words=False)  # fmt: skip
-        if len(lines) <= rows or budget <= 20:
-            break
-        budget -= 8
-    if level != "info" and advice and not compact:
-        lines.append(NOTE_INDENT + "do: " + headline(advice, NOTE_WIDTH - len(NOTE_INDENT) - 4))
-    return lines[: rows + 1]
+    budget = max(10, NOTE_WIDTH - len(head) - len(others))
+    return (head + headline(notes[0].message, budget) + others)[:NOTE_WIDTH]
 
 
 def _verbose_block(code: str, notes: list, advice: str, level: str) -> list[str]:

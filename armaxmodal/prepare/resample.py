@@ -119,11 +119,10 @@ def oversampling_note(mode_freqs: np.ndarray, fs: float, oversampled_fraction: f
         QualityWarning(
             "oversampled",
             (),
-            f"every mode found lies below {100 * share:.1f} % of the Nyquist frequency (the highest at "
-            f"{top:.3g} Hz of {fs / 2:g} Hz): the input excites far above the structure, so the rate was kept, "
-            "and at this rate the poles crowd z = 1 where ARMAX models resolve them poorly; modes may be "
-            f"missed or biased. Rerun with band=(0, {hi:g}) (CLI: --band 0:{hi:g}), which resamples to "
-            f"{new_fs:.4g} Hz.",
+            f"every mode lies below {100 * share:.1f} % of Nyquist: rerun with --band 0:{hi:g}, which resamples "
+            f"to {new_fs:.4g} Hz (in Python band=(0, {hi:g}); the highest mode at {top:.3g} Hz of {fs / 2:g} Hz). "
+            "The input excites far above the structure, so the rate was kept, and at this rate the poles crowd "
+            "z = 1 where ARMAX models resolve them poorly; modes may be missed or biased.",
             share,
         )
     ]
