@@ -20,6 +20,11 @@ __all__ = [
 class ArmaxModalError(Exception):
     """Base class of every error raised on purpose by armaxmodal.
 
+    See Also
+    --------
+    armaxmodal.DataError : Bad input data.
+    armaxmodal.OrderError : Orders a record cannot support.
+
     Examples
     --------
     >>> import armaxmodal as am
@@ -30,6 +35,10 @@ class ArmaxModalError(Exception):
 
 class DataError(ArmaxModalError, ValueError):
     """A signal, recording or file is unusable as given (NaN, wrong shape, bad column...).
+
+    See Also
+    --------
+    armaxmodal.ArmaxModalError : The base of the package's errors.
 
     Examples
     --------
@@ -45,6 +54,10 @@ class DataError(ArmaxModalError, ValueError):
 
 class OrderError(ArmaxModalError, ValueError):
     """Model orders are invalid or need more samples than the record has.
+
+    See Also
+    --------
+    armaxmodal.ArmaxModalError : The base of the package's errors.
 
     Examples
     --------
@@ -62,6 +75,10 @@ class OrderError(ArmaxModalError, ValueError):
 class StructureError(ArmaxModalError, ValueError):
     """Mass, damping or stiffness matrices are not physical, or not of the asked topology.
 
+    See Also
+    --------
+    armaxmodal.Structure : What it guards.
+
     Examples
     --------
     >>> import armaxmodal as am
@@ -76,6 +93,10 @@ class StructureError(ArmaxModalError, ValueError):
 class PickError(ArmaxModalError, ValueError):
     """A mode picked by hand is not one the stabilisation diagram offers (outside the band, no
     stable cluster near it, two picks on one cluster).
+
+    See Also
+    --------
+    armaxmodal.select_modes : Its picks.
 
     Examples
     --------
@@ -95,6 +116,10 @@ class SettingsError(ArmaxModalError, ValueError):
     """A threshold of the mode selection's settings is outside what it can be (not a positive
     number, a probability above 1, bounds the wrong way round).
 
+    See Also
+    --------
+    armaxmodal.modes.settings.SelectionSettings : The thresholds it guards.
+
     Examples
     --------
     >>> from armaxmodal.exceptions import SettingsError
@@ -109,6 +134,10 @@ class SettingsError(ArmaxModalError, ValueError):
 
 class ConvergenceWarning(UserWarning):
     """An iterative estimator stopped before its convergence test was met.
+
+    See Also
+    --------
+    armaxmodal.fit_armax : Warns with it.
 
     Examples
     --------

@@ -412,6 +412,11 @@ class QualityWarning:
     the message); ``freq_hz``, the frequencies (Hz) it is about, if any (what the one-line
     summary of the notes names).
 
+    See Also
+    --------
+    armaxmodal.prepare.check_quality : The record's checks.
+    armaxmodal.ModeSelection : Carries the selection's notes.
+
     Examples
     --------
     >>> import armaxmodal as am

@@ -38,6 +38,11 @@ class Recording:
     meta : dict
         Anything else worth keeping (source file, simulation truth, ...).
 
+    See Also
+    --------
+    armaxmodal.read_recording : Read one from a file.
+    armaxmodal.simulate_recording : Simulate one with known truth.
+
     Examples
     --------
     >>> import numpy as np

@@ -317,6 +317,10 @@ def local_polynomial_noise(u: np.ndarray, y: np.ndarray, half_width: int = LPM_H
     ValueError
         Arrays of other shapes, or fewer lines than a window holds.
 
+    See Also
+    --------
+    armaxmodal.modes.mode_count.model_adequacy : Compares a model's residual with it.
+
     Examples
     --------
     >>> import numpy as np

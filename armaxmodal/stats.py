@@ -122,6 +122,10 @@ def effective_fraction(residual: np.ndarray, max_lag: int) -> float:
     float
         In (0, 1]; 1 when neighbouring lines are uncorrelated (white noise's DFT).
 
+    See Also
+    --------
+    armaxmodal.modes.count_search.count_modes : Scales the criterion's penalty by it.
+
     Examples
     --------
     >>> import numpy as np

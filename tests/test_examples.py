@@ -48,3 +48,12 @@ def test_the_examples_run(name):
     runner = doctest.DocTestRunner(optionflags=doctest.NORMALIZE_WHITESPACE)
     result = runner.run(test, out=lambda text: print(text, end=""))
     assert result.failed == 0, f"{name}: {result.failed} of {result.attempted} examples failed (see the output)"
+
+
+def test_every_function_and_class_of_the_api_reference_points_to_its_relatives():
+    """A See Also on each: what makes an object, what takes it, what runs beside it."""
+    listed = re.findall(r"^ {3}(armaxmodal\.[\w.]+)$", API.read_text(), re.M)
+    objects = [(path, obj) for path in listed if not inspect.ismodule(obj := _api_object(path))]
+    assert len(objects) > 90
+    missing = [path for path, obj in objects if "See Also\n" not in (inspect.getdoc(obj) or "")]
+    assert not missing

@@ -87,6 +87,10 @@ class Diagnosis:
     """What :func:`~armaxmodal.diagnosis.diagnose` found. ``to_dict`` is the JSON contract of
     ``armaxmodal diagnose``.
 
+    See Also
+    --------
+    armaxmodal.diagnosis.diagnose : What makes one.
+
     Examples
     --------
     >>> import armaxmodal as am

@@ -68,6 +68,10 @@ class DftLines:
     band_hz : (float, float)
         The band of the lines, Hz.
 
+    See Also
+    --------
+    armaxmodal.estimate.dft_model.fit_modal_model : Fits a modal model to them.
+
     Examples
     --------
     >>> import armaxmodal as am
@@ -214,6 +218,10 @@ class ModalModel:
         The pole's frequency or damping is held at a bound of the fit (the solver's active set):
         its Wald interval means nothing there. None: not known.
 
+    See Also
+    --------
+    armaxmodal.estimate.dft_model.fit_modal_model : What makes one.
+
     Examples
     --------
     >>> import armaxmodal as am
@@ -336,6 +344,11 @@ def fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited",
     -------
     ModalModel
         The fit.
+
+    See Also
+    --------
+    armaxmodal.estimate.dft_model.ModalModel : What it returns.
+    armaxmodal.estimate.dft_model.DftLines : The lines it fits.
 
     Examples
     --------

@@ -44,6 +44,11 @@ def default_nb(na: int, nk: int) -> int:
     int
         The number of B coefficients.
 
+    See Also
+    --------
+    armaxmodal.estimate.default_nc : The C polynomial's order beside it.
+    armaxmodal.fit_armax : Uses both when only na is given.
+
     Examples
     --------
     >>> from armaxmodal.estimate import default_nb
@@ -65,6 +70,11 @@ def default_nc(na: int) -> int:
     -------
     int
         The order of C.
+
+    See Also
+    --------
+    armaxmodal.estimate.default_nb : The B polynomial's order beside it.
+    armaxmodal.fit_armax : Uses both when only na is given.
 
     Examples
     --------
@@ -88,6 +98,11 @@ class Orders(NamedTuple):
 @dataclass(frozen=True)
 class OrderChoice:
     """The chosen fit and the criterion table (one row per candidate).
+
+    See Also
+    --------
+    armaxmodal.choose_orders : What makes one.
+    armaxmodal.estimate.information_criterion : The criterion it ranks by.
 
     Examples
     --------
@@ -128,6 +143,10 @@ def information_criterion(fit: ArmaxFit, kind: str = "bic", unit: np.ndarray | N
     -------
     float
         The criterion, summed over sensors; smaller is better.
+
+    See Also
+    --------
+    armaxmodal.choose_orders : Ranks orders by it.
 
     Examples
     --------

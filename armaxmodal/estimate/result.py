@@ -48,6 +48,11 @@ class ArmaxFit:
     n_samples : int
         Samples in the fit window.
 
+    See Also
+    --------
+    armaxmodal.fit_armax : What makes one.
+    armaxmodal.choose_orders : Orders for it by an information criterion.
+
     Examples
     --------
     >>> import armaxmodal as am

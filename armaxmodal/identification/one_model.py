@@ -52,6 +52,11 @@ class Identification:
     preparation : Preparation or None
         What was done to the record before the fit, with the data-quality warnings.
 
+    See Also
+    --------
+    armaxmodal.identify : What makes one.
+    armaxmodal.ModeSelection : The modes of a whole sweep instead of one model.
+
     Examples
     --------
     >>> import armaxmodal as am

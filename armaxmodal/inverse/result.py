@@ -38,6 +38,12 @@ class InverseSolution:
         covariance at the solution; model updating only). A component held at a bound, or
         fixed by the scale, has 0.
 
+    See Also
+    --------
+    armaxmodal.inverse.model_update : The joint update.
+    armaxmodal.inverse.evphc : The eigenvalue-problem solution (Chapter 2).
+    armaxmodal.inverse.pia : The Pilkey-Inman baseline.
+
     Examples
     --------
     >>> import armaxmodal as am

@@ -309,6 +309,10 @@ def weight_sweep(eigenvalues, shapes, frf, weights=None, **kwargs):
         One row per weight: weight, modal_rms (frequency, damping and shape residuals in
         noise units), frf_rms, and the model's frequencies and damping ratios.
 
+    See Also
+    --------
+    armaxmodal.inverse.model_update : The joint update the weight sets.
+
     Examples
     --------
     The supine body's exact modes against the FRF of the same body with the legs' spring 30 %

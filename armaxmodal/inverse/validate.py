@@ -28,6 +28,11 @@ def scale_to_subject(structure: Structure, mass_kg: float) -> Structure:
     Structure
         The scaled model.
 
+    See Also
+    --------
+    armaxmodal.inverse.InverseSolution : The model it scales.
+    armaxmodal.study.run_study : Scales the average subject with ``model=True``.
+
     Examples
     --------
     >>> import armaxmodal as am
@@ -63,6 +68,11 @@ def predict_recording(structure: Structure, recording: Recording, hold: str = "b
     -------
     pandas.DataFrame
         One row per sensor: ``fit_percent`` and ``correlation``.
+
+    See Also
+    --------
+    armaxmodal.inverse.InverseSolution : The model it simulates.
+    armaxmodal.simulate_recording : The simulation underneath.
 
     Examples
     --------

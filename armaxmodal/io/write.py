@@ -214,6 +214,10 @@ def write_json(obj, path: str | os.PathLike) -> Path:
     Path
         The file written.
 
+    See Also
+    --------
+    armaxmodal.write_recording_csv : The recordings' writer beside it.
+
     Examples
     --------
     >>> import json, tempfile, pathlib

@@ -52,6 +52,10 @@ def relative_transmissibility(rec: Recording, a: str, b: str, nperseg: int | Non
     measurable : (n_freq,) ndarray
         The smaller coherence of either relative motion with the base.
 
+    See Also
+    --------
+    armaxmodal.lumping.lump_check : Judges two segments by it.
+
     Examples
     --------
     The feet's motion relative to the base over the legs', well below the feet's own mode
@@ -85,6 +89,10 @@ def relative_transmissibility(rec: Recording, a: str, b: str, nperseg: int | Non
 @dataclass(frozen=True)
 class LumpCheck:
     """The answer and its evidence (see :func:`~armaxmodal.lumping.lump_check`).
+
+    See Also
+    --------
+    armaxmodal.lumping.lump_check : What makes one.
 
     Examples
     --------
@@ -175,6 +183,11 @@ def lump_check(
     -------
     LumpCheck
         ``verdict`` is "lump", "separate" or "undetermined" (too few measurable frequencies).
+
+    See Also
+    --------
+    armaxmodal.lumping.LumpCheck : What it returns.
+    armaxmodal.lumping.wavelet_coherence : Its time-frequency evidence.
 
     Examples
     --------

@@ -48,6 +48,10 @@ class Scalogram:
     coi_hz : (n,) ndarray
         Cone of influence as a frequency: below it, edge effects dominate.
 
+    See Also
+    --------
+    armaxmodal.lumping.scalogram : What makes one.
+
     Examples
     --------
     >>> import numpy as np
@@ -92,6 +96,10 @@ class WaveletCoherence:
         Positive where y lags x.
     significance : (n_scales,) ndarray
         Red-noise level of ``r2`` at the chosen confidence (NaN when not computed).
+
+    See Also
+    --------
+    armaxmodal.lumping.wavelet_coherence : What makes one.
 
     Examples
     --------
@@ -142,6 +150,11 @@ def scalogram(x, fs: float, band: tuple[float, float]) -> Scalogram:
     Scalogram
         The wavelet coefficients, frequencies and cone of influence.
 
+    See Also
+    --------
+    armaxmodal.lumping.Scalogram : What it returns.
+    armaxmodal.lumping.wavelet_coherence : Two signals' coherence.
+
     Examples
     --------
     >>> import numpy as np
@@ -191,6 +204,11 @@ def wavelet_coherence(
     -------
     WaveletCoherence
         Coherence, phase, frequencies, cone of influence and significance level.
+
+    See Also
+    --------
+    armaxmodal.lumping.WaveletCoherence : What it returns.
+    armaxmodal.lumping.scalogram : One signal's wavelet power.
 
     Examples
     --------

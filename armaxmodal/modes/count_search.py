@@ -306,6 +306,11 @@ def count_modes(
     -------
     ModeCount
 
+    See Also
+    --------
+    armaxmodal.modes.mode_count.ModeCount : What it returns.
+    armaxmodal.modes.mode_count.model_adequacy : Which world the count runs in.
+
     Examples
     --------
     Started one mode short, the count adds it:

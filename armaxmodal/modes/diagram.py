@@ -64,6 +64,11 @@ class StabilisationDiagram:
     preparation : Preparation or None
         What was done to the record first, with the quality warnings.
 
+    See Also
+    --------
+    armaxmodal.stabilisation_diagram : What makes one.
+    armaxmodal.select_modes : Picks the physical modes from it.
+
     Examples
     --------
     >>> import armaxmodal as am
@@ -172,6 +177,11 @@ def choose_nk(recording: Recording, nk_values=NK_SEARCH, na_values=DELAY_CHOICE_
     -------
     int
         The delay, in samples.
+
+    See Also
+    --------
+    armaxmodal.estimate.information_criterion : The criterion behind the choice.
+    armaxmodal.stabilisation_diagram : Chooses the delay this way when none is given.
 
     Examples
     --------

@@ -75,6 +75,10 @@ class ModalCheck:
         Per output, the lowest and highest coherent line it was checked on (Hz; NaN where it was
         not checked): outside them the fitted FRF is an extrapolation of its residual terms.
 
+    See Also
+    --------
+    armaxmodal.modes.check_modes : What makes one.
+
     Examples
     --------
     >>> import armaxmodal as am
@@ -294,6 +298,11 @@ def check_modes(recording: Recording, freq_hz, damping, band=None, *, fit_delay:
     Returns
     -------
     ModalCheck
+
+    See Also
+    --------
+    armaxmodal.modes.ModalCheck : What it returns.
+    armaxmodal.select_modes : Runs it on the modes it selects.
 
     Examples
     --------

@@ -67,6 +67,10 @@ class Adequacy:
     level : float
         The largest ratio of an adequate model (``CountSettings.adequacy_ratio``).
 
+    See Also
+    --------
+    armaxmodal.modes.mode_count.model_adequacy : What makes one.
+
     Examples
     --------
     >>> import numpy as np
@@ -119,6 +123,11 @@ def model_adequacy(model: ModalModel, u: np.ndarray, level: float) -> Adequacy:
     Adequacy
         Each sensor's ratio; NaN for all where the band holds fewer lines than the method's window
         (13), which is not shown adequate.
+
+    See Also
+    --------
+    armaxmodal.modes.mode_count.Adequacy : What it returns.
+    armaxmodal.spectra.local_polynomial_noise : The noise it compares the residual with.
 
     Examples
     --------
@@ -283,6 +292,10 @@ class ModeCount:
         ``(criterion's difference, its modes' Hz)``: the model the criterion and the halves chose
         where the record's model is not adequate and the stated rule refused it (its criterion less
         the chosen one's is minus the difference); empty where the two agree.
+
+    See Also
+    --------
+    armaxmodal.modes.count_search.count_modes : What makes one.
 
     Examples
     --------

@@ -49,6 +49,10 @@ UNRESOLVED_DAMPING = "damping not resolved"
 class Tolerances:
     """Stability tolerances between consecutive orders and the pole-rejection rules.
 
+    See Also
+    --------
+    armaxmodal.stabilisation_diagram : Marks each pole's stability with them.
+
     Examples
     --------
     >>> from armaxmodal.modes import Tolerances

@@ -74,6 +74,11 @@ class ModeSelection:
     segments : int
         The disjoint segments of the segment spread (``modes`` holds its columns where at least 2).
 
+    See Also
+    --------
+    armaxmodal.select_modes : What makes one.
+    armaxmodal.modes.settings.SelectionSettings : The thresholds it carries.
+
     Examples
     --------
     >>> import armaxmodal as am

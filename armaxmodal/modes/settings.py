@@ -20,6 +20,18 @@ __all__ = ["AgreementSettings", "ClusterSettings", "CountSettings", "DftSettings
            "NoteSettings", "Resolution", "SelectionSettings", "SweepSettings"]
 
 
+class _Settings:
+    """Settings print the fields that differ from their defaults: a signature's default reads
+    ``CountSettings()``, not every threshold's value, and a tuned object names what was tuned."""
+
+    def __repr__(self) -> str:
+        def default(f):
+            return f.default_factory() if f.default is MISSING else f.default  # type: ignore[misc]
+
+        changed = [f"{f.name}={getattr(self, f.name)!r}" for f in fields(self) if getattr(self, f.name) != default(f)]
+        return f"{type(self).__name__}({', '.join(changed)})"
+
+
 @dataclass(frozen=True)
 class Resolution:
     """How finely an H1 must resolve the narrowest mode: ``lines_per_bandwidth`` Welch lines in its
@@ -64,8 +76,8 @@ def _checked(settings) -> None:
                                 f"default is {default!r}).")  # fmt: skip
 
 
-@dataclass(frozen=True)
-class ClusterSettings:
+@dataclass(frozen=True, repr=False)
+class ClusterSettings(_Settings):
     """Which poles of the diagram are one mode (stages ``candidates`` and ``merge``)."""
 
     #: relative frequency distance within which a pole joins a cluster (its median); also a pick's
@@ -100,8 +112,8 @@ class ClusterSettings:
         _checked(self)
 
 
-@dataclass(frozen=True)
-class LineSettings:
+@dataclass(frozen=True, repr=False)
+class LineSettings(_Settings):
     """Is a pole a line (a periodic disturbance) or a mode, in one place for the diagram's
     ``periodic_disturbance`` note, the count's reported poles and the diagnosis."""
 
@@ -126,8 +138,8 @@ class LineSettings:
         _checked(self)
 
 
-@dataclass(frozen=True)
-class FrfSettings:
+@dataclass(frozen=True, repr=False)
+class FrfSettings(_Settings):
     """What the measured H1 says (stages ``screen_by_frf`` and ``check``): the LSFD check, the
     support F-test and the clusters it proposes."""
 
@@ -178,8 +190,8 @@ class FrfSettings:
         _checked(self)
 
 
-@dataclass(frozen=True)
-class DftSettings:
+@dataclass(frozen=True, repr=False)
+class DftSettings(_Settings):
     """The variable-projection fits of the modal model to the record's DFT (stages ``refit`` and
     ``count``)."""
 
@@ -200,8 +212,8 @@ class DftSettings:
                                 f"({self.max_damping!r}).")  # fmt: skip
 
 
-@dataclass(frozen=True)
-class NoteSettings:
+@dataclass(frozen=True, repr=False)
+class NoteSettings(_Settings):
     """Thresholds of the informative notes (stage ``finish``)."""
 
     #: every mode found below this share of the Nyquist frequency: the record is oversampled
@@ -214,8 +226,8 @@ class NoteSettings:
         _checked(self)
 
 
-@dataclass(frozen=True)
-class CountSettings:
+@dataclass(frozen=True, repr=False)
+class CountSettings(_Settings):
     """The count by nested tests of the maximum-likelihood modal model (stage ``count``): the
     only stage that keeps or drops a mode."""
 
@@ -266,8 +278,8 @@ class CountSettings:
         _checked(self)
 
 
-@dataclass(frozen=True)
-class AgreementSettings:
+@dataclass(frozen=True, repr=False)
+class AgreementSettings(_Settings):
     """Does the record agree with itself, asked three ways: its two halves (a count's new pole, a mode
     the H1 cannot confirm), its disjoint segments (each mode's spread) and its two estimators. One
     multiplicity policy for the three: each test is one family, its false-alarm rate over every value
@@ -295,8 +307,8 @@ class AgreementSettings:
                                 f"({self.alpha!r}).")  # fmt: skip
 
 
-@dataclass(frozen=True)
-class SelectionSettings:
+@dataclass(frozen=True, repr=False)
+class SelectionSettings(_Settings):
     """Every threshold of :func:`armaxmodal.select_modes`, one object per stage.
 
     Attributes
@@ -317,6 +329,11 @@ class SelectionSettings:
         The one level of the halves', the segments' and the two estimators' tests.
     notes : NoteSettings
         The informative notes' thresholds.
+
+    See Also
+    --------
+    armaxmodal.select_modes : Takes them as ``settings``.
+    armaxmodal.modes.settings.SweepSettings : The sweep's own numbers.
 
     Examples
     --------
@@ -359,8 +376,8 @@ class SelectionSettings:
 DEFAULTS = SelectionSettings()
 
 
-@dataclass(frozen=True)
-class SweepSettings:
+@dataclass(frozen=True, repr=False)
+class SweepSettings(_Settings):
     """The numbers of the stabilisation sweep (:func:`armaxmodal.stabilisation_diagram`), which runs
     before any selection and so stands beside :class:`~armaxmodal.modes.settings.SelectionSettings`,
     not in it; the JSON reports what they made (``orders_na``, ``nk``).
@@ -386,6 +403,11 @@ class SweepSettings:
         The orders swept when none are given, capped at what the record supports.
     min_default_top : int
         A default sweep capped below this top order has too few orders to show stability: refused.
+
+    See Also
+    --------
+    armaxmodal.stabilisation_diagram : The sweep they set.
+    armaxmodal.modes.settings.SelectionSettings : The selection's thresholds.
 
     Examples
     --------

@@ -155,6 +155,10 @@ def refine_modes(recording: Recording, freq_hz, damping, *, band_hz: tuple[float
         The refit, its modes in the order of ``freq_hz``; ``hold_cost``: each tried assumption's
         weighted residual sum of squares where it was decided (after the first steps, or converged).
 
+    See Also
+    --------
+    armaxmodal.estimate.dft_model.fit_modal_model : The fitter it runs.
+
     Examples
     --------
     >>> import armaxmodal as am

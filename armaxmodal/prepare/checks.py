@@ -33,6 +33,11 @@ def check_quality(recording: Recording) -> list[QualityWarning]:
     list of QualityWarning
         The findings, in the order the checks run.
 
+    See Also
+    --------
+    armaxmodal.prepare.prepare : Runs these checks, then detrends, aligns and resamples.
+    armaxmodal.QualityWarning : What each check returns.
+
     Examples
     --------
     >>> import numpy as np

@@ -58,6 +58,11 @@ class Preparation:
         Channel -> samples it was moved earlier at the original rate (positive: it lagged).
     warnings : tuple of QualityWarning
 
+    See Also
+    --------
+    armaxmodal.prepare.prepare : What makes one.
+    armaxmodal.prepare.check_quality : The checks whose notes it carries.
+
     Examples
     --------
     A ride logged at 240 Hz for a 0.5-25 Hz band is fitted at a lower rate:
@@ -140,6 +145,11 @@ def prepare(
     Returns
     -------
     Preparation
+
+    See Also
+    --------
+    armaxmodal.prepare.Preparation : What it returns.
+    armaxmodal.stabilisation_diagram : Prepares the record itself, then sweeps.
 
     Examples
     --------

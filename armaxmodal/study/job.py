@@ -39,6 +39,11 @@ class StudySettings:
     lump : (a, b) or None
         A pair of segments to test for lumping (Chapter 5) where a recording has both.
 
+    See Also
+    --------
+    armaxmodal.study.run_study : Takes them.
+    armaxmodal.study.track_modes : Takes them too.
+
     Examples
     --------
     >>> from armaxmodal.study import StudySettings
@@ -92,6 +97,10 @@ def analyse_recording(rec: Recording, settings: StudySettings, sensors: tuple[st
         ``per_sensor`` (Table 3.2 rows), ``warnings``, ``reconstruction_error`` and
         ``quality`` (the modal-model check's misfit and verdict), ``lump`` and ``figure_png``
         (base64).
+
+    See Also
+    --------
+    armaxmodal.study.run_study : Runs it on every recording.
 
     Examples
     --------

@@ -36,6 +36,10 @@ class Entry:
     labels : dict
         The manifest's other columns.
 
+    See Also
+    --------
+    armaxmodal.study.read_manifest : What makes them.
+
     Examples
     --------
     >>> import tempfile, pathlib
@@ -71,6 +75,10 @@ def read_manifest(source: str | Path) -> tuple[list[Entry], list[dict]]:
     entries : list of Entry
     failures : list of dict
         ``{"file", "reason"}`` for a missing file, a duplicate row or an unusable mass.
+
+    See Also
+    --------
+    armaxmodal.study.run_study : Reads its source with it.
 
     Examples
     --------

@@ -41,6 +41,11 @@ class Study:
     reused : int
         Recordings taken from the cache of an earlier run.
 
+    See Also
+    --------
+    armaxmodal.study.run_study : What makes one.
+    armaxmodal.study.write_study : Its files.
+
     Examples
     --------
     Two subjects' random rides (:func:`~armaxmodal.study.make_study`) analysed:

@@ -130,6 +130,10 @@ def make_study(
     dict
         The truth written to ``truth.json``.
 
+    See Also
+    --------
+    armaxmodal.study.run_study : Analyse what it writes.
+
     Examples
     --------
     >>> import tempfile

@@ -46,6 +46,10 @@ class StudyTables:
     geomean : DataFrame
         Per ride, mode and sensor the geometric mean of the subjects' magnitudes (Fig. 3.7).
 
+    See Also
+    --------
+    armaxmodal.study.build_tables : What makes them.
+
     Examples
     --------
     The ride's modes over two subjects, each body scaled to its subject (``n``: the subjects whose
@@ -96,6 +100,10 @@ def match_modes(freqs: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray]]:
     labels : list of int arrays
         Per recording, the 1-based reference mode of each of its modes, 0 where none fits.
 
+    See Also
+    --------
+    armaxmodal.study.match_tracks : Across events of one structure, by amplitude.
+
     Examples
     --------
     >>> import numpy as np
@@ -134,6 +142,10 @@ def build_tables(recordings: list[dict], sensors) -> StudyTables:
     Returns
     -------
     StudyTables
+
+    See Also
+    --------
+    armaxmodal.study.StudyTables : What it returns.
 
     Examples
     --------
@@ -291,6 +303,10 @@ def summarise_subjects(
     dict
         ``table`` (one row per subject plus ``Average`` and ``SD`` rows, sample SD) and
         ``shape_geomean`` ((n_sensors, n_modes), when shapes are given).
+
+    See Also
+    --------
+    armaxmodal.study.build_tables : Builds Table 3.3 from a study's recordings.
 
     Examples
     --------

@@ -75,6 +75,10 @@ class ChainComponents:
     """Springs and dampers of a chain (Fig. 4.3): element i ties mass i to the base, s_i ties
     masses i and i+1. Units: kg, N/m, N s/m.
 
+    See Also
+    --------
+    armaxmodal.Structure : The chain they build (``Structure.from_chain``).
+
     Examples
     --------
     >>> import armaxmodal as am
@@ -131,6 +135,10 @@ class ExactModes:
     real_poles : (k,) float
         Real (over-damped) poles, rad/s; empty for an under-damped structure.
     names : tuple of str
+
+    See Also
+    --------
+    armaxmodal.Structure : Whose modes they are.
 
     Examples
     --------
@@ -212,6 +220,11 @@ class Structure:
         Stiffness matrix, symmetric positive definite (N/m).
     names : sequence of str, optional
         One name per degree of freedom (default ``dof1..dofn``).
+
+    See Also
+    --------
+    armaxmodal.simulate_recording : Simulate a record of it.
+    armaxmodal.ExactModes : Its exact modes.
 
     Examples
     --------

@@ -265,3 +265,19 @@ def test_a_mode_the_check_drops_twice_is_one_doubt_with_its_first_note():
     from armaxmodal.modes.frf import each_once
 
     assert each_once(doubts) == ((5.99, 0.13, first), (8.57, 0.03, other))
+
+
+def test_settings_print_what_was_tuned_and_signatures_stay_short():
+    """A default settings object prints as its bare constructor (the API's signatures read
+    ``settings=SelectionSettings()``, not every threshold); a tuned one names the tuned value and
+    no other, nested or not; the value still round-trips through ``eval``."""
+    from armaxmodal.modes.settings import CountSettings, SelectionSettings, SweepSettings
+
+    assert repr(SelectionSettings()) == "SelectionSettings()" and repr(SweepSettings()) == "SweepSettings()"
+    tuned = SelectionSettings(count=CountSettings(decisive_bic=20.0), cluster=ClusterSettings(min_orders=8))
+    assert repr(tuned) == (
+        "SelectionSettings(cluster=ClusterSettings(min_orders=8), count=CountSettings(decisive_bic=20.0))"
+    )
+    namespace = {"SelectionSettings": SelectionSettings, "CountSettings": CountSettings,
+                 "ClusterSettings": ClusterSettings}  # fmt: skip
+    assert eval(repr(tuned), namespace) == tuned
