@@ -56,6 +56,21 @@ import track_bridges as _track_bridges  # noqa: E402
 
 _track_bridges.write_page()
 
+def _glossary_page() -> str:
+    """The glossary, written from the terms the reports print (:data:`armaxmodal.io.report.glossary.TERMS`)."""
+    from armaxmodal.io.report.glossary import TERMS
+
+    lines = ["# Glossary", "", "The terms the command line, the JSON and the reports use (each report ends with",
+             "this list; this page is generated from the same definitions when the docs build).", ""]  # fmt: skip
+    for term, text in TERMS.items():
+        lines += [f"**{term}**", f": {text}", ""]
+    return "\n".join(lines)
+
+
+_glossary = Path(__file__).parent / "user_guide" / "glossary.md"
+if not _glossary.exists() or _glossary.read_text() != _glossary_page():
+    _glossary.write_text(_glossary_page())
+
 _page = Path(__file__).parent / "user_guide" / "warnings.md"
 if not _page.exists() or _page.read_text() != _warning_page():
     _page.write_text(_warning_page())
@@ -82,7 +97,7 @@ templates_path = ["_templates"]
 exclude_patterns = ["_build", "examples", "auto_examples/*.ipynb", "auto_examples/*.py", "auto_examples/*.zip"]
 myst_heading_anchors = 3
 # $...$ and $$...$$ for the method page's equations (rendered by MathJax)
-myst_enable_extensions = ["dollarmath"]
+myst_enable_extensions = ["dollarmath", "deflist"]
 suppress_warnings = ["myst.header"]
 
 autosummary_generate = True

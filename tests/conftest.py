@@ -45,9 +45,10 @@ def light_ride():
     return s, am.simulate_recording(s, u, 50.0, noise=0.02, seed=4, hold="bandlimited")
 
 
-def open_in_headless_chromium(page: Path, profile: Path):
+def open_in_headless_chromium(page: Path, profile: Path, width: int = 1400):
     """``(dom, console errors)`` of an HTML file opened in headless Chromium (Debian package
-    'chromium'), or a skip where it is not installed: the reports are looked at as a reader would."""
+    'chromium'), or a skip where it is not installed: the reports are looked at as a reader would, in a
+    window ``width`` pixels wide."""
     import shutil
     import subprocess
 
@@ -56,6 +57,6 @@ def open_in_headless_chromium(page: Path, profile: Path):
         pytest.skip("Chromium not installed (Debian package 'chromium'); the static checks ran")
     flags = ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking",
              "--disable-component-update", "--disable-sync", f"--user-data-dir={profile}", "--enable-logging=stderr",
-             "--v=0", "--virtual-time-budget=5000", "--dump-dom"]  # fmt: skip
+             "--v=0", "--virtual-time-budget=5000", f"--window-size={width},900", "--dump-dom"]  # fmt: skip
     run = subprocess.run([chromium, *flags, page.as_uri()], capture_output=True, text=True, timeout=120)
     return run.stdout, [line for line in run.stderr.splitlines() if "CONSOLE" in line and "rror" in line]

@@ -28,12 +28,20 @@ def test_stabilise_writes_a_self_contained_report_a_browser_shows(fixtures_dir, 
     # a setting the run did not use is left out, not shown empty; no picks, no picks column
     assert "band (Hz)" not in html and "picked at" not in html and "picks (Hz)" not in html
     assert "<td>detrend</td>" in html
-    # the modes table holds the JSON's numbers
+    # the modes table holds the JSON's numbers, each quantity at one precision (its interval too)
     record = __import__("json").loads((tmp_path / "m.json").read_text())
     for mode in record["modes"]:
-        assert f"{mode['freq_hz']:.5g}" in html
-    dom, console_errors = open_in_headless_chromium(page, tmp_path / "profile")
-    assert 'data-figures="2/2"' in dom and not console_errors
+        lo, hi = mode["freq_ci95"]
+        assert f"<td>{mode['freq_hz']:.3f}</td>" in html and f"<td>[{lo:.3f}, {hi:.3f}]</td>" in html
+        assert f"<td>{mode['damping']:.4f}</td>" in html
+    # a glossary of its terms, the one the docs print
+    from armaxmodal.io.report.glossary import TERMS
+
+    assert "<h2 id=glossary>Glossary" in html and all(f"<dt>{term}</dt>" in html for term in ("H1", "LSFD", "nk"))
+    assert len(TERMS) >= 15
+    for width in (390, 1400):  # a phone and a desktop: nothing runs off the screen, the figures load
+        dom, console_errors = open_in_headless_chromium(page, tmp_path / f"profile{width}", width)
+        assert 'data-figures="2/2"' in dom and 'data-overflow="no"' in dom and not console_errors
 
 
 @pytest.mark.parametrize("report, message", [("run.txt", "expected an .html file name"),
@@ -68,8 +76,12 @@ def test_the_report_groups_the_notes_by_code_what_moves_the_verdict_first(tmp_pa
     assert "<li>first text</li><li>second</li>" in html and "<li>resampled by 1/9</li>" in html
     from armaxmodal.quality_warnings import CODES
 
+    from armaxmodal.io.report.html_page import marked_up
+
     advice = next(c.advice for c in CODES if c.code == "count_undecided")
-    assert f"<p>{__import__('html').escape(advice)}</p>" in html
+    assert f"<p>{marked_up(advice)}</p>" in html
+    notes = [am.QualityWarning("drift", ("pelvis",), "rerun with `--detrend linear` & look")]
+    assert "<li>rerun with <code>--detrend linear</code> &amp; look</li>" in _notes(notes)  # no raw backticks
 
 
 def test_the_report_of_an_uncertain_run_shows_its_notes_in_a_browser(fixtures_dir, tmp_path):

@@ -6,10 +6,11 @@ from __future__ import annotations
 import base64
 import html
 import io
+import re
 
 import pandas as pd
 
-__all__ = ["STYLE", "SCRIPT", "figure_uri", "page", "table"]
+__all__ = ["STYLE", "SCRIPT", "figure_uri", "marked_up", "page", "table"]
 
 STYLE = """
 body{font-family:system-ui,sans-serif;margin:2em auto;max-width:1200px;padding:0 1em;color:#222}
@@ -22,6 +23,8 @@ figure{margin:0;text-align:center;font-size:0.8em}.thumbs img{width:260px;cursor
 #full.on{display:flex}#full img{max-width:95vw;max-height:95vh;background:#fff}
 .fail{color:#900}.note{color:#555}img{max-width:100%}.wide{overflow-x:auto}
 .verdict{font-size:1.15em;padding:.5em .8em;border-left:6px solid #888;background:#f7f7f7}
+.text td{overflow-wrap:anywhere}.text td:first-child{overflow-wrap:normal;white-space:nowrap}code{background:#f3f3f3;padding:0 .2em}
+dl.glossary dt{font-weight:bold;margin-top:.5em}dl.glossary dd{margin-left:1.2em}
 .verdict.good{border-color:#2a7}.verdict.uncertain{border-color:#d90}.verdict.poor{border-color:#c22}
 """
 SCRIPT = """
@@ -31,7 +34,8 @@ var full=document.getElementById('full');
 if(full){full.addEventListener('click',function(){this.classList.remove('on');});}
 window.addEventListener('load',function(){var imgs=[].slice.call(document.querySelectorAll('img[src]'));
 var ok=imgs.filter(function(i){return i.complete&&i.naturalWidth>0;}).length;
-document.documentElement.dataset.figures=ok+'/'+imgs.length;});
+document.documentElement.dataset.figures=ok+'/'+imgs.length;
+document.documentElement.dataset.overflow=document.documentElement.scrollWidth>window.innerWidth?'yes':'no';});
 """
 
 
@@ -42,10 +46,31 @@ def figure_uri(fig, dpi: int = 90) -> str:
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
 
-def table(frame: pd.DataFrame, digits: int = 4) -> str:
-    """A DataFrame as an HTML table (missing values shown as X), scrolling when wide."""
+def marked_up(text: str) -> str:
+    """A note's text as HTML: escaped, its `code` spans set as code, not shown as backticks.
+
+    Parameters
+    ----------
+    text : str
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from armaxmodal.io.report.html_page import marked_up
+    >>> marked_up("widen `--orders` & retry")
+    'widen <code>--orders</code> &amp; retry'
+    """
+    return re.sub(r"`([^`]+)`", r"<code>\1</code>", html.escape(text))
+
+
+def table(frame: pd.DataFrame, digits: int = 4, text: bool = False) -> str:
+    """A DataFrame as an HTML table (missing values shown as X), scrolling when wide; ``text``: a
+    table of words (a command, a checksum, a path), whose long cells wrap on a narrow screen."""
     html_table = frame.to_html(index=False, na_rep="X", float_format=lambda v: f"{v:.{digits}g}", border=0)
-    return f"<div class=wide>{html_table}</div>"
+    return f"<div class='wide{' text' if text else ''}'>{html_table}</div>"
 
 
 def page(title: str, body: str) -> str:

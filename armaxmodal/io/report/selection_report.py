@@ -5,7 +5,8 @@ The page holds, under a list of its sections: the verdict; what made it (the pac
 date, the command and the input's checksum); the record (input, outputs, rates); the notes, one
 group per code with how it moves the verdict, what to do and every full text; the stabilisation
 diagram over the FRF; the modes with their intervals; the modal-model check per output; the shapes;
-and the settings of the run that were used. MNE-Python's ``Report`` is the model.
+the settings of the run that were used; and a glossary of its terms. MNE-Python's ``Report`` is the
+model.
 """
 
 from __future__ import annotations
@@ -15,24 +16,28 @@ import html
 import numpy as np
 import pandas as pd
 
-from armaxmodal.io.report.html_page import figure_uri, page, table
+from armaxmodal.io.report.glossary import glossary_html
+from armaxmodal.io.report.html_page import figure_uri, marked_up, page, table
 
 __all__ = ["render_selection_report", "modes_table"]
 
 
 def modes_table(selection) -> pd.DataFrame:
-    """The modes as a person reads them: frequency and damping with their 95 % intervals, the
-    estimator, and whether the mode was picked by hand."""
+    """The modes as a person reads them: frequency and damping with their 95 % intervals, each
+    quantity at one precision (frequencies to 1 mHz, damping ratios to 1e-4), the estimator, and
+    whether the mode was picked by hand."""
     m = selection.modes
     freq_ci = zip(m.freq_ci95_lo, m.freq_ci95_hi, strict=True)
     damping_ci = zip(m.damping_ci95_lo, m.damping_ci95_hi, strict=True)
-    out = pd.DataFrame({
-        "mode": np.arange(1, len(m) + 1),
-        "f (Hz)": m.freq_hz.to_numpy(float),
-        "f 95 % interval (Hz)": [f"[{lo:.4g}, {hi:.4g}]" for lo, hi in freq_ci],
-        "damping": m.damping.to_numpy(float),
-        "damping 95 % interval": [f"[{lo:.3g}, {hi:.3g}]" for lo, hi in damping_ci],
-    })  # fmt: skip
+    out = pd.DataFrame(
+        {
+            "mode": np.arange(1, len(m) + 1),
+            "f (Hz)": [f"{f:.3f}" for f in m.freq_hz],
+            "f 95 % interval (Hz)": [f"[{lo:.3f}, {hi:.3f}]" for lo, hi in freq_ci],
+            "damping": [f"{x:.4f}" for x in m.damping],
+            "damping 95 % interval": [f"[{lo:.4f}, {hi:.4f}]" for lo, hi in damping_ci],
+        }
+    )
     if "estimator" in m:
         out["estimator"] = m.estimator.to_numpy()
     if "picked_hz" in m and np.isfinite(m.picked_hz.to_numpy(float)).any():
@@ -59,8 +64,8 @@ def _notes(warnings) -> str:
     items = []  # what moves the verdict first, then by the stage that raised it
     for code in sorted(groups, key=lambda c: (effect(c), order.get(c, len(order)))):
         spec, texts, level = known.get(code), groups[code], effect(code)
-        advice = f"<p>{esc(spec.advice)}</p>" if spec is not None else ""
-        full = "".join(f"<li>{esc(w.message)}</li>" for w in texts)
+        advice = f"<p>{marked_up(spec.advice)}</p>" if spec is not None else ""
+        full = "".join(f"<li>{marked_up(w.message)}</li>" for w in texts)
         items.append(f"<details{' open' if level < 2 else ''}><summary><b>{esc(code)}</b> ({len(texts)}): "
                      f"{effects[level]}</summary>{advice}<ul>{full}</ul></details>")  # fmt: skip
     return "".join(items) or "<p>none</p>"
@@ -79,10 +84,21 @@ def _made_by(provenance: dict) -> pd.DataFrame:
 
 
 def _check_table(check) -> pd.DataFrame:
-    return pd.DataFrame({
-        "output": list(check.sensors), "misfit (%)": 100 * check.error, "H1 random error (%)": 100 * check.random_error,
-        "model error (%)": 100 * check.model_error, "delay (ms)": 1e3 * check.delay_s, "lines": check.n_lines,
-    })  # fmt: skip
+    """Per output the check's percentages to 0.1 %, its delay to 0.1 ms and its lines."""
+
+    def tenths(values) -> list[str]:
+        return [f"{v:.1f}" for v in values]
+
+    return pd.DataFrame(
+        {
+            "output": list(check.sensors),
+            "misfit (%)": tenths(100 * check.error),
+            "H1 random error (%)": tenths(100 * check.random_error),
+            "model error (%)": tenths(100 * check.model_error),
+            "delay (ms)": tenths(1e3 * check.delay_s),
+            "lines": check.n_lines,
+        }
+    )
 
 
 def _record_table(selection, source: str) -> pd.DataFrame:
@@ -142,7 +158,7 @@ def render_selection_report(selection, verdict: str, source: str, settings: dict
         plt.close(fig)
     n_modes = len(selection.modes)
     sections = [
-        ("record", "The record", table(_record_table(selection, source))),
+        ("record", "The record", table(_record_table(selection, source), text=True)),
         ("notes", f"Notes ({len(selection.warnings)})", _notes(selection.warnings)),
         ("diagram", "Stabilisation diagram over the measured FRF", f"<img alt='diagram' src='{diagram}'>"),
         ("modes", f"Modes ({n_modes})", table(modes_table(selection), 5) if n_modes else "<p>none</p>"),
@@ -150,10 +166,11 @@ def render_selection_report(selection, verdict: str, source: str, settings: dict
          else table(_check_table(selection.check), 3)),
         ("shapes", "Mode shapes", f"<img alt='mode shapes' src='{shapes}'>" if shapes else None),
         ("settings", "Settings", table(_settings_table(selection, settings or {}))),
+        ("glossary", "Glossary", glossary_html()),
     ]  # fmt: skip
     sections = [(key, title, content) for key, title, content in sections if content is not None]
     nav = " · ".join(f"<a href='#{key}'>{esc(title)}</a>" for key, title, _ in sections)
     body = (f"<h1>armaxmodal stabilise: {esc(source)}</h1><p class=\"verdict {esc(selection.quality)}\">{esc(verdict)}"
-            f"</p>{table(_made_by(provenance or {}))}<nav>{nav}</nav>"
+            f"</p>{table(_made_by(provenance or {}), text=True)}<nav>{nav}</nav>"
             + "".join(f"<h2 id={key}>{esc(title)}</h2>{content}" for key, title, content in sections))  # fmt: skip
     return page(f"armaxmodal stabilise: {source}", body)
