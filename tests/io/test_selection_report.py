@@ -74,9 +74,8 @@ def test_the_report_groups_the_notes_by_code_what_moves_the_verdict_first(tmp_pa
     assert "<details open><summary><b>count_undecided</b> (2): makes the verdict uncertain" in html
     assert "<details><summary><b>resampled</b> (1): informative" in html
     assert "<li>first text</li><li>second</li>" in html and "<li>resampled by 1/9</li>" in html
-    from armaxmodal.quality_warnings import CODES
-
     from armaxmodal.io.report.html_page import marked_up
+    from armaxmodal.quality_warnings import CODES
 
     advice = next(c.advice for c in CODES if c.code == "count_undecided")
     assert f"<p>{marked_up(advice)}</p>" in html

@@ -23,7 +23,8 @@ figure{margin:0;text-align:center;font-size:0.8em}.thumbs img{width:260px;cursor
 #full.on{display:flex}#full img{max-width:95vw;max-height:95vh;background:#fff}
 .fail{color:#900}.note{color:#555}img{max-width:100%}.wide{overflow-x:auto}
 .verdict{font-size:1.15em;padding:.5em .8em;border-left:6px solid #888;background:#f7f7f7}
-.text td{overflow-wrap:anywhere}.text td:first-child{overflow-wrap:normal;white-space:nowrap}code{background:#f3f3f3;padding:0 .2em}
+.text td{overflow-wrap:anywhere}.text td:first-child{overflow-wrap:normal;white-space:nowrap}
+code{background:#f3f3f3;padding:0 .2em}
 dl.glossary dt{font-weight:bold;margin-top:.5em}dl.glossary dd{margin-left:1.2em}
 .verdict.good{border-color:#2a7}.verdict.uncertain{border-color:#d90}.verdict.poor{border-color:#c22}
 """
