@@ -136,6 +136,39 @@ def order_range(text: str) -> range:
     return range(lo, hi + 1, 2)
 
 
+def model_orders(text: str) -> tuple[int, int, int, int] | None:
+    """``--model``: ``'auto'`` (None: chosen by BIC) or the four orders ``na,nb,nc,nk``.
+
+    Parameters
+    ----------
+    text : str
+
+    Returns
+    -------
+    tuple of int or None
+
+    Raises
+    ------
+    OrderError
+        Not 'auto' and not four integers.
+
+    Examples
+    --------
+    >>> from armaxmodal.cli.common import model_orders
+    >>> model_orders("6,12,6,-5"), model_orders("auto")
+    ((6, 12, 6, -5), None)
+    """
+    if text == "auto":
+        return None
+    try:
+        orders = tuple(int(v) for v in text.split(","))
+    except ValueError as exc:
+        raise OrderError(f"--model: expected 'auto' or na,nb,nc,nk, got {text!r}.") from exc
+    if len(orders) != 4:
+        raise OrderError(f"--model: expected four integers na,nb,nc,nk, got {text!r}.")
+    return orders  # type: ignore[return-value]
+
+
 #: a note's line on the terminal, and how many lines of codes fit one screen with the header
 NOTE_WIDTH, NOTE_LINES = 100, 23
 

@@ -10,12 +10,14 @@ from armaxmodal.cli.common import (
     add_data_args,
     check_report_path,
     load_recording,
+    model_orders,
     output_format,
     parse_pair,
     print_notes,
     write_outputs,
 )
 from armaxmodal.diagnosis.report import short_parameters
+from armaxmodal.exceptions import DataError
 from armaxmodal.io.write import write_json
 
 
@@ -27,6 +29,9 @@ def add_parser(sub, parents) -> None:
     add_data_args(p)
     p.add_argument("--band", default=None, help="frequency band LO:HI in Hz (sets the analysis rate)")
     p.add_argument("--max-rounds", type=NONNEG_INT, default=3, help="effects added at most; default 3")
+    p.add_argument("--model", default="auto",
+                   help="the model to diagnose, na,nb,nc,nk (shared poles), or 'auto' (orders by BIC); default auto. "
+                   "An order too low tries the loop's missing mode: 6,12,6,-5 on the supine ride")  # fmt: skip
     p.add_argument("--json", default=None, help="write the diagnosis as JSON")
     p.add_argument("--plot", default=None, help="figure page (.png/.svg/.pdf)")
     p.add_argument("--report", default=None, help="one self-contained HTML page of the diagnosis (.html)")
@@ -41,8 +46,18 @@ def run(args) -> int:
     band = check_band(parse_pair(args.band, "--band")) if args.band else None
     if args.report:
         check_report_path(args.report)
+    orders = model_orders(args.model)
+    if orders is not None and band is not None:
+        raise DataError("--model with --band: the model is fitted at the record's own rate, the band resamples it; "
+                        "give one of them.")  # fmt: skip
     rec = load_recording(args)
-    result = diagnose(rec, band=band, max_rounds=args.max_rounds, progress=args.verbose and not args.quiet)
+    baseline = None
+    if orders is not None:
+        from armaxmodal.estimate.fit import fit_armax
+
+        baseline = fit_armax(rec, *orders, shared_poles=True, warn=False)
+    result = diagnose(rec, band=band, max_rounds=args.max_rounds, baseline=baseline,
+                      progress=args.verbose and not args.quiet)  # fmt: skip
     print_notes(result.warnings, args.verbose)
     report = result.to_dict()
     print(_diagnosis_text(args.data, report))

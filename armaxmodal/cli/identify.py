@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from armaxmodal.cli.common import DETREND_HELP, add_data_args, load_recording, parse_pair, print_notes
+from armaxmodal.cli.common import DETREND_HELP, add_data_args, load_recording, model_orders, parse_pair, print_notes
 from armaxmodal.cli.stabilise import print_check
-from armaxmodal.exceptions import OrderError
 from armaxmodal.io.write import write_all, write_json
 from armaxmodal.modes.result import verdict
 
@@ -29,14 +28,7 @@ def run(args) -> int:
     from armaxmodal.identification import identify
 
     rec = load_recording(args)
-    orders = None
-    if args.model != "auto":
-        try:
-            orders = tuple(int(v) for v in args.model.split(","))
-        except ValueError as exc:
-            raise OrderError(f"--model: expected 'auto' or na,nb,nc,nk, got {args.model!r}.") from exc
-        if len(orders) != 4:
-            raise OrderError(f"--model: expected four integers na,nb,nc,nk, got {args.model!r}.")
+    orders = model_orders(args.model)
     band = parse_pair(args.band, "--band") if args.band else None
     result = identify(rec, orders, band=band, progress=not args.quiet, detrend=args.detrend)
     print_notes(result.warnings, args.verbose)

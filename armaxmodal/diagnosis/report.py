@@ -15,13 +15,30 @@ __all__ = ["effects_table", "render_diagnosis_report", "short_parameters"]
 
 
 def short_parameters(params: dict) -> str:
-    """A fix's parameters as a person reads them: numbers to 4 significant digits."""
+    """A fix's parameters as a person reads them: numbers to 4 significant digits, nested ones too.
+
+    Parameters
+    ----------
+    params : dict
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from armaxmodal.diagnosis.report import short_parameters
+    >>> short_parameters({"na": 8, "added_modes": [{"freq_hz": 15.887815, "damping": 0.26535077}]})
+    'na 8, added_modes [(freq_hz 15.89, damping 0.2654)]'
+    """
 
     def fmt(v):
         if isinstance(v, float):
             return f"{v:.4g}"
         if isinstance(v, list):
             return "[" + ", ".join(fmt(x) for x in v) + "]"
+        if isinstance(v, dict):  # an added mode, say: its numbers rounded like the rest
+            return "(" + ", ".join(f"{k} {fmt(x)}" for k, x in v.items()) + ")"
         return str(v)
 
     return ", ".join(f"{k} {fmt(v)}" for k, v in params.items())

@@ -724,3 +724,19 @@ def test_outliers_other_sensors_share_are_not_one_sensors_glitches():
     rate = float(np.mean(np.convolve(shared.max(axis=1) > SHARED_LEVEL, np.ones(7), mode="same") > 0))
     assert shared_by_others(at, shared) == pytest.approx(binom.sf(9, 10, rate), rel=1e-9) and rate < 0.1
     assert shared_by_others(at[:2], shared) == 1.0 and shared_by_others(at, np.zeros((n, 0))) == 1.0
+
+
+def test_a_model_one_mode_short_is_tried_from_the_command_line(fixtures_dir, tmp_path, capsys):
+    """``diagnose --model`` diagnoses the model given: one mode short, the loop names the missing
+    mode first and adds one near the exact mode it lacks; with --band the model is refused up front."""
+    out = tmp_path / "d.json"
+    data = str(fixtures_dir / "supine_random.csv")
+    assert main(["--quiet", "diagnose", data, "--model", "6,12,6,-5", "--json", str(out)]) == 0
+    first = capsys.readouterr().out.splitlines()[1]
+    assert first.startswith("verdict: found and confirmed: unmodelled_mode")
+    effect = json.loads(out.read_text())["effects"][0]
+    (added,) = effect["parameters"]["added_modes"]
+    assert np.min(np.abs(am.supine_human().modes().freq_hz / added["freq_hz"] - 1)) < 0.03
+    assert main(["--quiet", "diagnose", data, "--model", "6,12,6", "--json", str(out)]) == 2
+    assert main(["--quiet", "diagnose", data, "--model", "6,12,6,-5", "--band", "0.5:25"]) == 2
+    assert "--model with --band" in capsys.readouterr().err
