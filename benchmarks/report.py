@@ -41,7 +41,7 @@ def peer_rows() -> list[str]:
         return [(f"(not run) | | no saved result (`{PEERS}`) | |", "")]
     record = json.loads(path.read_text())
     machine = record["machine_info"]
-    when = (f"{record['datetime'][:10]}, {record['commit_info']['id'][:7]}, {machine['cpu'].get('count', '?')} "
+    when = (f"{record['datetime'][:10]}, {machine['cpu'].get('count', '?')} "
             f"cores, {machine['machine']}, Python {machine['python_version']}")  # fmt: skip
     groups: dict[str, dict] = {}
     for bench in record["benchmarks"]:
@@ -69,7 +69,7 @@ def ratio_table() -> str:
             continue
         record = json.loads(path.read_text())
         for row in record["rows"]:
-            when = f"`{command}`, {record['date']}, {record['commit']}, {record['machine']}"
+            when = f"`{command}`, {record['date']}, {record['machine']}"
             rows.append((f"{row['what']} | {row['goal']} | {row['measured']} | {_met(row['met'])} |", when))
     table = [*HEADER, *(f"| {k} | {cells}" for k, (cells, _) in enumerate(rows, 1))]
     measured_on = [f"{k}. {when}" for k, (_, when) in enumerate(rows, 1) if when]
@@ -120,12 +120,48 @@ def expectations() -> str:
     return "\n".join(f"- {item}" for item in items) + "\n"
 
 
+GOAL = re.compile(r"(<=|>=)\s*([\d.]+)")
+FIGURE = HERE.parent / "docs" / "generated_results" / "performance.png"
+
+
+def ratios_figure() -> Path:
+    """Each saved ratio against its target, as the share of the target it uses (at most 1 meets it)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    labels, shares = [], []
+    for name in SCRIPTS:
+        path = RESULTS / f"{name}.json"
+        for row in json.loads(path.read_text())["rows"] if path.is_file() else []:
+            goal = GOAL.search(row["goal"])
+            measured = re.search(r"median ([\d.]+)", row["measured"]) or re.match(r"([\d.]+)", row["measured"])
+            if goal is None or measured is None:
+                continue
+            value, target = float(measured.group(1)), float(goal.group(2))
+            shares.append(value / target if goal.group(1) == "<=" else target / value)
+            labels.append(row["what"][:60] + ("..." if len(row["what"]) > 60 else ""))
+    fig, ax = plt.subplots(figsize=(8, 0.5 + 0.45 * len(shares)))
+    ax.barh(range(len(shares)), shares, color=["#2a7" if s <= 1 else "#c22" for s in shares])
+    ax.axvline(1, color="k", lw=1)
+    ax.set_yticks(range(len(shares)), labels, fontsize=8)
+    ax.set_xlabel("share of the target used (at most 1: met)")
+    fig.tight_layout()
+    FIGURE.parent.mkdir(exist_ok=True)
+    fig.savefig(FIGURE, dpi=90)
+    plt.close(fig)
+    return FIGURE
+
+
 def write() -> Path:
-    """Write the generated part of the performance page (only when it changed)."""
+    """Write the generated part of the performance page (only when it changed), and its figure."""
+    ratios_figure()
     intro = "On this project's 2-core machine (each figure from the last run of its benchmark):"
     text = ("<!-- written by benchmarks/report.py from benchmarks/results/*.json; do not edit -->\n\n"
             + f"## What to expect\n\n{intro}\n\n" + expectations()
-            + "\n## Against their targets and peers\n\n" + ratio_table())  # fmt: skip
+            + "\n## Against their targets and peers\n\n"
+            + "![Each ratio against its target](generated_results/performance.png)\n\n" + ratio_table())  # fmt: skip
     if not PAGE.is_file() or PAGE.read_text() != text:
         PAGE.write_text(text)
     return PAGE

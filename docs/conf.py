@@ -56,6 +56,12 @@ import track_bridges as _track_bridges  # noqa: E402
 
 _track_bridges.write_page()
 
+# the validation pages' tables and figures, from the saved results of their scripts
+sys.path.insert(0, str(ROOT / "tools"))
+import validation_pages as _validation_pages  # noqa: E402
+
+_validation_pages.write()
+
 def _glossary_page() -> str:
     """The glossary, written from the terms the reports print (:data:`armaxmodal.io.report.glossary.TERMS`)."""
     from armaxmodal.io.report.glossary import TERMS
@@ -94,7 +100,8 @@ extensions = [
 ]
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 templates_path = ["_templates"]
-exclude_patterns = ["_build", "examples", "auto_examples/*.ipynb", "auto_examples/*.py", "auto_examples/*.zip"]
+exclude_patterns = ["_build", "examples", "generated_results/*.md", "auto_examples/*.ipynb", "auto_examples/*.py",
+                    "auto_examples/*.zip"]
 myst_heading_anchors = 3
 # $...$ and $$...$$ for the method page's equations (rendered by MathJax)
 myst_enable_extensions = ["dollarmath", "deflist"]

@@ -55,6 +55,8 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=40)
     parser.add_argument("--hold", choices=["zoh", "bandlimited"], default="zoh")
     parser.add_argument("--duration", type=float, default=120.0)
+    parser.add_argument("--results", help="write each mode's coverage to this JSON file (the validation page is "
+                        "drawn from benchmarks/results/validation/mc_coverage_<hold>.json)")  # fmt: skip
     args = parser.parse_args()
     structure = am.supine_human()
     truth = structure.modes().to_frame()
@@ -76,11 +78,31 @@ def main() -> None:
             f"| {k + 1} | {f:.2f} / {x:.3f} | {found.sum()}/{len(r)} | {np.mean(got[:, 1]):.0%} | "
             f"{np.mean(got[:, 2]):.0%} | {np.mean(got[:, 3]):.0%} | {ratio_f:.2f} | {ratio_x:.2f} |"
         )
+    if args.results:
+        _write_results(args, truth, r)
     all_found = r[r[:, :, 0] == 1]
     print(
         f"overall: frequency coverage {np.mean(all_found[:, 1]):.1%}, damping coverage "
         f"{np.mean(all_found[:, 2]):.1%} over {len(all_found)} found modes; {time.perf_counter() - start:.0f} s"
     )
+
+
+def _write_results(args, truth, r) -> None:
+    import json
+    from pathlib import Path
+
+    from armaxmodal.io.write import strict_json
+
+    modes = []
+    for k, (f, x) in enumerate(zip(truth.freq_hz, truth.damping, strict=True)):
+        got = r[r[:, k, 0] == 1, k]
+        modes.append({"freq_hz": float(f), "damping": float(x), "found": int(len(got)), "rides": int(len(r)),
+                      "freq_covered": float(np.mean(got[:, 1])), "damping_covered": float(np.mean(got[:, 2])),
+                      "freq_sd_over_se": float(np.std(got[:, 4], ddof=1) / np.mean(got[:, 6])),
+                      "damping_sd_over_se": float(np.std(got[:, 5], ddof=1) / np.mean(got[:, 7]))})  # fmt: skip
+    summary = {"hold": args.hold, "seeds": args.seeds, "duration_s": args.duration, "modes": modes,
+               "armaxmodal_version": am.__version__}  # fmt: skip
+    Path(args.results).write_text(json.dumps(strict_json(summary), indent=1, allow_nan=False) + "\n")
 
 
 if __name__ == "__main__":

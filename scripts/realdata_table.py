@@ -103,7 +103,11 @@ def _run(args: list[str]) -> tuple[dict | None, float, str]:
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--shared", default=str(ROOT.parent / "shared"))
-    real = Path(parser.parse_args().shared) / "realdata"
+    parser.add_argument("--results", help="write every run's modes and verdict to this JSON file (the validation "
+                        "page is drawn from benchmarks/results/validation/realdata.json)")  # fmt: skip
+    options = parser.parse_args()
+    real = Path(options.shared) / "realdata"
+    results = []
     f16 = ["--input", "Force", "--outputs", "Acceleration_1,Acceleration_2,Acceleration_3", "--orders", "2:50"]
     runs = {
         f"F-16 multisine level {k}": [str(real / "f16_gvt" / f"F16Data_FullMSine_Level{k}.mat"), *f16]
@@ -120,6 +124,7 @@ def main() -> None:
         print("|---|---|---|---|---|---|")
         for name, args in runs.items():
             data, elapsed, err = _run(args)
+            results.append(_result(name, data, elapsed, err))
             if data is None:
                 print(f"| {name} | | failed: {err} | | | {elapsed:.1f} s |")
                 continue
@@ -127,6 +132,21 @@ def main() -> None:
             flagged = ", ".join(f"{m['freq_hz']:.2f}" for m in data["modes"] if m.get("model_error_dominates")) or "-"
             codes = ", ".join(sorted({w["code"] for w in data["warnings"]})) or "-"
             print(f"| {name} | {data['analysis_fs']:.4g} Hz | {modes} | {flagged} | {codes} | {elapsed:.1f} s |")
+    if options.results:
+        from armaxmodal import __version__
+        from armaxmodal.io.write import strict_json
+
+        summary = {"runs": results, "armaxmodal_version": __version__}
+        Path(options.results).write_text(json.dumps(strict_json(summary), indent=1, allow_nan=False) + "\n")
+
+
+def _result(name: str, data: dict | None, elapsed: float, err: str) -> dict:
+    """One run for the validation page: its modes with their intervals, verdict, notes and time."""
+    if data is None:
+        return {"record": name, "failed": err, "seconds": elapsed}
+    modes = [{"freq_hz": m["freq_hz"], "freq_ci95": m["freq_ci95"], "damping": m["damping"]} for m in data["modes"]]
+    return {"record": name, "analysis_fs": data["analysis_fs"], "quality": data["quality"], "modes": modes,
+            "codes": sorted({w["code"] for w in data["warnings"]}), "seconds": elapsed}  # fmt: skip
 
 
 if __name__ == "__main__":

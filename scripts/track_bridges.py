@@ -211,7 +211,7 @@ def write_page() -> Path:
         "# Bridges under earthquakes",
         "",
         "Three overpasses of the California strong-motion network, twelve earthquakes between them",
-        "(`../shared/realdata/bridge_*`, CSMIP's corrected records). Each bridge's events go through",
+        "(CSMIP's corrected records, in the project's shared data folder). Each bridge's events go through",
         "one `track` run, as a structural engineer would run it:",
         "",
         "```bash",

@@ -30,6 +30,10 @@ PAGES = {
     "validation/simulated.html": "Validation: simulated systems",
     "validation/real.html": "Validation: measured records",
     "validation/limits.html": "Validation: limits",
+    "validation/bridges.html": "Bridges under earthquakes",
+    "user_guide/track.html": "Many events of one structure",
+    "user_guide/glossary.html": "Glossary",
+    "measurement_log.html": "Measurement log",
     "user_guide/warnings.html": "Notes and warning codes",
     "user_guide/cli.html": "Command-line reference",
     "performance.html": "Performance",
@@ -66,6 +70,43 @@ PRE = re.compile(r"<pre[^>]*>(.*?)</pre>", re.S)
 #: the development's own bookkeeping, which a user page should not show: issue numbers and paths
 #: outside the repository (the changelog, a dated development record, may name issues)
 INTERNALS = re.compile(r"\bissues? #?\d+|\.\./shared|/work/")
+
+
+#: the history of the work, which belongs in the development notes: a commit's short hash, a round of work
+COMMIT = re.compile(r"\b(?=[0-9a-f]{7,12}\b)(?=[0-9a-f]*[a-f])[0-9a-f]*[0-9][0-9a-f]*\b")
+ROUND = re.compile(r"\b(?:sessions?|rounds? of (?:the )?work)\b", re.I)
+#: the pages that keep that history (dated notes, the measurement log) and say which version holds what
+DEVELOPMENT = {"changelog.html", "measurement_log.html", "release_notes.html"}
+#: pages that must show what they measure in at least one figure, within a reader's length
+MEASURED = ("validation/simulated.html", "validation/real.html", "validation/limits.html",
+            "validation/bridges.html", "performance.html")  # fmt: skip
+MAX_LINES = 300
+INCLUDE = re.compile(r"^```\{include\}\s+(\S+)", re.M)
+
+
+def history(dom: str) -> list[str]:
+    """Commit hashes and rounds of work in a page's visible text."""
+    text = re.sub(r"<(style|script)\b.*?</\1>", " ", dom, flags=re.S)
+    text = html.unescape(re.sub(r"<[^>]+>", " ", text))
+    shown = sorted(set(COMMIT.findall(text)) | {m.lower() for m in ROUND.findall(text)})
+    return [f"shows the history of the work (development notes' matter): {m!r}" for m in shown]
+
+
+def source_lines(source: Path) -> int:
+    """Lines of a page's Markdown source with the files it includes."""
+    text = source.read_text()
+    return len(text.splitlines()) + sum(
+        source_lines((source.parent / name).resolve()) for name in INCLUDE.findall(text) if name.endswith(".md")
+    )
+
+
+def measured_page(site: Path, name: str, dom: str) -> list[str]:
+    """A validation or performance page: at least one figure, and under ``MAX_LINES`` lines."""
+    found = [] if "<img" in dom else [f"{name}: no figure"]
+    source = site.parents[1] / name.replace(".html", ".md")
+    if source.is_file() and (n := source_lines(source)) >= MAX_LINES:
+        found.append(f"{name}: {n} lines with what it includes (a reader's page: under {MAX_LINES})")
+    return found
 
 
 def internals(dom: str) -> list[str]:
@@ -136,8 +177,10 @@ def problems(site: Path, browser: str) -> list[str]:
         if "Traceback (most recent call last)" in dom:
             found.append(f"{name}: shows a traceback")
         found += [f"{name}: {problem}" for problem in shown_as_text(dom)]
-        if name != "changelog.html":
-            found += [f"{name}: {problem}" for problem in internals(dom)]
+        if name not in DEVELOPMENT:
+            found += [f"{name}: {problem}" for problem in internals(dom) + history(dom)]
+        if name in MEASURED:
+            found += measured_page(site, name, dom)
         figure = "sphx-glr-single-img" in dom or "sphx-glr-multi-img" in dom
         if name.startswith("auto_examples/plot_") and not figure:
             found.append(f"{name}: no figure")
