@@ -272,6 +272,11 @@ class Trend:
     def at(self, log_peak: float) -> tuple[float, float]:
         """The trend's value (Hz) at ``log10`` of a peak input, and that value's variance (Hz²).
 
+        Parameters
+        ----------
+        log_peak : float
+            ``log10`` of the peak input.
+
         Returns
         -------
         value : float
