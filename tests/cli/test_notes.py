@@ -35,6 +35,7 @@ def test_each_code_says_what_was_found_on_one_screen_what_moves_the_verdict_firs
     assert set(shown[n_problems : n_problems + n_uncertain]) == set(UNCERTAIN_CODES)  # then what makes it uncertain
     first = CODES[0].code
     assert f"{first} (2, head): {first}: a long measured sentence" in heads[shown.index(first)]  # the finding
+    assert heads[shown.index(first)].endswith(" ... (+1 more)")  # cut to leave room for the others' count
     assert len(heads) == NOTE_LINES  # as many codes as fit the screen, a line each
 
 

@@ -70,6 +70,9 @@ def test_each_mode_is_one_track_whose_slope_is_the_law(followed):
         assert np.allclose(rows.freq_hz, [f0 * law(r) for r in rms], rtol=0.02)
         slope = -SOFTENING * f0  # Hz per tenfold input, in the RMS as in the peak
         assert abs(trends.slope_hz_per_decade[mode] - slope) < SLOPE_SDS * trends.slope_sd[mode]
+    # fitted over the events not flagged, which agree within their intervals: no scatter to speak of
+    # (through the planted event too, it would read 0.16-0.40 Hz)
+    assert (trends.tau_hz < 0.02).all(), trends.tau_hz
 
 
 def test_the_planted_outlier_and_no_other_event_is_flagged(followed):
@@ -170,3 +173,26 @@ def test_the_command_writes_its_files_from_the_cache(events, followed, cache, tm
     assert data["settings"]["input_unit"] == "m/s2" and data["events"][0]["date"].startswith("2026-")
     assert sum(row["flagged"] for row in data["modes"]) == 4
     assert "mode 1 on event3.csv" in (out / "track.html").read_text()
+
+
+def test_events_are_matched_from_the_weakest_shaking_not_in_the_manifests_order():
+    """A mode that softens 40 % over five events, listed by date in another order than their
+    shaking: matched weakest first, each step is within the frequency ratio and the mode is one
+    track; matched in the listed order, its first and second events are 1.67 apart and it splits."""
+    from types import SimpleNamespace
+
+    from armaxmodal.study.track import follow
+
+    def event(k: int, peak: float, freq: float) -> dict:
+        shape = {"head": {"mag": 1.0, "phase_deg": 0.0}}
+        mode = {"freq_hz": freq, "freq_ci95": [freq - 0.05, freq + 0.05], "damping": 0.05,
+                "damping_ci95": [0.04, 0.06], "shape": shape}  # fmt: skip
+        return {"file": f"e{k}.csv", "labels": {"date": f"2026-0{k + 1}-01"}, "peak_input": peak,
+                "quality": "good", "modes": [mode]}  # fmt: skip
+
+    listed = [(0.1, 4.0), (10.0, 2.4), (0.3, 3.6), (3.0, 2.8), (1.0, 3.2)]  # by date, not by shaking
+    study = SimpleNamespace(recordings=[event(k, p, f) for k, (p, f) in enumerate(listed)], sensors=("head",),
+                            notes=[], tables=SimpleNamespace(notes=[]), failures=[])  # fmt: skip
+    followed = follow(study, TrackSettings())
+    assert followed.table["mode"].tolist() == [1] * 5
+    assert followed.table.freq_hz.tolist() == [4.0, 3.6, 3.2, 2.8, 2.4]  # in the order of the shaking
