@@ -183,8 +183,12 @@ class SeparableModel:
         seen_basis = seen_basis.T if self.formed else self._r_inv_t(seen_basis.T)
         on_basis = (seen_basis @ w.reshape(4 * n, -1)).real
         on_basis = on_basis.reshape(-1, width, 2 * n)
-        e = scipy.linalg.solve_triangular(self.r, _basis_slopes_times(seen, d_lam, coef.shape[0]).reshape(
-            coef.shape[0], -1), trans="T", check_finite=False).reshape(-1, width, 2 * n)  # fmt: skip
+        e = scipy.linalg.solve_triangular(
+            self.r,
+            _basis_slopes_times(seen, d_lam, coef.shape[0]).reshape(coef.shape[0], -1),
+            trans="T",
+            check_finite=False,
+        ).reshape(-1, width, 2 * n)
         # conj(S) S', from the upper half BLAS fills
         slopes_gram = hermitian_from_upper(scipy.linalg.blas.zherk(1.0, slopes.T, trans=2))
         m_m = np.einsum("csi,csk->ik", np.conj(w), (slopes_gram @ w.reshape(4 * n, -1)).reshape(w.shape)).real

@@ -240,9 +240,7 @@ def resolving_nperseg(recording, freq_hz, damping, lines_per_bandwidth: int, min
     return int(np.clip(2 ** int(np.ceil(np.log2(max(want, 16)))), min(256, longest), longest))
 
 
-
-def coherent_peaks(recording, nperseg: int, span_lines: int, band=None
-                   ) -> list[tuple[float, str, float]]:  # fmt: skip
+def coherent_peaks(recording, nperseg: int, span_lines: int, band=None) -> list[tuple[float, str, float]]:
     """Clear, coherent peaks of each sensor's measured FRF: ``(freq_hz, sensor, |H1|)``.
 
     A clear peak: coherence at least 0.8 on it and two lines either side, a third of its
@@ -269,7 +267,6 @@ def coherent_peaks(recording, nperseg: int, span_lines: int, band=None
     return out
 
 
-
 def explains(freq_hz: float, line_hz: float, modes_hz, damping) -> bool:
     """A mode lies within the peak's half-power bandwidth ``2 xi f`` (at least 1 % or 3 lines)."""
     return any(
@@ -284,8 +281,9 @@ def explains(freq_hz: float, line_hz: float, modes_hz, damping) -> bool:
 LPM_HALF_WIDTH, LPM_DEGREE = 6, 2
 
 
-def local_polynomial_noise(u: np.ndarray, y: np.ndarray, half_width: int = LPM_HALF_WIDTH,
-                           degree: int = LPM_DEGREE) -> np.ndarray:  # fmt: skip
+def local_polynomial_noise(
+    u: np.ndarray, y: np.ndarray, half_width: int = LPM_HALF_WIDTH, degree: int = LPM_DEGREE
+) -> np.ndarray:
     """The noise variance of each output's DFT line, measured without a parametric model.
 
     The local polynomial method (Pintelon, Schoukens, Vandersteen and Barbé, Mechanical Systems and
@@ -335,12 +333,16 @@ def local_polynomial_noise(u: np.ndarray, y: np.ndarray, half_width: int = LPM_H
     """
     u, y = np.asarray(u, complex), np.asarray(y, complex)
     if u.ndim != 1 or y.ndim != 2 or y.shape[0] != u.size:
-        raise ValueError(f"local_polynomial_noise: expected u of shape (n_lines,) and y of shape (n_lines, n_outputs), "
-                         f"got {u.shape} and {y.shape}: give one output per column, on the input's lines.")  # fmt: skip
+        raise ValueError(
+            f"local_polynomial_noise: expected u of shape (n_lines,) and y of shape (n_lines, n_outputs), "
+            f"got {u.shape} and {y.shape}: give one output per column, on the input's lines."
+        )
     n, width, unknowns = u.size, 2 * half_width + 1, 2 * (degree + 1)
     if n < width or width <= unknowns:
-        raise ValueError(f"local_polynomial_noise: {n} lines, window of {width} for {unknowns} unknowns: "
-                         "give more lines or a wider window.")  # fmt: skip
+        raise ValueError(
+            f"local_polynomial_noise: {n} lines, window of {width} for {unknowns} unknowns: "
+            "give more lines or a wider window."
+        )
     centres = np.clip(np.arange(n), half_width, n - 1 - half_width)
     rows = centres[:, None] + np.arange(-half_width, half_width + 1)[None, :]  # (n, width): each line's window
     offset = (rows - np.arange(n)[:, None]) / half_width  # scaled, so the powers stay of order one

@@ -264,8 +264,8 @@ MUTANTS = [
     ),
     (
         'armaxmodal/modes/frf.py',
-        'reach="nearest",\n',
-        'reach="overlapping",\n',
+        'reach="nearest", settings=frf',
+        'reach="overlapping", settings=frf',
         'a candidate judged without its nearest neighbour refitted (check)',
     ),
     (
@@ -847,8 +847,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        'if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > search.cfg.same_mode_freq]',
-        "if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > 1.0]",
+        "if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > search.cfg.same_mode_freq\n",
+        "if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > 1.0\n",
         "no start pole ever counted as carried away (count)",
     ),
     (
@@ -997,8 +997,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/counted.py",
-        '>= same_shape]',
-        ">= 0.0]",
+        "if mac(m.shapes[:, poles[a]], m.shapes[:, poles[b]]) >= same_shape",
+        "if mac(m.shapes[:, poles[a]], m.shapes[:, poles[b]]) >= 0.0",
         "pairs merged whatever their shapes (count)",
     ),
     (
@@ -1186,8 +1186,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/notes.py",
-        '"count_undecided" if inside else "mode_count", (),',
-        '"mode_count", (),',
+        '"count_undecided" if inside else "mode_count",\n',
+        '"mode_count",\n',
         "a stand-in inside the band said informative, and the verdict good (stand-in)",
     ),
     # an output is incoherent only when low over the input's spectrum and over its own (run with
@@ -1214,14 +1214,14 @@ MUTANTS = [
     #   --match "(row-facts)" --tests tests/modes/test_mode_count.py)
     (
         'armaxmodal/modes/counted.py',
-        'freq_sd_armax=m.freq_sd[i], damping_sd_armax=m.damping_sd[i],',
-        '',
+        "            freq_sd_armax=m.freq_sd[i],\n            damping_sd_armax=m.damping_sd[i],\n",
+        "",
         "the neighbour's ARMAX deviation kept (row-facts)",
     ),
     (
         "armaxmodal/modes/counted.py",
-        "orders_damping_unresolved=0, energy=np.nan,",
-        "orders_damping_unresolved=0,",
+        "            orders_damping_unresolved=0,\n            energy=np.nan,\n",
+        "            orders_damping_unresolved=0,\n",
         "the neighbour's energy kept (row-facts)",
     ),
     # the mode nearest the residual's peak split once after the search, for the likelihood's flag (run
@@ -1498,8 +1498,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "free = _searched(data, freq_hz, damping, candidates, supported=supported, rule=False,",
-        "free = _searched(data, freq_hz, damping, candidates, supported=supported, rule=True,",
+        "data, freq_hz, damping, candidates, supported=supported, rule=False, search=search,",
+        "data, freq_hz, damping, candidates, supported=supported, rule=True, search=search,",
         "the first search under the column rule (adequacy)",
     ),
 

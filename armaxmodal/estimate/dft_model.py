@@ -259,9 +259,15 @@ class ModalModel:
             A copy whose per-mode arrays and shape columns are in ascending frequency.
         """
         order = np.argsort(self.freq_hz)
-        return replace(self, freq_hz=self.freq_hz[order], damping=self.damping[order], freq_sd=self.freq_sd[order],
-                       damping_sd=self.damping_sd[order], shapes=self.shapes[:, order],
-                       at_bound=None if self.at_bound is None else self.at_bound[order])  # fmt: skip
+        return replace(
+            self,
+            freq_hz=self.freq_hz[order],
+            damping=self.damping[order],
+            freq_sd=self.freq_sd[order],
+            damping_sd=self.damping_sd[order],
+            shapes=self.shapes[:, order],
+            at_bound=None if self.at_bound is None else self.at_bound[order],
+        )
 
     @property
     def n_modes(self) -> int:
@@ -318,8 +324,17 @@ class ModalModel:
 
 
 @single_blas_thread
-def fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited", max_nfev: int = 40, *,
-                    settings: FitLimits, intervals: bool = True, by_frequency: bool = True) -> ModalModel:  # fmt: skip
+def fit_modal_model(
+    data: DftLines,
+    freq_hz,
+    damping,
+    hold: str = "bandlimited",
+    max_nfev: int = 40,
+    *,
+    settings: FitLimits,
+    intervals: bool = True,
+    by_frequency: bool = True,
+) -> ModalModel:
     """Fit the modal model with every pole free, from a start.
 
     Parameters
@@ -368,22 +383,30 @@ def fit_modal_model(data: DftLines, freq_hz, damping, hold: str = "bandlimited",
     return model.by_frequency() if by_frequency else model
 
 
-def _fit(data: DftLines, start: np.ndarray, hold: str, max_nfev: int, settings: FitLimits,
-         intervals: bool = True) -> ModalModel:  # fmt: skip
+def _fit(
+    data: DftLines, start: np.ndarray, hold: str, max_nfev: int, settings: FitLimits, intervals: bool = True
+) -> ModalModel:
     """The fit from ``start`` (``(ln omega_n, xi)`` per mode), its modes in the start's order,
     under the caller's BLAS threads."""
     n = start.size // 2
     if 2 * data.s.size < 3 * (4 * n + 2):  # plant and transient pairs, direct and constant terms
         lo_hz, hi_hz = data.band_hz
-        raise OrderError(f"{data.s.size} DFT lines in {lo_hz:g}-{hi_hz:g} Hz cannot fit {n} modes; "
-                         "record longer or widen the band.")  # fmt: skip
+        raise OrderError(
+            f"{data.s.size} DFT lines in {lo_hz:g}-{hi_hz:g} Hz cannot fit {n} modes; record longer or widen the band."
+        )
     lo, hi = x_bounds(np.abs(data.s[0]), data.dt, n, settings.min_damping, settings.max_damping)
     start = np.clip(start, lo + 1e-9, hi - 1e-9)
     model = SeparableModel(data.s, data.z_inv, data.u, data.y, data.dt, hold)
     compressed = GramCompressed(model)
     res = scipy.optimize.least_squares(
-        compressed.residual, start, jac=compressed.jacobian, bounds=(lo, hi), x_scale="jac", max_nfev=max_nfev,
-        ftol=settings.fit_tol, xtol=settings.fit_tol,
+        compressed.residual,
+        start,
+        jac=compressed.jacobian,
+        bounds=(lo, hi),
+        x_scale="jac",
+        max_nfev=max_nfev,
+        ftol=settings.fit_tol,
+        xtol=settings.fit_tol,
     )
     model.residual(res.x)
     coef, resid = model.coef, model.resid
@@ -396,9 +419,18 @@ def _fit(data: DftLines, start: np.ndarray, hold: str, max_nfev: int, settings: 
         r = r * mu * lam / (mu - 1.0)
     model.release()
     f = np.abs(lam) / (2 * np.pi)
-    return ModalModel(freq_hz=f, damping=-lam.real / np.abs(lam), freq_sd=f * sd[0::2], damping_sd=sd[1::2],
-                      shapes=-r / lam**2, rss=rss, n_real=data.n_real, hold=hold,
-                      residual=resid[: data.s.size] + 1j * resid[data.s.size :],
-                      converged=bool(res.status > 0),  # 0: stopped at max_nfev
-                      band_hz=data.band_hz, nyquist_hz=0.5 / data.dt,
-                      at_bound=(res.active_mask != 0).reshape(n, 2).any(axis=1))  # fmt: skip
+    return ModalModel(
+        freq_hz=f,
+        damping=-lam.real / np.abs(lam),
+        freq_sd=f * sd[0::2],
+        damping_sd=sd[1::2],
+        shapes=-r / lam**2,
+        rss=rss,
+        n_real=data.n_real,
+        hold=hold,
+        residual=resid[: data.s.size] + 1j * resid[data.s.size :],
+        converged=bool(res.status > 0),  # 0: stopped at max_nfev
+        band_hz=data.band_hz,
+        nyquist_hz=0.5 / data.dt,
+        at_bound=(res.active_mask != 0).reshape(n, 2).any(axis=1),
+    )

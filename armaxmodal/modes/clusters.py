@@ -53,8 +53,9 @@ def clustered_modes(diagram, band, nas, cluster: ClusterSettings, n_jobs, bar=No
     return pd.DataFrame(rows), vectors
 
 
-def representative_pole(diagram, resolved: pd.DataFrame, bic: dict, finished: dict,
-                        max_shift: float = DEFAULTS.cluster.finished_max_shift) -> pd.Series | None:
+def representative_pole(
+    diagram, resolved: pd.DataFrame, bic: dict, finished: dict, max_shift: float = DEFAULTS.cluster.finished_max_shift
+) -> pd.Series | None:
     """The cluster's pole from the fit of lowest BIC, finished to full convergence; the next
     order's when finishing takes a lightly damped pole's damping to zero or below (None when
     every one does: the record gives this mode no damping estimate)."""
@@ -110,8 +111,10 @@ def why_no_mode(diagram: StabilisationDiagram, band, nas, cluster: ClusterSettin
     if clusters:
         best = max(clusters, key=len)
         f = float(cand.loc[best].freq_hz.median())
-        facts.append(f"the best-supported cluster of the rest ({len(clusters)} in all), at {f:.3g} Hz, holds "
-                     f"poles of {len(best)} of {len(nas)} orders, where a mode needs {need}")  # fmt: skip
+        facts.append(
+            f"the best-supported cluster of the rest ({len(clusters)} in all), at {f:.3g} Hz, holds "
+            f"poles of {len(best)} of {len(nas)} orders, where a mode needs {need}"
+        )
     return f"no stable mode found{where}: " + "; ".join(facts)
 
 
@@ -241,6 +244,7 @@ def _is_split(modes, vectors, i, j, merge_mac, duration_s) -> bool:
     unresolvable = gap <= 2.0 / duration_s
     return unresolvable or (gap <= half_power and mac(vectors[i], vectors[j]) >= merge_mac)
 
+
 def check_picks(picks, band, fs: float, cluster: ClusterSettings = DEFAULTS.cluster) -> np.ndarray:
     """The picked frequencies (Hz) as a sorted array, refused with the reason when one is not a
     finite positive number, lies outside ``band`` (Hz) or at or above the Nyquist frequency, or
@@ -269,12 +273,16 @@ def check_picks(picks, band, fs: float, cluster: ClusterSettings = DEFAULTS.clus
     if not np.all(np.isfinite(values) & (values > 0)):
         raise PickError(f"picks: every frequency must be a positive number of Hz, got {values.tolist()}.")
     if band is None and np.any(values >= fs / 2):
-        raise PickError(f"picks {values[values >= fs / 2].tolist()} Hz lie at or above the Nyquist frequency "
-                        f"({fs / 2:g} Hz): no mode of this record is there; pick below it.")  # fmt: skip
+        raise PickError(
+            f"picks {values[values >= fs / 2].tolist()} Hz lie at or above the Nyquist frequency "
+            f"({fs / 2:g} Hz): no mode of this record is there; pick below it."
+        )
     outside = values[(values < band[0]) | (values > band[1])] if band is not None else values[:0]
     if outside.size:
-        raise PickError(f"picks {outside.tolist()} Hz lie outside the band {band[0]:g}-{band[1]:g} Hz; pick inside "
-                        "it, or widen --band.")  # fmt: skip
+        raise PickError(
+            f"picks {outside.tolist()} Hz lie outside the band {band[0]:g}-{band[1]:g} Hz; pick inside "
+            "it, or widen --band."
+        )
     close = np.flatnonzero(np.diff(values) / values[:-1] <= cluster.pick_reach)
     if close.size:
         i = int(close[0])
@@ -285,8 +293,9 @@ def check_picks(picks, band, fs: float, cluster: ClusterSettings = DEFAULTS.clus
     return values
 
 
-def picked_modes(diagram, picks: np.ndarray, band, nas, cluster: ClusterSettings = DEFAULTS.cluster
-                 ) -> tuple[pd.DataFrame, list[np.ndarray]]:  # fmt: skip
+def picked_modes(
+    diagram, picks: np.ndarray, band, nas, cluster: ClusterSettings = DEFAULTS.cluster
+) -> tuple[pd.DataFrame, list[np.ndarray]]:
     """For each pick, the nearest cluster of the diagram's shared poles that holds poles of at
     least ``cluster.min_orders`` orders, reported from its
     lowest-BIC fit as an automatic mode is (:func:`armaxmodal.modes.clusters.mode_row`).
@@ -322,8 +331,10 @@ def picked_modes(diagram, picks: np.ndarray, band, nas, cluster: ClusterSettings
     rows, vectors = [], []
     for f in picks:
         if not centres.size:
-            raise PickError(f"pick {f:g} Hz: the diagram holds no pole stable over {cluster.min_orders} orders "
-                            "in the band; extend --orders or check that the input excites the structure.")  # fmt: skip
+            raise PickError(
+                f"pick {f:g} Hz: the diagram holds no pole stable over {cluster.min_orders} orders "
+                "in the band; extend --orders or check that the input excites the structure."
+            )
         k = int(np.argmin(np.abs(np.log(centres / f))))
         if abs(centres[k] / f - 1) > cluster.pick_reach:
             raise PickError(

@@ -39,28 +39,48 @@ __all__ = ["count_modes"]
 class _Search:
     """One search's fits: each candidate screened (``screen_nfev``), the best of a kind converged."""
 
-    def __init__(self, data: DftLines, hold: str, n_effective: float, max_nfev: int, n_jobs: int | None = 1,
-                 settings: CountSettings = DEFAULTS.count, lines: LineSettings = DEFAULTS.lines,
-                 dft: DftSettings = DEFAULTS.dft, fitter: Callable = fit_modal_model,
-                 agreement: AgreementSettings = DEFAULTS.agreement):  # fmt: skip
+    def __init__(
+        self,
+        data: DftLines,
+        hold: str,
+        n_effective: float,
+        max_nfev: int,
+        n_jobs: int | None = 1,
+        settings: CountSettings = DEFAULTS.count,
+        lines: LineSettings = DEFAULTS.lines,
+        dft: DftSettings = DEFAULTS.dft,
+        fitter: Callable = fit_modal_model,
+        agreement: AgreementSettings = DEFAULTS.agreement,
+    ):
         self.data, self.hold, self.n_eff, self.max_nfev, self.n_jobs = data, hold, n_effective, max_nfev, n_jobs
         self.cfg, self.lines, self.dft, self.trials, self.table = settings, lines, dft, 0, ModelTable(n_effective)
         self.fitter, self.agreement, self.logged = fitter, agreement, self.table.add
 
-    def screened(self, starts: list[tuple[np.ndarray, np.ndarray]], labels: list[tuple[str, float]],
-                 intervals: bool = True) -> list[ModalModel | None]:  # fmt: skip
+    def screened(
+        self, starts: list[tuple[np.ndarray, np.ndarray]], labels: list[tuple[str, float]], intervals: bool = True
+    ) -> list[ModalModel | None]:
         """Each start ``(freq_hz, damping)`` fitted for ``settings.screen_nfev`` steps, over the worker threads
         (numpy releases the interpreter in their array work); ``labels``: each start's ``(action, Hz)``;
         ``intervals=False``: fits compared by their criterion alone, without standard deviations."""
         self.trials += sum(len(f) > 0 for f, _ in starts)
 
         one = partial(self.fitter, self.data, settings=self.dft, intervals=intervals)
-        fits = parallel_map(lambda start: one(*start, self.hold, self.cfg.screen_nfev) if len(start[0]) else None,
-                            starts, self.n_jobs, min_items=2)  # fmt: skip
+        fits = parallel_map(
+            lambda start: one(*start, self.hold, self.cfg.screen_nfev) if len(start[0]) else None,
+            starts,
+            self.n_jobs,
+            min_items=2,
+        )
         return [self.logged(action, f, fit) for (action, f), fit in zip(labels, fits, strict=True)]
 
-    def fit(self, freq_hz, damping, max_nfev: int | None = None, counted: bool = True,
-            label: tuple[str, float] | None = ("converge", float("nan"))) -> ModalModel | None:  # fmt: skip
+    def fit(
+        self,
+        freq_hz,
+        damping,
+        max_nfev: int | None = None,
+        counted: bool = True,
+        label: tuple[str, float] | None = ("converge", float("nan")),
+    ) -> ModalModel | None:
         """One fit to convergence (or ``max_nfev``); ``counted=False`` where the caller counts it; ``label``:
         its ``(action, Hz)`` in the table (None: the caller logs it, as fits run in threads do, in their order)."""
         if len(freq_hz) == 0:
@@ -82,8 +102,9 @@ class _Search:
             chosen.append(min(trials, key=lambda t: self.bic(t[2])) if trials else None)
         todo = [t for t in chosen if t is not None and t[2] is not None]
         self.trials += len(todo)
-        fits = parallel_map(lambda t: self.fit(t[2].freq_hz, t[2].damping, counted=False, label=None), todo,
-                            self.n_jobs, min_items=2)  # fmt: skip
+        fits = parallel_map(
+            lambda t: self.fit(t[2].freq_hz, t[2].damping, counted=False, label=None), todo, self.n_jobs, min_items=2
+        )
         fits = [self.logged(t[0], t[1], fit) for t, fit in zip(todo, fits, strict=True)]
         converged = {id(t): (t[0], t[1], fit) for t, fit in zip(todo, fits, strict=True)}
         out = []
@@ -111,8 +132,11 @@ class _Search:
 
     def removals(self, current: ModalModel) -> list[tuple[str, float, ModalModel | None]]:
         keep = [np.arange(current.n_modes) != m for m in range(current.n_modes)]
-        fits = self.screened([(current.freq_hz[k], current.damping[k]) for k in keep],  # the best is converged
-                             [("remove", float(f)) for f in current.freq_hz], intervals=False)  # fmt: skip
+        fits = self.screened(
+            [(current.freq_hz[k], current.damping[k]) for k in keep],  # the best is converged
+            [("remove", float(f)) for f in current.freq_hz],
+            intervals=False,
+        )
         return [("remove", float(f), fit) for f, fit in zip(current.freq_hz, fits, strict=True)]
 
     def additions(self, current: ModalModel, candidates, peak_hz: float) -> list[tuple[str, float, ModalModel]]:
@@ -161,8 +185,11 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     ((start Hz, Hz), ...), kept unreported: ((start Hz, Hz, rise), ...), tentative: (Hz, ...))``."""
     start_hz = np.atleast_1d(np.asarray(start_hz, float))
     shown = reported(model, search.data.band_hz, search.lines)
-    moved = [(i, j) for i, j in matched_poles(start_hz, model.freq_hz)
-             if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > search.cfg.same_mode_freq]  # fmt: skip
+    moved = [
+        (i, j)
+        for i, j in matched_poles(start_hz, model.freq_hz)
+        if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > search.cfg.same_mode_freq
+    ]
     unfounded, tentative = [], []
     for i, j in moved:
         f, x = model.freq_hz[i], model.damping[i]
@@ -177,8 +204,9 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     keep = np.setdiff1d(np.arange(model.n_modes), [i for i, _ in unfounded])
     if not unfounded or keep.size == 0:  # nothing else to stand on: the search's model stays
         return model, (), (), tuple(tentative)
-    without = search.fit(model.freq_hz[keep], model.damping[keep], search.cfg.final_nfev,
-                         label=("leave out", unfounded[0][1][1]))
+    without = search.fit(
+        model.freq_hz[keep], model.damping[keep], search.cfg.final_nfev, label=("leave out", unfounded[0][1][1])
+    )
     rise = search.bic(without) - search.bic(model)
     if rise >= search.cfg.decisive_bic:  # the model needs them: they stay in it, unreported
         return model, (), tuple((*moved, float(rise)) for _, moved in unfounded), tuple(tentative)
@@ -199,8 +227,9 @@ def _equally_good(search: _Search, chosen: ModalModel, rise: np.ndarray, additio
     return tuple(out)
 
 
-def _wanted(search: _Search, current: ModalModel, addition, gain: float, new_hz: float, halves,
-            supported=None) -> tuple:  # fmt: skip
+def _wanted(
+    search: _Search, current: ModalModel, addition, gain: float, new_hz: float, halves, supported=None
+) -> tuple:
     """The refused addition the likelihood wants (see :attr:`ModeCount.wanted`), or ``()``. The
     likelihood ratio is ``-2 ln L`` of the current model less the addition's, on the effective
     lines; it is a chi-square of the parameters one mode adds where the record holds no more."""
@@ -209,8 +238,9 @@ def _wanted(search: _Search, current: ModalModel, addition, gain: float, new_hz:
     return _likelihood_wants(search, current, addition[2], new_hz, gain, halves, supported)
 
 
-def _likelihood_wants(search: _Search, current: ModalModel, model: ModalModel, new_hz: float, gain: float,
-                      halves, supported) -> tuple:  # fmt: skip
+def _likelihood_wants(
+    search: _Search, current: ModalModel, model: ModalModel, new_hz: float, gain: float, halves, supported
+) -> tuple:
     """A :class:`Wanted` when ``model``'s likelihood ratio over ``current`` is beyond
     ``settings.likelihood_alpha`` and its new poles are the same in both halves, else ``()``;
     ``supported(Hz, ratio)``: does the diagram hold a column at its new pole (``new_hz``) to pick?"""
@@ -324,14 +354,37 @@ def count_modes(
     >>> [step.action for step in count.steps], [round(float(f), 1) for f in sorted(count.model.freq_hz)]
     (['add'], [5.8, 8.3, 13.6, 16.2])
     """
-    return _count_modes(data, freq_hz, damping, candidates, hold=hold, max_nfev=max_nfev, halves=halves,
-                        supported=supported, search=search, n_jobs=n_jobs, settings=settings, lines=lines, dft=dft,
-                        fitter=fitter, agreement=agreement, adequacy=adequacy)  # fmt: skip
+    return _count_modes(
+        data,
+        freq_hz,
+        damping,
+        candidates,
+        hold=hold,
+        max_nfev=max_nfev,
+        halves=halves,
+        supported=supported,
+        search=search,
+        n_jobs=n_jobs,
+        settings=settings,
+        lines=lines,
+        dft=dft,
+        fitter=fitter,
+        agreement=agreement,
+        adequacy=adequacy,
+    )
 
 
 def _count_modes(
-    data: DftLines, freq_hz, damping, candidates, *, supported, search, settings: CountSettings,
-    adequacy: Callable | None = None, **options,
+    data: DftLines,
+    freq_hz,
+    damping,
+    candidates,
+    *,
+    supported,
+    search,
+    settings: CountSettings,
+    adequacy: Callable | None = None,
+    **options,
 ) -> ModeCount:
     """:func:`count_modes` itself (its parameters), under the caller's BLAS threads (the public one holds one).
 
@@ -341,18 +394,21 @@ def _count_modes(
     one stated rule (an added mode also stands in a stable diagram column, ``supported``), both
     searches' fits in the table, and ``rule_refused`` keeps what the first chose where its criterion
     is lower."""
-    free = _searched(data, freq_hz, damping, candidates, supported=supported, rule=False, search=search,
-                     settings=settings, **options)  # fmt: skip
+    free = _searched(
+        data, freq_hz, damping, candidates, supported=supported, rule=False, search=search, settings=settings, **options
+    )
     test = (adequacy or _adequacy_at(settings.adequacy_ratio))(free.model, data)
     if test.adequate or supported is None or not search:
         return replace(free, adequacy=test)
-    ruled = _searched(data, freq_hz, damping, candidates, supported=supported, rule=True, search=search,
-                      settings=settings, **options)  # fmt: skip
+    ruled = _searched(
+        data, freq_hz, damping, candidates, supported=supported, rule=True, search=search, settings=settings, **options
+    )
     n_eff = free.effective_fraction * data.n_real * data.y.shape[1]  # both searches start from one model
     fall = float(ruled.model.bic(n_eff) - free.model.bic(n_eff))
     refused = (fall, tuple(np.sort(free.model.freq_hz))) if fall > 0 else ()  # what the criterion preferred
-    return replace(ruled, adequacy=test, rule_refused=refused, trials=free.trials + ruled.trials,
-                   models=free.models + ruled.models)  # fmt: skip
+    return replace(
+        ruled, adequacy=test, rule_refused=refused, trials=free.trials + ruled.trials, models=free.models + ruled.models
+    )
 
 
 def _adequacy_at(level: float) -> Callable:
@@ -361,8 +417,23 @@ def _adequacy_at(level: float) -> Callable:
 
 
 def _searched(
-    data: DftLines, freq_hz, damping, candidates, *, hold, max_nfev, halves, supported, rule: bool, search, n_jobs,
-    settings: CountSettings, lines, dft, fitter, agreement,
+    data: DftLines,
+    freq_hz,
+    damping,
+    candidates,
+    *,
+    hold,
+    max_nfev,
+    halves,
+    supported,
+    rule: bool,
+    search,
+    n_jobs,
+    settings: CountSettings,
+    lines,
+    dft,
+    fitter,
+    agreement,
 ) -> ModeCount:
     """One search from the starting set; ``rule``: an addition is admitted only where ``supported`` says
     (which also says whether a wanted mode has a column to pick)."""
@@ -373,12 +444,28 @@ def _searched(
     data = data.noise_weighted(start_model)
     start_model = fitter(data, start_model.freq_hz, start_model.damping, hold, max_nfev, settings=dft)
     fraction = effective_fraction(start_model.residual, settings.max_correlation_lag)
-    searching, search = search, _Search(data, hold, fraction * data.n_real * data.y.shape[1], max_nfev, n_jobs,
-                                        settings, lines, dft, fitter, agreement)  # fmt: skip
+    searching, search = (
+        search,
+        _Search(
+            data,
+            hold,
+            fraction * data.n_real * data.y.shape[1],
+            max_nfev,
+            n_jobs,
+            settings,
+            lines,
+            dft,
+            fitter,
+            agreement,
+        ),
+    )
     search.logged("start", float("nan"), start_model)
     # a start the free fit carried away (a weak mode's pole to beyond the band) is tried again as an addition
-    lost = [(f, x) for f, x in zip(np.atleast_1d(freq_hz), np.atleast_1d(damping), strict=True)
-            if np.min(np.abs(np.log(start_model.freq_hz / f))) > settings.same_mode_freq]  # fmt: skip
+    lost = [
+        (f, x)
+        for f, x in zip(np.atleast_1d(freq_hz), np.atleast_1d(damping), strict=True)
+        if np.min(np.abs(np.log(start_model.freq_hz / f))) > settings.same_mode_freq
+    ]
     current, steps, candidates, unconfirmed, unsettled = start_model, [], list(candidates) + lost, [], []
 
     def neighbours():
@@ -418,10 +505,14 @@ def _searched(
     final = search.fit(current.freq_hz, current.damping, settings.final_nfev)
     if search.bic(final) < here:
         rise, gain, current = rise + here - search.bic(final), gain - (here - search.bic(final)), final
-    current, carried_away, stand_ins, tentative = (_without_unfounded(search, freq_hz, current, column, halves)
-                                                   if searching else (current, (), (), ()))  # fmt: skip
-    unsettled += [f for f in tentative  # one note a pole: the search may have taken it so already
-                  if not any(abs(np.log(f / u)) <= settings.same_mode_freq for u in unsettled)]
+    current, carried_away, stand_ins, tentative = (
+        _without_unfounded(search, freq_hz, current, column, halves) if searching else (current, (), (), ())
+    )
+    unsettled += [
+        f
+        for f in tentative  # one note a pole: the search may have taken it so already
+        if not any(abs(np.log(f / u)) <= settings.same_mode_freq for u in unsettled)
+    ]
     if carried_away:  # the model lost a pole: its neighbours are judged again, from where it stands
         here, removed, best_removal, best_addition = neighbours()
         rise, gain, new_hz = _margins(search, here, current, removed, best_removal, best_addition)
@@ -433,8 +524,25 @@ def _searched(
         # as good as the chosen model: its modes are the record's too
         if wanted and abs(wanted.rise) < settings.decisive_bic:
             alternatives += ((wanted.rise, split),)
-    return ModeCount(model=current, start=start_model, steps=tuple(steps), removal_rise=rise, best_addition=float(gain),
-                     best_addition_hz=new_hz, effective_fraction=fraction, trials=search.trials, wanted=wanted,
-                     unconfirmed_hz=tuple(unconfirmed), unsettled_hz=tuple(unsettled), alternatives=alternatives,
-                     carried_away=carried_away, stand_ins=stand_ins, models=tuple(search.table.rows),
-                     band_hz=data.band_hz, settings=settings, lines=lines, dft=dft, agreement=agreement)  # fmt: skip
+    return ModeCount(
+        model=current,
+        start=start_model,
+        steps=tuple(steps),
+        removal_rise=rise,
+        best_addition=float(gain),
+        best_addition_hz=new_hz,
+        effective_fraction=fraction,
+        trials=search.trials,
+        wanted=wanted,
+        unconfirmed_hz=tuple(unconfirmed),
+        unsettled_hz=tuple(unsettled),
+        alternatives=alternatives,
+        carried_away=carried_away,
+        stand_ins=stand_ins,
+        models=tuple(search.table.rows),
+        band_hz=data.band_hz,
+        settings=settings,
+        lines=lines,
+        dft=dft,
+        agreement=agreement,
+    )

@@ -50,8 +50,9 @@ __all__ = ["confirmed_where_incoherent", "counted_modes", "without_column"]
 WEAK_RESIDUE = "negligible residue"
 
 
-def _candidates(diagram, modes: pd.DataFrame, band, nas, settings: SelectionSettings = DEFAULTS
-                ) -> list[tuple[float, float]]:  # fmt: skip
+def _candidates(
+    diagram, modes: pd.DataFrame, band, nas, settings: SelectionSettings = DEFAULTS
+) -> list[tuple[float, float]]:
     """The diagram's stable clusters the selection left out: (Hz, ratio), the clean ones first
     (largest first), then those whose every pole the sweep rejected only for a small residue. A
     weakly driven or weakly seen mode is stable across orders with a small residue at each (a
@@ -76,14 +77,24 @@ def _on_whole_record(count: ModeCount, whole: DftLines, hold: str) -> ModeCount:
     """The counted model fitted to the whole record's lines (``whole``) from where the search left it."""
     start = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, 1, settings=count.dft)
     whole = whole.noise_weighted(start)
-    final = fit_modal_model(whole, count.model.freq_hz, count.model.damping, hold, count.settings.final_nfev,
-                            settings=count.dft)
+    final = fit_modal_model(
+        whole, count.model.freq_hz, count.model.damping, hold, count.settings.final_nfev, settings=count.dft
+    )
     return replace(count, model=final)
 
 
 def counted_modes(
-    diagram, work: SelectionState, band_hz, hold: str, nas, settings: SelectionSettings = DEFAULTS, band=None, *,
-    picked: bool = False, n_jobs: int | None = None, counter: Callable = count_modes,
+    diagram,
+    work: SelectionState,
+    band_hz,
+    hold: str,
+    nas,
+    settings: SelectionSettings = DEFAULTS,
+    band=None,
+    *,
+    picked: bool = False,
+    n_jobs: int | None = None,
+    counter: Callable = count_modes,
 ) -> SelectionState:
     """Count the modes from the selection's and return them as the selection reports modes.
 
@@ -127,8 +138,11 @@ def counted_modes(
     # the modes the FRF's check doubts are tried first, as additions the likelihood, the halves and
     # the diagram must all accept; then the diagram's other left-out clusters
     offered = [(f, x) for f, x, _ in work.doubts]
-    candidates = offered + [c for c in _candidates(diagram, modes, band, nas, settings)
-                            if all(abs(np.log(c[0] / f)) > settings.cluster.freq for f, _ in offered)]  # fmt: skip
+    candidates = offered + [
+        c
+        for c in _candidates(diagram, modes, band, nas, settings)
+        if all(abs(np.log(c[0] / f)) > settings.cluster.freq for f, _ in offered)
+    ]
     halves = tuple(DftLines.from_recording(half, band_hz) for half in part.split(2))
     supported = stable_in_diagram(diagram, band, settings.cluster)
     start_f, start_x = modes.freq_hz.to_numpy(), modes.damping.to_numpy()
@@ -136,9 +150,21 @@ def counted_modes(
         model = work.count.model
         hidden = ~work.count.reported(band_hz)
         start_f, start_x = np.r_[start_f, model.freq_hz[hidden]], np.r_[start_x, model.damping[hidden]]
-    count = counter(data, start_f, start_x, candidates, hold=hold, halves=halves, supported=supported,
-                    search=not picked, n_jobs=n_jobs, settings=settings.count, lines=settings.lines,
-                    dft=settings.dft, agreement=settings.agreement)  # fmt: skip
+    count = counter(
+        data,
+        start_f,
+        start_x,
+        candidates,
+        hold=hold,
+        halves=halves,
+        supported=supported,
+        search=not picked,
+        n_jobs=n_jobs,
+        settings=settings.count,
+        lines=settings.lines,
+        dft=settings.dft,
+        agreement=settings.agreement,
+    )
     whole = data if part is rec else DftLines.from_recording(rec, band_hz)  # each cut's lines built once
     if part is not rec:
         count = _on_whole_record(count, whole, hold)
@@ -149,18 +175,24 @@ def counted_modes(
     if picked:
         return replace(_picked_result(_doubts_said(work, ()), count, keep, verdicts, hold, settings), **lines)
     if not keep.any():  # the model keeps no mode in the band: the selection's stand, undecided
-        return _doubts_said(work, ()).warned(no_mode_kept_note(count, modes, data.band_hz),
-                                             *rule_notes(count, rec.sensors), **lines)
+        return _doubts_said(work, ()).warned(
+            no_mode_kept_note(count, modes, data.band_hz), *rule_notes(count, rec.sensors), **lines
+        )
     rows = pd.DataFrame([_row(modes, count, i, hold, same_row, verdicts[i]) for i in np.flatnonzero(keep)])
-    rows, shapes, merged = _one_where_not_separated(rows, count.model.shapes[:, keep], count, keep, whole, hold,
-                                                    settings)  # fmt: skip
+    rows, shapes, merged = _one_where_not_separated(
+        rows, count.model.shapes[:, keep], count, keep, whole, hold, settings
+    )
     rows, disagree = covering_both_estimators(rows, settings.agreement.alpha)
     # where two poles are reported as one, the check fits the model's poles, not the row's
     poles = tuple(zip(count.model.freq_hz[keep].tolist(), count.model.damping[keep].tolist(), strict=True))
     work = work.with_modes(rows, shapes, check_poles=poles if merged else None, counted=True, **lines)
     work = _doubts_said(work, count.model.freq_hz[keep], same_row)
-    return work.warned(*count_notes(count, keep, data.band_hz, same_row), *merged, *disagree,
-                       *rule_notes(count, rec.sensors, without_column(count, keep, supported)))
+    return work.warned(
+        *count_notes(count, keep, data.band_hz, same_row),
+        *merged,
+        *disagree,
+        *rule_notes(count, rec.sensors, without_column(count, keep, supported)),
+    )
 
 
 def without_column(count: ModeCount, keep: np.ndarray, supported) -> list[float]:
@@ -201,8 +233,15 @@ def _counted_part(rec, max_samples: int):
     return rec if rec.n_samples <= max_samples else rec.split(rec.n_samples // max_samples)[0]
 
 
-def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: ModeCount, keep: np.ndarray,
-                             whole: DftLines, hold: str, settings: SelectionSettings = DEFAULTS):  # fmt: skip
+def _one_where_not_separated(
+    rows: pd.DataFrame,
+    shapes: np.ndarray,
+    count: ModeCount,
+    keep: np.ndarray,
+    whole: DftLines,
+    hold: str,
+    settings: SelectionSettings = DEFAULTS,
+):
     """Two counted modes the record does not separate -- neither by frequency (:func:`not_separated`,
     on the model's own intervals) nor by shape (MAC at least the merge's ``merge_mac``) -- reported as
     one: the
@@ -216,19 +255,35 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
     # judged on the model's own intervals and shapes: two bodies' heavily damped modes 7-8 % apart
     # were 1.8 and 2.3 SD apart, and their shapes told them apart (MAC 0.70 and 0.05); the F-16's
     # pair at its highest level, 0.2 SD apart, has one shape as far as three sensors can tell
-    own = pd.DataFrame({"freq_hz": m.freq_hz[poles], "freq_ci95_lo": m.freq_hz[poles] - Z95 * m.freq_sd[poles],
-                        "freq_ci95_hi": m.freq_hz[poles] + Z95 * m.freq_sd[poles]})  # fmt: skip
+    own = pd.DataFrame(
+        {
+            "freq_hz": m.freq_hz[poles],
+            "freq_ci95_lo": m.freq_hz[poles] - Z95 * m.freq_sd[poles],
+            "freq_ci95_hi": m.freq_hz[poles] + Z95 * m.freq_sd[poles],
+        }
+    )
     level, same_shape = settings.count.separation_sd, settings.cluster.merge_mac
-    pairs = [(a, b, gap) for a, b, gap in not_separated(own, level)
-             if mac(m.shapes[:, poles[a]], m.shapes[:, poles[b]]) >= same_shape]  # fmt: skip
+    pairs = [
+        (a, b, gap)
+        for a, b, gap in not_separated(own, level)
+        if mac(m.shapes[:, poles[a]], m.shapes[:, poles[b]]) >= same_shape
+    ]
     if not pairs:
         return rows, shapes, []
     data = whole.noise_weighted(count.model)
     rows, shapes, notes, gone = rows.copy(), shapes.copy(), [], []
     for a, b, gap in pairs:
-        fits = [fit_modal_model(data, np.delete(m.freq_hz, k), np.delete(m.damping, k), hold, settings.count.final_nfev,
-                                settings=settings.dft)
-                for k in (poles[a], poles[b])]  # fmt: skip
+        fits = [
+            fit_modal_model(
+                data,
+                np.delete(m.freq_hz, k),
+                np.delete(m.damping, k),
+                hold,
+                settings.count.final_nfev,
+                settings=settings.dft,
+            )
+            for k in (poles[a], poles[b])
+        ]
         one = min(fits, key=lambda fit: fit.bic())
         both = rows.loc[[a, b]]
         k = nearest_pole(one.freq_hz, float(both.freq_hz.mean()))
@@ -250,8 +305,9 @@ def _one_where_not_separated(rows: pd.DataFrame, shapes: np.ndarray, count: Mode
     return rows.iloc[kept].reset_index(drop=True), shapes[:, kept], notes
 
 
-def confirmed_where_incoherent(work: SelectionState, unconfirmed_hz, settings: SelectionSettings = DEFAULTS
-                               ) -> tuple[tuple[float, ...], list]:  # fmt: skip
+def confirmed_where_incoherent(
+    work: SelectionState, unconfirmed_hz, settings: SelectionSettings = DEFAULTS
+) -> tuple[tuple[float, ...], list]:
     """Of the modes the modal-model check cannot confirm (``unconfirmed_hz``: no coherent H1 line near
     them), those the maximum-likelihood modal model confirms: the likelihood needs it decisively (its
     removal raises the criterion by the count's ``decisive_bic`` or more) and the record's two
@@ -277,8 +333,14 @@ def confirmed_where_incoherent(work: SelectionState, unconfirmed_hz, settings: S
     return tuple(confirmed), notes
 
 
-def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, verdicts: np.ndarray, hold: str,
-                   settings: SelectionSettings) -> SelectionState:  # fmt: skip
+def _picked_result(
+    work: SelectionState,
+    count: ModeCount,
+    keep: np.ndarray,
+    verdicts: np.ndarray,
+    hold: str,
+    settings: SelectionSettings,
+) -> SelectionState:
     """The picked rows (finite ``picked_hz``) reported: from the modal model where it keeps the pick
     as a mode of the band, else as the selection had it (the diagram's or the refit's values) with a
     ``pick_not_supported`` note that says where the model took it. The rows not picked stay in the
@@ -294,8 +356,9 @@ def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, ver
     for j in np.flatnonzero(picked):
         i = pairs[j]
         if keep[i]:
-            rows.append({**_row(work.modes, count, i, hold, same_row, verdicts[i]),
-                         "picked_hz": work.modes.picked_hz.iloc[j]})
+            rows.append(
+                {**_row(work.modes, count, i, hold, same_row, verdicts[i]), "picked_hz": work.modes.picked_hz.iloc[j]}
+            )
             shapes.append(m.shapes[:, i])
             continue
         row = work.modes.iloc[j].to_dict()
@@ -311,8 +374,13 @@ def _picked_result(work: SelectionState, count: ModeCount, keep: np.ndarray, ver
     notes += disagree
     # the check stage judges the model the picks come from: the picks and the modes not picked
     f, x = np.r_[rows.freq_hz.to_numpy(), m.freq_hz[others]], np.r_[rows.damping.to_numpy(), m.damping[others]]
-    work = work.with_modes(rows, np.column_stack([shapes[k] for k in order]), count=count, counted=True,
-                           check_poles=tuple(zip(f.tolist(), x.tolist(), strict=True)))
+    work = work.with_modes(
+        rows,
+        np.column_stack([shapes[k] for k in order]),
+        count=count,
+        counted=True,
+        check_poles=tuple(zip(f.tolist(), x.tolist(), strict=True)),
+    )
     return work.warned(*notes)
 
 
@@ -330,14 +398,29 @@ def _row(modes: pd.DataFrame, count: ModeCount, i: int, hold: str, same_row_freq
     else:  # a mode the diagram's clusters did not hold
         # nor an ARMAX estimate: the segments' spread is judged against the modal model's own
         # deviation (as a mode the FRF screen adds), not the neighbouring row's
-        row.update(count=0, support=0.0, freq_spread=np.nan, damping_spread=np.nan, medoid_freq_hz=np.nan,
-                   medoid_damping=np.nan, orders_damping_unresolved=0, energy=np.nan,
-                   freq_sd_armax=m.freq_sd[i], damping_sd_armax=m.damping_sd[i],
-                   **dict.fromkeys(EARLIER_COLUMNS, np.nan))  # fmt: skip
+        row.update(
+            count=0,
+            support=0.0,
+            freq_spread=np.nan,
+            damping_spread=np.nan,
+            medoid_freq_hz=np.nan,
+            medoid_damping=np.nan,
+            orders_damping_unresolved=0,
+            energy=np.nan,
+            freq_sd_armax=m.freq_sd[i],
+            damping_sd_armax=m.damping_sd[i],
+            **dict.fromkeys(EARLIER_COLUMNS, np.nan),
+        )
     other, widened = count.other_structures(i, same_row_freq)
     row.update(
-        freq_hz=f, damping=x, damped_freq_hz=f * np.sqrt(1 - x**2), freq_sd=m.freq_sd[i], damping_sd=m.damping_sd[i],
-        **other, estimator=f"ml-{hold}", count_undecided=verdict == "undecided",
+        freq_hz=f,
+        damping=x,
+        damped_freq_hz=f * np.sqrt(1 - x**2),
+        freq_sd=m.freq_sd[i],
+        damping_sd=m.damping_sd[i],
+        **other,
+        estimator=f"ml-{hold}",
+        count_undecided=verdict == "undecided",
         structure_widened=widened,
-    )  # fmt: skip
+    )
     return row

@@ -136,9 +136,17 @@ def sweep_fit(recording: Recording, job, max_iter: int, tol: float, covariance: 
     resume, start = (extra, None) if source == SHARED else (None, extra)
     try:
         return fit_resumable(
-            rec, orders, shared_poles=source == SHARED, max_iter=max_iter, tol=tol, stop="decrease", warn=False,
-            resume=resume, start=start, covariance=covariance,
-        )  # fmt: skip
+            rec,
+            orders,
+            shared_poles=source == SHARED,
+            max_iter=max_iter,
+            tol=tol,
+            stop="decrease",
+            warn=False,
+            resume=resume,
+            start=start,
+            covariance=covariance,
+        )
     except OrderError:
         return None, None
 
@@ -203,15 +211,20 @@ def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=Tr
     (checked on every fixture, a lightly damped structure and the real recordings against 20 and 50);
     where BIC is flatter the cap decides between delays the record does not tell apart
     (docs/performance.md)."""
-    nk, known = choose_delay(recording, nk_values, na_values, max_iter=DELAY_CHOICE_ITERATIONS, tol=tol,
-                             n_jobs=n_jobs, bar=bar)  # fmt: skip
+    nk, known = choose_delay(
+        recording, nk_values, na_values, max_iter=DELAY_CHOICE_ITERATIONS, tol=tol, n_jobs=n_jobs, bar=bar
+    )
     if extend and nk == min(nk_values):
         # the best delay is the most non-causal one searched: look NK_EXTENSION further, once
         from tqdm import tqdm
 
         further = range(nk, nk - NK_EXTENSION - 1, -1)
-        with tqdm(total=len(further) * len(na_values), desc=f"input delay choice beyond nk = {nk}", unit="fit",
-                  disable=bar is None or bar.disable) as more:  # fmt: skip
+        with tqdm(
+            total=len(further) * len(na_values),
+            desc=f"input delay choice beyond nk = {nk}",
+            unit="fit",
+            disable=bar is None or bar.disable,
+        ) as more:
             return _choose_nk(recording, further, na_values, n_jobs, tol, extend=False, bar=more)
     return nk, {(SHARED, orders): checkpoint for orders, checkpoint in known.items()}
 
@@ -357,12 +370,13 @@ def _default_orders(recording: Recording, preparation: Preparation | None) -> tu
         return list(DEFAULT_ORDERS), ()  # refused by _check_top_order, with its advice
     capped = [na for na in DEFAULT_ORDERS if na <= top]
     note = QualityWarning(
-        "orders_capped", (),
+        "orders_capped",
+        (),
         f"the default orders 2-{max(DEFAULT_ORDERS)} were capped at na = {max(capped)}: this record "
         f"({recording.n_samples} samples at {recording.fs:g} Hz) supports at most na = {top} "
         f"({SAMPLES_PER_PARAMETER} samples a parameter); a longer record allows higher orders",
         float(max(capped)),
-    )  # fmt: skip
+    )
     return capped, (note,)
 
 

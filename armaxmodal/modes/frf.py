@@ -72,7 +72,14 @@ def nearest_neighbour(freq_hz, damping, m: int, bandwidths: float = DEFAULTS.frf
 
 
 def mode_support(
-    recording: Recording, freq_hz, damping, m: int, check: ModalCheck, band=None, *, reach: str = "overlapping",
+    recording: Recording,
+    freq_hz,
+    damping,
+    m: int,
+    check: ModalCheck,
+    band=None,
+    *,
+    reach: str = "overlapping",
     settings: FrfSettings = DEFAULTS.frf,
 ) -> ModeSupport:
     """How much the check of ``check`` needs mode ``m`` (see ``ModeSupport``).
@@ -132,8 +139,9 @@ def mode_support(
     return ModeSupport(np.sqrt(with_m), np.sqrt(without), p, j, settings)
 
 
-def modes_the_record_needs(recording: Recording, work: SelectionState, band, settings: SelectionSettings = DEFAULTS,
-                           doubts: list | None = None) -> SelectionState:  # fmt: skip
+def modes_the_record_needs(
+    recording: Recording, work: SelectionState, band, settings: SelectionSettings = DEFAULTS, doubts: list | None = None
+) -> SelectionState:
     """Selection by the data: drop, one at a time and least supported first, every mode the
     modal-model check does not need (``mode_support``: leaving it
     out, a neighbour inside its half-power band refitted in its place, raises no output's
@@ -149,8 +157,10 @@ def modes_the_record_needs(recording: Recording, work: SelectionState, band, set
         work = replace(work, check=check)
         if len(modes) < 2 or not np.isfinite(check.error).any():
             return work
-        support = [mode_support(recording, modes.freq_hz, modes.damping, m, check, band, settings=frf)
-                   for m in range(len(modes))]  # fmt: skip
+        support = [
+            mode_support(recording, modes.freq_hz, modes.damping, m, check, band, settings=frf)
+            for m in range(len(modes))
+        ]
         weak = [m for m in range(len(modes)) if not support[m].needed]
         if not weak:
             return work
@@ -174,8 +184,9 @@ def each_once(doubts) -> tuple:
     return tuple(sorted(once.values(), key=lambda d: d[0]))
 
 
-def refit_with_added(diagram, work: SelectionState, band, settings: SelectionSettings = DEFAULTS,
-                     refine: Callable = refine_modes) -> SelectionState:  # fmt: skip
+def refit_with_added(
+    diagram, work: SelectionState, band, settings: SelectionSettings = DEFAULTS, refine: Callable = refine_modes
+) -> SelectionState:
     """The frequency-domain refit again, of every mode once the check has added some: a mode
     missing from a refit biases its neighbours (a five-segment chain's 13.5 Hz mode came out
     at 12.5 Hz while the 24.8 Hz one was missing, and its refit was refused as too far; now
@@ -183,8 +194,9 @@ def refit_with_added(diagram, work: SelectionState, band, settings: SelectionSet
     refit: re-chosen here, a held ride whose first refit was held by 258 went band-limited by 8
     (both converged) and lost its top mode. A refit that cannot be made (by ``refine``) leaves the modes, said."""
     hold = work.refinement.hold if work.refinement is not None else "auto"
-    refit = selection_job(diagram.recording, [], work.modes, ("refit", refit_band(diagram.recording, band)),
-                          settings, refine, hold)  # fmt: skip
+    refit = selection_job(
+        diagram.recording, [], work.modes, ("refit", refit_band(diagram.recording, band)), settings, refine, hold
+    )
     if isinstance(refit, RefitFailure):
         work = work.warned(*refit.notes("the modes with those the check added", uncounted=False))
     else:  # the first refit's start lacked these modes: its refusals may not stand
@@ -194,8 +206,9 @@ def refit_with_added(diagram, work: SelectionState, band, settings: SelectionSet
     return replace(work, check=check)
 
 
-def modes_the_check_adds(diagram, work: SelectionState, band, nas, settings: SelectionSettings = DEFAULTS
-                        ) -> SelectionState:  # fmt: skip
+def modes_the_check_adds(
+    diagram, work: SelectionState, band, nas, settings: SelectionSettings = DEFAULTS
+) -> SelectionState:
     """Stable clusters the support rule left out enter when the modal-model check needs them
     (as :func:`modes_the_record_needs` judges, but with the nearest mode refitted in its place,
     not only an overlapping one: one at a time, the largest first): the
@@ -217,8 +230,9 @@ def modes_the_check_adds(diagram, work: SelectionState, band, nas, settings: Sel
         trial_check = check_modes(diagram.recording, *trial, band, settings=frf)
         if centre[0] in trial_check.unconfirmed_hz:
             continue  # no coherent line there: the check cannot judge it, so it cannot enter
-        if not mode_support(diagram.recording, *trial, len(modes), trial_check, band, reach="nearest",
-                            settings=frf).needed:  # fmt: skip
+        if not mode_support(
+            diagram.recording, *trial, len(modes), trial_check, band, reach="nearest", settings=frf
+        ).needed:
             continue
         core = sub[np.abs(sub.freq_hz / centre[0] - 1) <= frf.peak_cluster_freq]  # reported from near the centre
         rep = representative_pole(diagram, core if len(core) else sub, bic, {}, settings.cluster.finished_max_shift)
@@ -232,8 +246,9 @@ def modes_the_check_adds(diagram, work: SelectionState, band, nas, settings: Sel
     return work.with_modes(modes, shapes, check=check).kept(modes.sort_values("freq_hz").index)
 
 
-def _left_out_clusters(diagram, modes: pd.DataFrame, band, nas, settings: SelectionSettings
-                       ) -> list[tuple[pd.DataFrame, bool]]:  # fmt: skip
+def _left_out_clusters(
+    diagram, modes: pd.DataFrame, band, nas, settings: SelectionSettings
+) -> list[tuple[pd.DataFrame, bool]]:
     """The candidate clusters of :func:`modes_the_check_adds`, the largest first, each with
     whether it stands at an unexplained peak."""
     cluster, frf = settings.cluster, settings.frf
@@ -242,8 +257,9 @@ def _left_out_clusters(diagram, modes: pd.DataFrame, band, nas, settings: Select
     found = []
     for peak in unexplained_peaks(diagram.recording, modes.freq_hz.to_numpy(), modes.damping.to_numpy(), band):
         near = cand[np.abs(cand.freq_hz / peak.value - 1) <= frf.peak_cluster_freq]
-        clusters = [c for c in cluster_poles(near, nas, frf.peak_cluster_freq, None)
-                    if len(c) >= frf.peak_cluster_min_orders]  # fmt: skip
+        clusters = [
+            c for c in cluster_poles(near, nas, frf.peak_cluster_freq, None) if len(c) >= frf.peak_cluster_min_orders
+        ]
         if clusters:
             found.append((near.loc[max(clusters, key=len)], True))
     # away from a peak, a cluster in the top of the input's band is its edge's, not a mode
@@ -279,10 +295,15 @@ def _merged(peaks, df) -> list[QualityWarning]:
     for g in groups:
         f0 = max(g, key=lambda p: p[2])[0]
         sensors = tuple(sorted({p[1] for p in g}))
-        warnings.append(QualityWarning(
-            "unexplained_peak", sensors,
-            f"the measured FRF has a clear, coherent peak at {f0:.2f} Hz ({', '.join(sensors)}) that no "
-            "selected mode explains: a mode the selection missed (widen --orders or --modes), or a disturbance "
-            "(run 'armaxmodal diagnose')", f0, (f0,),
-        ))  # fmt: skip
+        warnings.append(
+            QualityWarning(
+                "unexplained_peak",
+                sensors,
+                f"the measured FRF has a clear, coherent peak at {f0:.2f} Hz ({', '.join(sensors)}) that no "
+                "selected mode explains: a mode the selection missed (widen --orders or --modes), or a disturbance "
+                "(run 'armaxmodal diagnose')",
+                f0,
+                (f0,),
+            )
+        )
     return warnings

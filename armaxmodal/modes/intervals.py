@@ -68,9 +68,21 @@ from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.stats import Z95, damping_interval
 
-__all__ = ["EARLIER_COLUMNS", "QUANTITIES", "N_SEGMENTS", "apply_segment_spread", "covering_both_estimators",
-           "earlier_estimate", "interval", "interval_columns", "not_separated", "segment_jobs", "segment_poles",
-           "segment_spread", "with_intervals"]
+__all__ = [
+    "EARLIER_COLUMNS",
+    "QUANTITIES",
+    "N_SEGMENTS",
+    "apply_segment_spread",
+    "covering_both_estimators",
+    "earlier_estimate",
+    "interval",
+    "interval_columns",
+    "not_separated",
+    "segment_jobs",
+    "segment_poles",
+    "segment_spread",
+    "with_intervals",
+]
 
 #: ``(part prefix, value column)`` of each quantity that has an interval
 QUANTITIES = (("freq", "freq_hz"), ("damping", "damping"))
@@ -150,6 +162,7 @@ def not_separated(modes: pd.DataFrame, separation_sd: float) -> list[tuple[int, 
         i += 1
     return pairs
 
+
 #: the columns a counted row keeps of the selection's earlier estimate of its mode
 EARLIER_COLUMNS = tuple(f"{q}_{part}" for q, _ in QUANTITIES for part in ("earlier", "earlier_sd"))
 
@@ -167,8 +180,9 @@ def earlier_estimate(row: dict) -> dict:
     return columns
 
 
-def covering_both_estimators(rows: pd.DataFrame, alpha: float = DEFAULTS.agreement.alpha
-                             ) -> tuple[pd.DataFrame, list[QualityWarning]]:  # fmt: skip
+def covering_both_estimators(
+    rows: pd.DataFrame, alpha: float = DEFAULTS.agreement.alpha
+) -> tuple[pd.DataFrame, list[QualityWarning]]:
     """Counted ``rows`` (with :data:`EARLIER_COLUMNS`) with their intervals covering the earlier
     estimator's where the record shows the two disagree (the module's docstring).
 
@@ -214,16 +228,18 @@ def covering_both_estimators(rows: pd.DataFrame, alpha: float = DEFAULTS.agreeme
     out["estimator_widened"] = widened
     where = ", ".join(f"{f:.3f}" for f in out.freq_hz[widened])
     note = QualityWarning(
-        "estimators_disagree", (),
+        "estimators_disagree",
+        (),
         f"the modal model's modes and the diagram's fit of them differ beyond their noise (sum of squared "
         f"standardised differences {statistic:.1f} for {z.size} values, its {100 * (1 - alpha):g} % point "
         f"{critical:.1f}): one of them is biased here, by model error the two weight differently (a nonlinearity, the "
         "inter-sample behaviour, leakage) or by orders too low for a mode. One record cannot say which, so every "
-        "mode's interval covers both estimates"
-        + (f"; widened at {where} Hz" if where else ""),
-        statistic, tuple(out.freq_hz[widened]),
-    )  # fmt: skip
+        "mode's interval covers both estimates" + (f"; widened at {where} Hz" if where else ""),
+        statistic,
+        tuple(out.freq_hz[widened]),
+    )
     return out, [note]
+
 
 def segment_spread(
     recording: Recording,
@@ -302,8 +318,10 @@ def _matched_pole(poles: pd.DataFrame | None, freqs: np.ndarray, i: int, match_f
     if poles is None or poles.empty:
         return None
     poles = poles[poles.damping > 0]
-    found = {j: _mutual_nearest(poles, freqs, j, match_freq)
-             for j in np.flatnonzero(np.abs(freqs / freqs[i] - 1) <= match_freq)}  # fmt: skip
+    found = {
+        j: _mutual_nearest(poles, freqs, j, match_freq)
+        for j in np.flatnonzero(np.abs(freqs / freqs[i] - 1) <= match_freq)
+    }
     return None if any(pole is None for pole in found.values()) else found[i]
 
 
@@ -335,8 +353,9 @@ def segment_poles(parts: list[Recording], job) -> pd.DataFrame | None:
     return pd.DataFrame(pole_rows(fit, SHARED)) if fit is not None else None
 
 
-def apply_segment_spread(modes: pd.DataFrame, spread: pd.DataFrame, n_segments: int = N_SEGMENTS,
-                         alpha: float = DEFAULTS.agreement.alpha):  # fmt: skip
+def apply_segment_spread(
+    modes: pd.DataFrame, spread: pd.DataFrame, n_segments: int = N_SEGMENTS, alpha: float = DEFAULTS.agreement.alpha
+):
     """Join the spread to ``modes``, set the segments' part of the intervals where it dominates, and say so.
     ``alpha``: the test's family-wise false-alarm rate over all modes and both parameters (Bonferroni).
 
@@ -384,7 +403,8 @@ def apply_segment_spread(modes: pd.DataFrame, spread: pd.DataFrame, n_segments: 
                 f"refitted on {n_segments} disjoint segments, {len(flagged)} mode(s) scatter beyond their statistical "
                 f"intervals: {listed}. Their 95 % intervals were widened to the segments' spread. The model misses "
                 "an effect of the data (amplitude-dependent or time-varying behaviour, a disturbance, a missing mode).",
-                float(len(flagged)), tuple(modes.freq_hz[flagged]),
+                float(len(flagged)),
+                tuple(modes.freq_hz[flagged]),
             )
         )
     return modes, warnings

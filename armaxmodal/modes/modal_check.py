@@ -42,6 +42,7 @@ from armaxmodal.stats import H1_COHERENCE
 
 __all__ = ["ModalCheck", "check_modes", "confirmed_modes", "poles_of", "rss_at"]
 
+
 @dataclass(frozen=True)
 class ModalCheck:
     """The LSFD fit of the measured FRF by the selected modes (see the module notes).
@@ -158,32 +159,42 @@ class ModalCheck:
         found = []
         if self.unconfirmed_hz:
             where = ", ".join(f"{f:.2f}" for f in self.unconfirmed_hz)
-            found.append(QualityWarning(
-                "modes_do_not_explain_frf", tuple(self.sensors),
-                f"the record does not confirm the mode(s) at {where} Hz: no output's H1 is coherent "
-                f"({H1_COHERENCE:g}) near them, so the check cannot test them (another "
-                "excitation, several moving supports, or noise dominate there). Treat them as unconfirmed",
-                float(self.unconfirmed_hz[0]), tuple(self.unconfirmed_hz),
-            ))  # fmt: skip
+            found.append(
+                QualityWarning(
+                    "modes_do_not_explain_frf",
+                    tuple(self.sensors),
+                    f"the record does not confirm the mode(s) at {where} Hz: no output's H1 is coherent "
+                    f"({H1_COHERENCE:g}) near them, so the check cannot test them (another "
+                    "excitation, several moving supports, or noise dominate there). Treat them as unconfirmed",
+                    float(self.unconfirmed_hz[0]),
+                    tuple(self.unconfirmed_hz),
+                )
+            )
         checked = np.isfinite(self.model_error)
         if checked.any() and np.all(self.model_error[checked] <= self.limit):
             return found
         if not self.failing:
-            return found + [QualityWarning(
-                "modes_do_not_explain_frf", tuple(self.sensors),
-                "no output's H1 is coherent (0.8) on enough lines of the band to check the selected modes against: "
-                "treat them as unconfirmed; a longer record or a broader excitation gives the lines",
-            )]  # fmt: skip
+            return found + [
+                QualityWarning(
+                    "modes_do_not_explain_frf",
+                    tuple(self.sensors),
+                    "no output's H1 is coherent (0.8) on enough lines of the band to check the selected modes against: "
+                    "treat them as unconfirmed; a longer record or a broader excitation gives the lines",
+                )
+            ]
         worst = float(np.nanmax(self.model_error))
         where = "; ".join(f"{s} {lo:.2f}-{hi:.2f} Hz" for s, lo, hi in self.bands) or "spread over the band"
-        return found + [QualityWarning(
-            "modes_do_not_explain_frf", self.failing,
-            f"the selected modes do not explain the measured FRF of {', '.join(self.failing)}: model error up to "
-            f"{100 * worst:.0f} % (limit {100 * self.limit:.0f} %) beyond the H1's random error, misfit "
-            f"{'at ' if self.bands else ''}{where}. Treat these modes as unconfirmed: look at the figure, widen "
-            "--orders or --band, or run 'armaxmodal diagnose'",
-            worst,
-        )]  # fmt: skip
+        return found + [
+            QualityWarning(
+                "modes_do_not_explain_frf",
+                self.failing,
+                f"the selected modes do not explain the measured FRF of {', '.join(self.failing)}: model error up to "
+                f"{100 * worst:.0f} % (limit {100 * self.limit:.0f} %) beyond the H1's random error, misfit "
+                f"{'at ' if self.bands else ''}{where}. Treat these modes as unconfirmed: look at the figure, widen "
+                "--orders or --band, or run 'armaxmodal diagnose'",
+                worst,
+            )
+        ]
 
     def to_dict(self) -> dict:
         """The JSON form: per output its misfit, the H1's random error, the model error, the
@@ -249,8 +260,9 @@ def check_nperseg(recording: Recording, freq_hz, damping) -> int:
     return resolving_nperseg(recording, freq_hz, damping, res.lines_per_bandwidth, res.min_segments)
 
 
-def _fit_delays(lines: CoherentLines, basis: np.ndarray, fs: float, search: bool, settings: FrfSettings
-                ) -> tuple[float, np.ndarray, float]:  # fmt: skip
+def _fit_delays(
+    lines: CoherentLines, basis: np.ndarray, fs: float, search: bool, settings: FrfSettings
+) -> tuple[float, np.ndarray, float]:
     """The delay (s) of the grid (or zero without ``search``) whose fit leaves the least
     misfit, its coefficients and residual sum of squares. All delays are solved at once
     through one QR of the basis."""
@@ -276,8 +288,9 @@ def rss_at(lines: CoherentLines, poles: np.ndarray, delay_s: float) -> float:
     return float(np.sum((y - a @ coef) ** 2))
 
 
-def check_modes(recording: Recording, freq_hz, damping, band=None, *, fit_delay: bool = True,
-                settings: FrfSettings = DEFAULTS.frf) -> ModalCheck:  # fmt: skip
+def check_modes(
+    recording: Recording, freq_hz, damping, band=None, *, fit_delay: bool = True, settings: FrfSettings = DEFAULTS.frf
+) -> ModalCheck:
     """Fit the measured FRF with the modes' poles fixed (see the module notes).
 
     Parameters
@@ -334,22 +347,35 @@ def check_modes(recording: Recording, freq_hz, damping, band=None, *, fit_delay:
         error[k] = np.sqrt(rss / norm)
         rand[k] = np.sqrt(np.sum(lines.sigma**2) / norm)
     model = np.sqrt(np.clip(error**2 - rand**2, 0.0, None))
-    checked_hz = tuple((float(ln.freq_hz[0]), float(ln.freq_hz[-1])) if np.isfinite(error[k]) else (np.nan, np.nan)
-                       for k, ln in enumerate(all_lines))  # fmt: skip
+    checked_hz = tuple(
+        (float(ln.freq_hz[0]), float(ln.freq_hz[-1])) if np.isfinite(error[k]) else (np.nan, np.nan)
+        for k, ln in enumerate(all_lines)
+    )
     seen = confirmed_modes(all_lines, freq_hz, damping, recording.fs / nperseg, settings.confirm_lines)
     check = ModalCheck(
-        tuple(recording.sensors), error, rand, model, delay,
-        np.array([ln.freq_hz.size for ln in all_lines]), nperseg, (), residues, terms, poles,
-        tuple(float(f) for f, ok in zip(freq_hz, seen, strict=True) if not ok), settings.model_error_limit,
+        tuple(recording.sensors),
+        error,
+        rand,
+        model,
+        delay,
+        np.array([ln.freq_hz.size for ln in all_lines]),
+        nperseg,
+        (),
+        residues,
+        terms,
+        poles,
+        tuple(float(f) for f, ok in zip(freq_hz, seen, strict=True) if not ok),
+        settings.model_error_limit,
         checked_hz,
-    )  # fmt: skip
+    )
     if check.passed:
         return check
     return ModalCheck(**{**check.__dict__, "bands": _misfit_bands(check, all_lines, settings.band_min_lines)})
 
 
-def confirmed_modes(all_lines: list[CoherentLines], freq_hz, damping, line_hz: float,
-                    confirm_lines: int = DEFAULTS.frf.confirm_lines) -> np.ndarray:  # fmt: skip
+def confirmed_modes(
+    all_lines: list[CoherentLines], freq_hz, damping, line_hz: float, confirm_lines: int = DEFAULTS.frf.confirm_lines
+) -> np.ndarray:
     """Per mode: does some output have a coherent line (:func:`~armaxmodal.spectra.coherent_lines`) within
     ``|f - f_m| <= xi_m f_m + confirm_lines`` lines? A mode where no H1 is coherent is
     one the record cannot confirm: the check's fit never sees it. (The lines next to a sharp

@@ -43,8 +43,20 @@ from armaxmodal.modes.settings import DEFAULTS, AgreementSettings, CountSettings
 from armaxmodal.spectra import LPM_HALF_WIDTH, local_polynomial_noise
 from armaxmodal.stats import Z95
 
-__all__ = ["Adequacy", "Alternative", "FittedModel", "LeftOut", "ModeCount", "ModelTable", "StandIn", "Step", "Wanted",
-           "halves_chi2", "model_adequacy", "split_start"]
+__all__ = [
+    "Adequacy",
+    "Alternative",
+    "FittedModel",
+    "LeftOut",
+    "ModeCount",
+    "ModelTable",
+    "StandIn",
+    "Step",
+    "Wanted",
+    "halves_chi2",
+    "model_adequacy",
+    "split_start",
+]
 
 #: the count's thresholds when none are given (:class:`~armaxmodal.modes.settings.CountSettings`)
 COUNT = DEFAULTS.count
@@ -102,8 +114,12 @@ class Adequacy:
         dict
             Strict-JSON-ready (None for NaN).
         """
-        return {"ratio": [finite(r) for r in self.ratio], "level": float(self.level),
-                "adequate": self.adequate, "rule": self.rule}  # fmt: skip
+        return {
+            "ratio": [finite(r) for r in self.ratio],
+            "level": float(self.level),
+            "adequate": self.adequate,
+            "rule": self.rule,
+        }
 
 
 def model_adequacy(model: ModalModel, u: np.ndarray, level: float) -> Adequacy:
@@ -369,16 +385,36 @@ class ModeCount:
         return {
             "effective_fraction": finite(self.effective_fraction),
             "trials": int(self.trials),
-            "steps": [{"action": st.action, "freq_hz": finite(st.freq_hz), "bic_fall": finite(st.bic_fall),
-                       "settled_hz": finite(st.settled_hz)} for st in self.steps],  # fmt: skip
-            "models": [{**row._asdict(), "freq_hz": finite(row.freq_hz), "neg2_loglik": finite(row.neg2_loglik),
-                        "bic": finite(row.bic)} for row in self.models],  # fmt: skip
+            "steps": [
+                {
+                    "action": st.action,
+                    "freq_hz": finite(st.freq_hz),
+                    "bic_fall": finite(st.bic_fall),
+                    "settled_hz": finite(st.settled_hz),
+                }
+                for st in self.steps
+            ],
+            "models": [
+                {
+                    **row._asdict(),
+                    "freq_hz": finite(row.freq_hz),
+                    "neg2_loglik": finite(row.neg2_loglik),
+                    "bic": finite(row.bic),
+                }
+                for row in self.models
+            ],
             "adequacy": None if self.adequacy is None else self.adequacy.to_dict(),
-            "rule_refused": ({"bic_difference": finite(self.rule_refused[0]),
-                              "freq_hz": [finite(f) for f in self.rule_refused[1]]} if self.rule_refused else None),
-            "poles": [{"freq_hz": finite(f), "damping": finite(x), "removal_rise": finite(rise), "verdict": verdict}
-                      for f, x, rise, verdict in zip(self.model.freq_hz, self.model.damping, self.removal_rise,
-                                                     self.verdicts(), strict=True)],  # fmt: skip
+            "rule_refused": (
+                {"bic_difference": finite(self.rule_refused[0]), "freq_hz": [finite(f) for f in self.rule_refused[1]]}
+                if self.rule_refused
+                else None
+            ),
+            "poles": [
+                {"freq_hz": finite(f), "damping": finite(x), "removal_rise": finite(rise), "verdict": verdict}
+                for f, x, rise, verdict in zip(
+                    self.model.freq_hz, self.model.damping, self.removal_rise, self.verdicts(), strict=True
+                )
+            ],
         }
 
     def verdicts(self, band_hz=None) -> np.ndarray:
@@ -471,16 +507,20 @@ class ModeCount:
             A counterpart's interval reaches beyond the mode's own.
         """
         m = self.model
-        own = {"freq": list(interval("freq", m.freq_hz[i], Z95 * m.freq_sd[i])),
-               "damping": list(interval("damping", m.damping[i], Z95 * m.damping_sd[i]))}  # fmt: skip
+        own = {
+            "freq": list(interval("freq", m.freq_hz[i], Z95 * m.freq_sd[i])),
+            "damping": list(interval("damping", m.damping[i], Z95 * m.damping_sd[i])),
+        }
         reach = dict.fromkeys(("freq_other_lo", "freq_other_hi", "damping_other_lo", "damping_other_hi"), np.nan)
         widened = False
         for alt in (alternative.model for alternative in self.alternatives):
             for k, j in matched_poles(m.freq_hz, alt.freq_hz):
                 if j != i or abs(np.log(alt.freq_hz[k] / m.freq_hz[i])) > same_row_freq:
                     continue
-                for q, value, sd in (("freq", alt.freq_hz[k], alt.freq_sd[k]), ("damping", alt.damping[k],
-                                                                                  alt.damping_sd[k])):  # fmt: skip
+                for q, value, sd in (
+                    ("freq", alt.freq_hz[k], alt.freq_sd[k]),
+                    ("damping", alt.damping[k], alt.damping_sd[k]),
+                ):
                     (lo, hi), ci = interval(q, value, Z95 * sd), own[q]
                     widened |= bool(lo < ci[0] or hi > ci[1])
                     ci[:] = [min(ci[0], lo), max(ci[1], hi)]
@@ -489,9 +529,16 @@ class ModeCount:
         return reach, widened
 
 
-def halves_chi2(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: int = COUNT.halves_nfev,
-                dft: DftSettings = DEFAULTS.dft, fitter=fit_modal_model,
-                agreement: AgreementSettings = DEFAULTS.agreement) -> np.ndarray:  # fmt: skip
+def halves_chi2(
+    data: DftLines,
+    model: ModalModel,
+    halves,
+    hold: str,
+    max_nfev: int = COUNT.halves_nfev,
+    dft: DftSettings = DEFAULTS.dft,
+    fitter=fit_modal_model,
+    agreement: AgreementSettings = DEFAULTS.agreement,
+) -> np.ndarray:
     """Per pole of ``model``: how far apart the record's two halves (``halves``, lines weighted as
     ``data``; each fitted from ``model``'s poles by ``fitter``) put it: the squared differences of its
     frequency and damping in standard deviations of the difference, summed (each half's pole the one
@@ -502,8 +549,9 @@ def halves_chi2(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: 
     -------
     (n_modes,) ndarray
     """
-    a, b = (fitter(h.weighted(data.weights), model.freq_hz, model.damping, hold, max_nfev, settings=dft)
-            for h in halves)  # fmt: skip
+    a, b = (
+        fitter(h.weighted(data.weights), model.freq_hz, model.damping, hold, max_nfev, settings=dft) for h in halves
+    )
     chi2 = np.zeros(model.n_modes)
     for i, f in enumerate(model.freq_hz):
         power = [h.response_power(f, agreement.match_freq) for h in halves]
@@ -511,8 +559,10 @@ def halves_chi2(data: DftLines, model: ModalModel, halves, hold: str, max_nfev: 
             chi2[i] = np.nan
             continue
         j, k = nearest_pole(a.freq_hz, f), nearest_pole(b.freq_hz, f)
-        for one, two, sd_one, sd_two in ((a.freq_hz, b.freq_hz, a.freq_sd, b.freq_sd),
-                                         (a.damping, b.damping, a.damping_sd, b.damping_sd)):  # fmt: skip
+        for one, two, sd_one, sd_two in (
+            (a.freq_hz, b.freq_hz, a.freq_sd, b.freq_sd),
+            (a.damping, b.damping, a.damping_sd, b.damping_sd),
+        ):
             chi2[i] += (abs(one[j] - two[k]) / max(np.hypot(sd_one[j], sd_two[k]), 1e-300)) ** 2
     return chi2
 
@@ -538,5 +588,7 @@ def split_start(model: ModalModel, m: int) -> tuple[np.ndarray, np.ndarray]:
     """``model``'s poles with mode ``m`` split in two, a half-power bandwidth apart: (Hz, ratio)."""
     f, x = model.freq_hz[m], model.damping[m]
     half = max(x, 0.01) / 2
-    return (np.r_[np.delete(model.freq_hz, m), f * (1 - half), f * (1 + half)],
-            np.r_[np.delete(model.damping, m), x / 2, x / 2])  # fmt: skip
+    return (
+        np.r_[np.delete(model.freq_hz, m), f * (1 - half), f * (1 + half)],
+        np.r_[np.delete(model.damping, m), x / 2, x / 2],
+    )

@@ -14,9 +14,19 @@ from armaxmodal.modes.mode_count import ModeCount, reported
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.stats import MAX_DAMPING, Z95
 
-__all__ = ["confirmed_where_incoherent_note", "count_notes", "dropped_where_peaks_remain", "no_mode_kept_note",
-           "not_needed_note", "not_picked_note", "not_separated_notes", "pick_moved_note", "pick_notes",
-           "reported_as_one_note", "unresolved_damping_notes"]
+__all__ = [
+    "confirmed_where_incoherent_note",
+    "count_notes",
+    "dropped_where_peaks_remain",
+    "no_mode_kept_note",
+    "not_needed_note",
+    "not_picked_note",
+    "not_separated_notes",
+    "pick_moved_note",
+    "pick_notes",
+    "reported_as_one_note",
+    "unresolved_damping_notes",
+]
 
 
 def no_mode_kept_note(count: ModeCount, modes: pd.DataFrame, band_hz) -> QualityWarning:
@@ -41,35 +51,50 @@ def pick_notes(count: ModeCount, keep: np.ndarray) -> list[QualityWarning]:
     notes = []
     for i in np.flatnonzero(keep & (count.verdicts() == "undecided")):
         rise, f = float(count.removal_rise[i]), float(count.model.freq_hz[i])
-        notes.append(QualityWarning(
-            "pick_not_supported", (),
-            f"the record does not support the mode picked at {f:.3f} Hz: without it (the other modes refitted "
-            f"free) the information criterion changes by {rise:+.1f}, less than the {decisive:g} a needed "
-            "mode raises it; treat it as tentative, or pick another column of the diagram", f, (f,),
-        ))  # fmt: skip
+        notes.append(
+            QualityWarning(
+                "pick_not_supported",
+                (),
+                f"the record does not support the mode picked at {f:.3f} Hz: without it (the other modes refitted "
+                f"free) the information criterion changes by {rise:+.1f}, less than the {decisive:g} a needed "
+                "mode raises it; treat it as tentative, or pick another column of the diagram",
+                f,
+                (f,),
+            )
+        )
     if count.best_addition > decisive and np.isfinite(count.best_addition_hz):
         f = count.best_addition_hz
-        notes.append(QualityWarning(
-            "mode_count", (),
-            f"the record holds one mode more than the modal model behind the picks, near {f:.3f} Hz: adding it lowers "
-            f"the information criterion by {count.best_addition:.1f}", f, (f,),
-        ))  # fmt: skip
+        notes.append(
+            QualityWarning(
+                "mode_count",
+                (),
+                f"the record holds one mode more than the modal model behind the picks, near {f:.3f} Hz: adding "
+                "it lowers "
+                f"the information criterion by {count.best_addition:.1f}",
+                f,
+                (f,),
+            )
+        )
     return notes
 
 
 def _why_not_reported(rise_bic: float) -> str:
     if rise_bic > 0:
         return f"the criterion (BIC) rises by {rise_bic:.1f}, so it is not reported"
-    return ("the search, which splits only the mode nearest the residual's peak, did not try it (with it the "
-            f"criterion falls by {-rise_bic:.1f}), so it is not reported")
+    return (
+        "the search, which splits only the mode nearest the residual's peak, did not try it (with it the "
+        f"criterion falls by {-rise_bic:.1f}), so it is not reported"
+    )
 
 
 def _what_to_do(in_diagram: bool) -> str:
     if in_diagram:
         return "pick it (--pick) to see what the record says of it"
     # a split's pole: the ARMAX fits merge it with its neighbour, and a pick takes a diagram's column
-    return ("the diagram holds no stable column there to pick (its ARMAX fits merge it with a neighbour); a longer "
-            "record would decide")
+    return (
+        "the diagram holds no stable column there to pick (its ARMAX fits merge it with a neighbour); a longer "
+        "record would decide"
+    )
 
 
 def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: float) -> list[QualityWarning]:
@@ -93,9 +118,14 @@ def count_notes(count: ModeCount, keep: np.ndarray, band_hz, same_row_freq: floa
         unreported, the intervals widened, and the poles that are no modes of the band.
     """
     verdicts = count.verdicts(band_hz)  # each pole's, decided once by the count
-    return [*_step_notes(count, same_row_freq), *_undecided_notes(count, keep, verdicts),
-            *_left_out_notes(count), *_widened_notes(count, keep, same_row_freq), *_stand_in_notes(count, band_hz),
-            *_outside_notes(count, verdicts, band_hz)]  # fmt: skip
+    return [
+        *_step_notes(count, same_row_freq),
+        *_undecided_notes(count, keep, verdicts),
+        *_left_out_notes(count),
+        *_widened_notes(count, keep, same_row_freq),
+        *_stand_in_notes(count, band_hz),
+        *_outside_notes(count, verdicts, band_hz),
+    ]
 
 
 def _step_notes(count: ModeCount, same_row_freq: float) -> list[QualityWarning]:
@@ -104,12 +134,16 @@ def _step_notes(count: ModeCount, same_row_freq: float) -> list[QualityWarning]:
     for step in count.steps:
         moved = np.isfinite(step.settled_hz) and abs(np.log(step.settled_hz / step.freq_hz)) > same_row_freq
         where = f" (its new pole settled at {step.settled_hz:.3f} Hz)" if moved else ""
-        notes.append(QualityWarning(
-            "mode_count", (),
-            f"the mode at {step.freq_hz:.3f} Hz {words[step.action]}{where}: the information criterion (BIC) of "
-            f"the maximum-likelihood modal model, every pole free, falls by {step.bic_fall:.1f}",
-            float(step.freq_hz), (step.freq_hz,),
-        ))  # fmt: skip
+        notes.append(
+            QualityWarning(
+                "mode_count",
+                (),
+                f"the mode at {step.freq_hz:.3f} Hz {words[step.action]}{where}: the information criterion (BIC) of "
+                f"the maximum-likelihood modal model, every pole free, falls by {step.bic_fall:.1f}",
+                float(step.freq_hz),
+                (step.freq_hz,),
+            )
+        )
     return notes
 
 
@@ -120,28 +154,44 @@ def _undecided_notes(count: ModeCount, keep: np.ndarray, verdicts: np.ndarray) -
     if undecided.any():
         rise = float(count.removal_rise[undecided].min())
         weakest = count.model.freq_hz[np.flatnonzero(undecided)[np.argmin(count.removal_rise[undecided])]]
-        notes.append(QualityWarning(
-            "count_undecided", (),
-            f"the record does not decide the number of modes: with one mode fewer (the rest refitted free) the "
-            f"criterion rises by only {rise:.1f} (under {decisive:g}, Kass & Raftery's 'very strong'); "
-            f"treat the weakest mode ({weakest:.3f} Hz) as tentative", rise, (weakest,),
-        ))  # fmt: skip
+        notes.append(
+            QualityWarning(
+                "count_undecided",
+                (),
+                f"the record does not decide the number of modes: with one mode fewer (the rest refitted free) the "
+                f"criterion rises by only {rise:.1f} (under {decisive:g}, Kass & Raftery's 'very strong'); "
+                f"treat the weakest mode ({weakest:.3f} Hz) as tentative",
+                rise,
+                (weakest,),
+            )
+        )
     if count.best_addition > -decisive and np.isfinite(count.best_addition_hz):
         f = count.best_addition_hz
-        notes.append(QualityWarning(
-            "count_undecided", (),
-            f"the record does not rule out one mode more (near {f:.3f} Hz): adding it changes the criterion by "
-            f"{-count.best_addition:+.1f}, less than {decisive:g} either way", f, (f,),
-        ))  # fmt: skip
+        notes.append(
+            QualityWarning(
+                "count_undecided",
+                (),
+                f"the record does not rule out one mode more (near {f:.3f} Hz): adding it changes the criterion by "
+                f"{-count.best_addition:+.1f}, less than {decisive:g} either way",
+                f,
+                (f,),
+            )
+        )
     if count.wanted:
         f, ratio, dof, rise_bic, in_diagram = count.wanted  # a Wanted
-        notes.append(QualityWarning(
-            "count_undecided", (),
-            f"the record may hold one mode more near {f:.3f} Hz: adding it raises the likelihood far beyond chance "
-            f"(likelihood ratio {ratio:.1f} for its {dof} parameters, p < {count.settings.likelihood_alpha:g}) and the "
-            f"mode is the same in both halves of the record, but {_why_not_reported(rise_bic)}; "
-            f"{_what_to_do(in_diagram)}", f, (f,),
-        ))  # fmt: skip
+        notes.append(
+            QualityWarning(
+                "count_undecided",
+                (),
+                f"the record may hold one mode more near {f:.3f} Hz: adding it raises the likelihood far beyond chance "
+                f"(likelihood ratio {ratio:.1f} for its {dof} parameters, p < "
+                f"{count.settings.likelihood_alpha:g}) and the "
+                f"mode is the same in both halves of the record, but {_why_not_reported(rise_bic)}; "
+                f"{_what_to_do(in_diagram)}",
+                f,
+                (f,),
+            )
+        )
     return notes
 
 
@@ -149,28 +199,51 @@ def _left_out_notes(count: ModeCount) -> list[QualityWarning]:
     """The starts the search carried away, and the additions the halves leave unsettled or refuse."""
     notes = []
     for start, went in count.carried_away:
-        notes.append(QualityWarning(
-            "mode_count", (),
-            f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
-            "damping unresolved, or not the same in both halves of the record); left out", went, (went,),
-        ))  # fmt: skip
+        notes.append(
+            QualityWarning(
+                "mode_count",
+                (),
+                f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
+                "damping unresolved, or not the same in both halves of the record); left out",
+                went,
+                (went,),
+            )
+        )
     for f in count.unsettled_hz:
-        notes.append(QualityWarning(
-            "count_undecided", (),
-            f"the mode at {f:.3f} Hz lowers the criterion decisively, but its frequency and damping in the record's "
-            f"two halves differ by more than chance allows at the {100 * count.agreement.alpha:g} % level, though not "
-            f"by enough ({count.agreement.unsettled_alpha:g}) to call it a change during the record: it is reported, "
-            "tentative; compare another record of the structure", f, (f,),
-        ))  # fmt: skip
+        notes.append(
+            QualityWarning(
+                "count_undecided",
+                (),
+                f"the mode at {f:.3f} Hz lowers the criterion decisively, but its frequency and damping in the "
+                "record's "
+                f"two halves differ by more than chance allows at the {100 * count.agreement.alpha:g} % level, "
+                "though not "
+                f"by enough ({count.agreement.unsettled_alpha:g}) to call it a change during the record: it is "
+                "reported, "
+                "tentative; compare another record of the structure",
+                f,
+                (f,),
+            )
+        )
     ruled = count.adequacy is not None and not count.adequacy.adequate  # the halves refuse at alpha, not below
     for f in count.unconfirmed_hz:
-        why = (f"its frequency and damping in the record's two halves differ beyond chance at the "
-               f"{100 * count.agreement.alpha:g} % level, which refuses it where the model misfits the record (the "
-               "count's rule): a change during the record or a mode the misfit disturbs; left out") if ruled else (
-               "not each of its halves: a change during the record (a drifting frequency, a transient, a "
-               "nonlinearity), not a mode; left out")  # fmt: skip
-        notes.append(QualityWarning("mode_count", (), f"one mode more near {f:.3f} Hz fits the whole record better "
-                                    f"but {why}", f, (f,)))  # fmt: skip
+        why = (
+            (
+                f"its frequency and damping in the record's two halves differ beyond chance at the "
+                f"{100 * count.agreement.alpha:g} % level, which refuses it where the model misfits the record (the "
+                "count's rule): a change during the record or a mode the misfit disturbs; left out"
+            )
+            if ruled
+            else (
+                "not each of its halves: a change during the record (a drifting frequency, a transient, a "
+                "nonlinearity), not a mode; left out"
+            )
+        )
+        notes.append(
+            QualityWarning(
+                "mode_count", (), f"one mode more near {f:.3f} Hz fits the whole record better but {why}", f, (f,)
+            )
+        )
     return notes
 
 
@@ -180,12 +253,17 @@ def _widened_notes(count: ModeCount, keep: np.ndarray, same_row_freq: float) -> 
     if not widened:
         return []
     sizes = ", ".join(f"{alt.n_modes} modes ({d:+.1f})" for d, alt in count.alternatives)
-    return [QualityWarning(
-        "mode_count", (),
-        f"the 95 % intervals of the mode(s) at {', '.join(f'{f:.3f}' for f in widened)} Hz also cover their values "
-        f"in the models the record cannot tell from the chosen one ({sizes} in the criterion): the number of modes "
-        "is part of their uncertainty", float(len(widened)), tuple(widened),
-    )]  # fmt: skip
+    return [
+        QualityWarning(
+            "mode_count",
+            (),
+            f"the 95 % intervals of the mode(s) at {', '.join(f'{f:.3f}' for f in widened)} Hz also cover their values "
+            f"in the models the record cannot tell from the chosen one ({sizes} in the criterion): the number of modes "
+            "is part of their uncertainty",
+            float(len(widened)),
+            tuple(widened),
+        )
+    ]
 
 
 def _stand_in_notes(count: ModeCount, band_hz) -> list[QualityWarning]:
@@ -195,15 +273,26 @@ def _stand_in_notes(count: ModeCount, band_hz) -> list[QualityWarning]:
         # inside the band, a pole the likelihood needs is the record's own: it does not decide whether a mode
         # is there (a body's 17.40 Hz mode stood there, its halves disagreeing, under 'good')
         inside = band_hz[0] <= went <= band_hz[1]
-        notes.append(QualityWarning(
-            "count_undecided" if inside else "mode_count", (),
-            f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
-            "damping unresolved, or not the same in both halves of the record), but the model needs it (without it "
-            f"the criterion rises by {rise_without:.1f}): it stays in the model, as a pole for what the record does "
-            "not resolve there, and is not reported"
-            + ("; whether a mode is there, the record does not decide: compare another record of the structure, or "
-               "pick it ('--pick') to see what the record says of it" if inside else ""), went, (went,),
-        ))  # fmt: skip
+        notes.append(
+            QualityWarning(
+                "count_undecided" if inside else "mode_count",
+                (),
+                f"the free fit carried the starting mode at {start:.3f} Hz to {went:.3f} Hz, where it is no mode (its "
+                "damping unresolved, or not the same in both halves of the record), but the model needs it (without it "
+                f"the criterion rises by {rise_without:.1f}): it stays in the model, as a pole for what the "
+                "record does "
+                "not resolve there, and is not reported"
+                + (
+                    "; whether a mode is there, the record does not decide: compare another record of the "
+                    "structure, or "
+                    "pick it ('--pick') to see what the record says of it"
+                    if inside
+                    else ""
+                ),
+                went,
+                (went,),
+            )
+        )
     return notes
 
 
@@ -217,13 +306,18 @@ def _outside_notes(count: ModeCount, verdicts: np.ndarray, band_hz) -> list[Qual
     if hidden:
         poles = zip(count.model.freq_hz[outside], count.model.damping[outside], strict=True)
         out = ", ".join(f"{f:.3g} Hz (damping {x:.2f})" for f, x in poles)
-        notes.append(QualityWarning(
-            "mode_count", (),
-            f"{hidden} pole(s) of the modal model lie outside the band {band_hz[0]:.3g}-{band_hz[1]:.3g} Hz, are "
-            f"damped beyond {MAX_DAMPING:g} or are lines (damping at the fit's floor): {out}. They stand for what lies "
-            "beyond the band or for a periodic disturbance, and are not reported as modes",
-            float(hidden), tuple(count.model.freq_hz[outside]),
-        ))  # fmt: skip
+        notes.append(
+            QualityWarning(
+                "mode_count",
+                (),
+                f"{hidden} pole(s) of the modal model lie outside the band {band_hz[0]:.3g}-{band_hz[1]:.3g} Hz, are "
+                f"damped beyond {MAX_DAMPING:g} or are lines (damping at the fit's floor): {out}. They stand for "
+                "what lies "
+                "beyond the band or for a periodic disturbance, and are not reported as modes",
+                float(hidden),
+                tuple(count.model.freq_hz[outside]),
+            )
+        )
     return notes
 
 
@@ -236,13 +330,15 @@ def _beyond_band_note(model, i: int, band_hz) -> QualityWarning:
     f, x, df, dx = _pole_and_reach(model, i)
     side, edge = ("above", f + df) if f > band_hz[1] else ("below", f - df)
     return QualityWarning(
-        "mode_beyond_band", (),
+        "mode_beyond_band",
+        (),
         f"the record holds a mode {side} the band {band_hz[0]:.4g}-{band_hz[1]:.4g} Hz: the modal model needs a pole "
         f"at {f:.3f} Hz (95 % interval {f - df:.4g}-{f + df:.4g} Hz), damping {x:.3f} ({x - dx:.3f}-{x + dx:.3f}). "
         f"It is not reported, as it lies outside the band (the input's excited band, or --band within it); to "
         f"report it, excite the structure and fit a band reaching {side.replace('above', 'past')} {edge:.3g} Hz",
-        float(f), (f,),
-    )  # fmt: skip
+        float(f),
+        (f,),
+    )
 
 
 def _borderline_note(model, i: int, band_hz) -> QualityWarning:
@@ -255,13 +351,15 @@ def _borderline_note(model, i: int, band_hz) -> QualityWarning:
         where.append(f"damped beyond {MAX_DAMPING:g}")
         reach.append(f"below {MAX_DAMPING:g}")
     return QualityWarning(
-        "count_undecided", (),
+        "count_undecided",
+        (),
         f"the modal model's pole at {f:.3f} Hz (damping {x:.2f}) lies {' and '.join(where)}, so it is not reported "
         f"as a mode, but its 95 % interval ({f - df:.4g}-{f + df:.4g} Hz, damping {x - dx:.2f}-{x + dx:.2f}) reaches "
         f"{' and '.join(reach)}: the record does not decide whether the band holds one mode more there (a heavily "
         "damped mode near the band's edge is estimated so); excite and fit a band reaching past it to decide",
-        float(f), (f,),
-    )  # fmt: skip
+        float(f),
+        (f,),
+    )
 
 
 def not_separated_notes(modes: pd.DataFrame, separation_sd: float) -> list[QualityWarning]:
@@ -269,11 +367,17 @@ def not_separated_notes(modes: pd.DataFrame, separation_sd: float) -> list[Quali
     differ by less than ``separation_sd`` standard deviations of the difference and that the
     count did not report as one (picks, or modes the count left)."""
     f = modes.freq_hz.to_numpy()
-    return [QualityWarning(
-        "modes_not_separated", (),
-        f"modes at {f[i]:.3f} and {f[j]:.3f} Hz are {gap:.1f} standard deviations of their difference apart (under "
-        f"{separation_sd:g}): the record does not separate them; they may be one mode", float(f[i]), (f[i], f[j]),
-    ) for i, j, gap in not_separated(with_intervals(modes), separation_sd)]  # fmt: skip
+    return [
+        QualityWarning(
+            "modes_not_separated",
+            (),
+            f"modes at {f[i]:.3f} and {f[j]:.3f} Hz are {gap:.1f} standard deviations of their difference apart (under "
+            f"{separation_sd:g}): the record does not separate them; they may be one mode",
+            float(f[i]),
+            (f[i], f[j]),
+        )
+        for i, j, gap in not_separated(with_intervals(modes), separation_sd)
+    ]
 
 
 def unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[QualityWarning]:
@@ -290,63 +394,84 @@ def unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[Quality
         if crossed:
             facts.append(f"its estimate is not positive at {crossed} of {n_orders} orders")
         if getattr(m, "model_error_dominates", False):
-            why = ("the interval is the spread of the record's thirds (model_error_dominates): the thirds disagree "
-                   "about this damping; run 'armaxmodal diagnose'")  # fmt: skip
+            why = (
+                "the interval is the spread of the record's thirds (model_error_dominates): the thirds disagree "
+                "about this damping; run 'armaxmodal diagnose'"
+            )
         elif getattr(m, "structure_widened", False) or getattr(m, "estimator_widened", False):
-            why = ("the interval covers the other models the record finds as good (another number of modes, two poles "
-                   "reported as one) or the other estimator's value, which disagree about this damping")  # fmt: skip
+            why = (
+                "the interval covers the other models the record finds as good (another number of modes, two poles "
+                "reported as one) or the other estimator's value, which disagree about this damping"
+            )
         else:
             why = "the damping is below what this record resolves: a longer record, or more excitation here, narrows it"
-        notes.append(QualityWarning(
-            "damping_unresolved", (),
-            f"mode at {m.freq_hz:.3f} Hz ([{m.freq_ci95_lo:.4g}, {m.freq_ci95_hi:.4g}] Hz): {'; '.join(facts)}. {why}",
-            float(m.freq_hz), (m.freq_hz,),
-        ))  # fmt: skip
+        notes.append(
+            QualityWarning(
+                "damping_unresolved",
+                (),
+                f"mode at {m.freq_hz:.3f} Hz ([{m.freq_ci95_lo:.4g}, {m.freq_ci95_hi:.4g}] Hz): "
+                f"{'; '.join(facts)}. {why}",
+                float(m.freq_hz),
+                (m.freq_hz,),
+            )
+        )
     return notes
+
 
 def reported_as_one_note(pair_hz, gap: float, level: float, same_shape: float, f: float, x: float) -> QualityWarning:
     """Two poles of the count reported as one mode at ``f`` Hz (damping ``x``): ``gap`` standard
     deviations apart (under ``level``), their shapes' MAC at least ``same_shape``."""
     return QualityWarning(
-        "modes_not_separated", (),
+        "modes_not_separated",
+        (),
         f"the modal model needs two poles at {pair_hz[0]:.3f} and {pair_hz[1]:.3f} Hz, but they are {gap:.1f} "
         f"standard deviations of their difference apart (under {level:g}) and their shapes agree (MAC at least "
         f"{same_shape:g}): the record does not separate them. Reported as one mode at {f:.3f} Hz (damping {x:.3g}, "
         "the model with one pole there), its intervals covering both: one resonance whose frequency moves during "
-        "the record (a nonlinearity, a change) or two modes this record cannot resolve", f, tuple(pair_hz),
-    )  # fmt: skip
+        "the record (a nonlinearity, a change) or two modes this record cannot resolve",
+        f,
+        tuple(pair_hz),
+    )
 
 
 def confirmed_where_incoherent_note(f: float, rise: float) -> QualityWarning:
     """A mode at ``f`` Hz no coherent H1 line tests, confirmed by the modal model (``rise``: the
     criterion's rise without it)."""
     return QualityWarning(
-        "mode_count", (),
+        "mode_count",
+        (),
         f"no output's H1 is coherent near {f:.3f} Hz, so the FRF check cannot test that mode; the maximum-likelihood "
         f"modal model, fitted to the record's DFT, confirms it: without it the criterion rises by {rise:.0f}, and "
-        "both halves of the record give it the same frequency and damping", float(f), (f,),
-    )  # fmt: skip
+        "both halves of the record give it the same frequency and damping",
+        float(f),
+        (f,),
+    )
 
 
 def pick_moved_note(picked_hz: float, f: float, x: float) -> QualityWarning:
     """A pick the modal model takes to ``f`` Hz (damping ``x``), where it is no mode of the band."""
     return QualityWarning(
-        "pick_not_supported", (),
+        "pick_not_supported",
+        (),
         f"the maximum-likelihood modal model takes the mode picked at {picked_hz:.3f} Hz to {f:.3f} Hz (damping "
         f"{x:.3g}): beyond the band, damped beyond {MAX_DAMPING:g} or a line. The record does not support a mode "
-        "there; it is reported from the diagram's fit, unconfirmed", float(picked_hz), (picked_hz,),
-    )  # fmt: skip
+        "there; it is reported from the diagram's fit, unconfirmed",
+        float(picked_hz),
+        (picked_hz,),
+    )
 
 
 def not_picked_note(model, others) -> QualityWarning:
     """The modes of ``model`` (indices ``others``) no pick took: kept in the model, not reported."""
     return QualityWarning(
-        "mode_count", (),
+        "mode_count",
+        (),
         f"{len(others)} mode(s) of the record were not picked and are not reported: "
         + ", ".join(f"{model.freq_hz[i]:.3f} Hz (damping {model.damping[i]:.3g})" for i in others)
         + "; they stay in the modal model, so that the picked modes' values are not biased by their absence",
-        float(len(others)), tuple(model.freq_hz[others]),
-    )  # fmt: skip
+        float(len(others)),
+        tuple(model.freq_hz[others]),
+    )
 
 
 def dropped_where_peaks_remain(count: ModeCount | None, peaks, same_row_freq: float) -> list[QualityWarning]:
@@ -360,40 +485,56 @@ def dropped_where_peaks_remain(count: ModeCount | None, peaks, same_row_freq: fl
         return []
     notes = []
     for start, went, fate in [(start, went, "left out") for start, went in count.carried_away]:
-        near = [p.value for p in peaks
-                if min(abs(np.log(p.value / start)), abs(np.log(p.value / went))) <= same_row_freq]  # fmt: skip
+        near = [
+            p.value for p in peaks if min(abs(np.log(p.value / start)), abs(np.log(p.value / went))) <= same_row_freq
+        ]
         if near:
-            notes.append(QualityWarning(
-                "count_undecided", (),
-                f"the starting mode at {start:.3f} Hz was {fate} (the free fit took it to {went:.3f} Hz, where it "
-                f"is no mode), but the measured FRF keeps a coherent peak no mode explains at "
-                f"{', '.join(f'{f:.2f}' for f in near)} Hz: the record does not decide whether a mode is there; "
-                "compare another record of the structure, or pick it ('--pick') to see what the record says of it",
-                float(start), (start, *near),
-            ))  # fmt: skip
+            notes.append(
+                QualityWarning(
+                    "count_undecided",
+                    (),
+                    f"the starting mode at {start:.3f} Hz was {fate} (the free fit took it to {went:.3f} Hz, where it "
+                    f"is no mode), but the measured FRF keeps a coherent peak no mode explains at "
+                    f"{', '.join(f'{f:.2f}' for f in near)} Hz: the record does not decide whether a mode is there; "
+                    "compare another record of the structure, or pick it ('--pick') to see what the record says of it",
+                    float(start),
+                    (start, *near),
+                )
+            )
     return notes
 
-def not_needed_note(f: float, x: float, neighbour_hz: float | None, level: float, alpha: float, rise: float,
-                    p: float) -> QualityWarning:  # fmt: skip
+
+def not_needed_note(
+    f: float, x: float, neighbour_hz: float | None, level: float, alpha: float, rise: float, p: float
+) -> QualityWarning:
     """The mode at ``f`` Hz (damping ``x``) the measured FRF does not need: without it the misfit rises by
     ``rise`` (a share), under ``level`` or not significantly (``p`` above ``alpha``); with ``neighbour_hz``,
     the mode there took the whole peak (a ``split_merged`` note), else a ``mode_not_needed`` one."""
-    evidence = (f"without it no output's misfit rises by {100 * level:g} % (at most {100 * rise:+.1f} %, p = {p:.2g})"
-                if rise < level else  # large enough, but within what chance gives on these lines
-                f"without it an output's misfit rises by {100 * rise:+.1f} %, but not significantly (p = {p:.2g}, "
-                f"above {alpha:g})")  # fmt: skip
+    evidence = (
+        f"without it no output's misfit rises by {100 * level:g} % (at most {100 * rise:+.1f} %, p = {p:.2g})"
+        if rise < level
+        # large enough, but within what chance gives on these lines
+        else f"without it an output's misfit rises by {100 * rise:+.1f} %, but not significantly (p = {p:.2g}, "
+        f"above {alpha:g})"
+    )
     if neighbour_hz is not None:
         return QualityWarning(
-            "split_merged", (),
+            "split_merged",
+            (),
             f"modes at {neighbour_hz:.3f} and {f:.3f} Hz overlap within their half-power bands and the measured FRF "
             f"does not need both: {evidence} once {neighbour_hz:.3f} Hz may take the whole peak; one peak split by "
-            f"the model, {neighbour_hz:.3f} Hz is reported", float(f), (neighbour_hz, f),
-        )  # fmt: skip
+            f"the model, {neighbour_hz:.3f} Hz is reported",
+            float(f),
+            (neighbour_hz, f),
+        )
     return QualityWarning(
-        "mode_not_needed", (),
+        "mode_not_needed",
+        (),
         f"a stable pole at {f:.3f} Hz (damping {x:.3f}) is left out: the measured FRF does not need it, {evidence}: "
-        "a spurious pole of the model (noise, a nonlinearity, leakage), not a mode of the record", float(f), (f,),
-    )  # fmt: skip
+        "a spurious pole of the model (noise, a nonlinearity, leakage), not a mode of the record",
+        float(f),
+        (f,),
+    )
 
 
 def rule_notes(count: ModeCount, sensors, without_column=()) -> list[QualityWarning]:
@@ -422,19 +563,30 @@ def rule_notes(count: ModeCount, sensors, without_column=()) -> list[QualityWarn
         worst, found = 0, "the band holds too few lines to measure the record's noise"
     else:
         worst = int(np.nanargmax(test.ratio))
-        found = (f"the modal model's residual holds {test.ratio[worst]:.2f} times the record's own noise on "
-                 f"'{sensors[worst]}' (at most {test.level:g} where a model explains the record)")  # fmt: skip
-    text = (f"{found}: the criterion, which assumes a right model, cannot count the modes alone, so a mode the "
-            "count adds must also stand in a stable column of the diagram")  # fmt: skip
+        found = (
+            f"the modal model's residual holds {test.ratio[worst]:.2f} times the record's own noise on "
+            f"'{sensors[worst]}' (at most {test.level:g} where a model explains the record)"
+        )
+    text = (
+        f"{found}: the criterion, which assumes a right model, cannot count the modes alone, so a mode the "
+        "count adds must also stand in a stable column of the diagram"
+    )
     if count.rule_refused:
         fall, freqs = count.rule_refused
-        text += (f"; the criterion alone chose {len(freqs)} modes ({', '.join(f'{f:.2f}' for f in freqs)} Hz, lower "
-                 f"by {fall:.1f}), refused by that rule")  # fmt: skip
+        text += (
+            f"; the criterion alone chose {len(freqs)} modes ({', '.join(f'{f:.2f}' for f in freqs)} Hz, lower "
+            f"by {fall:.1f}), refused by that rule"
+        )
     notes = [QualityWarning("model_inadequate", (sensors[worst],), text, float(test.ratio[worst]))]
     for f in without_column:
-        notes.append(QualityWarning(
-            "count_undecided", (),
-            f"the mode at {f:.3f} Hz stands in no stable column of the diagram, which the count's rule asks of a "
-            "mode where the model misfits the record: treat it as tentative", float(f), (float(f),),
-        ))  # fmt: skip
+        notes.append(
+            QualityWarning(
+                "count_undecided",
+                (),
+                f"the mode at {f:.3f} Hz stands in no stable column of the diagram, which the count's rule asks of a "
+                "mode where the model misfits the record: treat it as tentative",
+                float(f),
+                (float(f),),
+            )
+        )
     return notes

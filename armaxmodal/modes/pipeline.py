@@ -92,8 +92,18 @@ def refit(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     """The frequency-domain refit under the inter-sample behaviour the data choose
     (:func:`armaxmodal.modes.state.refine_modes`), reported for a band-limited record, with the segment refits
     of every mode's representative orders run beside it over the worker threads."""
-    fitted = refit_and_segment_fits(ctx.diagram, state.modes, ctx.band, True, ctx.segments, ctx.orders, ctx.n_jobs,
-                                    ctx.bar, ctx.settings, ctx.fitters)  # fmt: skip
+    fitted = refit_and_segment_fits(
+        ctx.diagram,
+        state.modes,
+        ctx.band,
+        True,
+        ctx.segments,
+        ctx.orders,
+        ctx.n_jobs,
+        ctx.bar,
+        ctx.settings,
+        ctx.fitters,
+    )
     done = fitted.pop("refit")
     c = ctx.settings.cluster
     state = refined_modes(ctx.diagram, replace(state, segment_fits=fitted), done, c.freq, c.damping, c.merge_mac)
@@ -102,8 +112,9 @@ def refit(state: SelectionState, ctx: SelectionContext) -> SelectionState:
 
 def segment_fits(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     """The segment refits of every mode's representative orders alone (no frequency-domain refit)."""
-    fitted = refit_and_segment_fits(ctx.diagram, state.modes, ctx.band, False, ctx.segments, ctx.orders, ctx.n_jobs,
-                                    ctx.bar)  # fmt: skip
+    fitted = refit_and_segment_fits(
+        ctx.diagram, state.modes, ctx.band, False, ctx.segments, ctx.orders, ctx.n_jobs, ctx.bar
+    )
     return replace(state, segment_fits=fitted)
 
 
@@ -142,8 +153,9 @@ def count(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     if state.refinement is None or not len(state.modes):  # nothing counts the doubts: the check's word stands
         return replace(state, doubts=()).warned(*(note for _, _, note in state.doubts)) if state.doubts else state
     hold, band_hz = state.refinement.hold, state.refinement.band_hz
-    state = counted_modes(ctx.diagram, state, band_hz, hold, ctx.nas, ctx.settings, ctx.band,
-                          n_jobs=ctx.n_jobs, counter=ctx.fitters.count)  # fmt: skip
+    state = counted_modes(
+        ctx.diagram, state, band_hz, hold, ctx.nas, ctx.settings, ctx.band, n_jobs=ctx.n_jobs, counter=ctx.fitters.count
+    )
     ctx.update_bar(state.count.trials)
     return state
 
@@ -170,8 +182,9 @@ def add_picks(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     if state.refinement is None:  # no modal model to fit them with: the picks as the diagram has them
         return state.kept(np.flatnonzero(np.isfinite(modes.picked_hz.to_numpy())))
     hold, band_hz = state.refinement.hold, state.refinement.band_hz
-    return counted_modes(ctx.diagram, state, band_hz, hold, ctx.nas, ctx.settings, ctx.band, picked=True,
-                         n_jobs=ctx.n_jobs)  # fmt: skip
+    return counted_modes(
+        ctx.diagram, state, band_hz, hold, ctx.nas, ctx.settings, ctx.band, picked=True, n_jobs=ctx.n_jobs
+    )
 
 
 def separate(state: SelectionState, ctx: SelectionContext) -> SelectionState:
@@ -205,8 +218,15 @@ def spread(state: SelectionState, ctx: SelectionContext) -> SelectionState:
         return state
     modes, orders = state.modes, ctx.orders
     limits = ctx.settings.agreement
-    table = segment_spread(ctx.diagram.recording, modes, lambda i: orders[int(modes.at[i, "na"])], ctx.segments,
-                           ctx.n_jobs, state.segment_fits, limits.match_freq)  # fmt: skip
+    table = segment_spread(
+        ctx.diagram.recording,
+        modes,
+        lambda i: orders[int(modes.at[i, "na"])],
+        ctx.segments,
+        ctx.n_jobs,
+        state.segment_fits,
+        limits.match_freq,
+    )
     modes, notes = apply_segment_spread(modes, table, ctx.segments, limits.alpha)
     return replace(state, modes=modes).warned(*notes)
 
@@ -235,8 +255,21 @@ def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
         *state.check.warnings(),
     )
     picks = None if ctx.picks is None else sorted(float(f) for f in ctx.picks)
-    result = ModeSelection(modes, state.shapes, per_sensor, weighted, diagram, state.refinement, state.warnings,
-                           state.check, state.count, ctx.settings, picks, state.counted, ctx.segments)  # fmt: skip
+    result = ModeSelection(
+        modes,
+        state.shapes,
+        per_sensor,
+        weighted,
+        diagram,
+        state.refinement,
+        state.warnings,
+        state.check,
+        state.count,
+        ctx.settings,
+        picks,
+        state.counted,
+        ctx.segments,
+    )
     return replace(state, result=result)
 
 
@@ -246,8 +279,19 @@ AUTOMATIC: tuple[Stage, ...] = (candidates, merge, refit, propose_by_frf, count,
 #: ``n_modes`` given: the best-supported candidates, refitted and checked; nothing dropped or added
 FIXED_COUNT: tuple[Stage, ...] = (candidates, merge, best_n, refit, check, spread, separate, finish)
 #: ``picks`` given: the picked clusters reported from the model the automatic selection counted
-PICKED: tuple[Stage, ...] = (take_picks, candidates, merge, refit, propose_by_frf, count, add_picks,
-                             check, spread, separate, finish)  # fmt: skip
+PICKED: tuple[Stage, ...] = (
+    take_picks,
+    candidates,
+    merge,
+    refit,
+    propose_by_frf,
+    count,
+    add_picks,
+    check,
+    spread,
+    separate,
+    finish,
+)
 
 
 def stages_for(n_modes: int | None, picks, refine: bool) -> tuple[Stage, ...]:
@@ -370,8 +414,20 @@ def select_modes(
         band = diagram.preparation.band
     checked = None if picks is None else check_picks(picks, band, diagram.recording.fs, settings.cluster)
     with one_blas_thread(), tqdm(desc="mode selection", unit="fit", disable=not progress) as bar:
-        ctx = SelectionContext(diagram, settings, band, sorted({o.na for o in diagram.orders}), n_modes, checked,
-                               segments, refine, n_jobs, bar, on_stage, fitters or Fitters())  # fmt: skip
+        ctx = SelectionContext(
+            diagram,
+            settings,
+            band,
+            sorted({o.na for o in diagram.orders}),
+            n_modes,
+            checked,
+            segments,
+            refine,
+            n_jobs,
+            bar,
+            on_stage,
+            fitters or Fitters(),
+        )
         return run_stages(stages, SelectionState.empty(len(diagram.recording.sensors)), ctx)
 
 

@@ -30,8 +30,18 @@ from armaxmodal.recording import Recording
 from armaxmodal.spectra import excited_band
 from armaxmodal.stats import MAX_DAMPING, Z95
 
-__all__ = ["Tolerances", "pole_rows", "stability_classes", "rejection_reasons", "POLE_COLUMNS", "borderline",
-           "disturbance_lines", "physical", "reported", "resolved"]
+__all__ = [
+    "Tolerances",
+    "pole_rows",
+    "stability_classes",
+    "rejection_reasons",
+    "POLE_COLUMNS",
+    "borderline",
+    "disturbance_lines",
+    "physical",
+    "reported",
+    "resolved",
+]
 
 SHARED = "shared"
 
@@ -73,9 +83,21 @@ class Tolerances:
 
 
 POLE_COLUMNS = [
-    "source", "na", "freq_hz", "damping", "damped_freq_hz", "freq_sd", "damping_sd", "freq_ci95_lo",
-    "freq_ci95_hi", "damping_ci95_lo", "damping_ci95_hi", "energy", "pole", "vector",
-]  # fmt: skip
+    "source",
+    "na",
+    "freq_hz",
+    "damping",
+    "damped_freq_hz",
+    "freq_sd",
+    "damping_sd",
+    "freq_ci95_lo",
+    "freq_ci95_hi",
+    "damping_ci95_lo",
+    "damping_ci95_hi",
+    "energy",
+    "pole",
+    "vector",
+]
 
 
 def pole_rows(fit: ArmaxFit, source: str) -> list[dict]:
@@ -167,9 +189,12 @@ def rejection_reasons(poles: pd.DataFrame, tol: Tolerances, recording: Recording
     return reasons
 
 
-
 def disturbance_lines(
-    poles: pd.DataFrame, min_energy: float, recording: Recording, shared: str = "shared", min_support: float = 0.4,
+    poles: pd.DataFrame,
+    min_energy: float,
+    recording: Recording,
+    shared: str = "shared",
+    min_support: float = 0.4,
     lines: LineSettings = DEFAULTS.lines,
 ) -> list[QualityWarning]:
     """One ``periodic_disturbance`` warning per line of the shared-pole sweep.

@@ -222,18 +222,21 @@ def filled_samples_scale(recording, preparation) -> tuple[float, list[QualityWar
     samples with ``k`` filled holds ``N - k`` observations, and a standard deviation the fit
     computed from ``N`` is too small by ``sqrt(N / (N - k))``. Counted in the record's own
     samples, before any resampling. Returns ``(factor, notes)``; 1 and none without filled samples."""
-    filled = sum(w.value or 0.0 for w in recording.meta.get("read_warnings", ())
-                 if w.code in ("gap_filled", "dropped_packet"))  # fmt: skip
+    filled = sum(
+        w.value or 0.0 for w in recording.meta.get("read_warnings", ()) if w.code in ("gap_filled", "dropped_packet")
+    )
     if not filled:
         return 1.0, []
     # gap_filled counts one channel's samples; a filled sample of any channel is lost to the fit
     n = recording.duration * (recording.fs if preparation is None else preparation.original_fs)
     factor = float(np.sqrt(n / max(n - filled, 1.0)))
     note = QualityWarning(
-        "gap_filled", (),
+        "gap_filled",
+        (),
         f"{filled:g} filled sample(s) carry no information: every interval is widened by {factor:.6f} "
-        f"(sqrt(N / (N - filled)), N = {n:.0f})", factor,
-    )  # fmt: skip
+        f"(sqrt(N / (N - filled)), N = {n:.0f})",
+        factor,
+    )
     return factor, [note]
 
 
@@ -262,8 +265,21 @@ def verdict(check, n_modes: int, uncertain_because: list[str] = ()) -> str:
 
 
 #: the columns of an empty selection (what the command line and the JSON read of a mode)
-_MODE_COLUMNS = ("freq_hz", "damping", "damped_freq_hz", "freq_ci95_lo", "freq_ci95_hi", "damping_ci95_lo",
-                 "damping_ci95_hi", "na", "count", "support", "freq_spread", "damping_spread", "estimator")  # fmt: skip
+_MODE_COLUMNS = (
+    "freq_hz",
+    "damping",
+    "damped_freq_hz",
+    "freq_ci95_lo",
+    "freq_ci95_hi",
+    "damping_ci95_lo",
+    "damping_ci95_hi",
+    "na",
+    "count",
+    "support",
+    "freq_spread",
+    "damping_spread",
+    "estimator",
+)
 
 
 def no_mode_selection(diagram: StabilisationDiagram, why: str, settings: SelectionSettings = DEFAULTS) -> ModeSelection:
@@ -275,8 +291,9 @@ def no_mode_selection(diagram: StabilisationDiagram, why: str, settings: Selecti
     empty = pd.DataFrame(columns=list(_MODE_COLUMNS))
     per_sensor = pd.DataFrame(columns=["sensor", "mode", "own_modal_constant"])
     shapes = np.zeros((len(diagram.recording.sensors), 0), dtype=complex)
-    return ModeSelection(empty, shapes, per_sensor, pd.DataFrame(columns=["mode"]), diagram, None, (note,), None,
-                         settings=settings)  # fmt: skip
+    return ModeSelection(
+        empty, shapes, per_sensor, pd.DataFrame(columns=["mode"]), diagram, None, (note,), None, settings=settings
+    )
 
 
 def record_header(recording: Recording, preparation: Preparation | None, warnings) -> dict:

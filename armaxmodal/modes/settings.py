@@ -16,8 +16,18 @@ from dataclasses import MISSING, asdict, dataclass, field, fields
 
 from armaxmodal.exceptions import SettingsError
 
-__all__ = ["AgreementSettings", "ClusterSettings", "CountSettings", "DftSettings", "FrfSettings", "LineSettings",
-           "NoteSettings", "Resolution", "SelectionSettings", "SweepSettings"]
+__all__ = [
+    "AgreementSettings",
+    "ClusterSettings",
+    "CountSettings",
+    "DftSettings",
+    "FrfSettings",
+    "LineSettings",
+    "NoteSettings",
+    "Resolution",
+    "SelectionSettings",
+    "SweepSettings",
+]
 
 
 class _Settings:
@@ -53,9 +63,21 @@ N_SEGMENTS = 3
 
 
 #: the thresholds that are a probability, a share or a MAC: at most 1
-_AT_MOST_ONE = frozenset({"min_support", "merge_mac", "support_alpha", "likelihood_alpha", "alpha",
-                          "unsettled_alpha", "edge_fraction", "oversampled_fraction", "min_damping",
-                          "max_damping", "excitation_ratio"})  # fmt: skip
+_AT_MOST_ONE = frozenset(
+    {
+        "min_support",
+        "merge_mac",
+        "support_alpha",
+        "likelihood_alpha",
+        "alpha",
+        "unsettled_alpha",
+        "edge_fraction",
+        "oversampled_fraction",
+        "min_damping",
+        "max_damping",
+        "excitation_ratio",
+    }
+)
 
 
 def _checked(settings) -> None:
@@ -69,11 +91,14 @@ def _checked(settings) -> None:
             kind = "whole number" if whole else "number"
             raise SettingsError(f"{name}.{f.name}: expected a {kind}, got {value!r} (the default is {default!r}).")
         if not (math.isfinite(value) and value > 0):
-            raise SettingsError(f"{name}.{f.name}: expected a positive number, got {value!r} (the default is "
-                                f"{default!r}).")  # fmt: skip
+            raise SettingsError(
+                f"{name}.{f.name}: expected a positive number, got {value!r} (the default is {default!r})."
+            )
         if f.name in _AT_MOST_ONE and value > 1:
-            raise SettingsError(f"{name}.{f.name}: a probability, share or MAC is at most 1, got {value!r} (the "
-                                f"default is {default!r}).")  # fmt: skip
+            raise SettingsError(
+                f"{name}.{f.name}: a probability, share or MAC is at most 1, got {value!r} (the "
+                f"default is {default!r})."
+            )
 
 
 @dataclass(frozen=True, repr=False)
@@ -208,8 +233,9 @@ class DftSettings(_Settings):
     def __post_init__(self):
         _checked(self)
         if self.min_damping >= self.max_damping:
-            raise SettingsError(f"DftSettings: min_damping ({self.min_damping!r}) must lie below max_damping "
-                                f"({self.max_damping!r}).")  # fmt: skip
+            raise SettingsError(
+                f"DftSettings: min_damping ({self.min_damping!r}) must lie below max_damping ({self.max_damping!r})."
+            )
 
 
 @dataclass(frozen=True, repr=False)
@@ -303,8 +329,9 @@ class AgreementSettings(_Settings):
     def __post_init__(self):
         _checked(self)
         if self.unsettled_alpha >= self.alpha:
-            raise SettingsError(f"AgreementSettings: unsettled_alpha ({self.unsettled_alpha!r}) must lie below alpha "
-                                f"({self.alpha!r}).")  # fmt: skip
+            raise SettingsError(
+                f"AgreementSettings: unsettled_alpha ({self.unsettled_alpha!r}) must lie below alpha ({self.alpha!r})."
+            )
 
 
 @dataclass(frozen=True, repr=False)
@@ -368,8 +395,10 @@ class SelectionSettings(_Settings):
         dict
             ``{stage: {name: value}}``; tuples as lists.
         """
-        return {name: {k: list(v) if isinstance(v, tuple) else v for k, v in part.items()}
-                for name, part in asdict(self).items()}  # fmt: skip
+        return {
+            name: {k: list(v) if isinstance(v, tuple) else v for k, v in part.items()}
+            for name, part in asdict(self).items()
+        }
 
 
 #: the defaults, shared by the functions that can also be called outside the pipeline
@@ -424,5 +453,6 @@ class SweepSettings(_Settings):
     samples_per_parameter: int = 20
     default_orders: tuple[int, ...] = tuple(range(2, 31, 2))
     min_default_top: int = 8
+
 
 SWEEP = SweepSettings()  #: the sweep's numbers

@@ -119,10 +119,18 @@ class SelectionState:
 
 
 @single_blas_thread
-def refine_modes(recording: Recording, freq_hz, damping, *, band_hz: tuple[float, float], hold: str = "auto",
-                 max_nfev: int = 60, settings: DftSettings = DEFAULTS.dft,
-                 decisive: float = DEFAULTS.count.decisive_bic,
-                 negligible: float = DEFAULTS.count.negligible_bic) -> ModalModel:  # fmt: skip
+def refine_modes(
+    recording: Recording,
+    freq_hz,
+    damping,
+    *,
+    band_hz: tuple[float, float],
+    hold: str = "auto",
+    max_nfev: int = 60,
+    settings: DftSettings = DEFAULTS.dft,
+    decisive: float = DEFAULTS.count.decisive_bic,
+    negligible: float = DEFAULTS.count.negligible_bic,
+) -> ModalModel:
     """Refit selected modes to the DFT of a recording, choosing the inter-sample behaviour.
 
     Both assumptions are fitted a few steps from the same start, with the same lines and the same number of
@@ -173,8 +181,9 @@ def refine_modes(recording: Recording, freq_hz, damping, *, band_hz: tuple[float
         raise ValueError(f"hold: expected 'auto', 'bandlimited' or 'zoh', got {hold!r}.")
     data = DftLines.from_recording(recording, band_hz).weighted_at_start(freq_hz, damping, settings)
     fit = partial(fit_modal_model, data, max_nfev=max_nfev, settings=settings, by_frequency=False)
-    fits = {h: fit(freq_hz, damping, h, **({"max_nfev": 4} if hold == "auto" else {})) for h in HOLDS
-            if hold in (h, "auto")}  # fmt: skip
+    fits = {
+        h: fit(freq_hz, damping, h, **({"max_nfev": 4} if hold == "auto" else {})) for h in HOLDS if hold in (h, "auto")
+    }
     cost = {h: float(np.sum(m.rss * data.weights**2)) for h, m in fits.items()}
     leader = min(cost, key=cost.get)
     if hold == "auto":  # a few steps tell the assumptions apart, unless within ``decisive``: then both converge
@@ -251,8 +260,18 @@ class SelectionContext:
             self.bar.update(n)
 
 
-def refit_and_segment_fits(diagram, modes, band, refine: bool, segments: int, orders: dict, n_jobs, bar=None,
-                           settings: SelectionSettings = DEFAULTS, fitters: Fitters = Fitters()) -> dict:  # fmt: skip
+def refit_and_segment_fits(
+    diagram,
+    modes,
+    band,
+    refine: bool,
+    segments: int,
+    orders: dict,
+    n_jobs,
+    bar=None,
+    settings: SelectionSettings = DEFAULTS,
+    fitters: Fitters = Fitters(),
+) -> dict:
     """The frequency-domain refit (key ``"refit"``) and the segment refits of every mode's
     representative orders (keys ``(orders, k)``), run together over the worker threads:
     the refit ran alone in this process before, while the workers waited. ``bar`` (tqdm)
@@ -275,16 +294,31 @@ def refit_band(recording: Recording, band) -> tuple[float, float]:
     return (lo, hi) if band is None else (max(lo, band[0]), min(hi, band[1]))
 
 
-def selection_job(recording: Recording, parts: list, modes: pd.DataFrame, job, settings: SelectionSettings = DEFAULTS,
-                  refine: Callable = refine_modes, hold: str = "auto"):  # fmt: skip
+def selection_job(
+    recording: Recording,
+    parts: list,
+    modes: pd.DataFrame,
+    job,
+    settings: SelectionSettings = DEFAULTS,
+    refine: Callable = refine_modes,
+    hold: str = "auto",
+):
     """One job of :func:`refit_and_segment_fits`: a segment's refit, or the frequency-domain refit by
     ``refine`` under ``hold`` (a :class:`RefitFailure` where it cannot be made)."""
     kind, what = job
     if kind == "segment":
         return segment_poles(parts, what)
     try:
-        return refine(recording, modes.freq_hz, modes.damping, band_hz=what, hold=hold, settings=settings.dft,
-                      decisive=settings.count.decisive_bic, negligible=settings.count.negligible_bic)  # fmt: skip
+        return refine(
+            recording,
+            modes.freq_hz,
+            modes.damping,
+            band_hz=what,
+            hold=hold,
+            settings=settings.dft,
+            decisive=settings.count.decisive_bic,
+            negligible=settings.count.negligible_bic,
+        )
     except (OrderError, np.linalg.LinAlgError) as exc:
         return RefitFailure(str(exc))  # too few lines or a degenerate basis: the ARMAX values stand, said
 
@@ -303,8 +337,12 @@ class RefitFailure:
                 (),
                 f"the frequency-domain refit of {which} could not be made ({self.reason.rstrip('.')}); "
                 "the values reported are the ARMAX fit's or an earlier refit's"
-                + (", and the modes are not counted by the modal model, which is fitted under the inter-sample "
-                   "behaviour the refit chooses" if uncounted else ""),
+                + (
+                    ", and the modes are not counted by the modal model, which is fitted under the inter-sample "
+                    "behaviour the refit chooses"
+                    if uncounted
+                    else ""
+                ),
             )
         ]
 

@@ -1,6 +1,7 @@
 """The loop tried from the command line, one effect at a time: ``simulate --effect`` plants each
 effect ``diagnose`` names, and ``diagnose`` names it, on its channel or joint, in its verdict, the
-first lines it prints. Sizes are the diagnosis battery's (``scripts/diagnose_battery.py``)."""
+first lines it prints, on one screen (at most 25 lines of at most 100 characters). Sizes are the
+diagnosis battery's (``scripts/diagnose_battery.py``)."""
 
 import pytest
 
@@ -39,7 +40,10 @@ def test_a_planted_effect_is_named_first(tmp_path, capsys, planted, options, nam
     assert main(["--quiet", "simulate", "--seed", "11", "--effect", planted, "--out", str(ride)]) == 0
     capsys.readouterr()
     assert main(["--quiet", "diagnose", str(ride), *options]) == 0
-    lines = capsys.readouterr().out.splitlines()
+    out, err = capsys.readouterr()
+    shown = out.strip().splitlines() + err.strip().splitlines()
+    assert len(shown) <= 25 and max(map(len, shown)) <= 100, shown  # one screen
+    lines = out.splitlines()
     first = next(k for k, line in enumerate(lines) if line.startswith("verdict: "))
     assert first <= 2, lines[:4]  # after the record's line (two where its path is long)
     verdict = " ".join(lines[first : first + 2])
