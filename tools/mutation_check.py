@@ -1415,6 +1415,12 @@ MUTANTS = [
         "    budget = max(10, NOTE_WIDTH - len(head))",
         "a finding's line with no room for its count of others (notes)",
     ),
+    (
+        "armaxmodal/modes/counted.py",
+        "        own = gap == gaps[np.asarray(nearest) == i].min()",
+        "        own = True",
+        "one pole confirming every incoherent mode near it (count)",
+    ),
     # many events of one structure (issue 68; run with --match "(track)" --tests tests/study/test_track.py)
     (
         "armaxmodal/study/track.py",

@@ -325,9 +325,13 @@ def confirmed_where_incoherent(
     agree = chdtrc(2, chi2) >= settings.agreement.alpha  # each pole alone: 2 degrees of freedom
     reach, needed = settings.cluster.same_row_freq, count.verdicts() == "needed"
     confirmed, notes = [], []
-    for f in unconfirmed_hz:
-        i = int(np.argmin(np.abs(m.freq_hz - f)))
-        if abs(m.freq_hz[i] / f - 1) <= reach and needed[i] and agree[i]:
+    nearest = [int(np.argmin(np.abs(m.freq_hz - f))) for f in unconfirmed_hz]
+    gaps = np.array([abs(np.log(m.freq_hz[i] / f)) for f, i in zip(unconfirmed_hz, nearest, strict=True)])
+    for f, i, gap in zip(unconfirmed_hz, nearest, gaps, strict=True):
+        # a pole confirms one mode, the nearest: three modes near one pole are not three confirmed
+        # modes (a report said "the criterion rises by 8243.4" of three, from one pole)
+        own = gap == gaps[np.asarray(nearest) == i].min()
+        if own and abs(m.freq_hz[i] / f - 1) <= reach and needed[i] and agree[i]:
             confirmed.append(f)
             notes.append(confirmed_where_incoherent_note(f, count.removal_rise[i]))
     return tuple(confirmed), notes

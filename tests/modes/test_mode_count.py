@@ -1115,3 +1115,26 @@ def test_a_record_of_one_mode_has_its_split_tried():
     wanted, model = _split_wanted(search, current, ("first half", "second half"))
     assert screened == [("split", 10.0)] and model is split
     assert wanted and wanted[1] == pytest.approx(200.0) and wanted[2] == 22
+
+
+def test_a_pole_confirms_one_incoherent_mode_the_nearest(monkeypatch):
+    """Three selected modes the FRF check cannot test, near one needed pole of the modal model: the
+    pole confirms the nearest only (a report said "the criterion rises by 8243.4" of three modes,
+    from one pole); a mode near a pole of its own is confirmed too."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from armaxmodal.modes import counted
+
+    monkeypatch.setattr(counted, "halves_chi2", lambda *args, **kwargs: np.zeros(2))  # the halves agree
+    model = SimpleNamespace(freq_hz=np.array([10.0, 20.0]))
+    lines = SimpleNamespace(noise_weighted=lambda m: lines)
+    count = SimpleNamespace(model=model, verdicts=lambda: np.array(["needed", "needed"]),
+                            removal_rise=np.array([8243.4, 120.0]), settings=SimpleNamespace(halves_nfev=1),
+                            dft=None)  # fmt: skip
+    work = SimpleNamespace(count=count, refinement=SimpleNamespace(hold="zoh"), count_lines=(lines, ()))
+    confirmed, notes = counted.confirmed_where_incoherent(work, (9.8, 10.1, 10.3, 20.2))
+    assert confirmed == (10.1, 20.2)
+    assert ["rises by 8243," in note.message for note in notes] == [True, False]
+    assert "rises by 120," in notes[1].message
