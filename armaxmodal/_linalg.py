@@ -5,8 +5,14 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-__all__ = ["CHOLESKY_QR_MAX_CONDITION", "ONE_PASS_MAX_CONDITION", "basis_factor", "hermitian_from_upper",
-           "orthonormal_basis", "ridged_cholesky"]
+__all__ = [
+    "CHOLESKY_QR_MAX_CONDITION",
+    "ONE_PASS_MAX_CONDITION",
+    "basis_factor",
+    "hermitian_from_upper",
+    "orthonormal_basis",
+    "ridged_cholesky",
+]
 
 #: a basis is made orthonormal through its Gram matrix, twice (CholeskyQR2: Fukaya et al. 2014;
 #: Yamamoto et al. 2015, a half of a Householder QR's time here), while its columns, scaled to unit

@@ -178,8 +178,14 @@ class Recording:
         >>> freq.tolist(), base.real.tolist(), response.shape, rec.dft()[1] is base  # computed once
         ([0.0, 1.25, 2.5, 3.75, 5.0], [1.0, 1.0, 1.0, 1.0, 1.0], (5, 1), True)
         """
-        return self._kept("dft", lambda: (np.fft.rfftfreq(self.n_samples, 1.0 / self.fs), np.fft.rfft(self.base),
-                                          np.fft.rfft(self.response, axis=0)))  # fmt: skip
+        return self._kept(
+            "dft",
+            lambda: (
+                np.fft.rfftfreq(self.n_samples, 1.0 / self.fs),
+                np.fft.rfft(self.base),
+                np.fft.rfft(self.response, axis=0),
+            ),
+        )
 
     def _kept(self, key, compute) -> tuple[np.ndarray, ...]:
         """``compute()``'s arrays, computed at the first call for ``key`` and kept read-only: every stage
@@ -254,8 +260,16 @@ class Recording:
         if isinstance(k, bool) or not isinstance(k, int | np.integer) or not 1 <= k <= self.n_samples:
             raise DataError(f"k: expected a whole number of parts from 1 to {self.n_samples} (the samples), got {k!r}.")
         n = self.n_samples // k
-        return [Recording(self.fs, self.base[i * n : (i + 1) * n], self.response[i * n : (i + 1) * n], self.sensors,
-                          self.input_name) for i in range(k)]  # fmt: skip
+        return [
+            Recording(
+                self.fs,
+                self.base[i * n : (i + 1) * n],
+                self.response[i * n : (i + 1) * n],
+                self.sensors,
+                self.input_name,
+            )
+            for i in range(k)
+        ]
 
     def to_frame(self) -> pd.DataFrame:
         """Columns ``time``, the input, then each sensor.

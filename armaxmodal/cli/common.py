@@ -92,9 +92,12 @@ def add_data_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--outputs", default=None, help="comma-separated output columns to use (default: all)")
     p.add_argument("--axis", default="Acc_X", help="Xsens exports: the column to use; default Acc_X")
     p.add_argument(
-        "--fill-gaps", type=POSITIVE, default=None, metavar="SECONDS",
+        "--fill-gaps",
+        type=POSITIVE,
+        default=None,
+        metavar="SECONDS",
         help="fill gaps (missing cells, dropped rows) of up to SECONDS by interpolation, each named in a warning",
-    )  # fmt: skip
+    )
 
 
 def load_recording(args):
@@ -103,8 +106,10 @@ def load_recording(args):
         from armaxmodal.io.xsens import read_xsens
 
         if getattr(args, "fill_gaps", None) is not None:
-            raise DataError("--fill-gaps fills the gaps of one file; per-sensor exports bridge up to 3 dropped packets "
-                            "each and refuse longer gaps (cut the record there).")  # fmt: skip
+            raise DataError(
+                "--fill-gaps fills the gaps of one file; per-sensor exports bridge up to 3 dropped packets "
+                "each and refuse longer gaps (cut the record there)."
+            )
         rec = read_xsens(args.data, input=args.input, axis=args.axis)
         args.data = " + ".join(args.data)
         return rec if outputs is None else rec.select(outputs)
@@ -191,13 +196,17 @@ def print_notes(warnings, verbose: bool = False) -> None:
         groups.setdefault(w.code, []).append(w)
     # problems, then what makes the verdict uncertain, then the other warnings, then information
     codes = sorted(groups, key=lambda c: (levels.index(severity(c)), c not in UNCERTAIN_CODES, order.get(c, 99)))
-    counts = [f"{n} {level}{'s' if n > 1 and level != 'info' else ''}"  # notes, of each severity
-              for level in levels if (n := sum(severity(w.code) == level for w in warnings))]  # fmt: skip
+    counts = [
+        f"{n} {level}{'s' if n > 1 and level != 'info' else ''}"  # notes, of each severity
+        for level in levels
+        if (n := sum(severity(w.code) == level for w in warnings))
+    ]
     more = "" if verbose else " (what to do, full texts: --verbose, --json, --report)"
     print(f"notes: {', '.join(counts)}{more}", file=sys.stderr)
     if verbose:
-        lines = [line for code in codes for line in _verbose_block(code, groups[code], advice.get(code, ""),
-                                                                    severity(code))]  # fmt: skip
+        lines = [
+            line for code in codes for line in _verbose_block(code, groups[code], advice.get(code, ""), severity(code))
+        ]
     else:
         lines = [_code_line(code, groups[code], severity(code)) for code in codes[:NOTE_LINES]]
     print("\n".join(lines), file=sys.stderr)
@@ -224,8 +233,9 @@ def _code_line(code: str, notes: list, level: str) -> str:
 
 def _verbose_block(code: str, notes: list, advice: str, level: str) -> list[str]:
     """A code's advice on its line, every note's full text under it."""
-    texts = [textwrap.fill(w.message, NOTE_WIDTH, initial_indent="      - ", subsequent_indent="        ")
-             for w in notes]  # fmt: skip
+    texts = [
+        textwrap.fill(w.message, NOTE_WIDTH, initial_indent="      - ", subsequent_indent="        ") for w in notes
+    ]
     return [_code_head(code, notes, level) + advice, *texts]
 
 

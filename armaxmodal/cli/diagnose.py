@@ -29,9 +29,12 @@ def add_parser(sub, parents) -> None:
     add_data_args(p)
     p.add_argument("--band", default=None, help="frequency band LO:HI in Hz (sets the analysis rate)")
     p.add_argument("--max-rounds", type=NONNEG_INT, default=3, help="effects added at most; default 3")
-    p.add_argument("--model", default="auto",
-                   help="the model to diagnose, na,nb,nc,nk (shared poles), or 'auto' (orders by BIC); default auto. "
-                   "An order too low tries the loop's missing mode: 6,12,6,-5 on the supine ride")  # fmt: skip
+    p.add_argument(
+        "--model",
+        default="auto",
+        help="the model to diagnose, na,nb,nc,nk (shared poles), or 'auto' (orders by BIC); default auto. "
+        "An order too low tries the loop's missing mode: 6,12,6,-5 on the supine ride",
+    )
     p.add_argument("--json", default=None, help="write the diagnosis as JSON")
     p.add_argument("--plot", default=None, help="figure page (.png/.svg/.pdf)")
     p.add_argument("--report", default=None, help="one self-contained HTML page of the diagnosis (.html)")
@@ -48,16 +51,19 @@ def run(args) -> int:
         check_report_path(args.report)
     orders = model_orders(args.model)
     if orders is not None and band is not None:
-        raise DataError("--model with --band: the model is fitted at the record's own rate, the band resamples it; "
-                        "give one of them.")  # fmt: skip
+        raise DataError(
+            "--model with --band: the model is fitted at the record's own rate, the band resamples it; "
+            "give one of them."
+        )
     rec = load_recording(args)
     baseline = None
     if orders is not None:
         from armaxmodal.estimate.fit import fit_armax
 
         baseline = fit_armax(rec, *orders, shared_poles=True, warn=False)
-    result = diagnose(rec, band=band, max_rounds=args.max_rounds, baseline=baseline,
-                      progress=args.verbose and not args.quiet)  # fmt: skip
+    result = diagnose(
+        rec, band=band, max_rounds=args.max_rounds, baseline=baseline, progress=args.verbose and not args.quiet
+    )
     print_notes(result.warnings, args.verbose)
     report = result.to_dict()
     print(_diagnosis_text(args.data, report))
@@ -89,14 +95,18 @@ def _diagnosis_text(name: str, report: dict) -> str:
     sensors = report["outputs"]
     base, final = report["baseline"], report["final"]
     orders = report["orders"]
-    lines = _wrapped(f"{name}: {len(sensors)} sensors at {report['analysis_fs']:g} Hz; baseline ARMAX "
-                     f"({orders['na']}, {orders['nb']}, {orders['nc']}, {orders['nk']})")  # fmt: skip
+    lines = _wrapped(
+        f"{name}: {len(sensors)} sensors at {report['analysis_fs']:g} Hz; baseline ARMAX "
+        f"({orders['na']}, {orders['nb']}, {orders['nc']}, {orders['nk']})"
+    )
     lines += _wrapped("verdict: " + report["verdict"])
     for e in report["effects"]:
         judged = e["judged_by"]
-        lines += _wrapped(f"kept {e['effect']} on {', '.join(e['channels'])}: held-out {judged['error']} error "
-                          f"{judged['before']:.4g} -> {judged['after']:.4g} ({e['evidence']['statistic']} p = "
-                          f"{e['evidence']['p']:.2g})")  # fmt: skip
+        lines += _wrapped(
+            f"kept {e['effect']} on {', '.join(e['channels'])}: held-out {judged['error']} error "
+            f"{judged['before']:.4g} -> {judged['after']:.4g} ({e['evidence']['statistic']} p = "
+            f"{e['evidence']['p']:.2g})"
+        )
         params = {k: v for k, v in e["parameters"].items() if not isinstance(v, dict) and k not in _SHOWN}
         lines += _wrapped(short_parameters(params), first="  ")
         if e.get("note"):

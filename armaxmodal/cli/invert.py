@@ -20,11 +20,16 @@ def add_parser(sub, parents) -> None:
     p.add_argument("modes", help="modes JSON written by 'stabilise --json', or UFF 55 ('stabilise --uff', .uff/.unv)")
     p.add_argument("--recording", default=None, help="the recording, for the measured transmissibility")
     p.add_argument("--input", default="base", help="the recording's input (base) channel; default base")
-    p.add_argument("--fs", type=POSITIVE, default=None,
-                   help="the recording's sampling rate, Hz, where its file has no time column")
-    p.add_argument("--method", choices=["model_update", "evphc", "pia", "inner"], default="model_update",
-                   help="joint model updating of modes and transmissibility (default), the thesis's EVPHC, the "
-                        "Pilkey-Inman baseline, or the chain that best satisfies the eigen-equations alone (no FRF)")
+    p.add_argument(
+        "--fs", type=POSITIVE, default=None, help="the recording's sampling rate, Hz, where its file has no time column"
+    )
+    p.add_argument(
+        "--method",
+        choices=["model_update", "evphc", "pia", "inner"],
+        default="model_update",
+        help="joint model updating of modes and transmissibility (default), the thesis's EVPHC, the "
+        "Pilkey-Inman baseline, or the chain that best satisfies the eigen-equations alone (no FRF)",
+    )
     p.add_argument("--total-mass", type=POSITIVE, default=None, help="subject mass in kg (sets the scale)")
     p.add_argument("--json", default=None, help="write M, C, K, components and modes as JSON")
     p.add_argument("--plot", default=None, help="predicted vs measured acceleration per sensor (.png/.svg/.pdf)")

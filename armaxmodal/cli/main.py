@@ -41,10 +41,15 @@ def build_parser() -> argparse.ArgumentParser:
     # from overwriting the top-level flag
     parser.add_argument("--verbose", action="store_true", help="every note's full text, not one line per code")
     quiet = argparse.ArgumentParser(add_help=False)
-    quiet.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS,
-                       help="no progress bars (the results still print)")  # fmt: skip
-    quiet.add_argument("--verbose", action="store_true", default=argparse.SUPPRESS,
-                       help="every note's full text, not one line per code")  # fmt: skip
+    quiet.add_argument(
+        "--quiet", action="store_true", default=argparse.SUPPRESS, help="no progress bars (the results still print)"
+    )
+    quiet.add_argument(
+        "--verbose",
+        action="store_true",
+        default=argparse.SUPPRESS,
+        help="every note's full text, not one line per code",
+    )
     sub = parser.add_subparsers(dest="command", required=True)
     for command in COMMANDS:
         command.add_parser(sub, [quiet])

@@ -9,8 +9,12 @@ from armaxmodal.io.write import write_json
 def add_parser(sub, parents) -> None:
     """Register the ``modes`` command."""
     p = sub.add_parser("modes", parents=parents, help="exact modes of a reference structure from the thesis")
-    p.add_argument("--system", choices=sorted(SYSTEMS), default="supine",
-                   help="the structure: the thesis's supine body (Table 4.3) or Chapter 2's chain; default supine")
+    p.add_argument(
+        "--system",
+        choices=sorted(SYSTEMS),
+        default="supine",
+        help="the structure: the thesis's supine body (Table 4.3) or Chapter 2's chain; default supine",
+    )
     p.add_argument("--json", default=None, help="write the modes as JSON")
     p.set_defaults(func=run)
 

@@ -10,21 +10,35 @@ from armaxmodal.io.write import write_recording_csv
 def add_parser(sub, parents) -> None:
     """Register the ``simulate`` command."""
     p = sub.add_parser("simulate", parents=parents, help="simulate a base-excitation ride of a reference structure")
-    p.add_argument("--system", choices=sorted(SYSTEMS), default="supine",
-                   help="the structure: the thesis's supine body (Table 4.3) or Chapter 2's chain; default supine")
-    p.add_argument("--excitation", choices=["random", "sweep"], default="random",
-                   help="the base acceleration: band-limited random vibration or a sine sweep; default random")
+    p.add_argument(
+        "--system",
+        choices=sorted(SYSTEMS),
+        default="supine",
+        help="the structure: the thesis's supine body (Table 4.3) or Chapter 2's chain; default supine",
+    )
+    p.add_argument(
+        "--excitation",
+        choices=["random", "sweep"],
+        default="random",
+        help="the base acceleration: band-limited random vibration or a sine sweep; default random",
+    )
     p.add_argument("--fs", type=POSITIVE, default=60.0, help="sampling rate, Hz; default 60")
     p.add_argument("--duration", type=POSITIVE, default=120.0, help="seconds; default 120")
     p.add_argument("--noise", type=NONNEG, default=0.05, help="sensor noise, fraction of each output's RMS")
-    p.add_argument("--hold", choices=["zoh", "bandlimited"], default="bandlimited",
-                   help="the input between samples: held (zoh) or band-limited, as an anti-aliased logger records "
-                        "it; default bandlimited")
+    p.add_argument(
+        "--hold",
+        choices=["zoh", "bandlimited"],
+        default="bandlimited",
+        help="the input between samples: held (zoh) or band-limited, as an anti-aliased logger records "
+        "it; default bandlimited",
+    )
     p.add_argument("--seed", type=NONNEG_INT, default=0, help="seed of the excitation and the noise; default 0")
     from armaxmodal.diagnosis.inject import PARAMETERS, RIDE_EFFECTS  # numba is loaded already: no cost
 
-    effects = "; ".join(f"{name} ({', '.join(need + tuple(f'[{k}]' for k in optional)) or 'no parameter'})"
-                        for name, (need, optional) in {**PARAMETERS, **RIDE_EFFECTS}.items())  # fmt: skip
+    effects = "; ".join(
+        f"{name} ({', '.join(need + tuple(f'[{k}]' for k in optional)) or 'no parameter'})"
+        for name, (need, optional) in {**PARAMETERS, **RIDE_EFFECTS}.items()
+    )
     p.add_argument(
         "--effect",
         action="append",
@@ -89,20 +103,33 @@ def _ride(structure, u, args, effect):
     name, channels, params = effect
     if name == "time_varying":
         if not 0 < params["time_s"] < args.duration:
-            raise DataError(f"--effect time_varying: time_s must lie inside the ride (0-{args.duration:g} s), "
-                            f"got {params['time_s']}.")  # fmt: skip
-        return stiffened_ride(structure, u, args.fs, params["time_s"], params["stiffening"], noise=args.noise,
-                              seed=args.seed, hold=args.hold)  # fmt: skip
+            raise DataError(
+                f"--effect time_varying: time_s must lie inside the ride (0-{args.duration:g} s), "
+                f"got {params['time_s']}."
+            )
+        return stiffened_ride(
+            structure,
+            u,
+            args.fs,
+            params["time_s"],
+            params["stiffening"],
+            noise=args.noise,
+            seed=args.seed,
+            hold=args.hold,
+        )
     names = list(structure.names)
     if not channels or len(channels) > 2 or any(c not in names for c in channels) or not params["ratio"] > 0:
-        raise DataError(f"--effect {name}: name the joint, one or two of {names} (one: to the base), and ratio > 0; "
-                        f"got {channels} and {params}.")  # fmt: skip
+        raise DataError(
+            f"--effect {name}: name the joint, one or two of {names} (one: to the base), and ratio > 0; "
+            f"got {channels} and {params}."
+        )
     if args.hold != "bandlimited":
         raise DataError(f"--effect {name}: a joint force is simulated with the band-limited input; drop --hold zoh.")
     between = (names.index(channels[0]), names.index(channels[1]) if len(channels) == 2 else -1)
     force = "cubic" if name == "stiffness_nonlinearity" else "friction"
-    return nonlinear_joint_ride(structure, u, args.fs, between, params["ratio"], force=force, noise=args.noise,
-                                seed=args.seed)  # fmt: skip
+    return nonlinear_joint_ride(
+        structure, u, args.fs, between, params["ratio"], force=force, noise=args.noise, seed=args.seed
+    )
 
 
 def _parse_effect(text: str):

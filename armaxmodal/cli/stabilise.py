@@ -33,9 +33,11 @@ def add_parser(sub, parents) -> None:
     )
     p.add_argument("--modes", type=POSITIVE_INT, default=None, help="number of modes to keep (default: automatic)")
     p.add_argument(
-        "--pick", default=None, help="modes picked by hand, F1,F2,... in Hz: each takes the nearest stable column "
-        "of the diagram (within 5 %%); not with --modes"
-    )  # fmt: skip
+        "--pick",
+        default=None,
+        help="modes picked by hand, F1,F2,... in Hz: each takes the nearest stable column "
+        "of the diagram (within 5 %%); not with --modes",
+    )
     p.add_argument("--band", default=None, help="frequency band LO:HI in Hz")
     p.add_argument("--plot", default=None, help="stabilisation plot (.png, .svg or .pdf)")
     p.add_argument("--json", default=None, help="selected modes as JSON")
@@ -44,9 +46,11 @@ def add_parser(sub, parents) -> None:
     p.add_argument("--uff", default=None, help="the modes as UFF 55 and the measured and modal-model FRFs as UFF 58")
     p.add_argument("--shapes-plot", default=None, help="the selected modes' shapes over the sensors (.png, .svg, .pdf)")
     p.add_argument(
-        "--positions", default=None, help="each sensor's place along the chain, NAME=VALUE,... (a height, a storey): "
-        "the shapes figure then draws the deflected chain"
-    )  # fmt: skip
+        "--positions",
+        default=None,
+        help="each sensor's place along the chain, NAME=VALUE,... (a height, a storey): "
+        "the shapes figure then draws the deflected chain",
+    )
     p.add_argument(
         "--detrend",
         choices=["mean", "linear", "none"],
@@ -184,8 +188,10 @@ def print_modes(modes, picked: bool = False) -> None:
     with its 95 % interval, the orders that support it, and the pick it answers where the modes were
     ``picked`` by hand (the JSON and ``--csv`` hold every column)."""
     picked = picked and bool(np.isfinite(modes.picked_hz.to_numpy(float)).any())
-    print(f"{'mode':>4} {'f (Hz)':>9}  {'95 % interval (Hz)':<22} {'damping':>7}  {'95 % interval':<16} {'orders':>6}"
-          + ("  picked (Hz)" if picked else ""))  # fmt: skip
+    print(
+        f"{'mode':>4} {'f (Hz)':>9}  {'95 % interval (Hz)':<22} {'damping':>7}  {'95 % interval':<16} {'orders':>6}"
+        + ("  picked (Hz)" if picked else "")
+    )
     for k, m in enumerate(modes.itertuples(index=False), start=1):
         f_ci = f"[{m.freq_ci95_lo:.4f}, {m.freq_ci95_hi:.4f}]"
         x_ci = f"[{m.damping_ci95_lo:.4f}, {m.damping_ci95_hi:.4f}]"
@@ -195,8 +201,12 @@ def print_modes(modes, picked: bool = False) -> None:
 
 def print_check(check) -> None:
     """The modal-model check per output, beside the H1's own random error."""
-    print(_fill("modal-model check (LSFD of each H1 by the selected poles, residual terms and a delay; model error = "
-                f"misfit beyond the H1's random error, limit {100 * check.limit:.0f} %):"))  # fmt: skip
+    print(
+        _fill(
+            "modal-model check (LSFD of each H1 by the selected poles, residual terms and a delay; model error = "
+            f"misfit beyond the H1's random error, limit {100 * check.limit:.0f} %):"
+        )
+    )
     for k, sensor in enumerate(check.sensors):
         if not np.isfinite(check.error[k]):
             print(f"  {sensor}: not checked (too few lines where its coherence is at least 0.8)")

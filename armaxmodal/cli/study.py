@@ -19,15 +19,11 @@ def add_parser(sub, parents) -> None:
     p.add_argument("source", help="manifest CSV (file, subject, ride, mass_kg, ...) or a folder of recordings")
     p.add_argument("--out", required=True, help="study folder for the tables, figures, study.json and the cache")
     p.add_argument("--report", default=None, help="HTML report path (default OUT/report.html)")
-    p.add_argument(
-        "--jobs", type=POSITIVE_INT, default=None, help="local worker processes (default: all cores)"
-    )
+    p.add_argument("--jobs", type=POSITIVE_INT, default=None, help="local worker processes (default: all cores)")
     p.add_argument("--scheduler", default=None, help="dask.distributed scheduler address, e.g. tcp://host:8786")
     p.add_argument("--input", default="base", help="base-acceleration channel; default 'base'")
     p.add_argument("--orders", default=None, help="range of na, LO:HI; default 2:30, capped to suit each record")
-    p.add_argument(
-        "--modes", type=POSITIVE_INT, default=None, help="modes per recording (default: automatic)"
-    )
+    p.add_argument("--modes", type=POSITIVE_INT, default=None, help="modes per recording (default: automatic)")
     p.add_argument("--band", default=None, help="frequency band LO:HI in Hz")
     p.add_argument("--detrend", choices=["mean", "linear", "none"], default="mean", help=DETREND_HELP)
     p.add_argument("--sensors", default=None, help="comma-separated sensors to analyse (default: those most share)")
@@ -62,8 +58,17 @@ def _check_paths(args) -> None:
     source = Path(args.source).resolve()
     # the study's own files must not land on the manifest, nor among the recordings of a
     # folder study (the next run would read summary.csv as a recording)
-    written = {"summary.csv", "modes.csv", "per_sensor.csv", "subjects.csv", "shapes.csv", "lump.csv",
-               "model_scaled.csv", "study.json", "report.html"}  # fmt: skip
+    written = {
+        "summary.csv",
+        "modes.csv",
+        "per_sensor.csv",
+        "subjects.csv",
+        "shapes.csv",
+        "lump.csv",
+        "model_scaled.csv",
+        "study.json",
+        "report.html",
+    }
     if out.resolve() == source or (source.is_file() and out.resolve() == source.parent and source.name in written):
         raise DataError(f"--out {args.out}: would write into the study's input; choose another folder.")
     if args.report:

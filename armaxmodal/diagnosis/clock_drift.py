@@ -86,8 +86,12 @@ def _finding(channel: str, rate: float, sd: float, p: float, s, extra: dict | No
     """A ``clock_drift`` finding: the rate in ppm with its interval, and the delay it adds over the
     record."""
     half = Z95 * sd
-    params = {"rate_ppm": 1e6 * rate, "rate_ci95_ppm": [1e6 * (rate - half), 1e6 * (rate + half)],
-              "delay_change_ms": 1e3 * rate * s.n / s.fs, **(extra or {})}  # fmt: skip
+    params = {
+        "rate_ppm": 1e6 * rate,
+        "rate_ci95_ppm": [1e6 * (rate - half), 1e6 * (rate + half)],
+        "delay_change_ms": 1e3 * rate * s.n / s.fs,
+        **(extra or {}),
+    }
     return Finding("clock_drift", (channel,), "drift_z", abs(rate) / sd, p, params)
 
 

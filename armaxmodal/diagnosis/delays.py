@@ -37,8 +37,6 @@ LEAD_MAX_LAG = 40
 LEAD_GUARD = 6
 
 
-
-
 def delay_findings(fitted: FittedModel, n_tests: int) -> list[Finding]:
     """A sensor or the input out of time, from the quasi-static transmissibility phase
     (:func:`armaxmodal.prepare.delay.estimate_delays`): its slope is the time offset whatever ``nk``

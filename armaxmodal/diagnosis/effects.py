@@ -131,8 +131,10 @@ def _second_input(ev: Evidence) -> list[Finding]:
 def _input_clipped(stage, finding: Finding) -> str:
     if finding.channels != (stage.model.raw.input_name,):
         return ""
-    return ("the input clipped: the structure felt base motion the record does not hold, so no fix can restore "
-            "it; record with a wider range, or analyse a stretch without clipping")  # fmt: skip
+    return (
+        "the input clipped: the structure felt base motion the record does not hold, so no fix can restore "
+        "it; record with a wider range, or analyse a stretch without clipping"
+    )
 
 
 def _explained(finding: Finding) -> list[str]:
@@ -147,23 +149,54 @@ REGISTRY: tuple[EffectKind, ...] = (
     EffectKind("sensor_fault", _faults, 0, fixes.add_fault, keep=acceptance.fault_kept),
     EffectKind("input_delay", _delays, 0, fixes.add_delay, refit=acceptance.refit_moved, keep=acceptance.delay_kept),
     EffectKind("unmodelled_mode", _modes, 1, fixes.add_mode, fixes.mode_parameters, "simulation"),
-    EffectKind("level_shift", _level_shifts, 1, fixes.add_level_shift, fixes.level_shift_parameters, "simulation",
-               refit=acceptance.refit_level_shift),  # fmt: skip
-    EffectKind("gain_change", _gain_changes, 1, fixes.add_gain_change, fixes.gain_change_parameters, "simulation",
-               refit=acceptance.refit_gain_change),  # fmt: skip
-    EffectKind("clock_drift", _clock_drifts, 0, fixes.add_clock_drift, fixes.clock_drift_parameters, "simulation",
-               refit=acceptance.refit_clock_drift),  # fmt: skip
+    EffectKind(
+        "level_shift",
+        _level_shifts,
+        1,
+        fixes.add_level_shift,
+        fixes.level_shift_parameters,
+        "simulation",
+        refit=acceptance.refit_level_shift,
+    ),
+    EffectKind(
+        "gain_change",
+        _gain_changes,
+        1,
+        fixes.add_gain_change,
+        fixes.gain_change_parameters,
+        "simulation",
+        refit=acceptance.refit_gain_change,
+    ),
+    EffectKind(
+        "clock_drift",
+        _clock_drifts,
+        0,
+        fixes.add_clock_drift,
+        fixes.clock_drift_parameters,
+        "simulation",
+        refit=acceptance.refit_clock_drift,
+    ),
     EffectKind("offset_drift", _trends, 1, fixes.add_trend, fixes.trend_parameters, "simulation"),
     EffectKind("periodic_disturbance", _lines, 1, fixes.add_line, fixes.line_parameters, "simulation"),
     EffectKind("coloured_noise", _whiteness, 2, fixes.add_noise_model, fixes.noise_model_parameters),
-    EffectKind("time_varying", _time_change, 3, None, fixes.time_change_parameters, "simulation",
-               refit=acceptance.refit_piecewise),  # fmt: skip
-    EffectKind("stiffness_nonlinearity", _joint_forces, 3, fixes.add_joint_force, fixes.joint_force_parameters,
-               "simulation"),  # fmt: skip
-    EffectKind("damping_nonlinearity", _joint_forces, 3, fixes.add_joint_force, fixes.joint_force_parameters,
-               "simulation"),  # fmt: skip
-    EffectKind("second_input", _second_input, 1, fixes.add_second_input, fixes.second_input_parameters,
-               judged_on=_explained),  # fmt: skip
+    EffectKind(
+        "time_varying",
+        _time_change,
+        3,
+        None,
+        fixes.time_change_parameters,
+        "simulation",
+        refit=acceptance.refit_piecewise,
+    ),
+    EffectKind(
+        "stiffness_nonlinearity", _joint_forces, 3, fixes.add_joint_force, fixes.joint_force_parameters, "simulation"
+    ),
+    EffectKind(
+        "damping_nonlinearity", _joint_forces, 3, fixes.add_joint_force, fixes.joint_force_parameters, "simulation"
+    ),
+    EffectKind(
+        "second_input", _second_input, 1, fixes.add_second_input, fixes.second_input_parameters, judged_on=_explained
+    ),
 )
 #: The vocabulary of effects (the JSON's ``effect``), in the order the tests run.
 EFFECTS = tuple(entry.name for entry in REGISTRY)

@@ -37,9 +37,20 @@ from armaxmodal.estimate.fit import record_supports
 from armaxmodal.prepare.quality import input_coherence
 from armaxmodal.stats import MAX_DAMPING, SECOND_INPUT_COHERENCE
 
-__all__ = ["clipping_findings", "fault_findings", "gradient_columns", "line_findings", "lm_f_test",
-           "merge_per_sensor", "projected_f", "second_input_findings", "time_findings", "trend_findings",
-           "whiteness_findings", "whiteness_p"]  # fmt: skip
+__all__ = [
+    "clipping_findings",
+    "fault_findings",
+    "gradient_columns",
+    "line_findings",
+    "lm_f_test",
+    "merge_per_sensor",
+    "projected_f",
+    "second_input_findings",
+    "time_findings",
+    "trend_findings",
+    "whiteness_findings",
+    "whiteness_p",
+]
 
 #: Lags of the residual in the Breusch-Godfrey whiteness test.
 WHITENESS_LAGS = 10
@@ -138,9 +149,10 @@ def fault_findings(
     scores = np.column_stack([outlier_scores(eps[:, k], m, mask) for k, m in enumerate(fitted.fit.models)])
     for k, name in enumerate(raw.sensors):
         runs = [
-            r for r in stuck_runs(raw.y[:, k])
+            r
+            for r in stuck_runs(raw.y[:, k])
             if r[0] + 1 not in known.get(name, ()) and not (r[0] == 0 and r[1] <= delayed.get(name, 0))
-        ]  # fmt: skip
+        ]
         lag = int(round(shifts.get(name, 0.0)))  # the residual is in the channel's shifted frame
         model = fitted.fit.models[k]
         spikes, sizes, largest = glitches(eps[:, k], model, mask & ~input_rail_reach(raw.u, model, lag))
@@ -215,7 +227,7 @@ def line_findings(fitted, mask, n_tests, table) -> list[Finding]:
             - response_free_of(
                 replace(fitted.spec, lines_hz=fitted.spec.lines_hz + (f,)), fitted.fit, s.inputs(fitted.spec), y_free
             )
-        )[mask]  # fmt: skip
+        )[mask]
         for f in undamped
     }
     out = []
@@ -333,8 +345,10 @@ def time_findings(fitted, mask, n_tests, table) -> list[Finding]:
         return []
     window = int(mask.sum()) // N_WINDOWS
     if not record_supports(window, spec.orders, 1 + len(spec.terms), len(s.sensors), True):
-        table["time_varying_not_run"] = (f"{N_WINDOWS} windows of {window} samples cannot hold the model's orders "
-                                         f"{spec.orders}: the record is too short for this test")  # fmt: skip
+        table["time_varying_not_run"] = (
+            f"{N_WINDOWS} windows of {window} samples cannot hold the model's orders "
+            f"{spec.orders}: the record is too short for this test"
+        )
         return []
     ref, freq, sd, rms, edges = _window_modes(fitted, mask)
     best = (0.0, None, None)
@@ -408,4 +422,3 @@ def second_input_findings(fitted, eps, mask, n_tests, table) -> list[Finding]:
             params = {"base_coherence": float(coherence[c]), "explains": explains, "p_per_channel": ps}
             out.append(Finding("second_input", (s.sensors[c],), "score_F", f_sum, min(ps.values()), params))
     return out
-

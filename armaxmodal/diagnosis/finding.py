@@ -38,5 +38,3 @@ class Finding:
 
     def evidence(self) -> dict:
         return {"statistic": self.statistic, "value": float(self.value), "p": float(self.p)}
-
-

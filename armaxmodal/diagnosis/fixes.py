@@ -160,8 +160,12 @@ def level_shift_parameters(finding: Finding, fitted) -> dict:
     (size,) = [v for c, t, v in fitted.spec.steps if (c, t) == (name, first)]
     left, sd = remaining_step(fitted, name, first)
     size += left
-    return {**finding.parameters, "size_first": finding.parameters["size"], "size": size,
-            "size_ci95": [size - Z95 * sd, size + Z95 * sd]}  # fmt: skip
+    return {
+        **finding.parameters,
+        "size_first": finding.parameters["size"],
+        "size": size,
+        "size_ci95": [size - Z95 * sd, size + Z95 * sd],
+    }
 
 
 def gain_change_parameters(finding: Finding, fitted) -> dict:
@@ -172,8 +176,12 @@ def gain_change_parameters(finding: Finding, fitted) -> dict:
     left, sd = remaining_gain(fitted, name, first)
     factor *= 1 + left
     sd /= seen_share(finding.parameters["factor"] - 1, factor - 1)
-    return {**finding.parameters, "factor_first": finding.parameters["factor"], "factor": factor,
-            "factor_ci95": [factor * (1 - Z95 * sd), factor * (1 + Z95 * sd)]}  # fmt: skip
+    return {
+        **finding.parameters,
+        "factor_first": finding.parameters["factor"],
+        "factor": factor,
+        "factor_ci95": [factor * (1 - Z95 * sd), factor * (1 + Z95 * sd)],
+    }
 
 
 def seen_share(first: float, total: float) -> float:

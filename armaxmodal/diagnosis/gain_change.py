@@ -109,9 +109,20 @@ def gain_change_findings(fitted, eps: np.ndarray, mask: np.ndarray, n_tests: int
         inside = np.flatnonzero(lam[lo : s.n - edge] ** 2 >= lam[at] ** 2 - CHANGE_POINT_LR_95 * widening) + lo
         lag = shifts.get(name, 0.0)  # the residual is in the channel's shifted frame
         first = int(round(at + lag))
-        out.append(Finding("gain_change", (name,), "gain_z", float(abs(d[at] / sd)), p, {
-            "sample": first, "time_s": first / s.fs,
-            "time_ci95_s": [round(inside.min() + lag) / s.fs, round(inside.max() + lag) / s.fs],
-            "factor": float(1 + d[at]), "factor_ci95": [float(1 + d[at] - Z95 * sd), float(1 + d[at] + Z95 * sd)],
-        }))  # fmt: skip
+        out.append(
+            Finding(
+                "gain_change",
+                (name,),
+                "gain_z",
+                float(abs(d[at] / sd)),
+                p,
+                {
+                    "sample": first,
+                    "time_s": first / s.fs,
+                    "time_ci95_s": [round(inside.min() + lag) / s.fs, round(inside.max() + lag) / s.fs],
+                    "factor": float(1 + d[at]),
+                    "factor_ci95": [float(1 + d[at] - Z95 * sd), float(1 + d[at] + Z95 * sd)],
+                },
+            )
+        )
     return out

@@ -132,8 +132,10 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, stru
     """
     check_effect(effect, params)
     if effect in RIDE_EFFECTS:
-        raise DataError(f"effect {effect!r} acts in the structure, not on a recorded channel: plant it as the ride is "
-                        "simulated (armaxmodal simulate --effect, or nonlinear_joint_ride).")  # fmt: skip
+        raise DataError(
+            f"effect {effect!r} acts in the structure, not on a recorded channel: plant it as the ride is "
+            "simulated (armaxmodal simulate --effect, or nonlinear_joint_ride)."
+        )
     if effect == "second_input":
         if structure is None:
             raise DataError("effect 'second_input' needs the structure the force acts on: pass structure=.")
@@ -142,13 +144,17 @@ def inject(recording: Recording, effect: str, channels=None, seed: int = 0, stru
             raise DataError(f"effect 'second_input': one channel (where the force acts), got {names}.")
         return add_second_input(recording, structure, names[0], float(params["level"]), seed)
     if effect in ("level_shift", "gain_change") and not 0 < float(params["time_s"]) < recording.duration:
-        raise DataError(f"effect {effect!r}: time_s must lie inside the record (0-{recording.duration:g} s), "
-                        f"got {params['time_s']}.")  # fmt: skip
+        raise DataError(
+            f"effect {effect!r}: time_s must lie inside the record (0-{recording.duration:g} s), "
+            f"got {params['time_s']}."
+        )
     if effect == "gain_change" and not float(params["factor"]) > 0:
         raise DataError(f"effect 'gain_change': factor must be > 0, got {params['factor']}.")
     if effect == "clock_drift" and not abs(float(params["rate_ppm"])) < MAX_RATE_PPM:
-        raise DataError(f"effect 'clock_drift': rate_ppm must lie within +-{MAX_RATE_PPM:g} (a clock off by more is "
-                        f"a wrong sampling rate, not a drift), got {params['rate_ppm']}.")  # fmt: skip
+        raise DataError(
+            f"effect 'clock_drift': rate_ppm must lie within +-{MAX_RATE_PPM:g} (a clock off by more is "
+            f"a wrong sampling rate, not a drift), got {params['rate_ppm']}."
+        )
     default = [recording.input_name] if effect == "input_delay" else list(recording.sensors)
     names = list(channels) if channels is not None else default
     base, y = recording.base.copy(), np.array(recording.response, dtype=float)
@@ -201,12 +207,22 @@ JOINT_FORCES = {"cubic": "stiffness_nonlinearity", "friction": "damping_nonlinea
 FRICTION_SMOOTHING = 0.01
 
 
-def cubic_spring_ride(structure, base: np.ndarray, fs: float, between: tuple[int, int], ratio: float, *,
-                      noise: float = 0.05, seed: int = 0, oversample: int = 16) -> Recording:  # fmt: skip
+def cubic_spring_ride(
+    structure,
+    base: np.ndarray,
+    fs: float,
+    between: tuple[int, int],
+    ratio: float,
+    *,
+    noise: float = 0.05,
+    seed: int = 0,
+    oversample: int = 16,
+) -> Recording:
     """A ride of ``structure`` with a cubic spring between DOFs ``between``: the truth for
     ``stiffness_nonlinearity`` (:func:`nonlinear_joint_ride` with ``force="cubic"``)."""
-    return nonlinear_joint_ride(structure, base, fs, between, ratio, force="cubic", noise=noise, seed=seed,
-                                oversample=oversample)  # fmt: skip
+    return nonlinear_joint_ride(
+        structure, base, fs, between, ratio, force="cubic", noise=noise, seed=seed, oversample=oversample
+    )
 
 
 def nonlinear_joint_ride(
@@ -302,8 +318,17 @@ def _rk4_joint(m_inv, c, k, fine, h, i, j, size, kind, scale):
     return out
 
 
-def stiffened_ride(structure, base: np.ndarray, fs: float, time_s: float, stiffening: float, *,
-                   noise: float = 0.05, seed: int = 0, hold: str = "bandlimited") -> Recording:  # fmt: skip
+def stiffened_ride(
+    structure,
+    base: np.ndarray,
+    fs: float,
+    time_s: float,
+    stiffening: float,
+    *,
+    noise: float = 0.05,
+    seed: int = 0,
+    hold: str = "bandlimited",
+) -> Recording:
     """A ride of ``structure`` whose every spring is ``stiffening`` times stiffer from ``time_s`` on
     (the truth for ``time_varying``): the stiffer structure's ride to the same input and noise from
     then on, so the state jumps there as in an instant change.
@@ -331,8 +356,10 @@ def stiffened_ride(structure, base: np.ndarray, fs: float, time_s: float, stiffe
     from armaxmodal.systems.structure import Structure
 
     if not (0 < time_s < base.size / fs and stiffening > 0):
-        raise DataError(f"time_varying: time_s inside the ride (0-{base.size / fs:g} s) and stiffening > 0; got "
-                        f"{time_s}, {stiffening}.")  # fmt: skip
+        raise DataError(
+            f"time_varying: time_s inside the ride (0-{base.size / fs:g} s) and stiffening > 0; got "
+            f"{time_s}, {stiffening}."
+        )
     stiffer = Structure(structure.M, structure.C, structure.K * stiffening, structure.names)
     before, after = (simulate_recording(s, base, fs, noise=noise, seed=seed, hold=hold) for s in (structure, stiffer))
     later = (np.arange(before.n_samples) / fs >= time_s)[:, None]
@@ -361,8 +388,10 @@ def add_second_input(recording: Recording, structure, at: str, level: float, see
     m, c, k = (np.asarray(x, float) for x in (structure.M, structure.C, structure.K))
     dof = m.shape[0]
     if recording.response.shape[1] != dof:
-        raise DataError(f"effect 'second_input': the recording has {recording.response.shape[1]} outputs, "
-                        f"the structure {dof} masses.")  # fmt: skip
+        raise DataError(
+            f"effect 'second_input': the recording has {recording.response.shape[1]} outputs, "
+            f"the structure {dof} masses."
+        )
     m_inv = np.linalg.inv(m)
     a = np.block([[np.zeros((dof, dof)), np.eye(dof)], [-m_inv @ k, -m_inv @ c]])
     b = np.r_[np.zeros(dof), m_inv[:, k_at]][:, None]
@@ -373,6 +402,8 @@ def add_second_input(recording: Recording, structure, at: str, level: float, see
     _, response, _ = dlsim((ad, bd, cd, dd, 1.0 / fs), force)
     scale = level * float(np.std(recording.response[:, k_at])) / float(np.std(response[:, k_at]))
     y = np.column_stack([recording.response + scale * response, scale * force])
-    meta = dict(recording.meta, injected={"effect": "second_input", "channels": ["force"], "at": at,
-                                         "level": level, "force_scale": scale})  # fmt: skip
+    meta = dict(
+        recording.meta,
+        injected={"effect": "second_input", "channels": ["force"], "at": at, "level": level, "force_scale": scale},
+    )
     return replace(recording, response=y, sensors=(*recording.sensors, "force"), meta=meta)

@@ -37,8 +37,13 @@ JOINT_TERMS = {
 
 
 #: each term as a person reads it (the verdict's words)
-TERM_WORDS = {"cubic": "a cubic spring", "quadratic": "a quadratic spring", "abs_times": "a |d| d spring",
-              "dry_friction": "dry friction", "quadratic_damping": "quadratic damping"}  # fmt: skip
+TERM_WORDS = {
+    "cubic": "a cubic spring",
+    "quadratic": "a quadratic spring",
+    "abs_times": "a |d| d spring",
+    "dry_friction": "dry friction",
+    "quadratic_damping": "quadratic damping",
+}
 
 
 def deflections(fitted: FittedModel, integrations: int = 2) -> dict[tuple[str, str], np.ndarray]:
@@ -125,5 +130,3 @@ def _place_evidence(places: dict[str, float]) -> dict:
     second, f2 = ranked[1] if len(ranked) > 1 else (None, 0.0)
     margin = ranked[0][1] / f2 if f2 > 0 else None  # one place (a single sensor): nothing to tell apart
     return {"place_score_F": dict(ranked), "runner_up_place": second, "place_margin": margin}
-
-

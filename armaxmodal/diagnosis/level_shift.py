@@ -30,8 +30,14 @@ from armaxmodal.diagnosis.finding import Finding
 from armaxmodal.prepare.detrend import STEP_EDGE
 from armaxmodal.stats import Z95
 
-__all__ = ["CHANGE_POINT_LR_95", "level_shift_findings", "newey_west_sum", "remaining_step", "search_start",
-           "step_scan"]
+__all__ = [
+    "CHANGE_POINT_LR_95",
+    "level_shift_findings",
+    "newey_west_sum",
+    "remaining_step",
+    "search_start",
+    "step_scan",
+]
 
 #: the change point's 95 % likelihood-ratio level: its ratio is not chi-square(1) but has
 #: P(LR <= x) = (1 - exp(-x / 2))^2 (Hansen 2000, threshold estimation), so -2 ln(1 - sqrt(0.95));
@@ -127,9 +133,20 @@ def level_shift_findings(fitted, eps: np.ndarray, mask: np.ndarray, n_tests: int
         lag = shifts.get(name, 0.0)  # the residual is in the channel's shifted frame
         first = int(round(at + lag))
         half = Z95 * sd
-        out.append(Finding("level_shift", (name,), "step_z", float(abs(z)), p, {
-            "sample": first, "time_s": first / s.fs,
-            "time_ci95_s": [round(inside.min() + lag) / s.fs, round(inside.max() + lag) / s.fs],
-            "size": float(size[at]), "size_ci95": [float(size[at] - half), float(size[at] + half)],
-        }))  # fmt: skip
+        out.append(
+            Finding(
+                "level_shift",
+                (name,),
+                "step_z",
+                float(abs(z)),
+                p,
+                {
+                    "sample": first,
+                    "time_s": first / s.fs,
+                    "time_ci95_s": [round(inside.min() + lag) / s.fs, round(inside.max() + lag) / s.fs],
+                    "size": float(size[at]),
+                    "size_ci95": [float(size[at] - half), float(size[at] + half)],
+                },
+            )
+        )
     return out

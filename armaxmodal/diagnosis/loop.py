@@ -138,8 +138,11 @@ def diagnose(
                 break
             # one entry per effect and channels, from the latest round that tried it
             unconfirmed[(finding.effect, frozenset(finding.channels))] = {
-                "effect": finding.effect, "channels": list(finding.channels), "reason": reason,
-                "evidence": finding.evidence()}  # fmt: skip
+                "effect": finding.effect,
+                "channels": list(finding.channels),
+                "reason": reason,
+                "evidence": finding.evidence(),
+            }
         if step is None:
             break
         effect, stage = step

@@ -50,11 +50,17 @@ def effects_table(report: dict) -> pd.DataFrame:
     rows = []
     for e in report["effects"]:
         params = {k: v for k, v in e["parameters"].items() if not isinstance(v, dict)}
-        rows.append({
-            "effect": e["effect"], "channels": ", ".join(e["channels"]), "test": e["evidence"]["statistic"],
-            "p": e["evidence"]["p"], "error before": e["error_before"], "error after": e["error_after"],
-            "fix": short_parameters(params),
-        })  # fmt: skip
+        rows.append(
+            {
+                "effect": e["effect"],
+                "channels": ", ".join(e["channels"]),
+                "test": e["evidence"]["statistic"],
+                "p": e["evidence"]["p"],
+                "error before": e["error_before"],
+                "error after": e["error_after"],
+                "fix": short_parameters(params),
+            }
+        )
     return pd.DataFrame(rows, columns=["effect", "channels", "test", "p", "error before", "error after", "fix"])
 
 
@@ -63,14 +69,20 @@ def _fits_table(report: dict) -> pd.DataFrame:
     inputs = set(final["inputs_added"])
 
     def shown(values, after=True):  # null: an output made an input (after), or a diverging simulation
-        return [("now an input" if after and name in inputs else "diverges") if v is None else v
-                for name, v in zip(report["outputs"], values, strict=True)]  # fmt: skip
+        return [
+            ("now an input" if after and name in inputs else "diverges") if v is None else v
+            for name, v in zip(report["outputs"], values, strict=True)
+        ]
 
-    return pd.DataFrame({
-        "output": report["outputs"], "fit before (%)": shown(base["fit_val_pct"], after=False),
-        "fit after (%)": shown(final["fit_val_pct"]), "residual RMS after": shown(final["sim_resid_rms"]),
-        "H1 noise floor": final["noise_floor_rms"],
-    })  # fmt: skip
+    return pd.DataFrame(
+        {
+            "output": report["outputs"],
+            "fit before (%)": shown(base["fit_val_pct"], after=False),
+            "fit after (%)": shown(final["fit_val_pct"]),
+            "residual RMS after": shown(final["sim_resid_rms"]),
+            "H1 noise floor": final["noise_floor_rms"],
+        }
+    )
 
 
 def _modes_table(report: dict) -> pd.DataFrame:
@@ -105,15 +117,27 @@ def render_diagnosis_report(result, source: str) -> str:
     body = f"""
 <h1>armaxmodal diagnose: {esc(source)}</h1>
 <p class="verdict">verdict: {esc(report["verdict"])}</p>
-<h2>The record</h2>{table(pd.DataFrame([("file", source), ("input", report["input"]),
-    ("outputs", ", ".join(report["outputs"])), ("sampling rate (Hz)", f"{report['fs']:g}"),
-    ("analysed at (Hz)", f"{report['analysis_fs']:g}"), ("baseline orders", str(report["orders"])),
-    ("validation", report["validation"])], columns=["", "value"]))}
+<h2>The record</h2>{
+        table(
+            pd.DataFrame(
+                [
+                    ("file", source),
+                    ("input", report["input"]),
+                    ("outputs", ", ".join(report["outputs"])),
+                    ("sampling rate (Hz)", f"{report['fs']:g}"),
+                    ("analysed at (Hz)", f"{report['analysis_fs']:g}"),
+                    ("baseline orders", str(report["orders"])),
+                    ("validation", report["validation"]),
+                ],
+                columns=["", "value"],
+            )
+        )
+    }
 <h2>Warnings ({len(report["warnings"])})</h2>{"<ul>" + warnings + "</ul>" if warnings else "<p>none</p>"}
 <h2>Each output's fit, before and after</h2>{table(_fits_table(report), 4)}
 <h2>Effects found and fixed ({len(effects)})</h2>{table(effects, 4) if len(effects) else "<p>none kept</p>"}
 {"<h2>Not confirmed</h2><ul>" + unconfirmed + "</ul>" if unconfirmed else ""}
 <h2>Modes before and after</h2>{table(_modes_table(report), 5)}
 <h2>Figures</h2><img alt='diagnosis figures' src='{figure_uri(plot_diagnosis(result), dpi=100)}'>
-"""  # fmt: skip
+"""
     return page(f"armaxmodal diagnose: {source}", body)

@@ -61,8 +61,11 @@ class Effect:
         """The held-out error that judged the fix (``"one-step"`` or ``"simulation"``), before and
         after: the one the keep rule read, which falls for every effect kept."""
         if "simulation" in self.parameters.get("criterion", ""):
-            return {"error": "simulation", "before": self.parameters["sim_error_before"],
-                    "after": self.parameters["sim_error_after"]}  # fmt: skip
+            return {
+                "error": "simulation",
+                "before": self.parameters["sim_error_before"],
+                "after": self.parameters["sim_error_after"],
+            }
         return {"error": "one-step", "before": self.error_before, "after": self.error_after}
 
     def to_dict(self) -> dict:
@@ -204,18 +207,25 @@ def _verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float = 0.01) 
     confirmed and a test fired (a dry friction confirmed as a damping nonlinearity read "unsure",
     for two side tests whose fixes did not help)."""
     held = diagnosis.baseline.held
-    diverges = (f" The baseline's held-out simulation diverges (a half-record model has a mode that grows "
-                f"{held.growth:.3g} times over the half it simulates: the record is too short or too nonstationary "
-                "for the model's order), so no fix judged on simulation can be confirmed."
-                ) if not held.simulates else ""  # fmt: skip
+    diverges = (
+        (
+            f" The baseline's held-out simulation diverges (a half-record model has a mode that grows "
+            f"{held.growth:.3g} times over the half it simulates: the record is too short or too nonstationary "
+            "for the model's order), so no fix judged on simulation can be confirmed."
+        )
+        if not held.simulates
+        else ""
+    )
     return _findings_verdict(diagnosis, whiteness, alpha) + diverges
 
 
 def _found(effect: Effect) -> str:
     """An effect kept, as the verdict names it: where, and the held-out error that judged it."""
     judged = effect.judged_by()
-    return (f"{effect.finding.effect}{_place(effect)} on {', '.join(effect.finding.channels)} (held-out "
-            f"{judged['error']} error {judged['before']:.3g} -> {judged['after']:.3g})")  # fmt: skip
+    return (
+        f"{effect.finding.effect}{_place(effect)} on {', '.join(effect.finding.channels)} (held-out "
+        f"{judged['error']} error {judged['before']:.3g} -> {judged['after']:.3g})"
+    )
 
 
 def _place(effect: Effect) -> str:
@@ -229,16 +239,24 @@ def _place(effect: Effect) -> str:
 def _findings_verdict(diagnosis: Diagnosis, whiteness: list[float], alpha: float) -> str:
     """What was found and confirmed, then what is left (:func:`_verdict`)."""
     coloured = [s for s, p in zip(diagnosis.sensors, whiteness, strict=True) if p is not None and p < alpha]
-    left = (f"the residual of {', '.join(coloured)} is still not white after the fixes; an effect the fixes do not "
+    left = (
+        (
+            f"the residual of {', '.join(coloured)} is still not white after the fixes; an effect the fixes do not "
             "capture (a non-smooth nonlinearity such as friction or a clearance, a time change, a missing mode) may "
-            "remain. Look at the figure.") if coloured else ""  # fmt: skip
+            "remain. Look at the figure."
+        )
+        if coloured
+        else ""
+    )
     if diagnosis.effects:
         found = "; ".join(_found(e) for e in diagnosis.effects)
         if left:
             return f"found and confirmed: {found}. But {left}"
         if diagnosis.unconfirmed:
-            return (f"found and confirmed: {found}; the effects listed explain the residual (white after the fixes). "
-                    "Other tests fired whose fixes did not lower the held-out error (see 'unconfirmed').")  # fmt: skip
+            return (
+                f"found and confirmed: {found}; the effects listed explain the residual (white after the fixes). "
+                "Other tests fired whose fixes did not lower the held-out error (see 'unconfirmed')."
+            )
         return f"found and confirmed: {found}; the effects listed explain the residual (white after the fixes)."
     if left:
         return f"unsure: {left}"

@@ -112,15 +112,34 @@ def fit_armax(
     97
     """
     return fit_resumable(
-        data, (na, nb, nc, nk), fs=fs, shared_poles=shared_poles, output_error=output_error, max_iter=max_iter,
-        tol=tol, stop=stop, warn=warn, start=start,
-    )[0]  # fmt: skip
+        data,
+        (na, nb, nc, nk),
+        fs=fs,
+        shared_poles=shared_poles,
+        output_error=output_error,
+        max_iter=max_iter,
+        tol=tol,
+        stop=stop,
+        warn=warn,
+        start=start,
+    )[0]
 
 
 def fit_resumable(
-    data, orders, *, fs=None, shared_poles=False, output_error=False, max_iter=100, tol=1e-6, stop="expected",
-    warn=True, start=None, resume=None, covariance=True,
-):  # fmt: skip
+    data,
+    orders,
+    *,
+    fs=None,
+    shared_poles=False,
+    output_error=False,
+    max_iter=100,
+    tol=1e-6,
+    stop="expected",
+    warn=True,
+    start=None,
+    resume=None,
+    covariance=True,
+):
     """:func:`~armaxmodal.fit_armax`'s work, returning ``(fit, checkpoint)``. Shared-pole fits only:
     ``resume`` (the ``checkpoint`` of an earlier fit of the same data, orders and form)
     continues that fit, and ``covariance=False`` leaves the covariances out (empty) for a
@@ -164,9 +183,15 @@ def fit_resumable(
         thetas, info = [], []
         for k in range(y.shape[1]):
             th, inf = fit_single(
-                np.ascontiguousarray(y_fit[:, k]), uT, *window, max_iter, tol, output_error,
-                None if thetas0 is None else thetas0[k], stop,
-            )  # fmt: skip
+                np.ascontiguousarray(y_fit[:, k]),
+                uT,
+                *window,
+                max_iter,
+                tol,
+                output_error,
+                None if thetas0 is None else thetas0[k],
+                stop,
+            )
             thetas.append(th)
             info.append(inf)
         info = merge_single_info(info)

@@ -193,8 +193,16 @@ def fit_or_none(recording, orders, **options):
         return None
 
 
-def choose_delay(recording: Recording, nk_values: Iterable[int], na_values: Iterable[int], *, max_iter: int,
-                 tol: float, n_jobs: int | None = None, bar=None) -> tuple[int, dict]:  # fmt: skip
+def choose_delay(
+    recording: Recording,
+    nk_values: Iterable[int],
+    na_values: Iterable[int],
+    *,
+    max_iter: int,
+    tol: float,
+    n_jobs: int | None = None,
+    bar=None,
+) -> tuple[int, dict]:
     """The input delay of the lowest-BIC shared-pole model over the orders ``na_values``, each
     delay fitted at each order for at most ``max_iter`` iterations (the delay and the order
     interact: band-limited data trade non-causal taps for poles, so they are chosen jointly).
@@ -234,8 +242,16 @@ def choose_delay(recording: Recording, nk_values: Iterable[int], na_values: Iter
 def _resumable_or_none(recording: Recording, orders: Orders, max_iter: int, tol: float):
     """``(fit, checkpoint)`` of a shared-pole candidate, ``(None, None)`` when the record cannot support it."""
     try:
-        return fit_resumable(recording, orders, shared_poles=True, max_iter=max_iter, tol=tol, stop="decrease",
-                             warn=False, covariance=False)  # fmt: skip
+        return fit_resumable(
+            recording,
+            orders,
+            shared_poles=True,
+            max_iter=max_iter,
+            tol=tol,
+            stop="decrease",
+            warn=False,
+            covariance=False,
+        )
     except OrderError:
         return None, None
 

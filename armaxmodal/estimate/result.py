@@ -16,9 +16,21 @@ from armaxmodal.stats import Z95
 __all__ = ["ArmaxFit"]
 
 _MODE_COLUMNS = [
-    "sensor", "freq_hz", "damping", "damped_freq_hz", "freq_ci95_lo", "freq_ci95_hi", "damping_ci95_lo",
-    "damping_ci95_hi", "freq_sd", "damping_sd", "pole", "residue", "residue_mag", "residue_phase_deg",
-]  # fmt: skip
+    "sensor",
+    "freq_hz",
+    "damping",
+    "damped_freq_hz",
+    "freq_ci95_lo",
+    "freq_ci95_hi",
+    "damping_ci95_lo",
+    "damping_ci95_hi",
+    "freq_sd",
+    "damping_sd",
+    "pole",
+    "residue",
+    "residue_mag",
+    "residue_phase_deg",
+]
 
 
 @dataclass(frozen=True)

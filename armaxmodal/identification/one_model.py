@@ -33,7 +33,6 @@ from armaxmodal.stats import MAX_DAMPING
 __all__ = ["identify", "Identification"]
 
 
-
 @dataclass(frozen=True)
 class Identification:
     """Modes of one recording.
@@ -89,8 +88,9 @@ class Identification:
         return (
             *found,
             *unexplained_peaks(self.recording, freq, damping, band),
-            *oversampling_note(freq, self.recording.fs, DEFAULTS.notes.oversampled_fraction,
-                               DEFAULTS.notes.suggested_band_factor),
+            *oversampling_note(
+                freq, self.recording.fs, DEFAULTS.notes.oversampled_fraction, DEFAULTS.notes.suggested_band_factor
+            ),
             *self.check.warnings(),
         )
 

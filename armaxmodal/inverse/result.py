@@ -96,14 +96,18 @@ class InverseSolution:
         """
         if self.components is None:
             s = self.structure
-            rows = [(kind, n, matrix[i, i]) for kind, matrix in (("M", s.M), ("K", s.K), ("C", s.C))
-                    for i, n in enumerate(s.names)]  # fmt: skip
+            rows = [
+                (kind, n, matrix[i, i])
+                for kind, matrix in (("M", s.M), ("K", s.K), ("C", s.C))
+                for i, n in enumerate(s.names)
+            ]
             return pd.DataFrame(rows, columns=["component", "location", "value"])
         table = self.components.to_frame()
         if self.std is None:
             return table
         std = self.std.to_frame()["value"].to_numpy()
         value = table["value"].to_numpy()
-        identified = np.where(std == 0, np.where(value == 0, "at zero", "fixed"),
-                              np.where(value - Z95 * std > 0, "yes", "no"))  # fmt: skip
+        identified = np.where(
+            std == 0, np.where(value == 0, "at zero", "fixed"), np.where(value - Z95 * std > 0, "yes", "no")
+        )
         return table.assign(std=std, identified=identified)

@@ -112,10 +112,12 @@ def _drop_unnamed_trailing(frame: pd.DataFrame, trailing: int, path: Path) -> tu
                 f"{frame.iloc[row, k]!r}); give it a name, or delete the column."
             )
     note = QualityWarning(
-        "empty_columns_dropped", (),
+        "empty_columns_dropped",
+        (),
         f"{trailing} empty column(s) without a name at the end of every line (columns {first + 1}-{frame.shape[1]}, "
-        "a spreadsheet's trailing commas) left out", float(trailing),
-    )  # fmt: skip
+        "a spreadsheet's trailing commas) left out",
+        float(trailing),
+    )
     return frame.iloc[:, :first], [note]
 
 

@@ -27,9 +27,19 @@ def read_mat_file(path: Path):
             f"{path.name}: MATLAB v7.3 (HDF5) files are not supported; save with save(..., '-v7') or export to CSV."
         ) from exc
     except (
-        MatReadError, ValueError, TypeError, IndexError, KeyError, OSError, struct.error, EOFError, zlib.error,
-        UnicodeDecodeError, OverflowError, MemoryError,
-    ) as exc:  # fmt: skip  -- what scipy raises on random bytes (tests/test_fuzz.py)
+        MatReadError,
+        ValueError,
+        TypeError,
+        IndexError,
+        KeyError,
+        OSError,
+        struct.error,
+        EOFError,
+        zlib.error,
+        UnicodeDecodeError,
+        OverflowError,
+        MemoryError,
+    ) as exc:  # what scipy raises on random bytes (tests/test_fuzz.py)
         raise DataError(f"{path.name}: not a readable MAT file ({type(exc).__name__}: {exc}).") from exc
     arrays = _struct_fields({k: v for k, v in data.items() if not k.startswith("__") and isinstance(v, np.ndarray)})
     numeric = {k: np.squeeze(v) for k, v in arrays.items() if v.dtype.kind in "fiu" and v.size > 0}

@@ -46,8 +46,10 @@ MAX_BRIDGED_SAMPLES = 3
 #: what a bridged gap means for the result, said with every ``dropped_packet`` note: the bridged
 #: samples are wrong in every channel at one instant and the fit takes them as data (two rows of a
 #: 120 s ride put a mode outside its interval and hid another), so the verdict is ``uncertain``
-BRIDGED = ("bridged by linear interpolation. The bridged samples enter the fit as data and can move modes, so the "
-           "verdict is at most uncertain; cut the record at the gap for a clean fit.")
+BRIDGED = (
+    "bridged by linear interpolation. The bridged samples enter the fit as data and can move modes, so the "
+    "verdict is at most uncertain; cut the record at the gap for a clean fit."
+)
 
 
 def is_number(text: str) -> bool:
@@ -198,12 +200,17 @@ def rounded_to_print(t: np.ndarray, printed_digit: float | None) -> list:
     if worst > printed_digit * (1 + 1e-6):
         return []
     steps = np.diff(t)
-    return [QualityWarning(
-        "time_rounded", (),
-        f"the time column is printed to {printed_digit:.0e} s, so its steps are uneven ({steps.min():.6g} to "
-        f"{steps.max():.6g} s); every stamp lies within {worst:.2g} s of a uniform grid: read at the rate of its whole "
-        f"span, {1 / dt:.4f} Hz", float(worst),
-    )]  # fmt: skip
+    return [
+        QualityWarning(
+            "time_rounded",
+            (),
+            f"the time column is printed to {printed_digit:.0e} s, so its steps are uneven ({steps.min():.6g} to "
+            f"{steps.max():.6g} s); every stamp lies within {worst:.2g} s of a uniform grid: read at the rate of its "
+            "whole "
+            f"span, {1 / dt:.4f} Hz",
+            float(worst),
+        )
+    ]
 
 
 def fill_missing_samples(channels: dict, max_samples: int, source: str) -> tuple[dict, list]:
@@ -244,13 +251,20 @@ def fill_missing_samples(channels: dict, max_samples: int, source: str) -> tuple
                     "cut the record there and analyse the parts apart, or allow a longer gap."
                 )
             if start == 0 or stop == x.size:
-                raise DataError(f"{where}: missing at the {'start' if start == 0 else 'end'} of the record, with "
-                                "nothing to interpolate from on one side; trim those rows.")  # fmt: skip
+                raise DataError(
+                    f"{where}: missing at the {'start' if start == 0 else 'end'} of the record, with "
+                    "nothing to interpolate from on one side; trim those rows."
+                )
         idx = np.arange(x.size)
         out[name] = np.where(missing, np.interp(idx, idx[~missing], x[~missing]), x)
         notes += [
-            QualityWarning("gap_filled", (name,), f"channel '{name}', data rows {start + 1}-{stop}: {stop - start} "
-                           "missing sample(s) filled by linear interpolation (--fill-gaps)", float(stop - start))
+            QualityWarning(
+                "gap_filled",
+                (name,),
+                f"channel '{name}', data rows {start + 1}-{stop}: {stop - start} "
+                "missing sample(s) filled by linear interpolation (--fill-gaps)",
+                float(stop - start),
+            )
             for start, stop in runs
-        ]  # fmt: skip
+        ]
     return out, notes

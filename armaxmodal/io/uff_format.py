@@ -1,5 +1,4 @@
-"""Universal File Format type 58 (pyuff): one function per record, complete records only.
-"""
+"""Universal File Format type 58 (pyuff): one function per record, complete records only."""
 
 from __future__ import annotations
 

@@ -79,23 +79,61 @@ def write_modes_uff(path: str | os.PathLike, freq_hz, damping, shapes, sensors, 
         os.unlink(tmp)  # pyuff refuses to overwrite in 'add' mode; let it create the file
         uff = pyuff.UFF(tmp)
         for m in range(freq_hz.size):
-            uff.write_sets(pyuff.prepare_55(
-                model_type=1, id1=f"armaxmodal mode {m + 1}: {freq_hz[m]:.6g} Hz, damping {damping[m]:.4g}, shape "
-                "largest = 1", id2=id2, id3=id3, id4=id4, id5=id5,
-                analysis_type=3, data_ch=2, spec_data_type=12, data_type=5, n_data_per_node=3,
-                r1=normalised_shape(shapes[:, m]), r2=zeros, r3=zeros, node_nums=list(range(1, len(sensors) + 1)),
-                load_case=1, mode_n=m + 1, eig=complex(poles[m]), modal_a=0j, modal_b=0j,
-            ), mode="add")  # fmt: skip
+            uff.write_sets(
+                pyuff.prepare_55(
+                    model_type=1,
+                    id1=f"armaxmodal mode {m + 1}: {freq_hz[m]:.6g} Hz, damping {damping[m]:.4g}, shape largest = 1",
+                    id2=id2,
+                    id3=id3,
+                    id4=id4,
+                    id5=id5,
+                    analysis_type=3,
+                    data_ch=2,
+                    spec_data_type=12,
+                    data_type=5,
+                    n_data_per_node=3,
+                    r1=normalised_shape(shapes[:, m]),
+                    r2=zeros,
+                    r3=zeros,
+                    node_nums=list(range(1, len(sensors) + 1)),
+                    load_case=1,
+                    mode_n=m + 1,
+                    eig=complex(poles[m]),
+                    modal_a=0j,
+                    modal_b=0j,
+                ),
+                mode="add",
+            )
         for label, k, f, values in frfs:
             f = np.asarray(f, float)
-            uff.write_sets(pyuff.prepare_58(
-                binary=0, id1=f"{label}: {sensors[k]} / base", id2="armaxmodal", id3="NONE", id4="NONE", id5="NONE",
-                func_type=4, rsp_node=k + 1, rsp_dir=1, ref_node=0, ref_dir=1, ord_data_type=6, num_pts=f.size,
-                abscissa_spacing=1, abscissa_min=float(f[0]), abscissa_inc=float(f[1] - f[0]),
-                abscissa_spec_data_type=18, ordinate_spec_data_type=12, orddenom_spec_data_type=12,
-                abscissa_axis_units_lab="Hz", ordinate_axis_units_lab="(m/s^2)/(m/s^2)",
-                data=np.asarray(values, complex), x=f,
-            ), mode="add")  # fmt: skip
+            uff.write_sets(
+                pyuff.prepare_58(
+                    binary=0,
+                    id1=f"{label}: {sensors[k]} / base",
+                    id2="armaxmodal",
+                    id3="NONE",
+                    id4="NONE",
+                    id5="NONE",
+                    func_type=4,
+                    rsp_node=k + 1,
+                    rsp_dir=1,
+                    ref_node=0,
+                    ref_dir=1,
+                    ord_data_type=6,
+                    num_pts=f.size,
+                    abscissa_spacing=1,
+                    abscissa_min=float(f[0]),
+                    abscissa_inc=float(f[1] - f[0]),
+                    abscissa_spec_data_type=18,
+                    ordinate_spec_data_type=12,
+                    orddenom_spec_data_type=12,
+                    abscissa_axis_units_lab="Hz",
+                    ordinate_axis_units_lab="(m/s^2)/(m/s^2)",
+                    data=np.asarray(values, complex),
+                    x=f,
+                ),
+                mode="add",
+            )
 
     return atomic_write(path, write)
 
@@ -123,8 +161,10 @@ def read_modes_uff(path: str | os.PathLike) -> dict:
     if not sets:
         raise DataError(f"{path.name}: no type-55 (data at nodes) data sets; write modes with 'stabilise --uff'.")
     if any(int(s.get("analysis_type", 0)) != 3 for s in sets):
-        raise DataError(f"{path.name}: the type-55 data sets are not complex modes (analysis type 3); armaxmodal "
-                        "reads complex modes, with their poles.")  # fmt: skip
+        raise DataError(
+            f"{path.name}: the type-55 data sets are not complex modes (analysis type 3); armaxmodal "
+            "reads complex modes, with their poles."
+        )
     nodes = [tuple(np.asarray(s["node_nums"], int)) for s in sets]
     if len(set(nodes)) != 1:
         raise DataError(f"{path.name}: the modes are given at different nodes; one set of nodes is needed.")
@@ -134,11 +174,16 @@ def read_modes_uff(path: str | os.PathLike) -> dict:
         lam = complex(s["eig"])
         wn = abs(lam)
         shape = np.asarray(s["r1"], complex)
-        modes.append({
-            "freq_hz": wn / (2 * np.pi), "damping": -lam.real / wn if wn > 0 else float("nan"),
-            "shape": {name: {"mag": float(abs(v)), "phase_deg": float(np.degrees(np.angle(v)))}
-                      for name, v in zip(sensors, shape, strict=True)},
-        })  # fmt: skip
+        modes.append(
+            {
+                "freq_hz": wn / (2 * np.pi),
+                "damping": -lam.real / wn if wn > 0 else float("nan"),
+                "shape": {
+                    name: {"mag": float(abs(v)), "phase_deg": float(np.degrees(np.angle(v)))}
+                    for name, v in zip(sensors, shape, strict=True)
+                },
+            }
+        )
     return {"outputs": sensors, "modes": modes, "source": str(path)}
 
 

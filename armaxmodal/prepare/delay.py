@@ -23,9 +23,15 @@ from armaxmodal.spectra import coherence, welch_segments
 from armaxmodal.stats import QUASI_STATIC_COHERENCE, welch_nperseg
 
 __all__ = [
-    "DELAY_ALPHA", "MIN_DELAY_SAMPLES", "QUASI_STATIC_MAGNITUDE", "DelayEstimate", "delay_and_inversion",
-    "estimate_delays", "jackknife_sd", "transmissibility_spectra",
-]  # fmt: skip
+    "DELAY_ALPHA",
+    "MIN_DELAY_SAMPLES",
+    "QUASI_STATIC_MAGNITUDE",
+    "DelayEstimate",
+    "delay_and_inversion",
+    "estimate_delays",
+    "jackknife_sd",
+    "transmissibility_spectra",
+]
 
 #: quasi-static band: |T| within these bounds of 1 and coherence at least QUASI_STATIC_COHERENCE
 QUASI_STATIC_MAGNITUDE = (0.8, 1.25)

@@ -35,6 +35,7 @@ from armaxmodal.recording import Recording
 
 __all__ = ["prepare", "Preparation", "check_band"]
 
+
 @dataclass(frozen=True)
 class Preparation:
     """What was done to a recording before fitting.

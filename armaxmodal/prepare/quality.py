@@ -39,10 +39,20 @@ from armaxmodal.spectra import coherence, welch_spectra
 from armaxmodal.stats import welch_nperseg
 
 __all__ = [
-    "CLIP_MIN_SAMPLES", "INCOHERENT", "NEIGHBOUR_LEVELS", "STUCK_EDGE_MIN", "STUCK_MIN_RUN", "clipped_channels",
-    "duplicate_channels", "incoherent_outputs", "input_coherence", "narrowband_input", "rail_pileup", "stuck_channels",
+    "CLIP_MIN_SAMPLES",
+    "INCOHERENT",
+    "NEIGHBOUR_LEVELS",
+    "STUCK_EDGE_MIN",
+    "STUCK_MIN_RUN",
+    "clipped_channels",
+    "duplicate_channels",
+    "incoherent_outputs",
+    "input_coherence",
+    "narrowband_input",
+    "rail_pileup",
+    "stuck_channels",
     "stuck_runs",
-]  # fmt: skip
+]
 
 #: An output less coherent with the input than this (averaged over the input's spectrum, and
 #: over the output's own) is not its response: response sensors read 0.63-1.00 on the measured
@@ -107,8 +117,11 @@ def incoherent_outputs(recording: Recording) -> list[QualityWarning]:
     coh = coherence(puu, puy, pyy)
     levels = _power_weighted(puu, coh)
     own = _power_weighted(pyy, coh)
-    low = [(name, float(c)) for name, c, o in zip(recording.sensors, levels, own, strict=True)
-           if c < INCOHERENT and o < INCOHERENT]  # fmt: skip
+    low = [
+        (name, float(c))
+        for name, c, o in zip(recording.sensors, levels, own, strict=True)
+        if c < INCOHERENT and o < INCOHERENT
+    ]
     if not low:
         return []
     every = len(low) == len(recording.sensors)
@@ -264,9 +277,10 @@ def stuck_channels(recording: Recording) -> list[QualityWarning]:
     found = []
     for k, name in enumerate(names):
         runs = [
-            r for r in stuck_runs(data[:, k])
+            r
+            for r in stuck_runs(data[:, k])
             if r[2] < STUCK_ALPHA / len(names) and (0 < r[0] and r[1] < len(data) or r[1] - r[0] >= STUCK_EDGE_MIN)
-        ]  # fmt: skip
+        ]
         if not runs:
             continue
         first, stop, p = max(runs, key=lambda r: r[1] - r[0])

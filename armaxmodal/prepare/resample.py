@@ -81,8 +81,9 @@ def decimate(data: np.ndarray, factor: int) -> np.ndarray:
     )
 
 
-def oversampling_note(mode_freqs: np.ndarray, fs: float, oversampled_fraction: float, suggested_band_factor: float
-                      ) -> list[QualityWarning]:  # fmt: skip
+def oversampling_note(
+    mode_freqs: np.ndarray, fs: float, oversampled_fraction: float, suggested_band_factor: float
+) -> list[QualityWarning]:
     """An ``oversampled`` warning when every mode found lies below ``oversampled_fraction`` of the
     Nyquist frequency: the input excites far above the structure (so the rate was kept), the poles
     crowd ``z = 1`` and the swept orders resolve them poorly (the supine ride at 1 kHz under a

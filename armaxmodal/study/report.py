@@ -12,6 +12,7 @@ from armaxmodal.io.report.html_page import figure_uri, page, table
 
 __all__ = ["render_report"]
 
+
 def _table_3_3(study) -> str:
     """Per ride: each subject's modes, then the Average and SD rows (Table 3.3 form)."""
     parts = []

@@ -220,15 +220,24 @@ def _num(v) -> float:
 def _mode_rows(r: dict, labels) -> list[dict]:
     rows = []
     for m, lab in zip(r["modes"], labels, strict=True):
-        rows.append({
-            "file": r["file"], "subject": r["subject"], "ride": r["ride"],
-            "mode": int(lab) if lab else pd.NA, "rank": m["rank"],
-            "freq_hz": _num(m["freq_hz"]), "damping": _num(m["damping"]),
-            "freq_ci95_lo": _num(m["freq_ci95"][0]), "freq_ci95_hi": _num(m["freq_ci95"][1]),
-            "damping_ci95_lo": _num(m["damping_ci95"][0]), "damping_ci95_hi": _num(m["damping_ci95"][1]),
-            "freq_hz_weighted": _num(m["freq_hz_weighted"]), "damping_weighted": _num(m["damping_weighted"]),
-            "mass_kg": _num(r.get("mass_kg")),
-        })  # fmt: skip
+        rows.append(
+            {
+                "file": r["file"],
+                "subject": r["subject"],
+                "ride": r["ride"],
+                "mode": int(lab) if lab else pd.NA,
+                "rank": m["rank"],
+                "freq_hz": _num(m["freq_hz"]),
+                "damping": _num(m["damping"]),
+                "freq_ci95_lo": _num(m["freq_ci95"][0]),
+                "freq_ci95_hi": _num(m["freq_ci95"][1]),
+                "damping_ci95_lo": _num(m["damping_ci95"][0]),
+                "damping_ci95_hi": _num(m["damping_ci95"][1]),
+                "freq_hz_weighted": _num(m["freq_hz_weighted"]),
+                "damping_weighted": _num(m["damping_weighted"]),
+                "mass_kg": _num(r.get("mass_kg")),
+            }
+        )
     return rows
 
 
@@ -236,21 +245,36 @@ def _sensor_rows(r: dict, labels) -> list[dict]:
     rows = []
     for p in r["per_sensor"]:
         lab = labels[p["mode"] - 1]
-        rows.append({
-            "file": r["file"], "subject": r["subject"], "ride": r["ride"], "sensor": p["sensor"],
-            "mode": int(lab) if lab else pd.NA, "rank": p["mode"], "shown": p["freq_hz"] is not None,
-            "freq_hz": _num(p["freq_hz"]), "damping": _num(p["damping"]),
-        })  # fmt: skip
+        rows.append(
+            {
+                "file": r["file"],
+                "subject": r["subject"],
+                "ride": r["ride"],
+                "sensor": p["sensor"],
+                "mode": int(lab) if lab else pd.NA,
+                "rank": p["mode"],
+                "shown": p["freq_hz"] is not None,
+                "freq_hz": _num(p["freq_hz"]),
+                "damping": _num(p["damping"]),
+            }
+        )
     return rows
 
 
 def _shape_rows(r: dict, labels) -> list[dict]:
     return [
-        {"file": r["file"], "subject": r["subject"], "ride": r["ride"], "mode": int(lab), "sensor": s,
-         "mag": _num(v["mag"])}
-        for m, lab in zip(r["modes"], labels, strict=True) if lab
+        {
+            "file": r["file"],
+            "subject": r["subject"],
+            "ride": r["ride"],
+            "mode": int(lab),
+            "sensor": s,
+            "mag": _num(v["mag"]),
+        }
+        for m, lab in zip(r["modes"], labels, strict=True)
+        if lab
         for s, v in m["shape"].items()
-    ]  # fmt: skip
+    ]
 
 
 def _across_subjects(modes: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:

@@ -66,8 +66,10 @@ def _notes(warnings) -> str:
         spec, texts, level = known.get(code), groups[code], effect(code)
         advice = f"<p>{marked_up(spec.advice)}</p>" if spec is not None else ""
         full = "".join(f"<li>{marked_up(w.message)}</li>" for w in texts)
-        items.append(f"<details{' open' if level < 2 else ''}><summary><b>{esc(code)}</b> ({len(texts)}): "
-                     f"{effects[level]}</summary>{advice}<ul>{full}</ul></details>")  # fmt: skip
+        items.append(
+            f"<details{' open' if level < 2 else ''}><summary><b>{esc(code)}</b> ({len(texts)}): "
+            f"{effects[level]}</summary>{advice}<ul>{full}</ul></details>"
+        )
     return "".join(items) or "<p>none</p>"
 
 
@@ -77,9 +79,12 @@ def _made_by(provenance: dict) -> pd.DataFrame:
 
     from armaxmodal._version import __version__
 
-    rows = [("armaxmodal", __version__),
-            ("run at (UTC)", provenance.get("date") or datetime.now(UTC).strftime("%Y-%m-%d %H:%M:%S")),
-            ("command", provenance.get("command")), ("input SHA-256", provenance.get("checksum"))]  # fmt: skip
+    rows = [
+        ("armaxmodal", __version__),
+        ("run at (UTC)", provenance.get("date") or datetime.now(UTC).strftime("%Y-%m-%d %H:%M:%S")),
+        ("command", provenance.get("command")),
+        ("input SHA-256", provenance.get("checksum")),
+    ]
     return pd.DataFrame([(k, v) for k, v in rows if v], columns=["", "value"])
 
 
@@ -103,8 +108,13 @@ def _check_table(check) -> pd.DataFrame:
 
 def _record_table(selection, source: str) -> pd.DataFrame:
     rec, prep = selection.diagram.recording, selection.diagram.preparation
-    rows = [("file", source), ("input", rec.input_name), ("outputs", ", ".join(rec.sensors)),
-            ("samples", f"{rec.n_samples}"), ("duration (s)", f"{rec.duration:.4g}")]  # fmt: skip
+    rows = [
+        ("file", source),
+        ("input", rec.input_name),
+        ("outputs", ", ".join(rec.sensors)),
+        ("samples", f"{rec.n_samples}"),
+        ("duration (s)", f"{rec.duration:.4g}"),
+    ]
     if prep is not None:
         rows += [("sampling rate (Hz)", f"{prep.original_fs:g}"), ("analysed at (Hz)", f"{prep.analysis_fs:g}")]
     else:
@@ -114,16 +124,20 @@ def _record_table(selection, source: str) -> pd.DataFrame:
 
 def _settings_table(selection, settings: dict) -> pd.DataFrame:
     d, t = selection.diagram, selection.diagram.tolerances
-    rows = [("orders na swept", f"{d.orders[0].na}-{d.orders[-1].na}"), ("input delay nk (samples)", d.orders[0].nk),
-            ("stability tolerances", f"f {100 * t.freq:g} %, damping {100 * t.damping:g} %, shape 1-MAC {t.shape:g}"),
-            ("inter-sample behaviour", None if selection.refinement is None else selection.refinement.hold),
-            ("picks (Hz)", selection.picks)]  # fmt: skip
+    rows = [
+        ("orders na swept", f"{d.orders[0].na}-{d.orders[-1].na}"),
+        ("input delay nk (samples)", d.orders[0].nk),
+        ("stability tolerances", f"f {100 * t.freq:g} %, damping {100 * t.damping:g} %, shape 1-MAC {t.shape:g}"),
+        ("inter-sample behaviour", None if selection.refinement is None else selection.refinement.hold),
+        ("picks (Hz)", selection.picks),
+    ]
     rows += list(settings.items())  # a setting the run did not use is left out, not shown empty
     return pd.DataFrame([(k, str(v)) for k, v in rows if v is not None and v != ""], columns=["setting", "value"])
 
 
-def render_selection_report(selection, verdict: str, source: str, settings: dict | None = None,
-                            provenance: dict | None = None) -> str:  # fmt: skip
+def render_selection_report(
+    selection, verdict: str, source: str, settings: dict | None = None, provenance: dict | None = None
+) -> str:
     """The HTML text of one recording's report.
 
     Parameters
@@ -162,15 +176,20 @@ def render_selection_report(selection, verdict: str, source: str, settings: dict
         ("notes", f"Notes ({len(selection.warnings)})", _notes(selection.warnings)),
         ("diagram", "Stabilisation diagram over the measured FRF", f"<img alt='diagram' src='{diagram}'>"),
         ("modes", f"Modes ({n_modes})", table(modes_table(selection), 5) if n_modes else "<p>none</p>"),
-        ("check", "The modal-model check per output", None if selection.check is None
-         else table(_check_table(selection.check), 3)),
+        (
+            "check",
+            "The modal-model check per output",
+            None if selection.check is None else table(_check_table(selection.check), 3),
+        ),
         ("shapes", "Mode shapes", f"<img alt='mode shapes' src='{shapes}'>" if shapes else None),
         ("settings", "Settings", table(_settings_table(selection, settings or {}))),
         ("glossary", "Glossary", glossary_html()),
-    ]  # fmt: skip
+    ]
     sections = [(key, title, content) for key, title, content in sections if content is not None]
     nav = " · ".join(f"<a href='#{key}'>{esc(title)}</a>" for key, title, _ in sections)
-    body = (f"<h1>armaxmodal stabilise: {esc(source)}</h1><p class=\"verdict {esc(selection.quality)}\">{esc(verdict)}"
-            f"</p>{table(_made_by(provenance or {}), text=True)}<nav>{nav}</nav>"
-            + "".join(f"<h2 id={key}>{esc(title)}</h2>{content}" for key, title, content in sections))  # fmt: skip
+    body = (
+        f'<h1>armaxmodal stabilise: {esc(source)}</h1><p class="verdict {esc(selection.quality)}">{esc(verdict)}'
+        f"</p>{table(_made_by(provenance or {}), text=True)}<nav>{nav}</nav>"
+        + "".join(f"<h2 id={key}>{esc(title)}</h2>{content}" for key, title, content in sections)
+    )
     return page(f"armaxmodal stabilise: {source}", body)

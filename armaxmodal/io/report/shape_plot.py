@@ -81,8 +81,10 @@ def check_positions(positions: dict, sensors) -> None:
     missing = [s for s in sensors if s not in positions]
     unknown = [p for p in positions if p not in sensors]
     if missing or unknown:
-        raise DataError(f"positions: every sensor needs one ({', '.join(sensors)}); missing {missing or 'none'}, "
-                        f"not a sensor {unknown or 'none'}.")  # fmt: skip
+        raise DataError(
+            f"positions: every sensor needs one ({', '.join(sensors)}); missing {missing or 'none'}, "
+            f"not a sensor {unknown or 'none'}."
+        )
     bad = [k for k, v in positions.items() if not np.isfinite(float(v))]
     if bad:
         raise DataError(f"positions: {bad} are not finite numbers.")
