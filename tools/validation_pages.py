@@ -38,6 +38,14 @@ def _load(name: str) -> dict | None:
     return json.loads(path.read_text()) if path.is_file() else None
 
 
+def _save(fig, name: str) -> None:
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    fig.savefig(OUT / name, dpi=90)
+    plt.close(fig)
+
+
 def _missing(script: str) -> str:
     return f"*No saved result: run `{script}`.*\n"
 
@@ -70,9 +78,7 @@ def count_battery() -> str:
     ax.set_yticks(range(len(kinds)), kinds)
     ax.set_xlabel("frequency error of each exact mode's nearest reported mode, in Cramér–Rao bounds (clipped at ±10)")
     ax.legend(loc="lower right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(OUT / "count_battery.png", dpi=90)
-    plt.close(fig)
+    _save(fig, "count_battery.png")
     wrong = [c for c in cases if not c["right"]]
     listed = "\n".join(f"- {c['case']} (`{c['quality']}`): {'; '.join(c['why'])}" for c in wrong)
     return (
@@ -110,9 +116,7 @@ def coverage() -> str:
     ax.set_ylim(50, 100)
     ax.set_ylabel("rides whose interval holds the truth (%)")
     ax.legend(fontsize=8, loc="lower right")
-    fig.tight_layout()
-    fig.savefig(OUT / "coverage.png", dpi=90)
-    plt.close(fig)
+    _save(fig, "coverage.png")
     return (
         f"{data['seeds']} rides of the supine body, {data['duration_s']:g} s at 60 Hz, 5 % sensor noise, "
         f"simulated {data['hold']} (`scripts/mc_coverage.py`):\n\n"
@@ -153,9 +157,7 @@ def efficiency() -> str:
     ax.set_xticks(range(len(sub)), [f"{r['freq_hz']:.2f} Hz" for r in sub])
     ax.set_ylabel("RMS error in Cramér–Rao bounds")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(OUT / "efficiency.png", dpi=90)
-    plt.close(fig)
+    _save(fig, "efficiency.png")
     return (
         f"{data['records']} rides of the five-segment body (`scripts/mc_crb_modal.py`), errors in units of "
         "each record's own bound (1: as good as any unbiased estimator can be):\n\n"
@@ -204,9 +206,7 @@ def realdata() -> str:
     ax.set_yticks([1, 3, 5, 7], ["level 1", "level 3", "level 5", "level 7"])
     ax.set_xlabel("natural frequency (Hz), 95 % interval")
     ax.set_title("F-16 ground vibration test: the modes soften as the force grows", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(OUT / "f16_levels.png", dpi=90)
-    plt.close(fig)
+    _save(fig, "f16_levels.png")
     return (
         "\n".join(lines) + "\n\n![The F-16's modes at four force levels](f16_levels.png)\n\n" + "\n".join(copies) + "\n"
     )

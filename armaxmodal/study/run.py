@@ -21,6 +21,8 @@ from armaxmodal.study.tables import StudyTables, build_tables
 __all__ = ["Study", "run_study"]
 
 CACHE_FOLDER = ".cache"
+#: the form of a cached result: raised when a result gains a field, so that older files are not read
+RESULT_FORM = 2
 
 
 @dataclass
@@ -329,16 +331,15 @@ def _on_dask(todo, settings, sensors, address, finished, bar) -> None:
 
 def _cache_path(cache: Path, digest: str, settings: StudySettings, sensors) -> Path:
     key = StudySettings(**{**settings.__dict__, "sensors": tuple(sensors)}).key()
-    return cache / f"{digest[:24]}-{key}.json"
+    return cache / f"{digest[:24]}-{key}-r{RESULT_FORM}.json"
 
 
 def _read_cache(cache: Path, digest, settings, sensors) -> dict | None:
     path = _cache_path(cache, digest, settings, sensors)
     try:
-        cached = json.loads(path.read_text(encoding="utf-8"))
+        return json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None  # absent or half-written by a crash: analyse again
-    return cached if "peak_input" in cached else None  # written before results carried it
 
 
 def _record(entry: Entry, digest: str, result: dict) -> dict:

@@ -87,7 +87,12 @@ def plot_track(track: Track):
         if dated:
             axes[1, 1].set_xlabel("date of the event")
             axes[r, 1].tick_params(axis="x", labelrotation=30)
-    axes[0, 0].legend(fontsize=7, loc="best")
+    if rows.empty:  # every event poor or without a mode: say so where the modes would be
+        axes[0, 0].text(
+            0.5, 0.5, "no event's modes to follow (see the notes)", ha="center", transform=axes[0, 0].transAxes
+        )
+    else:
+        axes[0, 0].legend(fontsize=7, loc="best")
     fig.suptitle("modes across events (red rings: beyond the other events' trend)", fontsize=10)
     fig.tight_layout()
     return fig

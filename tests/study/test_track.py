@@ -196,3 +196,19 @@ def test_events_are_matched_from_the_weakest_shaking_not_in_the_manifests_order(
     followed = follow(study, TrackSettings())
     assert followed.table["mode"].tolist() == [1] * 5
     assert followed.table.freq_hz.tolist() == [4.0, 3.6, 3.2, 2.8, 2.4]  # in the order of the shaking
+
+
+def test_a_structure_whose_every_event_is_poor_writes_its_files_and_says_why(tmp_path):
+    from types import SimpleNamespace
+
+    from armaxmodal.study import write_track
+    from armaxmodal.study.track import follow
+
+    poor = [{"file": f"e{k}.csv", "labels": {}, "peak_input": 0.1 * (k + 1), "quality": "poor", "modes": []}
+            for k in range(2)]  # fmt: skip
+    study = SimpleNamespace(recordings=poor, sensors=("deck",), notes=[], tables=SimpleNamespace(notes=[]),
+                            failures=[], to_dict=lambda: {"settings": {}})  # fmt: skip
+    followed = follow(study, TrackSettings())
+    assert followed.table.empty and len(followed.events) == 2
+    assert [note.split(":")[0] for note in followed.notes] == ["e0.csv", "e1.csv"]
+    assert {p.name for p in write_track(followed, tmp_path)} >= {"track.csv", "track.png", "track.html"}
