@@ -913,7 +913,7 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "                if column is None and search.p >= agreement.unsettled_alpha:  # see _without_unfounded",
+        "                if column is None and search.p >= settings.decisive_alpha:  # see _without_unfounded",
         "                if False:",
         "an addition the halves nearly confirm refused as a change in time (count)",
     ),
@@ -925,20 +925,20 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "        if agree is False and supported is None and search.p >= search.agreement.unsettled_alpha:",
+        "        if agree is False and supported is None and search.p >= search.cfg.decisive_alpha:",
         "        if agree is False and supported is None and search.p >= search.agreement.alpha:",
         "a moved pole the halves nearly confirm left out (count)",
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "        if agree is False and supported is None and search.p >= search.agreement.unsettled_alpha:",
-        "        if agree is False and search.p >= search.agreement.unsettled_alpha:",
+        "        if agree is False and supported is None and search.p >= search.cfg.decisive_alpha:",
+        "        if agree is False and search.p >= search.cfg.decisive_alpha:",
         "a moved pole the halves nearly confirm taken under the rule (count)",
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "                if column is None and search.p >= agreement.unsettled_alpha:  # see _without_unfounded",
-        "                if search.p >= agreement.unsettled_alpha:",
+        "                if column is None and search.p >= settings.decisive_alpha:  # see _without_unfounded",
+        "                if search.p >= settings.decisive_alpha:",
         "an addition the halves nearly confirm taken under the rule (count)",
     ),
     (
@@ -1039,8 +1039,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        'if dof <= 0 or not chdtrc(dof, ratio) < search.cfg.likelihood_alpha:',
-        'if dof <= 0 or not chdtrc(2 * dof, ratio) < search.cfg.likelihood_alpha:',
+        'if dof <= 0 or not chdtrc(dof, ratio) < search.cfg.decisive_alpha:',
+        'if dof <= 0 or not chdtrc(2 * dof, ratio) < search.cfg.decisive_alpha:',
         "the likelihood ratio's degrees of freedom doubled (count)",
     ),
     (
@@ -1252,8 +1252,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "if dof <= 0 or not chdtrc(dof, ratio) < search.cfg.likelihood_alpha:",
-        "if dof <= 0 or chdtrc(dof, ratio) >= search.cfg.likelihood_alpha:",
+        "if dof <= 0 or not chdtrc(dof, ratio) < search.cfg.decisive_alpha:",
+        "if dof <= 0 or chdtrc(dof, ratio) >= search.cfg.decisive_alpha:",
         "a likelihood ratio below zero (chdtrc's NaN) taken as beyond chance (split-wanted)",
     ),
     (

@@ -45,7 +45,7 @@ def clustered_modes(diagram, band, nas, cluster: ClusterSettings, n_jobs, bar=No
     rows, vectors = [], []
     for members in clusters:
         sub = cand.loc[members]
-        rep = representative_pole(diagram, sub[sub.damping > 0], bic, finished, cluster.finished_max_shift)
+        rep = representative_pole(diagram, sub[sub.damping > 0], bic, finished, cluster.freq)
         if rep is None:
             continue
         rows.append({**mode_row(rep, sub, len(nas)), "orders_damping_unresolved": int((sub.damping <= 0).sum())})
@@ -54,7 +54,7 @@ def clustered_modes(diagram, band, nas, cluster: ClusterSettings, n_jobs, bar=No
 
 
 def representative_pole(
-    diagram, resolved: pd.DataFrame, bic: dict, finished: dict, max_shift: float = DEFAULTS.cluster.finished_max_shift
+    diagram, resolved: pd.DataFrame, bic: dict, finished: dict, max_shift: float = DEFAULTS.cluster.freq
 ) -> pd.Series | None:
     """The cluster's pole from the fit of lowest BIC, finished to full convergence; the next
     order's when finishing takes a lightly damped pole's damping to zero or below (None when
@@ -343,7 +343,7 @@ def picked_modes(
                 "--orders."
             )
         sub = kept.loc[clusters[k]]
-        rep = representative_pole(diagram, sub, bic, {}, cluster.finished_max_shift)
+        rep = representative_pole(diagram, sub, bic, {}, cluster.freq)
         if rep is None:
             raise PickError(
                 f"pick {f:g} Hz: the cluster at {centres[k]:.3f} Hz has no order whose fit keeps a positive damping "

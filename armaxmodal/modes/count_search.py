@@ -177,7 +177,7 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     the converged model only (on the way a moved pole may stand in for a mode not yet added). Poles
     the model needs (the criterion rises by ``settings.decisive_bic`` or more without them) stay in
     it, unreported. The halves judge as they judge an addition: where no column is asked (the model
-    is adequate), a pole they refuse at ``agreement.alpha`` but not at ``agreement.unsettled_alpha`` is
+    is adequate), a pole they refuse at ``agreement.alpha`` but not at ``settings.decisive_alpha`` is
     founded, tentative; under the rule its standard deviations, from a model that misfits, are no
     judge of a near agreement, and the halves refuse at ``alpha``. The method page gives the cases
     behind these rules (a pelvis stuck for 53 samples, a bridge's start carried to 4.40 Hz, a body's
@@ -195,7 +195,7 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
         f, x = model.freq_hz[i], model.damping[i]
         founded = x - Z95 * model.damping_sd[i] > 0
         agree = search.in_both_halves(model, [i], halves) if founded and len(halves) == 2 else None
-        if agree is False and supported is None and search.p >= search.agreement.unsettled_alpha:
+        if agree is False and supported is None and search.p >= search.cfg.decisive_alpha:
             tentative.append(float(f))
             agree = True
         founded = founded and (agree if agree is not None else supported is None or supported(f, x))
@@ -242,11 +242,11 @@ def _likelihood_wants(
     search: _Search, current: ModalModel, model: ModalModel, new_hz: float, gain: float, halves, supported
 ) -> tuple:
     """A :class:`Wanted` when ``model``'s likelihood ratio over ``current`` is beyond
-    ``settings.likelihood_alpha`` and its new poles are the same in both halves, else ``()``;
+    ``settings.decisive_alpha`` and its new poles are the same in both halves, else ``()``;
     ``supported(Hz, ratio)``: does the diagram hold a column at its new pole (``new_hz``) to pick?"""
     dof = model.n_params - current.n_params
     ratio = current.neg2_loglik_on(search.n_eff) - model.neg2_loglik_on(search.n_eff)
-    if dof <= 0 or not chdtrc(dof, ratio) < search.cfg.likelihood_alpha:  # NaN below 0
+    if dof <= 0 or not chdtrc(dof, ratio) < search.cfg.decisive_alpha:  # NaN below 0
         return ()
     if not search.in_both_halves(model, new_poles(current.freq_hz, model.freq_hz), halves):
         return ()
@@ -481,7 +481,7 @@ def _searched(
         if best_addition is not None and search.bic(best_addition[2]) < here and len(halves) == 2:
             new = new_poles(current.freq_hz, best_addition[2].freq_hz)
             if search.in_both_halves(best_addition[2], new, halves) is False:  # refused, or taken undecided if near
-                if column is None and search.p >= agreement.unsettled_alpha:  # see _without_unfounded
+                if column is None and search.p >= settings.decisive_alpha:  # see _without_unfounded
                     unsettled.append(float(best_addition[2].freq_hz[new[0]]))
                 else:
                     unconfirmed.append(best_addition[1])

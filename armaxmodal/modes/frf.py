@@ -235,7 +235,7 @@ def modes_the_check_adds(
         ).needed:
             continue
         core = sub[np.abs(sub.freq_hz / centre[0] - 1) <= frf.peak_cluster_freq]  # reported from near the centre
-        rep = representative_pole(diagram, core if len(core) else sub, bic, {}, settings.cluster.finished_max_shift)
+        rep = representative_pole(diagram, core if len(core) else sub, bic, {}, settings.cluster.freq)
         if rep is None or (not at_peak and not rep.damping_ci95_lo > 0):
             continue  # without a peak, a pole whose damping the record does not resolve is no evidence
         row = {**mode_row(rep, sub, len(nas)), "orders_damping_unresolved": 0, "estimator": "armax"}

@@ -284,7 +284,7 @@ class ModeCount:
         of the chosen model. See ``_without_unfounded``.
     wanted : Wanted or ()
         The best addition BIC refuses decisively while its likelihood ratio is significant
-        (beyond ``settings.likelihood_alpha``) and its mode is the same in both halves, or else the best
+        (beyond ``settings.decisive_alpha``) and its mode is the same in both halves, or else the best
         split of a reported mode that passes the same test (its criterion's change either way:
         the search splits only one mode). Empty: none.
     stand_ins : tuple of StandIn
@@ -297,7 +297,7 @@ class ModeCount:
         The band of the lines the count decided on (Hz): which poles are modes of it.
     unsettled_hz : tuple of float
         Additions the criterion takes whose halves differ beyond the halves test's level
-        ``agreement.alpha`` but not beyond ``agreement.unsettled_alpha``: taken, undecided (Hz, where
+        ``agreement.alpha`` but not beyond ``settings.decisive_alpha``: taken, undecided (Hz, where
         the new pole settled).
     agreement : AgreementSettings
         The level of the halves' test.
@@ -423,7 +423,7 @@ class ModeCount:
         * ``"needed"``: a mode of the band whose removal (the rest refitted free) raises the
           criterion decisively (``settings.decisive_bic``);
         * ``"undecided"``: a mode of the band the record holds less firmly (the rise is smaller, or
-          its halves differ beyond chance but not beyond ``agreement.unsettled_alpha``: ``unsettled_hz``):
+          its halves differ beyond chance but not beyond ``settings.decisive_alpha``: ``unsettled_hz``):
           reported, and said tentative;
         * ``"stand_in"``: a start the search carried where no mode is founded but which the
           model needs (``stand_ins``, matched within ``settings.same_mode_freq``): kept in the

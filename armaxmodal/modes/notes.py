@@ -185,7 +185,7 @@ def _undecided_notes(count: ModeCount, keep: np.ndarray, verdicts: np.ndarray) -
                 (),
                 f"the record may hold one mode more near {f:.3f} Hz: adding it raises the likelihood far beyond chance "
                 f"(likelihood ratio {ratio:.1f} for its {dof} parameters, p < "
-                f"{count.settings.likelihood_alpha:g}) and the "
+                f"{count.settings.decisive_alpha:g}) and the "
                 f"mode is the same in both halves of the record, but {_why_not_reported(rise_bic)}; "
                 f"{_what_to_do(in_diagram)}",
                 f,
@@ -218,7 +218,7 @@ def _left_out_notes(count: ModeCount) -> list[QualityWarning]:
                 "record's "
                 f"two halves differ by more than chance allows at the {100 * count.agreement.alpha:g} % level, "
                 "though not "
-                f"by enough ({count.agreement.unsettled_alpha:g}) to call it a change during the record: it is "
+                f"by enough ({count.settings.decisive_alpha:g}) to call it a change during the record: it is "
                 "reported, "
                 "tentative; compare another record of the structure",
                 f,

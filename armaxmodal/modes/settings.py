@@ -68,9 +68,8 @@ _AT_MOST_ONE = frozenset(
         "min_support",
         "merge_mac",
         "support_alpha",
-        "likelihood_alpha",
+        "decisive_alpha",
         "alpha",
-        "unsettled_alpha",
         "edge_fraction",
         "oversampled_fraction",
         "min_damping",
@@ -106,7 +105,8 @@ class ClusterSettings(_Settings):
     """Which poles of the diagram are one mode (stages ``candidates`` and ``merge``)."""
 
     #: relative frequency distance within which a pole joins a cluster (its median); also a pick's
-    #: reach and a counted mode's row reach (:attr:`pick_reach`, :attr:`same_row_freq`)
+    #: reach, a counted mode's row reach (:attr:`pick_reach`, :attr:`same_row_freq`), and how far a
+    #: finished fit's pole may lie from the pole it finishes (farther, it is another pole)
     freq: float = 0.05
     #: relative damping distance within which a pole joins a cluster
     damping: float = 0.5
@@ -118,8 +118,6 @@ class ClusterSettings(_Settings):
     #: a pole is stable across the diagram when poles of at least this many orders lie near it:
     #: a left-out cluster is a candidate for the count, and a pick takes a cluster, only then
     min_orders: int = 3
-    #: a finished fit's pole farther than this (relative frequency) is another pole, not this one finished
-    finished_max_shift: float = 0.05
 
     @property
     def pick_reach(self) -> float:
@@ -263,12 +261,17 @@ class CountSettings(_Settings):
     #: ... and one below this is "not worth more than a bare mention": the refit's two inter-sample
     #: forms, both converged, that close leave the form of the first steps (a held ride 0.5 apart)
     negligible_bic: float = 2.0
-    #: a refused addition whose likelihood ratio a chi-square of its parameters puts beyond this
-    #: probability leaves the count undecided (when its mode is the same in both halves). BIC's
-    #: penalty grows with the data, so a weakly seen mode can raise the likelihood far beyond chance
-    #: and still lose on BIC; 1e-6 keeps the largest of a handful of candidates at chance (the
-    #: battery's 46 bodies: at most the 1e-3 quantile) far below it
-    likelihood_alpha: float = 1e-6
+    #: a probability this small is beyond chance among the handful of trials a count makes (the
+    #: probability-scale twin of :attr:`decisive_bic`). A refused addition whose likelihood ratio a
+    #: chi-square of its parameters puts beyond it leaves the count undecided (when its mode is the
+    #: same in both halves): BIC's penalty grows with the data, so a weakly seen mode can raise the
+    #: likelihood far beyond chance and still lose on BIC; 1e-6 keeps the largest of a handful of
+    #: candidates at chance (the battery's 46 bodies: at most the 1e-3 quantile) far below it.
+    #: Where the model is adequate, a new pole the halves refuse at ``agreement.alpha`` but not at
+    #: this level is taken, tentative (a weak mode's damping 3.6 standard deviations apart in its
+    #: halves; 1e-6: one value 5.3 apart); where it misfits, its standard deviations are no judge
+    #: and ``agreement.alpha`` refuses
+    decisive_alpha: float = 1e-6
     #: the residual's correlation across lines is summed up to this many lines (Bartlett's window):
     #: the widest structure of model error is a resonance's half-power band, 2 xi f = 3-10 Hz
     #: for the bodies, i.e. hundreds of lines; the sum stops earlier at the first negative value
@@ -316,10 +319,6 @@ class AgreementSettings(_Settings):
     #: each test's false-alarm rate (the estimators' test: 30-59 on the F-16's levels for 12 values, 77
     #: for 6 on a ride with a cubic spring, none on its linear twin; the 1 % points are 26.2 and 16.8)
     alpha: float = 0.01
-    #: where the count's model is adequate, a new pole the halves refuse at ``alpha`` but not at this rate
-    #: is taken, tentative (a weak mode's damping 3.6 standard deviations apart in its halves; 1e-6: one
-    #: value 5.3 apart); where it misfits, its standard deviations are no judge and ``alpha`` refuses
-    unsettled_alpha: float = 1e-6
     #: a segment's pole is the mode's when within this relative frequency of it
     match_freq: float = 0.05
     #: the halves test a pole where the poorer holds this share of the other's response power within match_freq
@@ -328,10 +327,6 @@ class AgreementSettings(_Settings):
 
     def __post_init__(self):
         _checked(self)
-        if self.unsettled_alpha >= self.alpha:
-            raise SettingsError(
-                f"AgreementSettings: unsettled_alpha ({self.unsettled_alpha!r}) must lie below alpha ({self.alpha!r})."
-            )
 
 
 @dataclass(frozen=True, repr=False)

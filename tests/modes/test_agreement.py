@@ -127,7 +127,7 @@ def test_the_one_level_reaches_the_segments_test():
                                                                                            body.names)))]  # fmt: skip
     rec = am.Recording(fs, np.concatenate([p.base for p in parts]), np.vstack([p.response for p in parts]),
                        parts[0].sensors)  # fmt: skip
-    strict = SelectionSettings(agreement=AgreementSettings(alpha=1e-40, unsettled_alpha=1e-41))
+    strict = SelectionSettings(agreement=AgreementSettings(alpha=1e-40))
     modes = am.select_modes(am.stabilisation_diagram(rec, per_sensor=False), segments=3, settings=strict).modes
     statistic = 2 / 3 * (modes.freq_segment_sd / modes.freq_sd_armax) ** 2  # three segments
     assert statistic.max() > chdtri(2, 0.01 / (2 * len(modes)))

@@ -843,7 +843,7 @@ def test_a_split_of_a_mode_the_search_did_not_split_is_tried_for_the_likelihood(
     new_hz, ratio, dof, _, in_diagram = got
     assert in_diagram is False  # no column anywhere to pick from; a split needs none
     assert np.min(np.abs(truth.freq_hz[2:] / new_hz - 1)) < FREQ_TOL, got
-    assert dof == 2 + 4 * data.y.shape[1] and chdtrc(dof, ratio) < CountSettings().likelihood_alpha
+    assert dof == 2 + 4 * data.y.shape[1] and chdtrc(dof, ratio) < CountSettings().decisive_alpha
 
 
 @pytest.mark.parametrize(

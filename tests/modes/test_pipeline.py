@@ -248,7 +248,6 @@ def test_a_wrong_settings_part_is_refused():
          "FrfSettings.model_error_limit: expected a positive number"),
         (lambda: ClusterSettings(freq=True), "ClusterSettings.freq: expected a number, got True"),
         (lambda: DftSettings(min_damping=0.5, max_damping=0.4), "min_damping .0.5. must lie below max_damping"),
-        (lambda: AgreementSettings(alpha=1e-3, unsettled_alpha=1e-2), "unsettled_alpha .0.01. must lie below alpha"),
         (lambda: AgreementSettings(alpha=1.5), "AgreementSettings.alpha: a probability, share or MAC is at most 1"),
     ],
 )

@@ -417,7 +417,7 @@ def test_finished_pole_takes_the_nearest_finished_estimate_within_five_percent()
     finished = pd.DataFrame([pole(5.1, 0.05), pole(9.0, 0.02), pole(20.0, 0.1)])
     diagram = SimpleNamespace()  # the cache holds order 8: nothing is fitted
     sweep = pole(5.0, 0.06, cls="f+d", rejected="")
-    reach = ClusterSettings().finished_max_shift  # 5 %
+    reach = ClusterSettings().freq  # 5 %
     out = _finished_pole(diagram, sweep, {8: finished}, reach)
     assert (out.freq_hz, out.damping, out.cls, out.rejected) == (5.1, 0.05, "f+d", "")
     assert _finished_pole(diagram, pole(9.4, 0.02), {8: finished}, reach).freq_hz == 9.0  # 4.3 % away: taken
