@@ -239,8 +239,7 @@ MUTANTS = [
     ),
     (
         'armaxmodal/modes/frf.py',
-        '    if reach == "nearest":\n        j = nearest_neighbour(f, x, m, settings.neighbour_bandwidths)\n'
-        '    else:\n        j = overlapping_neighbour(f, x, m)\n',
+        '    j = overlapping_neighbour(f, x, m)\n',
         '    j = None\n',
         'no neighbour refitted when a mode is left out (check)',
     ),
@@ -263,16 +262,16 @@ MUTANTS = [
         "the better-supported half of a split dropped (check)",
     ),
     (
-        'armaxmodal/modes/frf.py',
-        'reach="nearest", settings=frf',
-        'reach="overlapping", settings=frf',
-        'a candidate judged without its nearest neighbour refitted (check)',
+        "armaxmodal/modes/frf.py",
+        "if len(c) >= frf.peak_cluster_min_orders",
+        "if len(c) >= 99",
+        "no cluster at an unexplained peak proposed (check)",
     ),
     (
-        'armaxmodal/modes/frf.py',
-        'if len(members) >= cluster.min_orders and np.min(np.abs(selected',
-        'if len(members) >= 99 and np.min(np.abs(selected',
-        'no left-out cluster is a candidate (check)',
+        "armaxmodal/modes/frf.py",
+        "near = cand[np.abs(cand.freq_hz / peak.value - 1) <= frf.peak_cluster_freq]",
+        "near = cand",
+        "every pole proposed at every peak (check)",
     ),
     ("armaxmodal/modal.py", "dxi = (-(li**2)[:, None]", "dxi = ((li**2)[:, None]", "sign error in the damping SD"),
     (

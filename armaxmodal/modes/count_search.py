@@ -519,6 +519,8 @@ def _searched(
     close = best_addition[2] if best_addition is not None and gain > -settings.decisive_bic else None
     alternatives = _equally_good(search, current, rise, close)
     wanted = _wanted(search, current, best_addition, gain, new_hz, halves, supported) if searching else ()
+    if rule and wanted and not wanted.in_diagram:  # the misfit's likelihood is no judge: the rule refuses it
+        wanted = ()
     if searching and not wanted and close is None:  # one mode more is already undecided: said once
         wanted, split = _split_wanted(search, current, halves, supported)
         # as good as the chosen model: its modes are the record's too

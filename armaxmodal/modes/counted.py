@@ -135,9 +135,10 @@ def counted_modes(
     # fitted to the whole record, so a long ride costs one fit more, not a search more
     part = _counted_part(rec, settings.count.max_samples)
     data = DftLines.from_recording(part, band_hz)
-    # the modes the FRF's check doubts are tried first, as additions the likelihood, the halves and
-    # the diagram must all accept; then the diagram's other left-out clusters
-    offered = [(f, x) for f, x, _ in work.doubts]
+    # the modes the FRF's check doubts and the clusters at its unexplained peaks are tried first, as
+    # additions the likelihood and the halves (and, where the model misfits, the diagram) must accept;
+    # then the diagram's other left-out clusters
+    offered = [(f, x) for f, x, _ in work.doubts] + list(work.proposals)
     candidates = offered + [
         c
         for c in _candidates(diagram, modes, band, nas, settings)

@@ -1,26 +1,26 @@
 """What the measured FRF says of the selection (thesis Section 3.3.3's check, made quantitative):
-its clear, coherent peaks no selected mode explains (``unexplained_peaks``, at ``PEAK_RESOLUTION``),
-and which candidates the record needs -- the modal-model check (:mod:`armaxmodal.modes.modal_check`,
-at ``CHECK_RESOLUTION``) drops a mode the measured FRF does not need and adds a left-out cluster
-that explains a clear peak no selected mode explains.
+its clear, coherent peaks no selected mode explains (``unexplained_peaks``, at ``PEAK_RESOLUTION``);
+the diagram's clusters at those peaks, which it proposes to the count
+(``modes_at_unexplained_peaks``); and the candidates the modal-model check
+(:mod:`armaxmodal.modes.modal_check`, at ``CHECK_RESOLUTION``) does not need, which leave the
+count's start and are offered to it as additions (``modes_the_record_needs``). The count decides.
 
-``mode_support`` is the test both use: the check's misfit with and without a mode, a neighbour
-refitted in its place (``ModeSupport``: needed when the rise is large and significant).
+``mode_support`` is the check's test: its misfit with and without a mode, an overlapping
+neighbour refitted in its place (``ModeSupport``: needed when the rise is large and significant).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
 
-from armaxmodal.modes.clusters import candidate_poles, cluster_poles, mode_row, representative_pole
+from armaxmodal.modes.clusters import candidate_poles, cluster_poles
 from armaxmodal.modes.modal_check import ModalCheck, check_modes, poles_of, rss_at
 from armaxmodal.modes.notes import not_needed_note
 from armaxmodal.modes.settings import DEFAULTS, PEAK_RESOLUTION, FrfSettings, SelectionSettings
-from armaxmodal.modes.state import RefitFailure, SelectionState, refine_modes, refined_modes, refit_band, selection_job
+from armaxmodal.modes.state import SelectionState
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
 from armaxmodal.spectra import coherent_lines, coherent_peaks, explains, resolving_nperseg
@@ -59,18 +59,6 @@ def overlapping_neighbour(freq_hz, damping, m: int) -> int | None:
     return min(close, key=lambda i: gap[i]) if close else None
 
 
-def nearest_neighbour(freq_hz, damping, m: int, bandwidths: float = DEFAULTS.frf.neighbour_bandwidths) -> int | None:
-    """The mode nearest mode ``m`` within ``bandwidths`` half-power bandwidths
-    (``2 xi f``, the wider of the two), or None: the mode whose pole may take over what
-    ``m`` fits. A spurious pole beside a lightly damped mode corrects that mode's slightly
-    biased pole at the peak; with the neighbour's pole refitted it is not needed."""
-    f, x = np.asarray(freq_hz, dtype=float), np.asarray(damping, dtype=float)
-    gap = np.abs(f - f[m])
-    reach = bandwidths * np.maximum(2 * x * f, 2 * x[m] * f[m])
-    close = [i for i in range(f.size) if i != m and gap[i] <= reach[i]]
-    return min(close, key=lambda i: gap[i]) if close else None
-
-
 def mode_support(
     recording: Recording,
     freq_hz,
@@ -79,18 +67,15 @@ def mode_support(
     check: ModalCheck,
     band=None,
     *,
-    reach: str = "overlapping",
     settings: FrfSettings = DEFAULTS.frf,
 ) -> ModeSupport:
     """How much the check of ``check`` needs mode ``m`` (see ``ModeSupport``).
 
-    The fit without the mode keeps each output's delay. A neighbour -- ``reach="overlapping"``:
-    a mode whose half-power band overlaps this one's (:func:`overlapping_neighbour`);
-    ``"nearest"``: the nearest within ``settings.neighbour_bandwidths`` (:func:`nearest_neighbour`),
-    the stricter test a mode the diagram supports weakly must pass to enter -- has its
-    frequency and damping refitted (Nelder-Mead on the summed relative residual, residues
-    projected out) so it may take over: two poles always fit one peak at least as well as
-    one, so only a refitted single pole shows whether the record needs both. A neighbour
+    The fit without the mode keeps each output's delay. A neighbour, a mode whose half-power band
+    overlaps this one's (:func:`overlapping_neighbour`), has its frequency and damping refitted
+    (Nelder-Mead on the summed relative residual, residues projected out) so it may take over: two
+    poles always fit one peak at least as well as one, so only a refitted single pole shows whether
+    the record needs both. A neighbour
     that moves more than ``settings.neighbour_max_shift`` to take over is not refitted. The F-test
     compares the summed relative residual sums with ``q = 2 n_outputs`` (the residues)
     ``+ 2`` (the pole, unless the neighbour's refit spends them) over ``sum(lines) -
@@ -110,10 +95,7 @@ def mode_support(
 
     keep = [i for i in range(f.size) if i != m]
     with_m = relative_rss(poles_of(f, x))
-    if reach == "nearest":
-        j = nearest_neighbour(f, x, m, settings.neighbour_bandwidths)
-    else:
-        j = overlapping_neighbour(f, x, m)
+    j = overlapping_neighbour(f, x, m)
     fk, xk = f[keep], x[keep]
     if j is not None:
         at = keep.index(j)
@@ -178,80 +160,13 @@ def modes_the_record_needs(
             doubts.append((float(f_m), float(x_m), note))
 
 
-def each_once(doubts) -> tuple:
-    """The doubts by frequency, a mode the check dropped in both of its passes once (its first note)."""
-    once = {f: (f, x, note) for f, x, note in reversed(doubts)}
-    return tuple(sorted(once.values(), key=lambda d: d[0]))
-
-
-def refit_with_added(
-    diagram, work: SelectionState, band, settings: SelectionSettings = DEFAULTS, refine: Callable = refine_modes
-) -> SelectionState:
-    """The frequency-domain refit again, of every mode once the check has added some: a mode
-    missing from a refit biases its neighbours (a five-segment chain's 13.5 Hz mode came out
-    at 12.5 Hz while the 24.8 Hz one was missing, and its refit was refused as too far; now
-    13.3 Hz for the exact 13.54). The inter-sample form is the record's, chosen once by the first
-    refit: re-chosen here, a held ride whose first refit was held by 258 went band-limited by 8
-    (both converged) and lost its top mode. A refit that cannot be made (by ``refine``) leaves the modes, said."""
-    hold = work.refinement.hold if work.refinement is not None else "auto"
-    refit = selection_job(
-        diagram.recording, [], work.modes, ("refit", refit_band(diagram.recording, band)), settings, refine, hold
-    )
-    if isinstance(refit, RefitFailure):
-        work = work.warned(*refit.notes("the modes with those the check added", uncounted=False))
-    else:  # the first refit's start lacked these modes: its refusals may not stand
-        c = settings.cluster
-        work = refined_modes(diagram, work, refit, c.freq, c.damping, c.merge_mac, relaxed=True)
-    check = check_modes(diagram.recording, work.modes.freq_hz, work.modes.damping, band, settings=settings.frf)
-    return replace(work, check=check)
-
-
-def modes_the_check_adds(
-    diagram, work: SelectionState, band, nas, settings: SelectionSettings = DEFAULTS
-) -> SelectionState:
-    """Stable clusters the support rule left out enter when the modal-model check needs them
-    (as :func:`modes_the_record_needs` judges, but with the nearest mode refitted in its place,
-    not only an overlapping one: one at a time, the largest first): the
-    candidates are the cluster of poles of at least ``frf.peak_cluster_min_orders`` orders
-    within ``frf.peak_cluster_freq`` of each clear, coherent H1 peak no selected mode
-    explains (:func:`unexplained_peaks`), and every cluster of kept
-    poles of at least three orders away from the selected modes (heavily damped modes make
-    no clear peak, and their poles scatter over the orders; these need a damping the record
-    resolves, as a peak's cluster does not). A peak left unexplained is listed at the end as
-    before. Returns the selection with those added, by frequency, and its check."""
-    bic, frf = diagram.order_bic, settings.frf
-    modes, shapes, check = work.modes, work.shapes, work.check
-    for sub, at_peak in _left_out_clusters(diagram, modes, band, nas, settings):
-        # the cluster's centre is tried: its lowest-BIC pole may sit at its edge
-        centre = float(sub.freq_hz.median()), float(sub.damping.median())
-        if np.any(np.abs(modes.freq_hz.to_numpy() / centre[0] - 1) <= frf.duplicate_freq):
-            continue  # a selected mode's own pole
-        trial = np.r_[modes.freq_hz, centre[0]], np.r_[modes.damping, centre[1]]
-        trial_check = check_modes(diagram.recording, *trial, band, settings=frf)
-        if centre[0] in trial_check.unconfirmed_hz:
-            continue  # no coherent line there: the check cannot judge it, so it cannot enter
-        if not mode_support(
-            diagram.recording, *trial, len(modes), trial_check, band, reach="nearest", settings=frf
-        ).needed:
-            continue
-        core = sub[np.abs(sub.freq_hz / centre[0] - 1) <= frf.peak_cluster_freq]  # reported from near the centre
-        rep = representative_pole(diagram, core if len(core) else sub, bic, {}, settings.cluster.freq)
-        if rep is None or (not at_peak and not rep.damping_ci95_lo > 0):
-            continue  # without a peak, a pole whose damping the record does not resolve is no evidence
-        row = {**mode_row(rep, sub, len(nas)), "orders_damping_unresolved": 0, "estimator": "armax"}
-        row["freq_sd_armax"], row["damping_sd_armax"] = row["freq_sd"], row["damping_sd"]
-        modes = pd.concat([modes, pd.DataFrame([row])], ignore_index=True)
-        shapes = np.column_stack([shapes, rep.vector])
-        check = check_modes(diagram.recording, modes.freq_hz, modes.damping, band, settings=frf)
-    return work.with_modes(modes, shapes, check=check).kept(modes.sort_values("freq_hz").index)
-
-
-def _left_out_clusters(
-    diagram, modes: pd.DataFrame, band, nas, settings: SelectionSettings
-) -> list[tuple[pd.DataFrame, bool]]:
-    """The candidate clusters of :func:`modes_the_check_adds`, the largest first, each with
-    whether it stands at an unexplained peak."""
-    cluster, frf = settings.cluster, settings.frf
+def modes_at_unexplained_peaks(diagram, modes: pd.DataFrame, band, nas, frf: FrfSettings = DEFAULTS.frf) -> list:
+    """What the measured H1 proposes to the count: at each clear, coherent H1 peak no mode of
+    ``modes`` explains (:func:`unexplained_peaks`), the largest cluster of the diagram's poles of at
+    least ``frf.peak_cluster_min_orders`` orders within ``frf.peak_cluster_freq`` of it, as its
+    median ``(Hz, ratio)``. A proposal only: the count adds it where the likelihood, the record's
+    halves and (where the model misfits) the diagram's columns take it, and leaves it out otherwise.
+    Returns ``[(freq_hz, damping), ...]``, the largest cluster first."""
     cand = candidate_poles(diagram.poles, band)
     cand = cand[cand.damping > 0]
     found = []
@@ -261,16 +176,9 @@ def _left_out_clusters(
             c for c in cluster_poles(near, nas, frf.peak_cluster_freq, None) if len(c) >= frf.peak_cluster_min_orders
         ]
         if clusters:
-            found.append((near.loc[max(clusters, key=len)], True))
-    # away from a peak, a cluster in the top of the input's band is its edge's, not a mode
-    top = frf.edge_fraction * refit_band(diagram.recording, band)[1]
-    kept = cand[(cand.rejected == "") & (cand.freq_hz <= top)]
-    selected = modes.freq_hz.to_numpy()
-    for members in cluster_poles(kept, nas, cluster.freq, cluster.damping):
-        sub = kept.loc[members]
-        if len(members) >= cluster.min_orders and np.min(np.abs(selected / sub.freq_hz.median() - 1)) > cluster.freq:
-            found.append((sub, False))
-    return sorted(found, key=lambda item: len(item[0]), reverse=True)
+            found.append(near.loc[max(clusters, key=len)])
+    found.sort(key=len, reverse=True)
+    return [(float(sub.freq_hz.median()), float(sub.damping.median())) for sub in found]
 
 
 def unexplained_peaks(recording: Recording, freq_hz, damping, band=None) -> list[QualityWarning]:

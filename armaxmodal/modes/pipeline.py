@@ -7,7 +7,7 @@ and reads what does not change (the diagram, the band, the orders, the settings)
 arguments make, and each is named:
 
 * ``AUTOMATIC`` -- the diagram's stable clusters are the candidates; the measured FRF
-  proposes and screens them; the maximum-likelihood modal model counts them;
+  screens them and proposes more; the maximum-likelihood modal model counts them;
 * ``FIXED_COUNT`` -- ``n_modes`` given: the best-supported clusters, checked, not counted;
 * ``PICKED`` -- ``picks`` given: the picked clusters, reported from the counted model;
 * the same three without the frequency-domain refit (``refine=False``), which also leaves the
@@ -29,7 +29,7 @@ from armaxmodal.exceptions import PickError
 from armaxmodal.modes.clusters import check_picks, clustered_modes, merge_duplicates, picked_modes, why_no_mode
 from armaxmodal.modes.counted import confirmed_where_incoherent, counted_modes
 from armaxmodal.modes.diagram import StabilisationDiagram
-from armaxmodal.modes.frf import each_once, modes_the_check_adds, modes_the_record_needs, refit_with_added
+from armaxmodal.modes.frf import modes_at_unexplained_peaks, modes_the_record_needs
 from armaxmodal.modes.intervals import N_SEGMENTS, apply_segment_spread, segment_spread, with_intervals
 from armaxmodal.modes.modal_check import check_modes
 from armaxmodal.modes.notes import dropped_where_peaks_remain, not_separated_notes, unresolved_damping_notes
@@ -119,31 +119,20 @@ def segment_fits(state: SelectionState, ctx: SelectionContext) -> SelectionState
 
 
 def screen_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionState:
-    """Without a count: a mode the H1's LSFD check does not need goes, with its note; a left-out
-    cluster it needs comes in (:mod:`armaxmodal.modes.frf`)."""
-    return _screened(state, ctx, None)
+    """Without a count: a mode the H1's LSFD check does not need goes, with its note
+    (:func:`~armaxmodal.modes.frf.modes_the_record_needs`)."""
+    return modes_the_record_needs(ctx.diagram.recording, state, ctx.band, ctx.settings)
 
 
 def propose_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionState:
-    """The measured H1 proposes, the count decides: a left-out cluster the LSFD check needs comes in
-    (after an addition the refit is made again of all of them), and a mode it does not need leaves
-    the count's start but is offered to the count as a candidate (``doubts``): its
-    ``mode_not_needed`` note stands only where the count does not take it back."""
+    """The measured H1 proposes, the count decides. A candidate its LSFD check does not need leaves
+    the count's start and is offered to it as an addition (``doubts``; its ``mode_not_needed`` note
+    stands only where the count does not take it back), and so is the diagram's cluster at each
+    clear, coherent H1 peak no candidate explains (``proposals``)."""
     doubts: list = []
-    state = _screened(state, ctx, doubts)
-    return replace(state, doubts=each_once(doubts))
-
-
-def _screened(state: SelectionState, ctx: SelectionContext, doubts: list | None) -> SelectionState:
-    """The check's drops (into ``doubts`` when given) and additions (:mod:`armaxmodal.modes.frf`)."""
-    rec, n_before, settings = ctx.diagram.recording, len(state.modes), ctx.settings
-    state = modes_the_record_needs(rec, state, ctx.band, settings, doubts)
-    state = modes_the_check_adds(ctx.diagram, state, ctx.band, ctx.nas, settings)
-    if len(state.modes) > n_before:
-        state = modes_the_record_needs(rec, state, ctx.band, settings, doubts)
-    if ctx.refine and len(state.modes) > n_before:  # the refit saw fewer modes than are reported
-        state = refit_with_added(ctx.diagram, state, ctx.band, settings, ctx.fitters.refine)
-    return state
+    state = modes_the_record_needs(ctx.diagram.recording, state, ctx.band, ctx.settings, doubts)
+    proposals = modes_at_unexplained_peaks(ctx.diagram, state.modes, ctx.band, ctx.nas, ctx.settings.frf)
+    return replace(state, doubts=tuple(doubts), proposals=tuple(proposals))
 
 
 def count(state: SelectionState, ctx: SelectionContext) -> SelectionState:
@@ -296,9 +285,9 @@ PICKED: tuple[Stage, ...] = (
 
 def stages_for(n_modes: int | None, picks, refine: bool) -> tuple[Stage, ...]:
     """The stage list of a call: :data:`AUTOMATIC`, :data:`FIXED_COUNT` or :data:`PICKED`; without
-    the refit (``refine=False``) the same with ``segment_fits`` for ``refit`` and no ``count``
-    (the modal model is fitted under the hold the refit chooses), and so ``screen_by_frf``, whose
-    drops stand, for ``propose_by_frf``, whose drops the count judges."""
+    the refit (``refine=False``) the same with ``segment_fits`` for ``refit`` and no ``count`` (the
+    modal model is fitted under the hold the refit chooses), and so ``screen_by_frf``, whose drops
+    stand, for ``propose_by_frf``, whose drops and proposals the count judges."""
     if picks is not None and n_modes is not None:
         raise PickError("picks and n_modes do not mix: pick the modes, or give their number, not both.")
     stages = PICKED if picks is not None else FIXED_COUNT if n_modes is not None else AUTOMATIC
@@ -335,9 +324,9 @@ def select_modes(
        shapes agree (MAC at least ``settings.cluster.merge_mac``) are one mode split (**merge**).
     2. **refit** -- the candidates are refitted to the recording's DFT under the inter-sample
        behaviour the data choose (band-limited or held).
-    3. **propose_by_frf** -- the measured H1 proposes: a left-out stable cluster that explains a
-       peak comes in, and a candidate its LSFD check does not need leaves the start to be offered
-       to the count as an addition.
+    3. **propose_by_frf** -- the measured H1 proposes: a candidate its LSFD check does not need
+       leaves the count's start, and the diagram's cluster at a clear, coherent H1 peak no
+       candidate explains comes in, both offered to the count as additions.
     4. **count** -- the one keep-or-drop: the maximum-likelihood modal model with every pole free
        decides the number of modes by nested tests (BIC on the effective lines; an addition's new
        poles the same in both halves and stable across orders): it removes, adds or splits modes,

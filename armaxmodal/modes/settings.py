@@ -70,7 +70,6 @@ _AT_MOST_ONE = frozenset(
         "support_alpha",
         "decisive_alpha",
         "alpha",
-        "edge_fraction",
         "oversampled_fraction",
         "min_damping",
         "max_damping",
@@ -163,8 +162,8 @@ class LineSettings(_Settings):
 
 @dataclass(frozen=True, repr=False)
 class FrfSettings(_Settings):
-    """What the measured H1 says (stages ``screen_by_frf`` and ``check``): the LSFD check, the
-    support F-test and the clusters it proposes."""
+    """What the measured H1 says (stages ``propose_by_frf``, ``screen_by_frf`` and ``check``): the
+    LSFD check, the support F-test and the clusters it proposes."""
 
     #: a mode is kept when leaving it out raises the misfit of some output by at least this
     #: fraction (the relative RMS; 10 % in the residual sum of squares) and the rise is
@@ -175,23 +174,14 @@ class FrfSettings(_Settings):
     #: by 6-7 %, and the others by 12 % to several times.
     model_error_rise: float = 0.05
     support_alpha: float = 0.01
-    #: the nearest mode within this many half-power bandwidths is refitted when a mode is left out
-    neighbour_bandwidths: float = 3.0
-    #: ... and may take over only from within this relative frequency of its own place: on the
-    #: supine ride, heavily damped modes overlap, and a neighbour free to move 30 % took over
-    #: 5.8 Hz, then 7.6 and 8.3 Hz in turn, leaving two of four modes
+    #: an overlapping neighbour refitted when a mode is left out may take over only from within this
+    #: relative frequency of its own place: on the supine ride, heavily damped modes overlap, and a
+    #: neighbour free to move 30 % took over 5.8 Hz, then 7.6 and 8.3 Hz in turn, leaving two of four
     neighbour_max_shift: float = 0.05
-    #: a clear, coherent FRF peak no selected mode explains takes a cluster of poles of at least
-    #: this many orders within :attr:`peak_cluster_freq` of it, when the modal-model check needs it
+    #: a clear, coherent FRF peak no selected mode explains proposes to the count the cluster of
+    #: poles of at least this many orders within :attr:`peak_cluster_freq` of it
     peak_cluster_min_orders: int = 2
     peak_cluster_freq: float = 0.03
-    #: a left-out cluster away from any peak must lie below this fraction of the input's band: at
-    #: its edge the input's power falls away and the H1's bias grows. The clusters the check
-    #: took there were at 0.97-0.98 of it (the F-16 level 5's 14.66 Hz, damping 0.19; a study
-    #: sweep's 19.36 Hz); a real heavily damped mode at 0.90 (the chain with feet's 24.8 Hz)
-    edge_fraction: float = 0.95
-    #: a candidate pole this close (relative frequency) to a selected mode is that mode
-    duplicate_freq: float = 0.01
     #: delays searched, samples either way, in steps of :attr:`delay_step_samples`: channels
     #: are aligned by whole samples before the fit, so what is left is a few samples at most
     max_delay_samples: float = 4.0

@@ -72,6 +72,9 @@ class SelectionState:
     doubts : tuple of (float, float, QualityWarning)
         The modes the measured FRF's check does not need, ``(Hz, ratio, note)``: out of the
         selection, offered to the count as candidates; a note stands where the count leaves it out.
+    proposals : tuple of (float, float)
+        The measured H1's proposals to the count, ``(Hz, ratio)``: the diagram's clusters at its
+        unexplained peaks, tried as additions after the doubts.
     counted : bool
         The modes are the count's rows (:attr:`armaxmodal.ModeSelection.counted`).
     count_lines : (DftLines, tuple of DftLines) or None
@@ -91,6 +94,7 @@ class SelectionState:
     picked: tuple[pd.DataFrame, list] | None = field(default=None, repr=False)
     segment_fits: dict = field(default_factory=dict, repr=False)
     doubts: tuple[tuple[float, float, QualityWarning], ...] = ()
+    proposals: tuple[tuple[float, float], ...] = ()
     counted: bool = False
     count_lines: tuple[DftLines, tuple[DftLines, ...]] | None = field(default=None, repr=False)
     result: ModeSelection | None = field(default=None, repr=False)
@@ -348,47 +352,32 @@ class RefitFailure:
 
 
 def refined_modes(
-    diagram, work: SelectionState, refinement, cluster_freq, cluster_damping, merge_mac, relaxed=False
+    diagram, work: SelectionState, refinement, cluster_freq, cluster_damping, merge_mac
 ) -> SelectionState:
     """The frequency-domain refit (:func:`refine_modes`, or a
     :class:`RefitFailure` when it could not be made, which leaves the selection without one)
     reported for a band-limited record, and kept as the selection's ``refinement``.
-    ``relaxed``: the refit may move a mode by :func:`_refit_reach`, not ``cluster_freq``.
     ``merge_mac`` None: two modes the refit brings together stay two (modes picked by hand)."""
     if refinement is None or isinstance(refinement, RefitFailure):
         return replace(work, refinement=None)
     work = replace(work, refinement=refinement)
     if refinement.hold == "bandlimited":
-        modes, shapes = _apply_refinement(work.modes, work.shapes, refinement, cluster_freq, cluster_damping, relaxed)
+        modes, shapes = _apply_refinement(work.modes, work.shapes, refinement, cluster_freq, cluster_damping)
         work = work.with_modes(modes, shapes)
         if merge_mac is not None:  # two modes the refit brought together are one peak
             work = work.kept(merge_duplicates(modes, list(shapes.T), merge_mac, diagram.recording.duration))
     return work
 
 
-def _refit_reach(freq_hz: np.ndarray, i: int, max_freq_change: float) -> float:
-    """How far (relative frequency) the refit after added modes may move mode ``i``:
-    ``max_freq_change``, or less than halfway to the nearest other mode if that is farther
-    (at most twice ``max_freq_change``) -- a refit that stays nearer its own start than any
-    other mode's has not jumped to another mode. (A heavily damped mode the ARMAX fits
-    scatter over 12.2-14.0 Hz was refitted from 12.49 to 13.31 Hz, the exact 13.54 Hz, and
-    refused by the 5 % rule alone. For every first refit the 5 % rule stays: relaxed there,
-    it moved a study subject's 17.2 Hz mode to 16.1 Hz.)"""
-    others = np.delete(freq_hz, i)
-    half_gap = 0.5 * np.min(np.abs(others - freq_hz[i])) / freq_hz[i] if others.size else np.inf
-    return max(max_freq_change, min(half_gap, 2 * max_freq_change))
-
-
-def _apply_refinement(modes, shapes, ref, max_freq_change, max_damping_change, relaxed=False):
+def _apply_refinement(modes, shapes, ref, max_freq_change, max_damping_change):
     """Report the band-limited refit of each mode unless it left the mode's neighbourhood
-    (``max_freq_change``, or :func:`_refit_reach` when ``relaxed``, in frequency;
-    ``max_damping_change`` in damping; then the ARMAX value stays and ``estimator`` says so)."""
+    (``max_freq_change`` in frequency, ``max_damping_change`` in damping; then the ARMAX value
+    stays and ``estimator`` says so)."""
     modes, shapes = modes.copy(), shapes.copy()
     for i in range(len(modes)):
         df = abs(ref.freq_hz[i] / modes.at[i, "freq_hz"] - 1)
         dx = abs(ref.damping[i] / modes.at[i, "damping"] - 1)
-        reach = _refit_reach(modes.freq_hz.to_numpy(), i, max_freq_change) if relaxed else max_freq_change
-        if df > reach or dx > max_damping_change:
+        if df > max_freq_change or dx > max_damping_change:
             modes.at[i, "estimator"] = "armax (refit moved too far)"
             continue
         f, x = ref.freq_hz[i], ref.damping[i]

@@ -13,7 +13,7 @@ from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.diagram import DEFAULT_ORDERS, stabilisation_diagram
 from armaxmodal.modes.modal_check import ModalCheck, check_modes
 from armaxmodal.modes.pipeline import select_modes
-from armaxmodal.modes.settings import FrfSettings, SelectionSettings
+from armaxmodal.modes.settings import FrfSettings
 from armaxmodal.recording import Recording
 
 MODEL_ERROR_LIMIT = FrfSettings().model_error_limit  # the check's own limit
@@ -91,22 +91,20 @@ def test_the_verdict_is_the_limit_on_every_checked_output():
     assert not nothing.passed and nothing.warnings()[0].code == "modes_do_not_explain_frf"
 
 
-def test_a_cluster_the_support_rule_left_out_enters_when_the_check_needs_it(light_ride):
-    from armaxmodal.modes.frf import modes_the_check_adds
-    from armaxmodal.modes.state import SelectionState
+def test_the_h1_proposes_the_cluster_at_a_peak_no_mode_explains(light_ride):
+    from armaxmodal.modes.frf import modes_at_unexplained_peaks
 
     s, rec = light_ride
     diagram = stabilisation_diagram(rec, range(2, 21, 2), per_sensor=False)
     sel = select_modes(diagram, segments=0)
-    truth = s.modes().freq_hz
+    truth, exact_damping = s.modes().freq_hz, s.modes().damping
     np.testing.assert_allclose(sel.modes.freq_hz, truth, rtol=0.01)
     nas = sorted(o.na for o in diagram.orders)
-    one = sel.modes.iloc[[0]].reset_index(drop=True)
-    check = check_modes(rec, one.freq_hz, one.damping)
-    start = SelectionState(one, sel.shapes[:, [0]], check=check)
-    added = modes_the_check_adds(diagram, start, None, nas, SelectionSettings())
-    np.testing.assert_allclose(added.modes.freq_hz, truth, rtol=0.01)
-    assert added.shapes.shape == (2, 2) and added.check.passed
+    # with the second mode left out, its peak is unexplained and its cluster is proposed, alone
+    (proposal,) = modes_at_unexplained_peaks(diagram, sel.modes.iloc[[0]], None, nas)
+    assert proposal[0] == pytest.approx(truth[1], rel=0.01) and proposal[1] == pytest.approx(exact_damping[1], rel=0.3)
+    # with both, nothing is left to propose
+    assert modes_at_unexplained_peaks(diagram, sel.modes, None, nas) == []
 
 
 def test_default_orders_adapt_to_a_short_record_and_typed_ones_are_refused(fixtures_dir):
@@ -157,18 +155,6 @@ def test_the_five_segment_chain_with_feet_gives_its_five_modes():
     assert len(sel.modes) == 5 and sel.quality == "good"
     np.testing.assert_allclose(sel.modes.freq_hz, truth.freq_hz, rtol=0.03)
     np.testing.assert_allclose(sel.modes.damping, truth.damping, rtol=0.2)
-
-
-def test_a_refit_may_move_a_mode_halfway_to_its_neighbour_within_twice_the_cluster_rule():
-    from armaxmodal.modes.state import _refit_reach
-
-    far = np.array([8.27, 12.49, 16.08])
-    assert _refit_reach(far, 1, 0.05) == pytest.approx(0.10)  # half the gap is 14 %: capped at 10 %
-    near = np.array([10.0, 10.4])
-    assert _refit_reach(near, 0, 0.05) == pytest.approx(0.05)  # half the gap, 2 %, is below the rule
-    middle = np.array([10.0, 11.4])
-    assert _refit_reach(middle, 0, 0.05) == pytest.approx(0.07)
-    assert _refit_reach(np.array([10.0]), 0, 0.05) == pytest.approx(0.10)
 
 
 def test_a_mode_is_confirmed_by_a_coherent_line_within_its_half_width_and_four_lines():

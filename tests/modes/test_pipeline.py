@@ -129,6 +129,9 @@ def test_count_alone_needs_the_refit(diagram):
     note = QualityWarning("mode_not_needed", (), "a stable pole at 7.000 Hz is left out", 7.0)
     doubted = pipeline.count(replace(state, doubts=((7.0, 0.1, note),)), ctx)
     assert doubted.doubts == () and doubted.warnings == (note,)
+    # and a proposal at an unexplained peak is not added: nothing is, without the count
+    proposed = replace(state, proposals=((7.0, 0.1),))
+    assert pipeline.count(proposed, ctx) is proposed
 
 
 def test_check_alone_judges_the_modes_it_is_given(diagram):
@@ -256,14 +259,6 @@ def test_a_threshold_no_setting_can_take_is_refused_by_name(make, message):
         make()
     # at the limits, accepted
     assert ClusterSettings(min_support=1.0).min_support == 1.0 and CountSettings(max_steps=1).max_steps == 1
-
-
-def test_a_mode_the_check_drops_twice_is_one_doubt_with_its_first_note():
-    first, second, other = (QualityWarning("mode_not_needed", (), text, 5.99) for text in ("first", "second", "other"))
-    doubts = [(5.99, 0.13, first), (8.57, 0.03, other), (5.99, 0.13, second)]
-    from armaxmodal.modes.frf import each_once
-
-    assert each_once(doubts) == ((5.99, 0.13, first), (8.57, 0.03, other))
 
 
 def test_settings_print_what_was_tuned_and_signatures_stay_short():

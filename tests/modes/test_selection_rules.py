@@ -463,27 +463,6 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     assert out.refinement is None and out.modes is modes and out.shapes is shapes  # the ARMAX values stand
 
 
-@pytest.mark.parametrize("first", [None, "zoh", "bandlimited"])
-def test_the_refit_with_the_checks_additions_keeps_the_records_inter_sample_form(first):
-    """The inter-sample form is the record's: the first refit chooses it, and the refit of every mode
-    once the check has added some keeps it (a held ride, held by 258 at the first refit, went
-    band-limited by 8 when chosen again and lost its top mode); chosen by the data where the first
-    refit could not be made."""
-    from armaxmodal.modes.frf import refit_with_added
-
-    rec, seen = _recording(2000), []
-
-    def refit(recording, freq_hz, damping, band_hz, hold, settings=None, decisive=None, negligible=None):
-        seen.append(hold)
-        raise OrderError("too few lines")  # the modes stand, said
-
-    modes = _modes([5.0, 9.0], [0.1, 0.05], [1.0, 1.0])
-    first_refit = None if first is None else SimpleNamespace(hold=first)
-    work = SelectionState(modes, np.eye(2, dtype=complex), refinement=first_refit)
-    out = refit_with_added(SimpleNamespace(recording=rec), work, None, refine=refit)
-    assert seen == [first or "auto"] and [w.code for w in out.warnings] == ["refit_failed"]
-
-
 def _band_limited_refit(freq_hz, damping, shapes):
     freq_hz, damping = np.asarray(freq_hz, float), np.asarray(damping, float)
     return SimpleNamespace(hold="bandlimited", freq_hz=freq_hz, damping=damping, freq_sd=1e-3 * freq_hz,
