@@ -324,6 +324,20 @@ MUTANTS = [
         "if False:",
         "the halves test a pole one half does not excite (excitation)",
     ),
+    # the rule where the model misfits refuses a wanted mode without a column (issue 67); run with
+    # --match "(rule)" --tests tests/modes/test_mode_count.py
+    (
+        "armaxmodal/modes/count_search.py",
+        "    if rule and wanted and not wanted.in_diagram:",
+        "    if False:",
+        "a wanted mode the rule refuses still named (rule)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "    if rule and wanted and not wanted.in_diagram:",
+        "    if wanted and not wanted.in_diagram:",
+        "the rule refuses a wanted mode where the model is adequate too (rule)",
+    ),
     (
         "armaxmodal/modes/count_search.py",
         "tested = [i for i in new if np.isfinite(chi2[i])]",
