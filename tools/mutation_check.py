@@ -251,12 +251,6 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/frf.py",
-        'if abs(np.exp(best.x[0]) - 1) <= settings.neighbour_max_shift:',
-        "if True:",
-        "a neighbour takes over from anywhere (check)",
-    ),
-    (
-        "armaxmodal/modes/frf.py",
         "m = min(weak, key=lambda i: (rank.index(i), support[i].rise))",
         "m = max(weak, key=lambda i: (rank.index(i), support[i].rise))",
         "the better-supported half of a split dropped (check)",

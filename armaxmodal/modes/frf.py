@@ -75,8 +75,7 @@ def mode_support(
     overlaps this one's (:func:`overlapping_neighbour`), has its frequency and damping refitted
     (Nelder-Mead on the summed relative residual, residues projected out) so it may take over: two
     poles always fit one peak at least as well as one, so only a refitted single pole shows whether
-    the record needs both. A neighbour
-    that moves more than ``settings.neighbour_max_shift`` to take over is not refitted. The F-test
+    the record needs both. The F-test
     compares the summed relative residual sums with ``q = 2 n_outputs`` (the residues)
     ``+ 2`` (the pole, unless the neighbour's refit spends them) over ``sum(lines) -
     parameters`` degrees of freedom (one per complex line: the Hann-windowed,
@@ -106,11 +105,8 @@ def mode_support(
             return float(np.sum(relative_rss(poles_of(fj, xj))))
 
         best = minimize(cost, np.zeros(2), method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-9, "maxiter": 200})
-        if abs(np.exp(best.x[0]) - 1) <= settings.neighbour_max_shift:
-            fk, xk = fk.copy(), xk.copy()
-            fk[at], xk[at] = f[j] * np.exp(best.x[0]), min(x[j] * np.exp(best.x[1]), 0.9)
-        else:  # it took over only by leaving its own place: the two are distinct modes
-            j = None
+        fk, xk = fk.copy(), xk.copy()
+        fk[at], xk[at] = f[j] * np.exp(best.x[0]), min(x[j] * np.exp(best.x[1]), 0.9)
     without = relative_rss(poles_of(fk, xk))
     n_obs = sum(all_lines[k].freq_hz.size for k in used)
     q = 2 * len(used) + (0 if j is not None else 2)

@@ -174,10 +174,6 @@ class FrfSettings(_Settings):
     #: by 6-7 %, and the others by 12 % to several times.
     model_error_rise: float = 0.05
     support_alpha: float = 0.01
-    #: an overlapping neighbour refitted when a mode is left out may take over only from within this
-    #: relative frequency of its own place: on the supine ride, heavily damped modes overlap, and a
-    #: neighbour free to move 30 % took over 5.8 Hz, then 7.6 and 8.3 Hz in turn, leaving two of four
-    neighbour_max_shift: float = 0.05
     #: a clear, coherent FRF peak no selected mode explains proposes to the count the cluster of
     #: poles of at least this many orders within :attr:`peak_cluster_freq` of it
     peak_cluster_min_orders: int = 2
