@@ -257,13 +257,13 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/frf.py",
-        "if len(c) >= frf.peak_cluster_min_orders",
+        "if len(c) >= cluster.min_orders",
         "if len(c) >= 99",
         "no cluster at an unexplained peak proposed (check)",
     ),
     (
         "armaxmodal/modes/frf.py",
-        "near = cand[np.abs(cand.freq_hz / peak.value - 1) <= frf.peak_cluster_freq]",
+        "near = cand[np.abs(cand.freq_hz / peak.value - 1) <= cluster.freq]",
         "near = cand",
         "every pole proposed at every peak (check)",
     ),

@@ -19,7 +19,7 @@ import pandas as pd
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
 from armaxmodal.modes.modal_check import ModalCheck, check_modes, poles_of, rss_at
 from armaxmodal.modes.notes import not_needed_note
-from armaxmodal.modes.settings import DEFAULTS, PEAK_RESOLUTION, FrfSettings, SelectionSettings
+from armaxmodal.modes.settings import DEFAULTS, PEAK_RESOLUTION, ClusterSettings, FrfSettings, SelectionSettings
 from armaxmodal.modes.state import SelectionState
 from armaxmodal.quality_warnings import QualityWarning
 from armaxmodal.recording import Recording
@@ -156,21 +156,22 @@ def modes_the_record_needs(
             doubts.append((float(f_m), float(x_m), note))
 
 
-def modes_at_unexplained_peaks(diagram, modes: pd.DataFrame, band, nas, frf: FrfSettings = DEFAULTS.frf) -> list:
+def modes_at_unexplained_peaks(
+    diagram, modes: pd.DataFrame, band, nas, cluster: ClusterSettings = DEFAULTS.cluster
+) -> list:
     """What the measured H1 proposes to the count: at each clear, coherent H1 peak no mode of
     ``modes`` explains (:func:`unexplained_peaks`), the largest cluster of the diagram's poles of at
-    least ``frf.peak_cluster_min_orders`` orders within ``frf.peak_cluster_freq`` of it, as its
-    median ``(Hz, ratio)``. A proposal only: the count adds it where the likelihood, the record's
-    halves and (where the model misfits) the diagram's columns take it, and leaves it out otherwise.
+    least ``cluster.min_orders`` orders (a stable pole's) within the clustering's reach
+    ``cluster.freq`` of it, as its median ``(Hz, ratio)``. A proposal only: the count adds it where
+    the likelihood, the record's halves and (where the model misfits) the diagram's columns take it,
+    and leaves it out otherwise.
     Returns ``[(freq_hz, damping), ...]``, the largest cluster first."""
     cand = candidate_poles(diagram.poles, band)
     cand = cand[cand.damping > 0]
     found = []
     for peak in unexplained_peaks(diagram.recording, modes.freq_hz.to_numpy(), modes.damping.to_numpy(), band):
-        near = cand[np.abs(cand.freq_hz / peak.value - 1) <= frf.peak_cluster_freq]
-        clusters = [
-            c for c in cluster_poles(near, nas, frf.peak_cluster_freq, None) if len(c) >= frf.peak_cluster_min_orders
-        ]
+        near = cand[np.abs(cand.freq_hz / peak.value - 1) <= cluster.freq]
+        clusters = [c for c in cluster_poles(near, nas, cluster.freq, None) if len(c) >= cluster.min_orders]
         if clusters:
             found.append(near.loc[max(clusters, key=len)])
     found.sort(key=len, reverse=True)

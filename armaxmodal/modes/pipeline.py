@@ -131,7 +131,7 @@ def propose_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionSta
     clear, coherent H1 peak no candidate explains (``proposals``)."""
     doubts: list = []
     state = modes_the_record_needs(ctx.diagram.recording, state, ctx.band, ctx.settings, doubts)
-    proposals = modes_at_unexplained_peaks(ctx.diagram, state.modes, ctx.band, ctx.nas, ctx.settings.frf)
+    proposals = modes_at_unexplained_peaks(ctx.diagram, state.modes, ctx.band, ctx.nas, ctx.settings.cluster)
     return replace(state, doubts=tuple(doubts), proposals=tuple(proposals))
 
 

@@ -115,7 +115,8 @@ class ClusterSettings(_Settings):
     #: also the agreement at which two counted modes are not told apart by shape
     merge_mac: float = 0.8
     #: a pole is stable across the diagram when poles of at least this many orders lie near it:
-    #: a left-out cluster is a candidate for the count, and a pick takes a cluster, only then
+    #: a left-out cluster is a candidate for the count, a cluster at an unexplained H1 peak is
+    #: proposed to it, and a pick takes a cluster, only then
     min_orders: int = 3
 
     @property
@@ -174,10 +175,6 @@ class FrfSettings(_Settings):
     #: by 6-7 %, and the others by 12 % to several times.
     model_error_rise: float = 0.05
     support_alpha: float = 0.01
-    #: a clear, coherent FRF peak no selected mode explains proposes to the count the cluster of
-    #: poles of at least this many orders within :attr:`peak_cluster_freq` of it
-    peak_cluster_min_orders: int = 2
-    peak_cluster_freq: float = 0.03
     #: delays searched, samples either way, in steps of :attr:`delay_step_samples`: channels
     #: are aligned by whole samples before the fit, so what is left is a few samples at most
     max_delay_samples: float = 4.0
@@ -244,9 +241,6 @@ class CountSettings(_Settings):
     #: a change of the criterion this large is "very strong" evidence (Kass & Raftery 1995): a
     #: mode's removal, or a candidate's addition, that moves it less leaves the count undecided
     decisive_bic: float = 10.0
-    #: ... and one below this is "not worth more than a bare mention": the refit's two inter-sample
-    #: forms, both converged, that close leave the form of the first steps (a held ride 0.5 apart)
-    negligible_bic: float = 2.0
     #: a probability this small is beyond chance among the handful of trials a count makes (the
     #: probability-scale twin of :attr:`decisive_bic`). A refused addition whose likelihood ratio a
     #: chi-square of its parameters puts beyond it leaves the count undecided (when its mode is the

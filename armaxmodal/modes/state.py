@@ -133,16 +133,15 @@ def refine_modes(
     max_nfev: int = 60,
     settings: DftSettings = DEFAULTS.dft,
     decisive: float = DEFAULTS.count.decisive_bic,
-    negligible: float = DEFAULTS.count.negligible_bic,
 ) -> ModalModel:
     """Refit selected modes to the DFT of a recording, choosing the inter-sample behaviour.
 
     Both assumptions are fitted a few steps from the same start, with the same lines and the same number of
     parameters; the one with the lower weighted residual is the data's choice and is iterated to convergence
     (:mod:`armaxmodal.estimate.dft_model` gives the two forms). Where the few steps leave the two within
-    ``decisive``, both are converged and the lower residual there chooses, unless within ``negligible`` again
-    (a five-segment body's held ride: band-limited led after four steps, held by far converged, and only it
-    gave the exact dampings). Each sensor is weighted by one over its noise level at the start.
+    ``decisive``, both are converged and the lower residual there chooses (a five-segment body's held
+    ride: band-limited led after four steps, held by far converged, and only it gave the exact
+    dampings). Each sensor is weighted by one over its noise level at the start.
 
     Parameters
     ----------
@@ -157,9 +156,9 @@ def refine_modes(
         Cap on residual evaluations of the chosen assumption's fit.
     settings : DftSettings
         The damping bounds and the stopping tolerance.
-    decisive, negligible : float
-        Differences of weighted residual sums of squares (``-2 ln L`` at unit noise): one that
-        decides, and one that decides nothing (the count's ``decisive_bic`` and ``negligible_bic``).
+    decisive : float
+        The difference of weighted residual sums of squares (``-2 ln L`` at unit noise) that the
+        first steps must show to decide (the count's ``decisive_bic``).
 
     Returns
     -------
@@ -193,9 +192,9 @@ def refine_modes(
     if hold == "auto":  # a few steps tell the assumptions apart, unless within ``decisive``: then both converge
         close = abs(cost["zoh"] - cost["bandlimited"]) < decisive
         fits = {h: fit(m.freq_hz, m.damping, h) for h, m in fits.items() if close or h == leader}
-        if close:  # converged, the lower residual chooses where it is lower by ``negligible`` or more
+        if close:  # converged, the lower residual chooses
             cost = {h: float(np.sum(m.rss * data.weights**2)) for h, m in fits.items()}
-            leader = min(cost, key=cost.get) if abs(cost["zoh"] - cost["bandlimited"]) >= negligible else leader
+            leader = min(cost, key=cost.get)
     return replace(fits[leader], hold_cost=cost)
 
 
@@ -321,7 +320,6 @@ def selection_job(
             hold=hold,
             settings=settings.dft,
             decisive=settings.count.decisive_bic,
-            negligible=settings.count.negligible_bic,
         )
     except (OrderError, np.linalg.LinAlgError) as exc:
         return RefitFailure(str(exc))  # too few lines or a degenerate basis: the ARMAX values stand, said

@@ -434,11 +434,11 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     lo, hi = excited_band(rec)
     seen = []
 
-    def refit(recording, freq_hz, damping, band_hz, hold, settings=None, decisive=None, negligible=None):
+    def refit(recording, freq_hz, damping, band_hz, hold, settings=None, decisive=None):
         seen.append(band_hz)
         # the hold is decided by the data, at the count's levels
         assert hold == "auto"
-        assert (decisive, negligible) == (CountSettings().decisive_bic, CountSettings().negligible_bic)
+        assert decisive == CountSettings().decisive_bic
         return SimpleNamespace(hold="zoh")
 
     modes, shapes = _modes([5.0, 9.0], [0.1, 0.05], [1.0, 1.0]), np.eye(2, dtype=complex)
@@ -452,7 +452,7 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     # a held input: the ARMAX values are reported
     assert out.refinement is ref and out.modes is modes and out.shapes is shapes
 
-    def failing(recording, freq_hz, damping, band_hz, hold, settings=None, decisive=None, negligible=None):
+    def failing(recording, freq_hz, damping, band_hz, hold, settings=None, decisive=None):
         raise OrderError("too few lines")
 
     failed = st.selection_job(rec, [], modes, ("refit", (lo, hi)), refine=failing)
