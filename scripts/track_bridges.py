@@ -129,10 +129,6 @@ def main() -> None:
     print(write_page())
 
 
-if __name__ == "__main__":
-    main()
-
-
 # ---- the validation page, written from the saved results (the docs build runs this) ----
 
 DOCS = ROOT / "docs" / "validation"
@@ -234,3 +230,7 @@ def write_page() -> Path:
     if not page.is_file() or page.read_text() != text:
         page.write_text(text)
     return page
+
+
+if __name__ == "__main__":
+    main()

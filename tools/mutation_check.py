@@ -233,8 +233,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/frf.py",
-        'return bool(self.rise >= self.settings.model_error_rise and self.p_value <= self.settings.support_alpha)',
-        'return bool(self.rise >= self.settings.model_error_rise or self.p_value <= self.settings.support_alpha)',
+        "return bool(self.rise >= self.settings.model_error_rise and self.p_value <= self.alpha)",
+        "return bool(self.rise >= self.settings.model_error_rise or self.p_value <= self.alpha)",
         "a mode needed by either criterion (check)",
     ),
     (

@@ -36,6 +36,7 @@ class ModeSupport:
     p_value: float
     refitted_neighbour: int | None
     settings: FrfSettings = DEFAULTS.frf
+    alpha: float = DEFAULTS.agreement.alpha  #: the F-test's level: the selection's tests' one false-alarm rate
 
     @property
     def rise(self) -> float:
@@ -46,8 +47,8 @@ class ModeSupport:
 
     @property
     def needed(self) -> bool:
-        """The rise is at least ``settings.model_error_rise`` and significant at ``settings.support_alpha``."""
-        return bool(self.rise >= self.settings.model_error_rise and self.p_value <= self.settings.support_alpha)
+        """The rise is at least ``settings.model_error_rise`` and significant at ``alpha``."""
+        return bool(self.rise >= self.settings.model_error_rise and self.p_value <= self.alpha)
 
 
 def overlapping_neighbour(freq_hz, damping, m: int) -> int | None:
@@ -68,8 +69,9 @@ def mode_support(
     band=None,
     *,
     settings: FrfSettings = DEFAULTS.frf,
+    alpha: float = DEFAULTS.agreement.alpha,
 ) -> ModeSupport:
-    """How much the check of ``check`` needs mode ``m`` (see ``ModeSupport``).
+    """How much the check of ``check`` needs mode ``m`` (see ``ModeSupport``; ``alpha``: the F-test's level).
 
     The fit without the mode keeps each output's delay. A neighbour, a mode whose half-power band
     overlaps this one's (:func:`overlapping_neighbour`), has its frequency and damping refitted
@@ -114,7 +116,7 @@ def mode_support(
     s1, s0 = float(with_m.sum()), float(without.sum())
     stat = ((s0 - s1) / q) / (s1 / dof) if dof > 0 and s1 > 0 else float("nan")
     p = float(fdtrc(q, dof, stat)) if np.isfinite(stat) and stat > 0 else 1.0
-    return ModeSupport(np.sqrt(with_m), np.sqrt(without), p, j, settings)
+    return ModeSupport(np.sqrt(with_m), np.sqrt(without), p, j, settings, alpha)
 
 
 def modes_the_record_needs(
@@ -128,7 +130,7 @@ def modes_the_record_needs(
     ``doubts`` (a list), each dropped mode goes there as ``(Hz, ratio, note)`` instead of its note
     into the selection: the count tries it again and the note stands only if it stays out.
     Returns the selection of the modes kept, with their check."""
-    frf = settings.frf
+    frf, alpha = settings.frf, settings.agreement.alpha
     while True:
         modes = work.modes
         check = check_modes(recording, modes.freq_hz, modes.damping, band, settings=frf)
@@ -136,7 +138,7 @@ def modes_the_record_needs(
         if len(modes) < 2 or not np.isfinite(check.error).any():
             return work
         support = [
-            mode_support(recording, modes.freq_hz, modes.damping, m, check, band, settings=frf)
+            mode_support(recording, modes.freq_hz, modes.damping, m, check, band, settings=frf, alpha=alpha)
             for m in range(len(modes))
         ]
         weak = [m for m in range(len(modes)) if not support[m].needed]
@@ -148,7 +150,7 @@ def modes_the_record_needs(
         m = min(weak, key=lambda i: (rank.index(i), support[i].rise))
         s, f_m, x_m = support[m], modes.at[m, "freq_hz"], modes.at[m, "damping"]
         neighbour = None if s.refitted_neighbour is None else modes.at[s.refitted_neighbour, "freq_hz"]
-        note = not_needed_note(f_m, x_m, neighbour, frf.model_error_rise, frf.support_alpha, s.rise, s.p_value)
+        note = not_needed_note(f_m, x_m, neighbour, frf.model_error_rise, alpha, s.rise, s.p_value)
         work = work.kept(i for i in range(len(modes)) if i != m)
         if doubts is None:
             work = work.warned(note)

@@ -67,7 +67,6 @@ _AT_MOST_ONE = frozenset(
     {
         "min_support",
         "merge_mac",
-        "support_alpha",
         "decisive_alpha",
         "alpha",
         "oversampled_fraction",
@@ -164,17 +163,16 @@ class LineSettings(_Settings):
 @dataclass(frozen=True, repr=False)
 class FrfSettings(_Settings):
     """What the measured H1 says (stages ``propose_by_frf``, ``screen_by_frf`` and ``check``): the
-    LSFD check, the support F-test and the clusters it proposes."""
+    LSFD check and its support test (whose F-test runs at ``AgreementSettings.alpha``)."""
 
     #: a mode is kept when leaving it out raises the misfit of some output by at least this
     #: fraction (the relative RMS; 10 % in the residual sum of squares) and the rise is
-    #: significant (:attr:`support_alpha`). Measured with the product's own selections: the
-    #: spurious poles and halves of split peaks on the measured records (stiff 1-storey 42.9 Hz,
-    #: stiff 3-storey 9.0 Hz beside 8.0, flex 3-storey 36.8 and 38.0 Hz, a bridge's 6.6 Hz)
-    #: raise it by 0.5-4 %; the weakest real modes (the F-16's 3.96 and 6.61 Hz at level 1)
-    #: by 6-7 %, and the others by 12 % to several times.
+    #: significant (at ``AgreementSettings.alpha``, the selection's one false-alarm rate).
+    #: Measured with the product's own selections: the spurious poles and halves of split peaks
+    #: on the measured records (stiff 1-storey 42.9 Hz, stiff 3-storey 9.0 Hz beside 8.0, flex
+    #: 3-storey 36.8 and 38.0 Hz, a bridge's 6.6 Hz) raise it by 0.5-4 %; the weakest real modes
+    #: (the F-16's 3.96 and 6.61 Hz at level 1) by 6-7 %, and the others by 12 % to several times.
     model_error_rise: float = 0.05
-    support_alpha: float = 0.01
     #: delays searched, samples either way, in steps of :attr:`delay_step_samples`: channels
     #: are aligned by whole samples before the fit, so what is left is a few samples at most
     max_delay_samples: float = 4.0
@@ -297,7 +295,8 @@ class AgreementSettings(_Settings):
     mode's), values judged one by one share ``alpha`` (Bonferroni: the segments' modes)."""
 
     #: each test's false-alarm rate (the estimators' test: 30-59 on the F-16's levels for 12 values, 77
-    #: for 6 on a ride with a cubic spring, none on its linear twin; the 1 % points are 26.2 and 16.8)
+    #: for 6 on a ride with a cubic spring, none on its linear twin; the 1 % points are 26.2 and 16.8),
+    #: and the level of the modal-model check's support F-test (``FrfSettings.model_error_rise``)
     alpha: float = 0.01
     #: a segment's pole is the mode's when within this relative frequency of it
     match_freq: float = 0.05

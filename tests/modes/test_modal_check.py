@@ -178,7 +178,7 @@ def test_a_mode_is_confirmed_by_a_coherent_line_within_its_half_width_and_four_l
     assert ModeSupport(rise, flat, 1e-9, None).rise == pytest.approx(0.06)
     # both levels are settings the support carries
     assert not ModeSupport(rise, flat, 1e-9, None, FrfSettings(model_error_rise=0.07)).needed
-    assert ModeSupport(rise, flat, 0.02, None, FrfSettings(support_alpha=0.05)).needed
+    assert ModeSupport(rise, flat, 0.02, None, alpha=0.05).needed
     # the reach of a confirming line is a setting too: 0.39 Hz past the last line needs four lines
     assert not confirmed_modes(lines, [2.39], [0.0], 0.1, confirm_lines=3)[0]
 
