@@ -3,7 +3,7 @@ measure them (``benchmarks/results/validation/*.json``, ``benchmarks/results/*.j
 page cannot show a number its script no longer gives. The docs build runs :func:`write` (from
 ``docs/conf.py``); the pages include the fragments it writes to ``docs/generated_results/``.
 
-    python scripts/count_battery.py --results benchmarks/results/validation/count_battery.json
+    python scripts/count_battery.py --six 6 --results benchmarks/results/validation/count_battery.json
     python scripts/mc_coverage.py --hold bandlimited \
         --results benchmarks/results/validation/mc_coverage_bandlimited.json
     python scripts/realdata_table.py --results benchmarks/results/validation/realdata.json
