@@ -129,9 +129,10 @@ def propose_by_frf(state: SelectionState, ctx: SelectionContext) -> SelectionSta
     the count's start and is offered to it as an addition (``doubts``; its ``mode_not_needed`` note
     stands only where the count does not take it back), and so is the diagram's cluster at each
     clear, coherent H1 peak no candidate explains (``proposals``)."""
+    # the peaks are judged against every candidate: a doubted one's peak is offered once, as its doubt
+    proposals = modes_at_unexplained_peaks(ctx.diagram, state.modes, ctx.band, ctx.nas, ctx.settings.cluster)
     doubts: list = []
     state = modes_the_record_needs(ctx.diagram.recording, state, ctx.band, ctx.settings, doubts)
-    proposals = modes_at_unexplained_peaks(ctx.diagram, state.modes, ctx.band, ctx.nas, ctx.settings.cluster)
     return replace(state, doubts=tuple(doubts), proposals=tuple(proposals))
 
 
