@@ -217,6 +217,8 @@ class ModalModel:
     at_bound : (n_modes,) bool ndarray or None
         The pole's frequency or damping is held at a bound of the fit (the solver's active set):
         its Wald interval means nothing there. None: not known.
+    damping_floor : float
+        The lowest damping ratio the fit allowed (its settings' ``min_damping``).
 
     See Also
     --------
@@ -249,6 +251,7 @@ class ModalModel:
     hold_cost: dict = field(default_factory=dict)
     nyquist_hz: float = np.inf
     at_bound: np.ndarray | None = None
+    damping_floor: float = 0.0
 
     def by_frequency(self) -> ModalModel:
         """The same model, its modes sorted by frequency.
@@ -433,4 +436,5 @@ def _fit(
         band_hz=data.band_hz,
         nyquist_hz=0.5 / data.dt,
         at_bound=(res.active_mask != 0).reshape(n, 2).any(axis=1),
+        damping_floor=settings.min_damping,
     )

@@ -30,7 +30,7 @@ from armaxmodal.modes.mode_count import (
     split_start,
 )
 from armaxmodal.modes.poles import physical, reported, resolved
-from armaxmodal.modes.settings import DEFAULTS, AgreementSettings, CountSettings, DftSettings, LineSettings
+from armaxmodal.modes.settings import DEFAULTS, AgreementSettings, CountSettings, DftSettings
 from armaxmodal.stats import Z95, effective_fraction
 
 __all__ = ["count_modes"]
@@ -47,13 +47,12 @@ class _Search:
         max_nfev: int,
         n_jobs: int | None = 1,
         settings: CountSettings = DEFAULTS.count,
-        lines: LineSettings = DEFAULTS.lines,
         dft: DftSettings = DEFAULTS.dft,
         fitter: Callable = fit_modal_model,
         agreement: AgreementSettings = DEFAULTS.agreement,
     ):
         self.data, self.hold, self.n_eff, self.max_nfev, self.n_jobs = data, hold, n_effective, max_nfev, n_jobs
-        self.cfg, self.lines, self.dft, self.trials, self.table = settings, lines, dft, 0, ModelTable(n_effective)
+        self.cfg, self.dft, self.trials, self.table = settings, dft, 0, ModelTable(n_effective)
         self.fitter, self.agreement, self.logged = fitter, agreement, self.table.add
 
     def screened(
@@ -184,7 +183,7 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     top mode the model needs, a body's close pair at 14.40 and 15.62 Hz). Returns ``(model, left out:
     ((start Hz, Hz), ...), kept unreported: ((start Hz, Hz, rise), ...), tentative: (Hz, ...))``."""
     start_hz = np.atleast_1d(np.asarray(start_hz, float))
-    shown = reported(model, search.data.band_hz, search.lines)
+    shown = reported(model, search.data.band_hz)
     moved = [
         (i, j)
         for i, j in matched_poles(start_hz, model.freq_hz)
@@ -290,7 +289,6 @@ def count_modes(
     search: bool = True,
     n_jobs: int | None = None,
     settings: CountSettings = DEFAULTS.count,
-    lines: LineSettings = DEFAULTS.lines,
     dft: DftSettings = DEFAULTS.dft,
     fitter: Callable = fit_modal_model,
     agreement: AgreementSettings = DEFAULTS.agreement,
@@ -323,8 +321,8 @@ def count_modes(
         Worker threads for the screening fits (default: all cores).
     settings : CountSettings
         The count's thresholds (:mod:`armaxmodal.modes.settings`).
-    lines, dft, agreement : LineSettings, DftSettings, AgreementSettings
-        Which poles are lines, not modes; the modal model's fits; the halves' test's level.
+    dft, agreement : DftSettings, AgreementSettings
+        The modal model's fits (a pole at their damping floor is a line, not a mode); the halves' test's level.
     fitter : callable
         The fit, as :func:`~armaxmodal.estimate.dft_model.fit_modal_model` (a test's stands in for it).
     adequacy : callable, optional
@@ -366,7 +364,6 @@ def count_modes(
         search=search,
         n_jobs=n_jobs,
         settings=settings,
-        lines=lines,
         dft=dft,
         fitter=fitter,
         agreement=agreement,
@@ -430,7 +427,6 @@ def _searched(
     search,
     n_jobs,
     settings: CountSettings,
-    lines,
     dft,
     fitter,
     agreement,
@@ -453,7 +449,6 @@ def _searched(
             max_nfev,
             n_jobs,
             settings,
-            lines,
             dft,
             fitter,
             agreement,
@@ -544,7 +539,6 @@ def _searched(
         models=tuple(search.table.rows),
         band_hz=data.band_hz,
         settings=settings,
-        lines=lines,
         dft=dft,
         agreement=agreement,
     )

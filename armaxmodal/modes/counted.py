@@ -162,7 +162,6 @@ def counted_modes(
         search=not picked,
         n_jobs=n_jobs,
         settings=settings.count,
-        lines=settings.lines,
         dft=settings.dft,
         agreement=settings.agreement,
     )

@@ -39,7 +39,7 @@ from armaxmodal.io.write import finite_or_none as finite  # strict JSON: None fo
 from armaxmodal.modal import matched_poles, nearest_pole
 from armaxmodal.modes.intervals import interval
 from armaxmodal.modes.poles import beyond_band, borderline, reported
-from armaxmodal.modes.settings import DEFAULTS, AgreementSettings, CountSettings, DftSettings, LineSettings
+from armaxmodal.modes.settings import DEFAULTS, AgreementSettings, CountSettings, DftSettings
 from armaxmodal.spectra import LPM_HALF_WIDTH, local_polynomial_noise
 from armaxmodal.stats import Z95
 
@@ -340,7 +340,6 @@ class ModeCount:
     wanted: Wanted | tuple = ()
     stand_ins: tuple[StandIn, ...] = ()
     settings: CountSettings = COUNT
-    lines: LineSettings = DEFAULTS.lines
     dft: DftSettings = DEFAULTS.dft
     models: tuple[FittedModel, ...] = ()
     band_hz: tuple[float, float] = (0.0, float("inf"))
@@ -448,9 +447,9 @@ class ModeCount:
         band = self.band_hz if band_hz is None else band_hz
         needed = self.removal_rise >= self.settings.decisive_bic
         verdict = np.where(needed, "needed", "undecided").astype(object)
-        verdict[~reported(self.model, band, self.lines)] = "not_a_mode"
-        verdict[borderline(self.model, band, self.lines)] = "borderline"
-        verdict[needed & beyond_band(self.model, band, self.lines)] = "beyond_band"
+        verdict[~reported(self.model, band)] = "not_a_mode"
+        verdict[borderline(self.model, band)] = "borderline"
+        verdict[needed & beyond_band(self.model, band)] = "beyond_band"
         for f in self.unsettled_hz:  # taken, though its halves differ beyond chance
             at = self._pole_at(f)
             if at is not None and verdict[at] == "needed":

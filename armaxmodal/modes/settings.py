@@ -136,19 +136,14 @@ class ClusterSettings(_Settings):
 
 @dataclass(frozen=True, repr=False)
 class LineSettings(_Settings):
-    """Is a pole a line (a periodic disturbance) or a mode, in one place for the diagram's
-    ``periodic_disturbance`` note, the count's reported poles and the diagnosis."""
+    """Is a pole of the diagram a line (a periodic disturbance) or a mode, in one place for its
+    ``periodic_disturbance`` note and the diagnosis."""
 
     #: damping below this, at a pole the input does not drive, is a line, not a structural mode: a
     #: hum on a fixture copy's output gave 5e-5-3e-4 at every order, a line on the input alone up to
     #: 1.7e-3; the lightest mode of the measured records is 4.8e-3 (the F-16's torsion). The damping
     #: alone does not decide: a two-mass chain damped 0.05 % and 0.1 % is driven, and its modes are modes
     undamped: float = 2e-3
-    #: the modal model's pole damped this little sits at its fit's floor (twice the lower damping
-    #: bound): a line or a frequency that moves, not a mode (the supine ride's 0.3 m/s^2 hum at
-    #: 12.5 Hz came out at 12.500 Hz, damping 1e-4). The count has no residue-energy test, so it
-    #: cannot take :attr:`undamped`, which would drop the driven light modes above
-    at_fit_floor: float = 2e-4
     #: poles of one line across orders agree to this relative frequency (the hum: 3e-4)
     freq_tol: float = 1e-3
     #: the input carries the line too when its PSD there stands this far above the median of the
@@ -199,8 +194,9 @@ class DftSettings(_Settings):
     """The variable-projection fits of the modal model to the record's DFT (stages ``refit`` and
     ``count``)."""
 
-    #: the lowest and highest damping ratio a free pole may take: below, the pole is a line (a
-    #: periodic disturbance, not a mode of the structure); above, no resonance is left to fit
+    #: the lowest and highest damping ratio a free pole may take: a pole within twice the lowest is
+    #: a line (a periodic disturbance, not a mode of the structure: ``poles.at_fit_floor``); above
+    #: the highest, no resonance is left to fit
     min_damping: float = 1e-4
     max_damping: float = 0.95
     #: relative change of the cost and of the parameters at which a fit stops: a relative change
@@ -317,9 +313,10 @@ class SelectionSettings(_Settings):
     cluster : ClusterSettings
         Which poles are one mode (``candidates``, ``merge``, picks, the count's candidates).
     lines : LineSettings
-        Which poles are lines: the count reads ``at_fit_floor``; the diagram's
-        ``periodic_disturbance`` note and the diagnosis read the defaults (the diagram is made
-        before any selection).
+        Which poles of the diagram are lines: its ``periodic_disturbance`` note and the
+        diagnosis read the defaults (the diagram is made before any selection). The count's
+        lines are the modal model's poles at its fit's damping floor
+        (:func:`armaxmodal.modes.poles.at_fit_floor`).
     frf : FrfSettings
         The modal-model check of the measured H1, and what it proposes and screens.
     dft : DftSettings

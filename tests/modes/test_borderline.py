@@ -24,21 +24,22 @@ from armaxmodal.estimate.dft_model import DftLines
 from armaxmodal.modes.mode_count import ModeCount
 from armaxmodal.modes.notes import count_notes
 from armaxmodal.modes.poles import beyond_band, borderline
-from armaxmodal.modes.settings import DEFAULTS, ClusterSettings, LineSettings
+from armaxmodal.modes.settings import DEFAULTS, ClusterSettings
 from armaxmodal.stats import MAX_DAMPING, Z95
 
 # the fitter under the selection's default damping bounds and tolerance
 fit_modal_model = partial(dft_model.fit_modal_model, settings=DEFAULTS.dft)
 
 BAND = (1.0, 25.0)
-FLOOR = LineSettings().at_fit_floor
+FLOOR = 2 * DEFAULTS.dft.min_damping  # a pole within twice the fit's floor is a line
 NYQUIST = 50.0  # the stand-in models' bound on a pole's frequency (Hz)
 
 
 def _model(freq, damping, freq_sd, damping_sd):
     return SimpleNamespace(freq_hz=np.array(freq, float), damping=np.array(damping, float),
                            freq_sd=np.array(freq_sd, float), damping_sd=np.array(damping_sd, float),
-                           n_modes=len(freq), nyquist_hz=NYQUIST, at_bound=None)  # fmt: skip
+                           n_modes=len(freq), nyquist_hz=NYQUIST, at_bound=None,
+                           damping_floor=DEFAULTS.dft.min_damping)  # fmt: skip
 
 
 @pytest.mark.parametrize(

@@ -26,7 +26,6 @@ from armaxmodal.modes.settings import (
     AgreementSettings,
     ClusterSettings,
     CountSettings,
-    LineSettings,
     SelectionSettings,
 )
 from armaxmodal.stats import Z95, effective_fraction
@@ -177,7 +176,7 @@ def test_effective_fraction_is_bartletts_for_white_and_smoothed_noise():
 def _model(freq, damping, sd=0.01):
     freq, damping = np.array(freq, float), np.array(damping, float)
     return SimpleNamespace(freq_hz=freq, damping=damping, freq_sd=sd * freq, damping_sd=sd * damping,
-                           n_modes=freq.size, nyquist_hz=50.0, at_bound=None)  # fmt: skip
+                           n_modes=freq.size, nyquist_hz=50.0, at_bound=None, damping_floor=1e-4)  # fmt: skip
 
 
 def _count(rise, best_addition, best_hz=12.0, freq=(5.0, 30.0), damping=(0.2, 0.9), alternatives=()):
@@ -196,7 +195,8 @@ def test_the_count_names_what_the_search_hands_over_as_plain_tuples():
 
 
 def test_undecided_counts_and_out_of_band_poles_are_said():
-    keep = reported(SimpleNamespace(freq_hz=np.array([5.0, 30.0, 10.0]), damping=np.array([0.2, 0.3, 0.9])), (1, 25))
+    keep = reported(SimpleNamespace(freq_hz=np.array([5.0, 30.0, 10.0]), damping=np.array([0.2, 0.3, 0.9]),
+                                    damping_floor=1e-4), (1, 25))
     assert keep.tolist() == [True, False, False]  # above the band; damped beyond MAX_DAMPING
     decided = _notes(_count([50.0, 60.0], -40.0), np.array([True, False]), (1.0, 25.0), SAME_ROW)
     assert [n.code for n in decided] == ["mode_count"]  # only the out-of-band pole
@@ -372,9 +372,13 @@ def test_the_likelihood_does_not_depend_on_the_weights(supine):
 
 def test_a_model_that_keeps_no_mode_leaves_the_selection_and_says_so(bundled_diagram):
     before = am.select_modes(bundled_diagram, segments=0)
-    # every pole damped below 0.9 a line: the count's model keeps no mode of the band
-    lines = SelectionSettings(lines=LineSettings(at_fit_floor=0.9))
-    sel = am.select_modes(bundled_diagram, segments=0, settings=lines)
+    from armaxmodal.modes.state import Fitters
+
+    def every_pole_a_line(*args, **kwargs):  # a fit whose damping floor is 0.45: every pole below 0.9 a line
+        count = count_modes(*args, **kwargs)
+        return replace(count, model=replace(count.model, damping_floor=0.45))
+
+    sel = am.select_modes(bundled_diagram, segments=0, fitters=Fitters(count=every_pole_a_line))
     assert (sel.count.verdicts() == "not_a_mode").all()
     assert len(sel.modes) == len(before.modes) == 4 and sel.quality == "uncertain"
     assert "count_undecided" in sel.uncertain_because
@@ -450,7 +454,7 @@ class _Scored:
         lost = [f for f in (start if start is not None else ()) if np.min(np.abs(np.log(self.freq_hz / f))) > 0.05]
         self.split_of = lost[0] if len(lost) == 1 and self.n_modes > len(start) else None
 
-    converged, nyquist_hz, at_bound = True, 30.0, None  # the supine ride at 60 Hz
+    converged, nyquist_hz, at_bound, damping_floor = True, 30.0, None, 1e-4  # the supine ride at 60 Hz
 
     @property
     def n_modes(self):

@@ -82,7 +82,7 @@ def test_a_pick_the_modal_model_takes_out_of_the_band_is_reported_and_said():
     model = SimpleNamespace(
         freq_hz=np.array([5.1, 20.0, 12.1]), damping=np.array([0.1, 1e-4, 0.05]), freq_sd=np.full(3, 0.01),
         damping_sd=np.array([0.001, 0.0, 0.001]), shapes=np.array([[3.0, 4.0, 6.0]], dtype=complex), n_modes=3,
-        nyquist_hz=30.0, at_bound=None,
+        nyquist_hz=30.0, at_bound=None, damping_floor=1e-4,
     )  # fmt: skip
 
     count = ModeCount(model, model, (), np.array([80.0, -3.0, 60.0]), -50.0, np.nan, 1.0)
@@ -120,7 +120,8 @@ def test_a_pick_the_record_does_not_need_is_said():
     from armaxmodal.modes.notes import pick_notes as _pick_notes
 
     model = SimpleNamespace(freq_hz=np.array([5.0, 9.0]), damping=np.array([0.1, 0.05]), freq_sd=np.full(2, 0.01),
-                            damping_sd=np.full(2, 0.001), nyquist_hz=30.0, at_bound=None)  # fmt: skip
+                            damping_sd=np.full(2, 0.001), nyquist_hz=30.0, at_bound=None,
+                            damping_floor=1e-4)  # fmt: skip
     count = ModeCount(model, model, (), np.array([4.0, 80.0]), -30.0, 7.0, 1.0, settings=CountSettings())
     (note,) = _pick_notes(count, np.array([True, True]))
     assert note.code == "pick_not_supported" and note.value == 5.0 and "+4.0" in note.message
@@ -139,7 +140,8 @@ def test_the_picks_model_keeps_the_poles_the_automatic_model_hides(ride):
     m = sel.count.model  # the pole added at 40 Hz is beyond the band by its interval too (+-1 Hz)
     beyond = SimpleNamespace(freq_hz=np.r_[m.freq_hz, 40.0], damping=np.r_[m.damping, 0.1],
                              freq_sd=np.r_[m.freq_sd, 0.5], damping_sd=np.r_[m.damping_sd, 0.01],
-                             nyquist_hz=m.nyquist_hz, at_bound=np.r_[m.at_bound, False])  # fmt: skip
+                             nyquist_hz=m.nyquist_hz, at_bound=np.r_[m.at_bound, False],
+                             damping_floor=m.damping_floor)  # fmt: skip
     modes = sel.modes.assign(picked_hz=[5.9, 8.2, np.nan, np.nan])
     count = replace(sel.count, model=beyond, removal_rise=np.r_[sel.count.removal_rise, 50.0])  # one rise per pole
     work = SelectionState(modes, sel.shapes, sel.refinement, sel.check, count)

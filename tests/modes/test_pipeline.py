@@ -229,7 +229,7 @@ def test_the_json_carries_its_settings(diagram):
                                 settings=SelectionSettings(count=CountSettings(decisive_bic=12.0)))  # fmt: skip
     out = json.loads(json.dumps(selection.to_dict(), allow_nan=False))
     assert out["settings"]["count"]["decisive_bic"] == 12.0
-    assert out["settings"]["cluster"]["freq"] == 0.05 and out["settings"]["lines"]["at_fit_floor"] == 2e-4
+    assert out["settings"]["cluster"]["freq"] == 0.05 and out["settings"]["lines"]["undamped"] == 2e-3
     assert out["settings"]["frf"]["model_error_limit"] == 0.5 and out["settings"]["dft"]["min_damping"] == 1e-4
     _validator("stabilise").validate(out)
 
