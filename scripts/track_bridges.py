@@ -155,7 +155,7 @@ def _bridge_section(bridge: str) -> list[str]:
 
     from armaxmodal.study import plot_track
 
-    h1 = pd.read_csv(RESULTS / bridge / "h1.csv")
+    h1 = pd.read_csv(RESULTS / bridge / "h1.csv", dtype={"modes_hz": str})  # one mode a row: read as text, not a number
     track = _saved_track(bridge)
     fig = plot_track(track)
     (DOCS / "images").mkdir(exist_ok=True)
