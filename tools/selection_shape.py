@@ -6,7 +6,8 @@ The selection system is ``armaxmodal/modes/`` with ``estimate/dft_model.py``, ``
 * **branches**, counted on the AST: ``if``, ``for``, ``while``, ``try``, each extra operand of a
   boolean operator, conditional expressions and comprehensions' loops and conditions;
 * **characters** of the source;
-* **named thresholds**: numeric fields of the settings classes of ``modes/settings.py``;
+* **named thresholds**: numeric fields of the settings classes of ``modes/settings.py`` and of
+  ``modes.poles.Tolerances``;
 * files ``ruff format --check`` would reformat, and ``# fmt: skip`` markers.
 
     python tools/selection_shape.py [--strict]
@@ -47,10 +48,12 @@ def branches(tree: ast.AST) -> int:
 def named_thresholds() -> int:
     sys.path.insert(0, str(ROOT.parent))
     from armaxmodal.modes import settings
+    from armaxmodal.modes.poles import Tolerances
 
-    # the classes, not their instances (``SWEEP = SweepSettings()`` counted the sweep's five twice)
+    # the classes, not their instances (``SWEEP = SweepSettings()`` counted the sweep's five twice),
+    # and the diagram's stability and rejection rules (``Tolerances``, which the issue counts too)
     classes = [c for c in vars(settings).values() if isinstance(c, type) and dataclasses.is_dataclass(c)]
-    classes = [c for c in classes if c.__module__ == settings.__name__]
+    classes = [c for c in classes if c.__module__ == settings.__name__] + [Tolerances]
     return sum(1 for c in classes for f in dataclasses.fields(c)
                if isinstance(f.default, int | float) and not isinstance(f.default, bool))  # fmt: skip
 
