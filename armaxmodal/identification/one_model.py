@@ -210,7 +210,7 @@ def identify(
     # the same rejection rules as the stabilisation diagram (damping ceiling, 0 Hz and Nyquist,
     # the excited band, negligible residue), applied to this one order
     poles = pd.DataFrame(pole_rows(fit, SHARED), columns=POLE_COLUMNS)
-    poles = poles[np.array(rejection_reasons(poles, Tolerances(max_damping=max_damping), recording)) == ""]
+    poles = poles[np.array(rejection_reasons(poles, Tolerances(), recording, max_damping)) == ""]
     if band is not None:
         poles = poles[(poles.freq_hz >= band[0]) & (poles.freq_hz <= band[1])]
     poles = poles.sort_values("freq_hz")

@@ -67,14 +67,13 @@ class Tolerances:
     --------
     >>> from armaxmodal.modes import Tolerances
     >>> tol = Tolerances(freq=0.02)  # a pole is stable in frequency within 2 % of the previous order's
-    >>> tol.freq, tol.damping, tol.max_damping
-    (0.02, 0.05, 0.6)
+    >>> tol.freq, tol.damping, tol.shape
+    (0.02, 0.05, 0.02)
     """
 
     freq: float = 0.01  #: relative frequency change
     damping: float = 0.05  #: relative damping change
     shape: float = 0.02  #: 1 - MAC for shared shapes; relative residue change per sensor
-    max_damping: float = MAX_DAMPING  #: heavier damping is not a vibration mode here
     min_freq_hz: float | None = None  #: default: 3 / record length
     max_freq_fraction: float = 0.45  #: of fs; poles near Nyquist are filter artefacts
     min_energy: float = 0.01  #: residue energy relative to the largest pole at that order (lower it
@@ -164,7 +163,11 @@ def stability_classes(poles: pd.DataFrame, tol: Tolerances) -> list[str]:
     return cls
 
 
-def rejection_reasons(poles: pd.DataFrame, tol: Tolerances, recording: Recording) -> list[str]:
+def rejection_reasons(
+    poles: pd.DataFrame, tol: Tolerances, recording: Recording, max_damping: float = MAX_DAMPING
+) -> list[str]:
+    """Why each pole is not a mode candidate (``""``: it is). Damped beyond ``max_damping`` is
+    over-damped: by default the one bound every stage reads (``armaxmodal.stats.MAX_DAMPING``)."""
     f_min = tol.min_freq_hz if tol.min_freq_hz is not None else 3.0 / recording.duration
     f_max = tol.max_freq_fraction * recording.fs
     band_lo, band_hi = excited_band(recording, tol.min_input_db)
@@ -174,7 +177,7 @@ def rejection_reasons(poles: pd.DataFrame, tol: Tolerances, recording: Recording
         if row.damping <= 0:
             sd = getattr(row, "damping_sd", 0.0)
             reasons.append(UNRESOLVED_DAMPING if row.damping + Z95 * sd > 0 else "negative damping")
-        elif row.damping > tol.max_damping:
+        elif row.damping > max_damping:
             reasons.append("over-damped")
         elif row.freq_hz < f_min:
             reasons.append("near 0 Hz")

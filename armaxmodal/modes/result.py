@@ -202,7 +202,7 @@ class ModeSelection:
             **record_header(rec, prep, self.warnings),
             "nk": self.diagram.orders[0].nk,
             "orders_na": [o.na for o in self.diagram.orders],
-            "tolerances": {"freq": t.freq, "damping": t.damping, "shape": t.shape, "max_damping": t.max_damping},
+            "tolerances": {"freq": t.freq, "damping": t.damping, "shape": t.shape},
             "quality": self.quality,
             "reconstruction_error": finite_or_none(self.reconstruction_error),
             "modal_check": None if self.check is None else self.check.to_dict(),

@@ -319,7 +319,7 @@ def test_the_json_report_carries_the_selection_as_computed(light_diagram):
     assert d["warnings"] == [w.to_dict() for w in sel.warnings]
     assert (d["input"], d["outputs"]) == (rec.input_name, list(rec.sensors))
     assert d["nk"] == diagram.orders[0][3] and d["orders_na"] == list(range(2, 21, 2))
-    assert d["tolerances"] == {"freq": 0.01, "damping": 0.05, "shape": 0.02, "max_damping": 0.6}
+    assert d["tolerances"] == {"freq": 0.01, "damping": 0.05, "shape": 0.02}
     assert Tolerances() == diagram.tolerances
     assert d["reconstruction_error"] == sel.reconstruction_error
     assert d["intersample_hold"] == sel.refinement.hold and d["estimator"] == sorted(set(m.estimator))

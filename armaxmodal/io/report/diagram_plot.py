@@ -6,6 +6,7 @@ import numpy as np
 
 from armaxmodal.spectra import excited_band, measured_frf
 from armaxmodal.stats import H1_COHERENCE as COHERENT
+from armaxmodal.stats import MAX_DAMPING
 
 __all__ = ["plot_stabilisation", "plot_prediction"]
 
@@ -104,7 +105,7 @@ def plot_stabilisation(diagram, selection=None, ax=None):
     fig.legend(h1 + h2, l1 + l2, fontsize=7, loc="outside lower center", ncol=4, frameon=False)
     ax_d.set_ylabel("damping ratio")
     ax_d.set_xlabel("frequency (Hz)")
-    ax_d.set_ylim(0, tol.max_damping)
+    ax_d.set_ylim(0, MAX_DAMPING)
     return ax, ax_d
 
 
