@@ -383,7 +383,7 @@ CODES: tuple[WarningCode, ...] = (
     WarningCode(
         "modes_not_separated",
         "selection",
-        "two neighbouring modes less than 3 standard deviations of their difference apart",
+        "two neighbouring modes whose frequencies' difference has a 95 % interval holding zero",
         "where the model's own intervals are that close and the shapes agree (MAC ≥ 0.8), the two poles are reported "
         "as one mode (the model refitted with one pole there) whose intervals cover both (the F-16 at its highest "
         "level: 6.356 and 6.395 Hz, 0.2 SD apart, reported as 6.387 Hz); otherwise both are reported. Either way "

@@ -143,7 +143,7 @@ class _Search:
         that hides two leaves its largest residual in its band; splitting all found no more)."""
         trials = []
         for f, x in candidates:
-            if current.n_modes and np.min(np.abs(current.freq_hz / f - 1)) <= self.cfg.same_mode_freq:
+            if current.n_modes and np.min(np.abs(current.freq_hz / f - 1)) <= self.agreement.match_freq:
                 continue
             trials.append(("add", float(f), np.r_[current.freq_hz, f], np.r_[current.damping, x]))
         for m in [nearest_pole(current.freq_hz, peak_hz)] if current.n_modes else []:
@@ -169,7 +169,7 @@ def _margins(search: _Search, here: float, current: ModalModel, removed, best_re
 
 
 def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, halves=()):
-    """The chosen model without the starting poles the search carried beyond ``settings.same_mode_freq``
+    """The chosen model without the starting poles the search carried beyond ``agreement.match_freq``
     of every start to where no mode is founded, refitted. A pole reported there is a new pole and
     must show what a mode has: a resolved damping, and the same values in both halves of the record
     (``_Search.in_both_halves``; where they do not both excite it, stability across the orders), judged on
@@ -187,7 +187,7 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     moved = [
         (i, j)
         for i, j in matched_poles(start_hz, model.freq_hz)
-        if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > search.cfg.same_mode_freq
+        if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > search.agreement.match_freq
     ]
     unfounded, tentative = [], []
     for i, j in moved:
@@ -459,7 +459,7 @@ def _searched(
     lost = [
         (f, x)
         for f, x in zip(np.atleast_1d(freq_hz), np.atleast_1d(damping), strict=True)
-        if np.min(np.abs(np.log(start_model.freq_hz / f))) > settings.same_mode_freq
+        if np.min(np.abs(np.log(start_model.freq_hz / f))) > agreement.match_freq
     ]
     current, steps, candidates, unconfirmed, unsettled = start_model, [], list(candidates) + lost, [], []
 
@@ -506,7 +506,7 @@ def _searched(
     unsettled += [
         f
         for f in tentative  # one note a pole: the search may have taken it so already
-        if not any(abs(np.log(f / u)) <= settings.same_mode_freq for u in unsettled)
+        if not any(abs(np.log(f / u)) <= agreement.match_freq for u in unsettled)
     ]
     if carried_away:  # the model lost a pole: its neighbours are judged again, from where it stands
         here, removed, best_removal, best_addition = neighbours()

@@ -262,10 +262,10 @@ def _one_where_not_separated(
             "freq_ci95_hi": m.freq_hz[poles] + Z95 * m.freq_sd[poles],
         }
     )
-    level, same_shape = settings.count.separation_sd, settings.cluster.merge_mac
+    same_shape = settings.cluster.merge_mac
     pairs = [
         (a, b, gap)
-        for a, b, gap in not_separated(own, level)
+        for a, b, gap in not_separated(own)
         if mac(m.shapes[:, poles[a]], m.shapes[:, poles[b]]) >= same_shape
     ]
     if not pairs:
@@ -300,7 +300,7 @@ def _one_where_not_separated(
         rows.loc[a, "structure_widened"] = True
         shapes[:, a] = one.shapes[:, k]
         gone.append(b)
-        notes.append(reported_as_one_note(tuple(both.freq_hz), gap, level, same_shape, f, x))
+        notes.append(reported_as_one_note(tuple(both.freq_hz), gap, same_shape, f, x))
     kept = [i for i in range(len(rows)) if i not in gone]
     return rows.iloc[kept].reset_index(drop=True), shapes[:, kept], notes
 

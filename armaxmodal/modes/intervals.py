@@ -147,16 +147,17 @@ def _part(modes: pd.DataFrame, column: str) -> np.ndarray:
     return modes[column].to_numpy(float)
 
 
-def not_separated(modes: pd.DataFrame, separation_sd: float) -> list[tuple[int, int, float]]:
-    """The neighbouring rows ``(i, i + 1, gap in SD)`` whose frequencies differ by less than
-    ``separation_sd`` standard deviations of the difference (each SD from its 95 % interval),
-    taken left to right without overlap."""
+def not_separated(modes: pd.DataFrame) -> list[tuple[int, int, float]]:
+    """The neighbouring rows ``(i, i + 1, gap in SD)`` the record does not separate: the 95 %
+    interval of their frequencies' difference holds zero (they differ by less than ``Z95``
+    standard deviations of the difference, each SD from its row's 95 % interval), taken left to
+    right without overlap. The level of every interval the selection reports."""
     f = modes.freq_hz.to_numpy()
     sd = (modes.freq_ci95_hi.to_numpy() - modes.freq_ci95_lo.to_numpy()) / (2 * Z95)
     pairs, i = [], 0
     while i < len(f) - 1:
         gap = (f[i + 1] - f[i]) / float(np.hypot(sd[i], sd[i + 1]))
-        if gap < separation_sd:
+        if gap < Z95:
             pairs.append((i, i + 1, float(gap)))
             i += 1
         i += 1

@@ -351,7 +351,7 @@ def check_modes(
         (float(ln.freq_hz[0]), float(ln.freq_hz[-1])) if np.isfinite(error[k]) else (np.nan, np.nan)
         for k, ln in enumerate(all_lines)
     )
-    seen = confirmed_modes(all_lines, freq_hz, damping, recording.fs / nperseg, settings.confirm_lines)
+    seen = confirmed_modes(all_lines, freq_hz, damping, recording.fs / nperseg, settings.feature_lines)
     check = ModalCheck(
         tuple(recording.sensors),
         error,
@@ -370,11 +370,11 @@ def check_modes(
     )
     if check.passed:
         return check
-    return ModalCheck(**{**check.__dict__, "bands": _misfit_bands(check, all_lines, settings.band_min_lines)})
+    return ModalCheck(**{**check.__dict__, "bands": _misfit_bands(check, all_lines, settings.feature_lines)})
 
 
 def confirmed_modes(
-    all_lines: list[CoherentLines], freq_hz, damping, line_hz: float, confirm_lines: int = DEFAULTS.frf.confirm_lines
+    all_lines: list[CoherentLines], freq_hz, damping, line_hz: float, confirm_lines: int = DEFAULTS.frf.feature_lines
 ) -> np.ndarray:
     """Per mode: does some output have a coherent line (:func:`~armaxmodal.spectra.coherent_lines`) within
     ``|f - f_m| <= xi_m f_m + confirm_lines`` lines? A mode where no H1 is coherent is

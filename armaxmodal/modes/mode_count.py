@@ -425,7 +425,7 @@ class ModeCount:
           its halves differ beyond chance but not beyond ``settings.decisive_alpha``: ``unsettled_hz``):
           reported, and said tentative;
         * ``"stand_in"``: a start the search carried where no mode is founded but which the
-          model needs (``stand_ins``, matched within ``settings.same_mode_freq``): kept in the
+          model needs (``stand_ins``, matched within ``agreement.match_freq``): kept in the
           model, not reported;
         * ``"not_a_mode"``: beyond the band, damped beyond ``MAX_DAMPING``, or a line (:func:`reported`);
         * ``"borderline"``: not one by its estimate, one by its 95 % interval (``poles.borderline``):
@@ -461,12 +461,12 @@ class ModeCount:
         return verdict
 
     def _pole_at(self, f: float) -> int | None:
-        """The model's pole nearest ``f`` (Hz) if within ``settings.same_mode_freq`` of it, else None:
+        """The model's pole nearest ``f`` (Hz) if within ``agreement.match_freq`` of it, else None:
         one pole, not every pole near (a close pair's other mode is a mode of its own)."""
         if not self.model.n_modes:
             return None
         at = nearest_pole(self.model.freq_hz, f)
-        return at if abs(np.log(self.model.freq_hz[at] / f)) <= self.settings.same_mode_freq else None
+        return at if abs(np.log(self.model.freq_hz[at] / f)) <= self.agreement.match_freq else None
 
     def reported(self, band_hz=None) -> np.ndarray:
         """Which of the model's poles are reported as modes of the band (bool per pole): those

@@ -362,21 +362,21 @@ def _borderline_note(model, i: int, band_hz) -> QualityWarning:
     )
 
 
-def not_separated_notes(modes: pd.DataFrame, separation_sd: float) -> list[QualityWarning]:
-    """A ``modes_not_separated`` note for each pair of neighbouring modes whose frequencies
-    differ by less than ``separation_sd`` standard deviations of the difference and that the
-    count did not report as one (picks, or modes the count left)."""
+def not_separated_notes(modes: pd.DataFrame) -> list[QualityWarning]:
+    """A ``modes_not_separated`` note for each pair of neighbouring modes the record does not
+    separate (:func:`~armaxmodal.modes.intervals.not_separated`) and that the count did not report
+    as one (picks, or modes the count left)."""
     f = modes.freq_hz.to_numpy()
     return [
         QualityWarning(
             "modes_not_separated",
             (),
-            f"modes at {f[i]:.3f} and {f[j]:.3f} Hz are {gap:.1f} standard deviations of their difference apart (under "
-            f"{separation_sd:g}): the record does not separate them; they may be one mode",
+            f"modes at {f[i]:.3f} and {f[j]:.3f} Hz are {gap:.1f} standard deviations of their difference apart (the "
+            "95 % interval of the difference holds zero): the record does not separate them; they may be one mode",
             float(f[i]),
             (f[i], f[j]),
         )
-        for i, j, gap in not_separated(with_intervals(modes), separation_sd)
+        for i, j, gap in not_separated(with_intervals(modes))
     ]
 
 
@@ -418,17 +418,18 @@ def unresolved_damping_notes(modes: pd.DataFrame, n_orders: int) -> list[Quality
     return notes
 
 
-def reported_as_one_note(pair_hz, gap: float, level: float, same_shape: float, f: float, x: float) -> QualityWarning:
+def reported_as_one_note(pair_hz, gap: float, same_shape: float, f: float, x: float) -> QualityWarning:
     """Two poles of the count reported as one mode at ``f`` Hz (damping ``x``): ``gap`` standard
-    deviations apart (under ``level``), their shapes' MAC at least ``same_shape``."""
+    deviations apart (the 95 % interval of their difference holds zero), their shapes' MAC at least
+    ``same_shape``."""
     return QualityWarning(
         "modes_not_separated",
         (),
         f"the modal model needs two poles at {pair_hz[0]:.3f} and {pair_hz[1]:.3f} Hz, but they are {gap:.1f} "
-        f"standard deviations of their difference apart (under {level:g}) and their shapes agree (MAC at least "
-        f"{same_shape:g}): the record does not separate them. Reported as one mode at {f:.3f} Hz (damping {x:.3g}, "
-        "the model with one pole there), its intervals covering both: one resonance whose frequency moves during "
-        "the record (a nonlinearity, a change) or two modes this record cannot resolve",
+        "standard deviations of their difference apart (its 95 % interval holds zero) and their shapes agree "
+        f"(MAC at least {same_shape:g}): the record does not separate them. Reported as one mode at {f:.3f} Hz "
+        f"(damping {x:.3g}, the model with one pole there), its intervals covering both: one resonance whose "
+        "frequency moves during the record (a nonlinearity, a change) or two modes this record cannot resolve",
         f,
         tuple(pair_hz),
     )

@@ -181,7 +181,7 @@ def separate(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     """A ``modes_not_separated`` note for each neighbouring pair the record does not separate and
     that the count did not report as one: after ``spread``, so that the intervals judged are the
     reported ones, every widening included."""
-    return state.warned(*not_separated_notes(state.modes, ctx.settings.count.separation_sd))
+    return state.warned(*not_separated_notes(state.modes))
 
 
 def check(state: SelectionState, ctx: SelectionContext) -> SelectionState:

@@ -179,11 +179,11 @@ class FrfSettings(_Settings):
     #: ARMAX fit carries as doublets. The same records with their strongest mode left out read
     #: 0.50-0.96 on the output that shows it. The limit sits between the two.
     model_error_limit: float = 0.5
-    #: a mode is confirmed by a coherent line within its half-power half-width and this many lines
-    confirm_lines: int = 4
-    #: a band is named where the misfit of a line exceeds half the H1 there and three times
-    #: its random error, over at least this many neighbouring lines
-    band_min_lines: int = 3
+    #: what the H1 shows spans this many lines: a mode is confirmed by a coherent line within its
+    #: half-power half-width and this many lines, and a misfit band is named where the misfit of
+    #: a line exceeds half the H1 there and three times its random error over at least this many
+    #: neighbouring lines (3 for the bands until 2026-12-07: no real record's note changed at 4)
+    feature_lines: int = 4
 
     def __post_init__(self):
         _checked(self)
@@ -259,8 +259,6 @@ class CountSettings(_Settings):
     final_nfev: int = 200
     #: residual evaluations of each half's fit in the halves test
     halves_nfev: int = 40
-    #: a candidate addition within this relative frequency of a mode is that mode
-    same_mode_freq: float = 0.03
     #: the nested tests run on at most this many samples of a record (18 min at 60 Hz, 9 at 120 Hz:
     #: every body's modes are counted on less); a longer record's chosen model is fitted whole
     max_samples: int = 65_536
@@ -268,9 +266,6 @@ class CountSettings(_Settings):
     max_candidates: int = 3
     #: lines either side of the residual's peak averaged to place a new pole
     peak_width_lines: int = 9
-    #: two modes closer than this many standard deviations of their difference are not separated
-    #: by the record (a difference 3 SD from zero is the usual resolution rule)
-    separation_sd: float = 3.0
     #: the counted model is adequate where no sensor's residual power exceeds this multiple of the
     #: noise the local polynomial method measures in it (:func:`armaxmodal.modes.mode_count.model_adequacy`): 0.97-1.02
     #: on 11 simulated bodies and light chains; 1.3-35 on the bridge and shake-table records that misfit
@@ -294,7 +289,9 @@ class AgreementSettings(_Settings):
     #: for 6 on a ride with a cubic spring, none on its linear twin; the 1 % points are 26.2 and 16.8),
     #: and the level of the modal-model check's support F-test (``FrfSettings.model_error_rise``)
     alpha: float = 0.01
-    #: a segment's pole is the mode's when within this relative frequency of it
+    #: a pole of another fit is the mode's when within this relative frequency of it: a segment's,
+    #: a half's, and in the count a candidate addition's or where the search moved a start (3 %
+    #: there until 2026-12-07: at 5 % the battery and the real-data snapshot were unchanged)
     match_freq: float = 0.05
     #: the halves test a pole where the poorer holds this share of the other's response power within match_freq
     #: of it (sweeps 3e-5-1e-2 on the F-16 and a ride; at the modes, earthquakes, random 0.021-1, a 2 Hz sine 3e-3-0.4)

@@ -125,11 +125,11 @@ def test_neighbours_not_separated_are_taken_left_to_right_without_overlap():
         return with_intervals(pd.DataFrame({"freq_hz": f, "freq_sd": sd, "damping": 0.05, "damping_sd": 0.001}))
 
     # 10.0/10.1 and 20.0/20.5 are pairs (0.35 and 0.50 SD apart); 20.5/20.9 are 5.7 apart
-    got = not_separated(modes([10.0, 10.1, 20.0, 20.5, 20.9], [0.2, 0.2, 1.0, 0.05, 0.05]), 3.0)
+    got = not_separated(modes([10.0, 10.1, 20.0, 20.5, 20.9], [0.2, 0.2, 1.0, 0.05, 0.05]))
     assert [(i, j) for i, j, _ in got] == [(0, 1), (2, 3)]
     np.testing.assert_allclose([gap for _, _, gap in got], [0.1 / np.hypot(0.2, 0.2), 0.5 / np.hypot(1.0, 0.05)])
     # 20.0/20.5 with SDs of 0.05 each are 7.1 apart, whatever the wider modes before them
-    got = not_separated(modes([10.0, 10.1, 20.0, 20.5], [0.2, 0.2, 0.05, 0.05]), 3.0)
+    got = not_separated(modes([10.0, 10.1, 20.0, 20.5], [0.2, 0.2, 0.05, 0.05]))
     assert [(i, j) for i, j, _ in got] == [(0, 1)]
 
 

@@ -164,7 +164,7 @@ def test_a_mode_is_confirmed_by_a_coherent_line_within_its_half_width_and_four_l
 
     f = np.arange(1.0, 2.0001, 0.1)  # coherent lines 1.0-2.0 Hz, 0.1 Hz apart
     lines = [CoherentLines(f, np.ones(f.size, complex), np.full(f.size, 0.01))]
-    assert FrfSettings().confirm_lines == 4
+    assert FrfSettings().feature_lines == 4
     # 0.39 and 0.41 Hz past the last line with no damping: four lines reach 0.40 Hz; a 5 %-damped
     # mode at 2.50 Hz adds its half-power half-width, 0.125 Hz
     got = confirmed_modes(lines, [2.39, 2.41, 2.5, 1.5], [0.0, 0.0, 0.05, 0.01], 0.1)

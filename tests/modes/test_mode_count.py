@@ -251,12 +251,12 @@ def _modes(f, sd):
     return with_intervals(pd.DataFrame({"freq_hz": f, "freq_sd": sd, "damping": 0.05, "damping_sd": 0.001}))
 
 
-def test_modes_closer_than_three_deviations_are_not_separated():
-    assert [n.value for n in not_separated_notes(_modes([10.0, 10.5, 20.0], [0.2, 0.2, 0.2]), 3.0)] == [10.0]
-    assert not_separated_notes(_modes([10.0, 10.5], [0.05, 0.05]), 3.0) == []  # 7 SD apart
+def test_modes_whose_difference_holds_zero_at_95_percent_are_not_separated():
+    assert [n.value for n in not_separated_notes(_modes([10.0, 10.5, 20.0], [0.2, 0.2, 0.2]))] == [10.0]  # 1.8 SD
+    assert not_separated_notes(_modes([10.0, 10.5], [0.05, 0.05])) == []  # 7 SD apart
     # taken left to right without overlap: a run of three gives the first pair only
     run = _modes([10.0, 10.1, 10.2, 30.0], [0.2, 0.2, 0.2, 0.2])
-    assert not_separated(run, 3.0) == [(0, 1, pytest.approx(0.354, 1e-2))]
+    assert not_separated(run) == [(0, 1, pytest.approx(0.354, 1e-2))]
 
 
 def _rows_of(model):

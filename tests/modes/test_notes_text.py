@@ -189,10 +189,11 @@ def test_an_oversampled_record_is_told_the_band_and_rate_to_rerun_at():
 def test_modes_the_record_does_not_separate_are_named_with_their_distance():
     modes = with_intervals(pd.DataFrame({"freq_hz": [10.0, 10.5, 20.0], "freq_sd": [0.2, 0.2, 0.2], "damping": 0.05,
                                          "damping_sd": 0.001}))  # fmt: skip
-    assert _said(notes.not_separated_notes(modes, 3.0)) == [
+    assert _said(notes.not_separated_notes(modes)) == [
         ('modes_not_separated', 10.0,
             'modes at 10.000 and 10.500 Hz are 1.8 standard deviations of their difference apart '
-            '(under 3): the record does not separate them; they may be one mode'),
+            '(the 95 % interval of the difference holds zero): the record does not separate them; they may be one '
+            'mode'),
     ]
 
 
@@ -312,10 +313,11 @@ def test_the_count_and_screen_notes_say_their_numbers_in_their_places():
     """The notes the count's rows and the FRF screen write, each from known facts (read against
     them 2026-12-01): a pair reported as one, a mode only the modal model confirms, a pick the model
     takes away, the modes not picked, and a mode the FRF does not need, alone or beside a neighbour."""
-    assert _facts(notes.reported_as_one_note((6.356, 6.395), 0.2, 3.0, 0.8, 6.371, 0.0133)) == (
+    assert _facts(notes.reported_as_one_note((6.356, 6.395), 0.2, 0.8, 6.371, 0.0133)) == (
         "modes_not_separated", (), 6.371, (6.356, 6.395),
         "the modal model needs two poles at 6.356 and 6.395 Hz, but they are 0.2 standard deviations of their "
-        "difference apart (under 3) and their shapes agree (MAC at least 0.8): the record does not separate them. "
+        "difference apart (its 95 % interval holds zero) and their shapes agree (MAC at least 0.8): the record "
+        "does not separate them. "
         "Reported as one mode at 6.371 Hz (damping 0.0133, the model with one pole there), its intervals covering "
         "both: one resonance whose frequency moves during the record (a nonlinearity, a change) or two modes this "
         "record cannot resolve")  # fmt: skip

@@ -110,15 +110,17 @@ def test_best_n_alone_keeps_the_best_supported(diagram):
     assert pipeline.best_n(state, ctx).modes.freq_hz.tolist() == [5.0, 13.0]
 
 
-def test_separate_alone_uses_the_count_settings_level(diagram):
-    modes = pd.DataFrame({"freq_hz": [10.0, 10.5], "damping": [0.02, 0.02], "freq_sd": [0.1, 0.1],
-                          "damping_sd": [0.001, 0.001]})  # fmt: skip
-    state = SelectionState(modes, np.eye(2, dtype=complex))
-    at = lambda sd: SelectionContext(diagram, SelectionSettings(count=CountSettings(separation_sd=sd)), None, [4])  # noqa: E731
-    # 0.5 Hz apart with a difference's SD of 0.14 Hz: 3.5 SD
-    assert pipeline.separate(state, at(3.0)).warnings == ()
-    (note,) = pipeline.separate(state, at(4.0)).warnings
-    assert note.code == "modes_not_separated" and "under 4" in note.message
+def test_separate_alone_notes_a_pair_whose_difference_holds_zero_at_95_percent(diagram):
+    ctx = SelectionContext(diagram, SelectionSettings(), None, [4])
+
+    def pair(apart_hz):  # the difference's SD is 0.1 sqrt(2) = 0.141 Hz
+        modes = pd.DataFrame({"freq_hz": [10.0, 10.0 + apart_hz], "damping": [0.02, 0.02], "freq_sd": [0.1, 0.1],
+                              "damping_sd": [0.001, 0.001]})  # fmt: skip
+        return SelectionState(modes, np.eye(2, dtype=complex))
+
+    assert pipeline.separate(pair(0.28), ctx).warnings == ()  # 1.98 SD: its 95 % interval excludes zero
+    (note,) = pipeline.separate(pair(0.27), ctx).warnings  # 1.91 SD
+    assert note.code == "modes_not_separated" and "1.9 standard deviations" in note.message
 
 
 def test_count_alone_needs_the_refit(diagram):
