@@ -106,7 +106,7 @@ def refit(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     )
     done = fitted.pop("refit")
     c = ctx.settings.cluster
-    state = refined_modes(ctx.diagram, replace(state, segment_fits=fitted), done, c.freq, c.damping, c.merge_mac)
+    state = refined_modes(replace(state, segment_fits=fitted), done, c.freq, c.damping)
     return state.warned(*done.notes()) if isinstance(done, RefitFailure) else state
 
 

@@ -23,7 +23,6 @@ from armaxmodal._threads import single_blas_thread
 from armaxmodal.estimate.dft_model import HOLDS, DftLines, ModalModel, fit_modal_model
 from armaxmodal.estimate.pool import parallel_map
 from armaxmodal.exceptions import OrderError
-from armaxmodal.modes.clusters import merge_duplicates
 from armaxmodal.modes.count_search import count_modes
 from armaxmodal.modes.intervals import segment_jobs, segment_poles
 from armaxmodal.modes.settings import DEFAULTS, DftSettings, SelectionSettings
@@ -349,21 +348,17 @@ class RefitFailure:
         ]
 
 
-def refined_modes(
-    diagram, work: SelectionState, refinement, cluster_freq, cluster_damping, merge_mac
-) -> SelectionState:
+def refined_modes(work: SelectionState, refinement, cluster_freq, cluster_damping) -> SelectionState:
     """The frequency-domain refit (:func:`refine_modes`, or a
     :class:`RefitFailure` when it could not be made, which leaves the selection without one)
-    reported for a band-limited record, and kept as the selection's ``refinement``.
-    ``merge_mac`` None: two modes the refit brings together stay two (modes picked by hand)."""
+    reported for a band-limited record, and kept as the selection's ``refinement``. Two modes the
+    refit brings together stay two: the count judges them (with ``n_modes`` given, the
+    ``separate`` stage names them)."""
     if refinement is None or isinstance(refinement, RefitFailure):
         return replace(work, refinement=None)
     work = replace(work, refinement=refinement)
     if refinement.hold == "bandlimited":
-        modes, shapes = _apply_refinement(work.modes, work.shapes, refinement, cluster_freq, cluster_damping)
-        work = work.with_modes(modes, shapes)
-        if merge_mac is not None:  # two modes the refit brought together are one peak
-            work = work.kept(merge_duplicates(modes, list(shapes.T), merge_mac, diagram.recording.duration))
+        work = work.with_modes(*_apply_refinement(work.modes, work.shapes, refinement, cluster_freq, cluster_damping))
     return work
 
 

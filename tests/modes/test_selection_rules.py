@@ -442,13 +442,12 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
         return SimpleNamespace(hold="zoh")
 
     modes, shapes = _modes([5.0, 9.0], [0.1, 0.05], [1.0, 1.0]), np.eye(2, dtype=complex)
-    diagram = SimpleNamespace(recording=rec)
     assert st.refit_band(rec, (4.0, 12.0)) == (max(lo, 4.0), min(hi, 12.0))
     assert st.refit_band(rec, None) == (lo, hi)
     ref = st.selection_job(rec, [], modes, ("refit", (4.0, 12.0)), refine=refit)
     assert seen[-1] == (4.0, 12.0) and ref.hold == "zoh"
     work = SelectionState(modes, shapes)
-    out = st.refined_modes(diagram, work, ref, 0.05, 0.5, 0.8)
+    out = st.refined_modes(work, ref, 0.05, 0.5)
     # a held input: the ARMAX values are reported
     assert out.refinement is ref and out.modes is modes and out.shapes is shapes
 
@@ -459,7 +458,7 @@ def test_refit_runs_inside_the_users_band_and_is_reported_only_for_band_limited_
     assert isinstance(failed, st.RefitFailure) and failed.reason == "too few lines"  # said, not silent
     (note,) = failed.notes()
     assert note.code == "refit_failed" and "too few lines" in note.message
-    out = st.refined_modes(diagram, work, failed, 0.05, 0.5, 0.8)
+    out = st.refined_modes(work, failed, 0.05, 0.5)
     assert out.refinement is None and out.modes is modes and out.shapes is shapes  # the ARMAX values stand
 
 
@@ -480,8 +479,7 @@ def test_a_band_limited_refit_is_reported_within_its_reach_else_the_armax_value_
     modes = _modes([5.0, 9.0], [0.1, 0.05], [1.0, 1.0]).assign(estimator="armax", freq_sd=0.5, damping_sd=0.5)
     refit_shapes = np.array([[1.0, 0.2], [0.3, 1.0]], dtype=complex)
     ref = _band_limited_refit(freq_hz, damping, refit_shapes)
-    out = st.refined_modes(SimpleNamespace(recording=_recording(2000)), SelectionState(modes, np.eye(2, dtype=complex)),
-                           ref, 0.05, 0.5, 0.8)  # fmt: skip
+    out = st.refined_modes(SelectionState(modes, np.eye(2, dtype=complex)), ref, 0.05, 0.5)
     assert out.refinement is ref and len(out.modes) == 2
     for i, taken in enumerate(reported):
         expected = (freq_hz[i], damping[i], 1e-3 * freq_hz[i]) if taken else (modes.freq_hz[i], modes.damping[i], 0.5)
@@ -490,18 +488,15 @@ def test_a_band_limited_refit_is_reported_within_its_reach_else_the_armax_value_
         np.testing.assert_array_equal(out.shapes[:, i], refit_shapes[:, i] if taken else np.eye(2)[:, i])
 
 
-def test_two_modes_a_band_limited_refit_brings_together_are_one_unless_picked():
-    """5.00 and 5.25 Hz refitted to 5.10 and 5.12 Hz: closer than 2 / T (T = 33 s), one mode, the
-    better supported one; with ``merge_mac`` None (picks) both stay."""
+def test_two_modes_a_band_limited_refit_brings_together_stay_two_for_the_count():
+    """5.00 and 5.25 Hz refitted to 5.10 and 5.12 Hz: both stay, for the count to judge (the refit
+    merged them until 2026-12-07, and ``n_modes`` could come back short)."""
     import armaxmodal.modes.state as st
 
     modes = _modes([5.0, 5.25], [0.1, 0.1], [0.5, 1.0]).assign(estimator="armax", freq_sd=0.5, damping_sd=0.5)
     ref = _band_limited_refit([5.10, 5.12], [0.1, 0.1], np.eye(2, dtype=complex))
-    diagram, work = SimpleNamespace(recording=_recording(2000)), SelectionState(modes, np.eye(2, dtype=complex))
-    out = st.refined_modes(diagram, work, ref, 0.05, 0.5, 0.8)
-    assert out.modes.freq_hz.tolist() == [5.12] and out.modes.index.tolist() == [0]
-    assert out.shapes.tolist() == [[0.0], [1.0]]
-    assert st.refined_modes(diagram, work, ref, 0.05, 0.5, None).modes.freq_hz.tolist() == [5.10, 5.12]
+    out = st.refined_modes(SelectionState(modes, np.eye(2, dtype=complex)), ref, 0.05, 0.5)
+    assert out.modes.freq_hz.tolist() == [5.10, 5.12] and out.shapes.tolist() == [[1.0, 0.0], [0.0, 1.0]]
 
 
 def test_filled_samples_widen_every_interval_by_the_information_they_lack():
