@@ -854,7 +854,7 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/count_search.py",
-        "if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > search.agreement.match_freq\n",
+        "if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > search.reach\n",
         "if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > 1.0\n",
         "no start pole ever counted as carried away (count)",
     ),
@@ -956,7 +956,7 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/mode_count.py",
-        "        return at if abs(np.log(self.model.freq_hz[at] / f)) <= self.agreement.match_freq else None",
+        "        return at if abs(np.log(self.model.freq_hz[at] / f)) <= self.reach else None",
         "        return at",
         "a stand-in or unsettled pole matched at any distance (count)",
     ),

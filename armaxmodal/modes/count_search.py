@@ -50,10 +50,11 @@ class _Search:
         dft: DftSettings = DEFAULTS.dft,
         fitter: Callable = fit_modal_model,
         agreement: AgreementSettings = DEFAULTS.agreement,
+        reach: float = DEFAULTS.cluster.freq,
     ):
         self.data, self.hold, self.n_eff, self.max_nfev, self.n_jobs = data, hold, n_effective, max_nfev, n_jobs
         self.cfg, self.dft, self.trials, self.table = settings, dft, 0, ModelTable(n_effective)
-        self.fitter, self.agreement, self.logged = fitter, agreement, self.table.add
+        self.fitter, self.agreement, self.reach, self.logged = fitter, agreement, reach, self.table.add
 
     def screened(
         self, starts: list[tuple[np.ndarray, np.ndarray]], labels: list[tuple[str, float]], intervals: bool = True
@@ -124,7 +125,8 @@ class _Search:
         """Do the new poles of ``trial`` (indices ``new``) that both halves excite agree in them at ``agreement.alpha``,
         pooled (:func:`halves_chi2`; its probability ``self.p``)? None: none is excited, not asked. Into its row."""
         self.trials += 2
-        chi2 = halves_chi2(self.data, trial, halves, self.hold, self.max_nfev, self.dft, self.fitter, self.agreement)
+        fits = (self.hold, self.max_nfev, self.dft, self.fitter, self.agreement, self.reach)
+        chi2 = halves_chi2(self.data, trial, halves, *fits)
         tested = [i for i in new if np.isfinite(chi2[i])]
         self.p = float(chdtrc(2 * len(tested), np.sum(chi2[tested]))) if tested else 1.0  # no new pole: agreed
         return self.table.halves(trial, self.p >= self.agreement.alpha if tested or not new else None)
@@ -143,7 +145,7 @@ class _Search:
         that hides two leaves its largest residual in its band; splitting all found no more)."""
         trials = []
         for f, x in candidates:
-            if current.n_modes and np.min(np.abs(current.freq_hz / f - 1)) <= self.agreement.match_freq:
+            if current.n_modes and np.min(np.abs(current.freq_hz / f - 1)) <= self.reach:
                 continue
             trials.append(("add", float(f), np.r_[current.freq_hz, f], np.r_[current.damping, x]))
         for m in [nearest_pole(current.freq_hz, peak_hz)] if current.n_modes else []:
@@ -169,7 +171,7 @@ def _margins(search: _Search, here: float, current: ModalModel, removed, best_re
 
 
 def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, halves=()):
-    """The chosen model without the starting poles the search carried beyond ``agreement.match_freq``
+    """The chosen model without the starting poles the search carried beyond the clustering's reach
     of every start to where no mode is founded, refitted. A pole reported there is a new pole and
     must show what a mode has: a resolved damping, and the same values in both halves of the record
     (``_Search.in_both_halves``; where they do not both excite it, stability across the orders), judged on
@@ -187,7 +189,7 @@ def _without_unfounded(search: _Search, start_hz, model: ModalModel, supported, 
     moved = [
         (i, j)
         for i, j in matched_poles(start_hz, model.freq_hz)
-        if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > search.agreement.match_freq
+        if shown[i] and abs(np.log(model.freq_hz[i] / start_hz[j])) > search.reach
     ]
     unfounded, tentative = [], []
     for i, j in moved:
@@ -293,6 +295,7 @@ def count_modes(
     fitter: Callable = fit_modal_model,
     agreement: AgreementSettings = DEFAULTS.agreement,
     adequacy: Callable | None = None,
+    reach: float = DEFAULTS.cluster.freq,
 ) -> ModeCount:
     """Choose the number of modes by nested tests of free refits (see the module notes).
 
@@ -325,6 +328,9 @@ def count_modes(
         The modal model's fits (a pole at their damping floor is a line, not a mode); the halves' test's level.
     fitter : callable
         The fit, as :func:`~armaxmodal.estimate.dft_model.fit_modal_model` (a test's stands in for it).
+    reach : float
+        Two poles within this relative frequency are one mode (the clustering's reach,
+        ``ClusterSettings.freq``): a candidate near a mode, a start the search kept near, a half's pole.
     adequacy : callable, optional
         ``adequacy(model, data) -> Adequacy``: the adequacy test (default
         :func:`~armaxmodal.modes.mode_count.model_adequacy` at ``settings.adequacy_ratio``; a test's
@@ -368,6 +374,7 @@ def count_modes(
         fitter=fitter,
         agreement=agreement,
         adequacy=adequacy,
+        reach=reach,
     )
 
 
@@ -430,6 +437,7 @@ def _searched(
     dft,
     fitter,
     agreement,
+    reach,
 ) -> ModeCount:
     """One search from the starting set; ``rule``: an addition is admitted only where ``supported`` says
     (which also says whether a wanted mode has a column to pick)."""
@@ -452,6 +460,7 @@ def _searched(
             dft,
             fitter,
             agreement,
+            reach,
         ),
     )
     search.logged("start", float("nan"), start_model)
@@ -459,7 +468,7 @@ def _searched(
     lost = [
         (f, x)
         for f, x in zip(np.atleast_1d(freq_hz), np.atleast_1d(damping), strict=True)
-        if np.min(np.abs(np.log(start_model.freq_hz / f))) > agreement.match_freq
+        if np.min(np.abs(np.log(start_model.freq_hz / f))) > reach
     ]
     current, steps, candidates, unconfirmed, unsettled = start_model, [], list(candidates) + lost, [], []
 
@@ -506,7 +515,7 @@ def _searched(
     unsettled += [
         f
         for f in tentative  # one note a pole: the search may have taken it so already
-        if not any(abs(np.log(f / u)) <= agreement.match_freq for u in unsettled)
+        if not any(abs(np.log(f / u)) <= reach for u in unsettled)
     ]
     if carried_away:  # the model lost a pole: its neighbours are judged again, from where it stands
         here, removed, best_removal, best_addition = neighbours()
@@ -541,4 +550,5 @@ def _searched(
         settings=settings,
         dft=dft,
         agreement=agreement,
+        reach=reach,
     )

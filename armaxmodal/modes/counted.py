@@ -164,6 +164,7 @@ def counted_modes(
         settings=settings.count,
         dft=settings.dft,
         agreement=settings.agreement,
+        reach=settings.cluster.freq,
     )
     whole = data if part is rec else DftLines.from_recording(rec, band_hz)  # each cut's lines built once
     if part is not rec:
@@ -321,7 +322,16 @@ def confirmed_where_incoherent(
         return (), []
     m, hold, (data, halves) = count.model, work.refinement.hold, work.count_lines  # the count's own lines
     data = data.noise_weighted(m)
-    chi2 = halves_chi2(data, m, halves, hold, count.settings.halves_nfev, count.dft, agreement=settings.agreement)
+    chi2 = halves_chi2(
+        data,
+        m,
+        halves,
+        hold,
+        count.settings.halves_nfev,
+        count.dft,
+        agreement=settings.agreement,
+        reach=settings.cluster.freq,
+    )
     agree = chdtrc(2, chi2) >= settings.agreement.alpha  # each pole alone: 2 degrees of freedom
     reach, needed = settings.cluster.same_row_freq, count.verdicts() == "needed"
     confirmed, notes = [], []

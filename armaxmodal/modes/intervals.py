@@ -249,7 +249,7 @@ def segment_spread(
     n_segments: int = N_SEGMENTS,
     n_jobs: int | None = None,
     fitted: dict | None = None,
-    match_freq: float = DEFAULTS.agreement.match_freq,
+    match_freq: float = DEFAULTS.cluster.freq,
 ):
     """Between-segment standard deviation of each mode's frequency and damping.
 

@@ -347,6 +347,7 @@ class ModeCount:
     agreement: AgreementSettings = DEFAULTS.agreement
     adequacy: Adequacy | None = None
     rule_refused: tuple = ()
+    reach: float = DEFAULTS.cluster.freq
 
     def __post_init__(self):
         # the search hands its findings over as plain tuples; the result holds them by name
@@ -425,7 +426,7 @@ class ModeCount:
           its halves differ beyond chance but not beyond ``settings.decisive_alpha``: ``unsettled_hz``):
           reported, and said tentative;
         * ``"stand_in"``: a start the search carried where no mode is founded but which the
-          model needs (``stand_ins``, matched within ``agreement.match_freq``): kept in the
+          model needs (``stand_ins``, matched within ``reach``): kept in the
           model, not reported;
         * ``"not_a_mode"``: beyond the band, damped beyond ``MAX_DAMPING``, or a line (:func:`reported`);
         * ``"borderline"``: not one by its estimate, one by its 95 % interval (``poles.borderline``):
@@ -461,12 +462,12 @@ class ModeCount:
         return verdict
 
     def _pole_at(self, f: float) -> int | None:
-        """The model's pole nearest ``f`` (Hz) if within ``agreement.match_freq`` of it, else None:
+        """The model's pole nearest ``f`` (Hz) if within ``reach`` of it, else None:
         one pole, not every pole near (a close pair's other mode is a mode of its own)."""
         if not self.model.n_modes:
             return None
         at = nearest_pole(self.model.freq_hz, f)
-        return at if abs(np.log(self.model.freq_hz[at] / f)) <= self.agreement.match_freq else None
+        return at if abs(np.log(self.model.freq_hz[at] / f)) <= self.reach else None
 
     def reported(self, band_hz=None) -> np.ndarray:
         """Which of the model's poles are reported as modes of the band (bool per pole): those
@@ -537,12 +538,14 @@ def halves_chi2(
     dft: DftSettings = DEFAULTS.dft,
     fitter=fit_modal_model,
     agreement: AgreementSettings = DEFAULTS.agreement,
+    reach: float = DEFAULTS.cluster.freq,
 ) -> np.ndarray:
     """Per pole of ``model``: how far apart the record's two halves (``halves``, lines weighted as
     ``data``; each fitted from ``model``'s poles by ``fitter``) put it: the squared differences of its
     frequency and damping in standard deviations of the difference, summed (each half's pole the one
     nearest the model's): a chi-square of 2 degrees of freedom where the halves agree. NaN where the
-    sensors hardly move near it in one half (``agreement.excitation_ratio``: a sweep passes it in one).
+    sensors hardly move within ``reach`` of it in one half (``agreement.excitation_ratio``: a sweep
+    passes it in one).
 
     Returns
     -------
@@ -553,7 +556,7 @@ def halves_chi2(
     )
     chi2 = np.zeros(model.n_modes)
     for i, f in enumerate(model.freq_hz):
-        power = [h.response_power(f, agreement.match_freq) for h in halves]
+        power = [h.response_power(f, reach) for h in halves]
         if min(power) < agreement.excitation_ratio * max(power):
             chi2[i] = np.nan
             continue

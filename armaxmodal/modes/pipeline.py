@@ -215,7 +215,7 @@ def spread(state: SelectionState, ctx: SelectionContext) -> SelectionState:
         ctx.segments,
         ctx.n_jobs,
         state.segment_fits,
-        limits.match_freq,
+        ctx.settings.cluster.freq,
     )
     modes, notes = apply_segment_spread(modes, table, ctx.segments, limits.alpha)
     return replace(state, modes=modes).warned(*notes)

@@ -103,8 +103,10 @@ class ClusterSettings(_Settings):
     """Which poles of the diagram are one mode (stages ``candidates`` and ``merge``)."""
 
     #: relative frequency distance within which a pole joins a cluster (its median); also a pick's
-    #: reach, a counted mode's row reach (:attr:`pick_reach`, :attr:`same_row_freq`), and how far a
-    #: finished fit's pole may lie from the pole it finishes (farther, it is another pole)
+    #: reach, a counted mode's row reach (:attr:`pick_reach`, :attr:`same_row_freq`), how far a
+    #: finished fit's pole may lie from the pole it finishes (farther, it is another pole), and
+    #: where another fit's pole is the mode's: a segment's, a half's, a count's addition or moved
+    #: start (AgreementSettings.match_freq, 5 %, and the count's 3 % until 2026-12-07)
     freq: float = 0.05
     #: relative damping distance within which a pole joins a cluster
     damping: float = 0.5
@@ -289,11 +291,8 @@ class AgreementSettings(_Settings):
     #: for 6 on a ride with a cubic spring, none on its linear twin; the 1 % points are 26.2 and 16.8),
     #: and the level of the modal-model check's support F-test (``FrfSettings.model_error_rise``)
     alpha: float = 0.01
-    #: a pole of another fit is the mode's when within this relative frequency of it: a segment's,
-    #: a half's, and in the count a candidate addition's or where the search moved a start (3 %
-    #: there until 2026-12-07: at 5 % the battery and the real-data snapshot were unchanged)
-    match_freq: float = 0.05
-    #: the halves test a pole where the poorer holds this share of the other's response power within match_freq
+    #: the halves test a pole where the poorer holds this share of the other's response power within the
+    #: clustering's reach
     #: of it (sweeps 3e-5-1e-2 on the F-16 and a ride; at the modes, earthquakes, random 0.021-1, a 2 Hz sine 3e-3-0.4)
     excitation_ratio: float = 0.01
 

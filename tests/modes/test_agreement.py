@@ -11,7 +11,7 @@ from scipy.special import chdtrc
 import armaxmodal as am
 from armaxmodal.modes.count_search import _Search
 from armaxmodal.modes.mode_count import halves_chi2
-from armaxmodal.modes.settings import AgreementSettings, DftSettings, SelectionSettings
+from armaxmodal.modes.settings import AgreementSettings, ClusterSettings, DftSettings, SelectionSettings
 
 
 class _Half:
@@ -25,7 +25,7 @@ class _Half:
         return self
 
     def response_power(self, freq_hz, reach):
-        assert reach == AgreementSettings().match_freq  # where a half's pole is the mode's
+        assert reach == ClusterSettings().freq  # where a half's pole is the mode's: the clustering's reach
         return self.power.get(float(freq_hz), 1.0)
 
 
