@@ -18,6 +18,32 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 # (file, original text, mutated text, what it models)
 MUTANTS = [
+    # session 30's merges; run with --match "(merged)" --tests tests/modes/test_borderline.py
+    # tests/modes/test_mode_count.py tests/modes/test_pipeline.py tests/modes/test_agreement.py
+    (
+        "armaxmodal/modes/poles.py",
+        "    return model.damping <= 2 * model.damping_floor",
+        "    return model.damping <= model.damping_floor",
+        "a line only exactly at the fit's floor (merged)",
+    ),
+    (
+        "armaxmodal/modes/intervals.py",
+        "        if gap < Z95:",
+        "        if gap <= 3.0:",
+        "the old separation level (merged)",
+    ),
+    (
+        "armaxmodal/modes/mode_count.py",
+        "        power = [h.response_power(f, reach) for h in halves]",
+        "        power = [h.response_power(f, 0.001) for h in halves]",
+        "the halves' power read at one line, not the reach (merged)",
+    ),
+    (
+        "armaxmodal/modes/count_search.py",
+        "            if current.n_modes and np.min(np.abs(current.freq_hz / f - 1)) <= self.reach:",
+        "            if current.n_modes and np.min(np.abs(current.freq_hz / f - 1)) <= 0.0:",
+        "a candidate on a mode tried again (merged)",
+    ),
     # the clock drift (issue 70); run with --match "(clock drift)" --tests tests/diagnosis/test_clock_drift.py
     (
         "armaxmodal/diagnosis/clock_drift.py",

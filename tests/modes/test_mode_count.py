@@ -490,6 +490,16 @@ def test_the_search_takes_only_steps_that_lower_the_criterion(supine, start):
     assert sorted((d, alt.n_modes) for d, alt in count.alternatives) == [(2.0, 4), (5.0, 2), (5.0, 2), (5.0, 2)]
 
 
+def test_a_candidate_within_the_clusterings_reach_of_a_mode_is_that_mode_not_an_addition(supine):
+    """A left-out cluster 4 % from a mode of the model is that mode (the clustering's reach, 5 %):
+    not fitted as an addition; one 9 % away is."""
+    table = {2: 130.0, 3: 95.0, 4: 120.0, 5: 140.0}
+    count = count_modes(supine[0], [5.0, 9.0, 13.0], [0.3, 0.3, 0.3], [(9.36, 0.3), (14.2, 0.3)], hold="zoh",
+                        fitter=_scripted(table), adequacy=_world(True))  # fmt: skip
+    added = {round(row.freq_hz, 2) for row in count.models if row.action == "add"}
+    assert 14.2 in added and 9.36 not in added
+
+
 def test_a_decided_count_has_no_equally_good_model(supine):
     """Criterion 130, 95, 120 for 2, 3, 4 modes: every neighbour is worse by more than
     DECISIVE_BIC, so no other count enters the intervals."""
