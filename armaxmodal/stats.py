@@ -105,17 +105,16 @@ def welch_nperseg(n_samples: int, fs: float, seconds: float = 10.0, max_fraction
     return int(min(n_samples // max_fraction, 2 ** int(np.ceil(np.log2(fs * seconds)))))
 
 
-def effective_fraction(residual: np.ndarray, max_lag: int) -> float:
+def effective_fraction(residual: np.ndarray) -> float:
     """The fraction of DFT lines that are independent, from the residual's correlation across
     lines: ``1 / (1 + 2 sum_k rho_k)`` (Bartlett's effective sample size), the sum over lags
-    ``k = 1, 2, ...`` up to the first non-positive ``rho_k`` or ``max_lag``.
+    ``k = 1, 2, ...`` up to the first non-positive ``rho_k`` (at most a quarter of the lines: the
+    window ends where the correlation does, not at a set lag).
 
     Parameters
     ----------
     residual : (n_lines, n_sensors) complex ndarray
         A fit's residual on consecutive lines.
-    max_lag : int
-        The last lag summed.
 
     Returns
     -------
@@ -131,9 +130,9 @@ def effective_fraction(residual: np.ndarray, max_lag: int) -> float:
     >>> import numpy as np
     >>> from armaxmodal.stats import effective_fraction
     >>> white = np.random.default_rng(0).standard_normal((4000, 4)) @ [[1, 0], [1j, 0], [0, 1], [0, 1j]]
-    >>> round(effective_fraction(white, 10), 1)
+    >>> round(effective_fraction(white), 1)
     1.0
-    >>> round(effective_fraction(white + np.roll(white, 1, axis=0), 10), 1)  # neighbours correlated 0.5
+    >>> round(effective_fraction(white + np.roll(white, 1, axis=0)), 1)  # neighbours correlated 0.5
     0.5
     """
     r = np.asarray(residual) - np.mean(residual, axis=0)
@@ -141,7 +140,7 @@ def effective_fraction(residual: np.ndarray, max_lag: int) -> float:
     if power == 0 or r.shape[0] < 4:
         return 1.0
     total = 0.0
-    for k in range(1, min(max_lag, r.shape[0] // 4) + 1):
+    for k in range(1, r.shape[0] // 4 + 1):
         # complex correlation of lines k apart, pooled over sensors; its real part is what
         # shares information between the two lines
         rho = float(np.real(np.sum(np.conj(r[:-k]) * r[k:])) / power)

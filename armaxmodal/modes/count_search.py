@@ -447,7 +447,7 @@ def _searched(
     # concentrated over those levels; the weights only steer the fits)
     data = data.noise_weighted(start_model)
     start_model = fitter(data, start_model.freq_hz, start_model.damping, hold, max_nfev, settings=dft)
-    fraction = effective_fraction(start_model.residual, settings.max_correlation_lag)
+    fraction = effective_fraction(start_model.residual)
     searching, search = (
         search,
         _Search(

@@ -246,10 +246,6 @@ class CountSettings(_Settings):
     #: halves; 1e-6: one value 5.3 apart); where it misfits, its standard deviations are no judge
     #: and ``agreement.alpha`` refuses
     decisive_alpha: float = 1e-6
-    #: the residual's correlation across lines is summed up to this many lines (Bartlett's window):
-    #: the widest structure of model error is a resonance's half-power band, 2 xi f = 3-10 Hz
-    #: for the bodies, i.e. hundreds of lines; the sum stops earlier at the first negative value
-    max_correlation_lag: int = 400
     #: search steps at most (each accepted step changes the count by one)
     max_steps: int = 6
     #: residual evaluations of a screening fit: the candidates are compared after this many steps

@@ -166,11 +166,11 @@ def test_the_penalty_grows_with_the_data(supine):
 def test_effective_fraction_is_bartletts_for_white_and_smoothed_noise():
     rng = np.random.default_rng(5)
     white = rng.standard_normal((20000, 3)) + 1j * rng.standard_normal((20000, 3))
-    assert effective_fraction(white, 400) > 0.95
+    assert effective_fraction(white) > 0.95
     # a moving average over w lines: 1 + 2 sum (1 - k / w) = w, so a fraction of 1 / w
     w = 8
     smooth = np.apply_along_axis(lambda c: np.convolve(c, np.ones(w) / w, mode="valid"), 0, white)
-    assert effective_fraction(smooth, 400) == pytest.approx(1 / w, rel=0.15)
+    assert effective_fraction(smooth) == pytest.approx(1 / w, rel=0.15)
 
 
 def _model(freq, damping, sd=0.01):
