@@ -10,9 +10,10 @@ The selection system is ``armaxmodal/modes/`` with ``estimate/dft_model.py``, ``
   ``modes.poles.Tolerances``;
 * files ``ruff format --check`` would reformat, and ``# fmt: skip`` markers.
 
-    python tools/selection_shape.py [--strict]
+    python tools/selection_shape.py [--strict] [--hold MEASURE ...]
 
-``--strict`` exits 1 when a number is over its limit (not yet run by CI: the limits are not met).
+``--strict`` exits 1 when a number is over its limit; ``--hold MEASURE`` when that one is (CI holds
+the measures met, so that they stay met: the named thresholds and the formatting).
 """
 
 from __future__ import annotations
@@ -84,7 +85,9 @@ def reformatted(files: list[Path]) -> int:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--strict", action="store_true", help="exit 1 when a number is over its limit")
-    strict = parser.parse_args().strict
+    held = "exit 1 when this measure is over its limit (CI holds the ones met); repeatable"
+    parser.add_argument("--hold", action="append", default=[], choices=list(LIMITS), metavar="MEASURE", help=held)
+    args = parser.parse_args()
     files = selection_files()
     texts = [path.read_text() for path in files]
     shape = {
@@ -98,11 +101,11 @@ def main() -> int:
     print(f"selection system: {len(files)} files")
     for name, value in shape.items():
         verdict = "within" if value <= LIMITS[name] else "OVER"
-        over |= value > LIMITS[name]
-        print(f"  {name}: {value:,} ({verdict} the limit {LIMITS[name]:,})")
+        over |= value > LIMITS[name] and (args.strict or name in args.hold)
+        print(f"  {name}: {value:,} ({verdict} the limit {LIMITS[name]:,}{', held' if name in args.hold else ''})")
     print(f"  '# fmt: skip' markers: {skips}")
     print(f"  fixed numbers beside the thresholds in modes/settings.py: {fixed_numbers()}")
-    return int(strict and over)
+    return int(over)
 
 
 if __name__ == "__main__":
