@@ -196,7 +196,10 @@ def print_modes(modes, picked: bool = False) -> None:
         f_ci = f"[{m.freq_ci95_lo:.4f}, {m.freq_ci95_hi:.4f}]"
         x_ci = f"[{m.damping_ci95_lo:.4f}, {m.damping_ci95_hi:.4f}]"
         pick = f"  {m.picked_hz:11.4f}" if picked and np.isfinite(m.picked_hz) else ""
-        print(f"{k:>4} {m.freq_hz:9.4f}  {f_ci:<22} {m.damping:7.4f}  {x_ci:<16} {int(m.count):>6}{pick}")
+        orders = f"{int(m.count)}" if m.count > 0 else "-"
+        print(f"{k:>4} {m.freq_hz:9.4f}  {f_ci:<22} {m.damping:7.4f}  {x_ci:<16} {orders:>6}{pick}")
+    if (modes["count"] == 0).any():  # a zero would read as a mode no order supports
+        print("  orders -: added by the modal model's count; no column of the diagram holds it")
 
 
 def print_check(check) -> None:

@@ -171,3 +171,22 @@ def test_quiet_turns_the_progress_off_not_the_result(fixtures_dir, capsys):
     out, err = capsys.readouterr()
     assert "mode    f (Hz)" in out and "modal-model check" in out and "quality: " in out
     assert "fit/s" not in err and "%|" not in err
+
+
+def test_a_mode_the_count_added_shows_no_orders_and_says_why(capsys):
+    """A diagram cluster's mode prints the orders that hold it; a mode the modal model's count added
+    (no cluster: ``count`` 0) prints "-" and one line under the table, never a 0 that reads as a
+    mode no order supports."""
+    import pandas as pd
+
+    from armaxmodal.cli.stabilise import print_modes
+
+    modes = pd.DataFrame({"freq_hz": [5.83, 6.41], "freq_ci95_lo": [5.82, 6.30], "freq_ci95_hi": [5.84, 6.52],
+                          "damping": [0.26, 0.02], "damping_ci95_lo": [0.25, 0.01], "damping_ci95_hi": [0.27, 0.03],
+                          "count": [14, 0]})  # fmt: skip
+    print_modes(modes)
+    first, second, note = capsys.readouterr().out.splitlines()[1:]
+    assert first.split()[-1] == "14" and second.split()[-1] == "-"
+    assert note == "  orders -: added by the modal model's count; no column of the diagram holds it"
+    print_modes(modes.iloc[:1])
+    assert len(capsys.readouterr().out.splitlines()) == 2  # no such mode: no line
