@@ -300,7 +300,7 @@ def at_fit_floor(model) -> np.ndarray:
 
 def reported(model, band_hz) -> np.ndarray:
     """Which of a model's poles are modes of the band (bool per pole): not beyond it, not damped
-    beyond ``MAX_DAMPING``, and not a line (:func:`at_fit_floor`)."""
+    beyond ``MAX_DAMPING``, and not a line (``at_fit_floor``)."""
     f, x = model.freq_hz, model.damping
     return (f >= band_hz[0]) & (f <= band_hz[1]) & (x <= MAX_DAMPING) & ~at_fit_floor(model)
 

@@ -306,7 +306,7 @@ class SelectionSettings(_Settings):
         Which poles of the diagram are lines: its ``periodic_disturbance`` note and the
         diagnosis read the defaults (the diagram is made before any selection). The count's
         lines are the modal model's poles at its fit's damping floor
-        (:func:`armaxmodal.modes.poles.at_fit_floor`).
+        (``armaxmodal.modes.poles.at_fit_floor``).
     frf : FrfSettings
         The modal-model check of the measured H1, and what it proposes and screens.
     dft : DftSettings
