@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-CLI = [sys.executable, "-m", "armaxmodal"]
+CLI = [sys.executable, "-P", "-m", "armaxmodal"]  # -P: the package on the path, not the working directory's
 
 
 def _runs(real: Path) -> dict[str, list[str]]:

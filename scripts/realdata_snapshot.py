@@ -8,7 +8,6 @@ Run:  python scripts/realdata_snapshot.py OUT_DIR [--shared ../shared]
 from __future__ import annotations
 
 import argparse
-import os
 import re
 import subprocess
 import sys
@@ -18,12 +17,9 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from realdata_table import _damaged  # noqa: E402  (the damaged fixture copies of the table)
 
-import armaxmodal  # noqa: E402
-
-CLI = [sys.executable, "-m", "armaxmodal", "--quiet", "stabilise"]
-# the command line runs the package this script imports: "python -m" puts the working directory
-# first on the path, so run from a checkout with PYTHONPATH at a copy it ran the checkout's code
-CLI_ENV = {**os.environ, "PYTHONPATH": str(Path(armaxmodal.__file__).resolve().parents[1])}
+# -P: the command line runs the package on the path, as this script does; without it "python -m" puts
+# the working directory first, so run from a checkout with PYTHONPATH at a copy it ran the checkout
+CLI = [sys.executable, "-P", "-m", "armaxmodal", "--quiet", "stabilise"]
 
 
 def _runs(real: Path) -> dict[str, list[str]]:
@@ -53,9 +49,8 @@ def main() -> None:
         runs.update(_damaged(Path(tmp)))
         for name, run in runs.items():
             stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", name)
-            proc = subprocess.run([*CLI, *run, "--json", str(out.resolve() / f"{stem}.json"), "--csv",
-                                   str(out.resolve() / f"{stem}.csv")], capture_output=True, text=True, cwd=tmp,
-                                  env=CLI_ENV)  # fmt: skip
+            proc = subprocess.run([*CLI, *run, "--json", str(out / f"{stem}.json"), "--csv", str(out / f"{stem}.csv")],
+                                  capture_output=True, text=True)
             text = (proc.stdout + proc.stderr).replace(tmp, "TMP")
             (out / f"{stem}.txt").write_text(f"rc {proc.returncode}\n{text}")
             print(name, proc.returncode, flush=True)

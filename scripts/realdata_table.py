@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 ROOT = Path(__file__).resolve().parents[1]
-CLI = [sys.executable, "-m", "armaxmodal"]
+CLI = [sys.executable, "-P", "-m", "armaxmodal"]  # -P: the package on the path, not the working directory's
 
 
 def _damaged(tmp: Path) -> dict:
