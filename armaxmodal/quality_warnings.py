@@ -266,9 +266,8 @@ CODES: tuple[WarningCode, ...] = (
     WarningCode(
         "oversampled",
         "selection; identify too",
-        "the band the modes found need (2.5 × the highest) would lower the analysis rate by 2 or more: every mode "
-        "below 16 % of its Nyquist frequency (the measured records here: 28–66 %), because the input excites far "
-        "above the structure and the rate was kept",
+        "every mode found lies below 10 % of the Nyquist frequency of the analysis rate (the measured records here: "
+        "28–66 %), because the input excites far above the structure and the rate was kept",
         "reported with the band to rerun with (2.5 × the highest mode found) and the rate it gives. The supine model "
         "at 1 kHz under a 0.5–400 Hz ride: one of four modes (16.34 Hz), no word before; with the suggested `--band "
         "0:41` (111 Hz): 5.83, 8.32, 13.44, 16.22 Hz against 5.83, 8.31, 13.50, 16.25, in 3.3 s instead of 10.3 s. "

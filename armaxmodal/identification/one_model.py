@@ -78,7 +78,7 @@ class Identification:
         """Data-quality warnings found while preparing the record; ``unexplained_peak`` for
         each clear, coherent FRF peak no reported mode explains (as :func:`select_modes`
         gives: a fixed or BIC-chosen order can leave a mode out); and ``oversampled`` when
-        the band its modes need would lower the rate by 2 or more (``oversampling_note``).
+        every mode lies below a tenth of the Nyquist frequency (``oversampling_note``).
         Computed once (the peak check takes spectra)."""
         from armaxmodal.modes.frf import unexplained_peaks
 
@@ -88,7 +88,9 @@ class Identification:
         return (
             *found,
             *unexplained_peaks(self.recording, freq, damping, band),
-            *oversampling_note(freq, self.recording.fs, DEFAULTS.notes.suggested_band_factor),
+            *oversampling_note(
+                freq, self.recording.fs, DEFAULTS.notes.oversampled_fraction, DEFAULTS.notes.suggested_band_factor
+            ),
             *self.check.warnings(),
         )
 

@@ -240,7 +240,7 @@ def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     state = state.warned(
         *peaks,
         *dropped_where_peaks_remain(state.count, peaks, ctx.settings.cluster.same_row_freq),
-        *oversampling_note(freq, diagram.recording.fs, notes.suggested_band_factor),
+        *oversampling_note(freq, diagram.recording.fs, notes.oversampled_fraction, notes.suggested_band_factor),
         *unresolved_damping_notes(modes, len(ctx.nas)),
         *state.check.warnings(),
     )

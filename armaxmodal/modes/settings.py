@@ -69,6 +69,7 @@ _AT_MOST_ONE = frozenset(
         "merge_mac",
         "decisive_alpha",
         "alpha",
+        "oversampled_fraction",
         "min_damping",
         "max_damping",
         "excitation_ratio",
@@ -218,9 +219,10 @@ class DftSettings(_Settings):
 class NoteSettings(_Settings):
     """Thresholds of the informative notes (stage ``finish``)."""
 
-    #: the band the modes found need ends at this multiple of the highest; where it would lower the
-    #: rate by 2 or more the record is oversampled for its structure (every mode below 16 % of the
-    #: Nyquist frequency: the measured records here 28-66 %, the supine ride at 1 kHz 3 %)
+    #: every mode found below this share of the Nyquist frequency: the record is oversampled
+    #: for its structure (the measured records here: 28-66 %; the supine ride at 1 kHz: 3 %)
+    oversampled_fraction: float = 0.1
+    #: ... and the band suggested ends at this multiple of the highest mode found
     suggested_band_factor: float = 2.5
 
     def __post_init__(self):

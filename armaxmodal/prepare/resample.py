@@ -81,13 +81,15 @@ def decimate(data: np.ndarray, factor: int) -> np.ndarray:
     )
 
 
-def oversampling_note(mode_freqs: np.ndarray, fs: float, suggested_band_factor: float) -> list[QualityWarning]:
-    """An ``oversampled`` warning when the band the modes found need -- up to ``suggested_band_factor``
-    times the highest -- would let :func:`resample_to_band` lower the rate by 2 or more: the input
-    excites far above the structure (so the rate was kept), the poles crowd ``z = 1`` and the swept
-    orders resolve them poorly (the supine ride at 1 kHz under a 0.5-400 Hz ride gave one of its
-    four modes; with the band suggested here, all four). With the default factor 2.5 that is every
-    mode below 16 % of the Nyquist frequency (a separate share, 10 %, decided it until 2026-12-07).
+def oversampling_note(
+    mode_freqs: np.ndarray, fs: float, oversampled_fraction: float, suggested_band_factor: float
+) -> list[QualityWarning]:
+    """An ``oversampled`` warning when every mode found lies below ``oversampled_fraction`` of the
+    Nyquist frequency: the input excites far above the structure (so the rate was kept), the poles
+    crowd ``z = 1`` and the swept orders resolve them poorly (the supine ride at 1 kHz under a
+    0.5-400 Hz ride gave one of its four modes; with the band suggested here, all four). The band
+    suggested ends at ``suggested_band_factor`` times the highest mode found, and the rate it
+    resamples to is what :func:`resample_to_band` would choose for it.
 
     Parameters
     ----------
@@ -95,9 +97,9 @@ def oversampling_note(mode_freqs: np.ndarray, fs: float, suggested_band_factor: 
         Natural frequencies of the modes found, Hz.
     fs : float
         The analysis rate, Hz.
-    suggested_band_factor : float
-        The band suggested, as a multiple of the highest mode
-        (``armaxmodal.modes.settings.NoteSettings``, with its calibration).
+    oversampled_fraction, suggested_band_factor : float
+        The share of Nyquist that makes a record oversampled, and the band suggested
+        (``armaxmodal.modes.settings.NoteSettings``, with their calibration).
 
     Returns
     -------
@@ -105,12 +107,12 @@ def oversampling_note(mode_freqs: np.ndarray, fs: float, suggested_band_factor: 
         Empty, or one warning whose value is the highest mode's share of the Nyquist frequency.
     """
     mode_freqs = np.asarray(mode_freqs, dtype=float)
-    if mode_freqs.size == 0:
+    if mode_freqs.size == 0 or mode_freqs.max() >= oversampled_fraction * fs / 2:
         return []
     top = float(mode_freqs.max())
     hi = float(np.ceil(suggested_band_factor * top))
     factor = int(np.floor(BAND_FRACTION_OF_FS * fs / hi))
-    if factor < 2:  # the band suggested keeps the rate: not oversampled
+    if factor < 2:  # the band suggested keeps the rate: no lower rate to suggest
         return []
     new_fs = fs / factor
     share = top / (fs / 2)

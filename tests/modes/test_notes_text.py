@@ -169,7 +169,7 @@ def test_a_model_that_keeps_no_mode_lists_its_poles_and_the_band():
 def _oversampled(freq_hz, fs, settings=None):
     """The oversampling note under ``settings`` (the selection's ``NoteSettings``, as ``finish`` passes them)."""
     s = NoteSettings() if settings is None else settings
-    return oversampling_note(np.array(freq_hz, float), fs, s.suggested_band_factor)
+    return oversampling_note(np.array(freq_hz, float), fs, s.oversampled_fraction, s.suggested_band_factor)
 
 
 def test_an_oversampled_record_is_told_the_band_and_rate_to_rerun_at():
@@ -182,7 +182,7 @@ def test_an_oversampled_record_is_told_the_band_and_rate_to_rerun_at():
             'structure, so the rate was kept, and at this rate the poles crowd z = 1 where ARMAX models '
             'resolve them poorly; modes may be missed or biased.'),
     ][0][::2]
-    assert _oversampled([2.0, 8.1], 100.0) == []  # the band 0-21 Hz keeps the rate (0.4 fs / 21 Hz < 2)
+    assert _oversampled([2.0, 6.3], 100.0) == []  # the modes reach 13 % of Nyquist
     assert _oversampled([], 1000.0) == []
 
 
@@ -242,9 +242,8 @@ def test_a_model_without_poles_says_none():
 
 
 def test_the_oversampling_rule_at_its_edge():
-    """The band 2.5 x 80.4 Hz at 1 kHz keeps the rate (0.4 fs / 201 Hz < 2): not oversampled; at
-    40 Hz (8 % of Nyquist) the band 0-100 Hz lowers it to 250 Hz, with the share printed to 0.1 %."""
-    assert _oversampled([80.4], 1000.0) == []
+    """Modes at 10 % of Nyquist are not oversampled; at 8 % they are, with the share printed to 0.1 %."""
+    assert _oversampled([50.0], 1000.0) == []
     (said,) = _said(_oversampled([40.0], 1000.0))
     assert said[2].startswith(
         "every mode lies below 8.0 % of Nyquist: rerun with --band 0:100, which resamples to 250 Hz (")
@@ -252,9 +251,9 @@ def test_the_oversampling_rule_at_its_edge():
 
 
 def test_a_band_that_halves_the_rate_is_suggested():
-    """A mode at 8 Hz of 100 Hz suggests the band 0-20 Hz, which halves the rate: the smallest
-    reduction still worth saying (16 % of Nyquist)."""
-    (said,) = _said(_oversampled([8.0], 100.0))
+    """With every mode below 30 % of Nyquist counting as oversampled, a mode at 8 Hz of 100 Hz
+    suggests the band 0-20 Hz, which halves the rate: the smallest reduction still worth saying."""
+    (said,) = _said(_oversampled([8.0], 100.0, NoteSettings(oversampled_fraction=0.3)))
     assert said[2].startswith(
         "every mode lies below 16.0 % of Nyquist: rerun with --band 0:20, which resamples to 50 Hz (")
 

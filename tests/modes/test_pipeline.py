@@ -213,15 +213,15 @@ def test_the_oversampling_note_follows_its_settings():
 
     def note(freq_hz, fs, settings=None):  # as the finish stage passes them
         s = NoteSettings() if settings is None else settings
-        return oversampling_note(np.array(freq_hz), fs, s.suggested_band_factor)
+        return oversampling_note(np.array(freq_hz), fs, s.oversampled_fraction, s.suggested_band_factor)
 
     (said,) = note([5.0, 12.0], 1000.0)  # 12 Hz of a 500 Hz Nyquist: 2.4 %
     assert "band=(0, 30)" in said.message and said.value == pytest.approx(0.024)  # 2.5 x 12 Hz
     (wider,) = note([12.0], 1000.0, NoteSettings(suggested_band_factor=5.0))
     assert "band=(0, 60)" in wider.message
-    assert note([12.0], 1000.0, NoteSettings(suggested_band_factor=20.0)) == []  # 0-240 Hz: 1.67, the rate kept
-    # a band beyond the rate's: nothing to suggest (it divided by zero)
-    assert note([16.2], 60.0) == []
+    assert note([12.0], 1000.0, NoteSettings(oversampled_fraction=0.02)) == []
+    # a share so large that the band suggested keeps the rate: nothing to suggest (it divided by zero)
+    assert note([16.2], 60.0, NoteSettings(oversampled_fraction=0.6)) == []
 
 
 def test_the_json_carries_its_settings(diagram):

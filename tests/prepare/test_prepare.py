@@ -596,11 +596,11 @@ def test_a_record_sampled_far_above_its_structure_says_so_and_its_advice_finds_t
         warnings.simplefilter("ignore", am.ConvergenceWarning)
         ident = am.identify(rec, (8, 9, 8, -1))
     assert [w["code"] for w in ident.to_dict()["warnings"]].count("oversampled") == 1
-    # the threshold: a band of 2.5 x 80 Hz halves the rate (oversampled); 2.5 x 80.4 Hz does not
-    factor = DEFAULTS.notes.suggested_band_factor
-    assert oversampling_note(np.array([3.0, 80.4]), 1000.0, factor) == []
-    assert oversampling_note(np.array([]), 1000.0, factor) == []
-    assert oversampling_note(np.array([80.0]), 1000.0, factor)[0].value == pytest.approx(0.16)
+    # the threshold: the highest mode at 10 % of the Nyquist frequency is not oversampled
+    limits = DEFAULTS.notes.oversampled_fraction, DEFAULTS.notes.suggested_band_factor
+    assert oversampling_note(np.array([3.0, 50.0]), 1000.0, *limits) == []
+    assert oversampling_note(np.array([]), 1000.0, *limits) == []
+    assert oversampling_note(np.array([49.9]), 1000.0, *limits)[0].value == pytest.approx(0.0998)
 
 
 def test_a_lightly_damped_sensor_is_a_response_though_the_input_drives_it_little_elsewhere():
