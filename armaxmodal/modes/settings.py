@@ -393,8 +393,6 @@ class SweepSettings(_Settings):
         at the sweep's top order: fewer, and the fits describe the noise (and take minutes each).
     default_orders : tuple of int
         The orders swept when none are given, capped at what the record supports.
-    min_default_top : int
-        A default sweep capped below this top order has too few orders to show stability: refused.
 
     See Also
     --------
@@ -415,7 +413,12 @@ class SweepSettings(_Settings):
     delay_choice_iterations: int = 8
     samples_per_parameter: int = 20
     default_orders: tuple[int, ...] = tuple(range(2, 31, 2))
-    min_default_top: int = 8
+
+    @property
+    def min_default_top(self) -> int:
+        """A default sweep capped below the delay choice's lowest order is refused: the record
+        cannot support the fits that choose its delay (8 was a number of its own until 2026-12-07)."""
+        return min(self.delay_choice_orders)
 
 
 SWEEP = SweepSettings()  #: the sweep's numbers
