@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 
 from armaxmodal.spectra import excited_band, measured_frf
@@ -134,11 +136,12 @@ def _draw_check(ax, ax_f, f, selection) -> None:
     if check.unconfirmed_hz:
         where = ", ".join(f"{f:.2f}" for f in check.unconfirmed_hz)
         verdict = f"POOR: no coherent H1 confirms {where} Hz; elsewhere"
+    said = f"{verdict}: model error up to {100 * worst:.0f} % beyond the H1's random error "
+    said += f"(limit {100 * check.limit:.0f} %), coherence ≥ {COHERENT:g}"
     ax.text(
         0.01,
         0.01,
-        f"{verdict}: model error up to {100 * worst:.0f} % beyond the H1's random error "
-        f"(limit {100 * check.limit:.0f} %), coherence ≥ {COHERENT:g}",
+        textwrap.fill(said, 110),  # a line the axes hold: an unconfirmed mode's verdict ran past the figure's edge
         transform=ax.transAxes,
         fontsize=8,
         va="bottom",
