@@ -167,7 +167,8 @@ CODES: tuple[WarningCode, ...] = (
     WarningCode(
         "nk_at_search_edge",
         "preparation",
-        "the BIC-chosen delay at the end of its search (0 … −9, extended once)",
+        "the BIC-chosen delay at the most non-causal delay the record supports for the sweep's top order (the "
+        "search, 0 … −6, widens by 3 while its choice sits at its end)",
         "reported",
         "Check the input's timing (a delay beyond the search); give `--orders` with the delay you expect, or run "
         "`diagnose`.",

@@ -101,7 +101,7 @@ class StabilisationDiagram:
         # selection's quality, verdict or JSON reads these (the diagram is frozen, so they hold)
         found = list(self.preparation.warnings) if self.preparation is not None else []
         found += list(self.own_warnings)
-        found += _nk_edge_warning(self.orders[0].nk, self.recording)
+        found += _delay_warnings(self.orders[0].nk, self.recording, max(o.na for o in self.orders))
         return tuple(found + disturbance_lines(self.poles, self.tolerances.min_energy, self.recording, SHARED))
 
     @cached_property
@@ -203,30 +203,41 @@ def choose_nk(recording: Recording, nk_values=NK_SEARCH, na_values=DELAY_CHOICE_
     return _choose_nk(recording, nk_values, na_values, n_jobs)[0]
 
 
-def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, extend=True, bar=None):
+def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, deepest=None, bar=None):
     """``(nk, {(SHARED, orders): checkpoint})``: the delay :func:`~armaxmodal.estimate.orders.choose_delay`
     chooses and where its fits stopped, which the sweep continues instead of fitting those orders
-    again. ``bar`` (tqdm) counts the fits; the extension counts its own on a bar of its own, so that no
-    total grows. 8 iterations settle the choice where delays differ by tens of BIC units or more
+    again. A delay at the most non-causal end of the delays searched is a finding acted on: the search
+    goes ``NK_EXTENSION`` further, again while the choice stays at its end, down to ``deepest`` (the
+    most non-causal delay at which the record supports the sweep's top order; default: the delay
+    choice's). ``bar`` (tqdm) counts the fits; each extension counts its own on a bar of its own, so that
+    no total grows. 8 iterations settle the choice where delays differ by tens of BIC units or more
     (checked on every fixture, a lightly damped structure and the real recordings against 20 and 50);
     where BIC is flatter the cap decides between delays the record does not tell apart
     (docs/performance.md)."""
+    if deepest is None:
+        deepest = deepest_delay(recording, max(na_values))
     nk, known = choose_delay(
         recording, nk_values, na_values, max_iter=DELAY_CHOICE_ITERATIONS, tol=tol, n_jobs=n_jobs, bar=bar
     )
-    if extend and nk == min(nk_values):
-        # the best delay is the most non-causal one searched: look NK_EXTENSION further, once
+    beyond = range(nk - 1, max(nk - NK_EXTENSION, deepest) - 1, -1)
+    if nk == min(nk_values) and len(beyond):
+        further = [nk, *beyond]
         from tqdm import tqdm
 
-        further = range(nk, nk - NK_EXTENSION - 1, -1)
         with tqdm(
             total=len(further) * len(na_values),
             desc=f"input delay choice beyond nk = {nk}",
             unit="fit",
             disable=bar is None or bar.disable,
         ) as more:
-            return _choose_nk(recording, further, na_values, n_jobs, tol, extend=False, bar=more)
+            return _choose_nk(recording, further, na_values, n_jobs, tol, deepest, bar=more)
     return nk, {(SHARED, orders): checkpoint for orders, checkpoint in known.items()}
+
+
+def deepest_delay(recording: Recording, top_na: int) -> int:
+    """The most non-causal delay (samples) at which one sensor's model of order ``top_na``
+    (``3 na + 1 - nk`` parameters) has :data:`SAMPLES_PER_PARAMETER` samples a parameter."""
+    return 3 * top_na + 1 - recording.n_samples // SAMPLES_PER_PARAMETER
 
 
 def stabilisation_diagram(
@@ -318,7 +329,8 @@ def stabilisation_diagram(
         if nk is None:
             first = len(NK_SEARCH) * len(DELAY_CHOICE_ORDERS)
             with tqdm(total=first, desc="input delay choice", unit="fit", disable=not progress) as bar:
-                nk, known = _choose_nk(recording, NK_SEARCH, DELAY_CHOICE_ORDERS, n_jobs, tol, bar=bar)
+                deepest = deepest_delay(recording, max(orders))
+                nk, known = _choose_nk(recording, NK_SEARCH, DELAY_CHOICE_ORDERS, n_jobs, tol, deepest, bar=bar)
         sources = [SHARED] + (list(recording.sensors) if per_sensor else [])
         order_list = [Orders(na, default_nb(na, nk), default_nc(na), nk) for na in orders]
         # single sensors cannot support high orders (their bounds are wide): stop them earlier
@@ -402,19 +414,22 @@ def _check_top_order(na: int, recording: Recording, preparation: Preparation | N
     )
 
 
-def _nk_edge_warning(nk: int, recording: Recording) -> list[QualityWarning]:
-    """The BIC-chosen delay at the most non-causal end of its search range: the data may
-    need more (an input that lags the outputs)."""
-    edge = min(NK_SEARCH) - NK_EXTENSION
-    if nk > edge:
+def _delay_warnings(nk: int, recording: Recording, top_na: int) -> list[QualityWarning]:
+    """``nk_at_search_edge`` where the chosen delay sits at the most non-causal delay the record
+    supports for the sweep's top order: the widening search could go no further, and the outputs may
+    lead the input by more. (A delay beyond the first search names no lead by itself: the F-16's
+    level 3 takes nk = -8 at 40 Hz where the modal-model check's delays are 0.0 ms on every output,
+    and the supine ride's damaged copies take -5 or -6 at 60 Hz.)"""
+    if nk > deepest_delay(recording, top_na):
         return []
     return [
         QualityWarning(
             "nk_at_search_edge",
             (recording.input_name,),
-            f"the chosen input delay nk = {nk} sits at the edge of its search range "
-            f"({edge} to {max(NK_SEARCH)}): the outputs may lead the input by more (a late input "
-            "or a filter delay); look at the sensor_delay check and align the channels.",
+            f"the chosen input delay nk = {nk} ({-nk} samples, {1e3 * -nk / recording.fs:.0f} ms) sits at the most "
+            f"non-causal delay this record supports for orders up to na = {top_na} ({SAMPLES_PER_PARAMETER} samples "
+            "a parameter): the outputs may lead the input by more (a late input or a filter delay); look at the "
+            "sensor_delay check and align the channels, or sweep lower orders.",
             float(nk),
         )
     ]

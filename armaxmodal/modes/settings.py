@@ -383,7 +383,9 @@ class SweepSettings(_Settings):
     nk_search : tuple of int
         The input delays searched (non-causal taps for band-limited data).
     nk_extension : int
-        When the best delay is the most non-causal searched, this many more are tried, once.
+        When the best delay is the most non-causal searched, this many more are tried, again while the
+        choice stays at the end, down to the most non-causal delay the record supports at the sweep's
+        top order (``diagram.deepest_delay``).
     delay_choice_orders : tuple of int
         The middle orders at which the delay is chosen (jointly with the order: ``choose_nk``).
     delay_choice_iterations : int

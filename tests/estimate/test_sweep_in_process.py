@@ -17,9 +17,12 @@ from armaxmodal.modes.diagram import (
     DELAY_CHOICE_ORDERS,
     NK_EXTENSION,
     NK_SEARCH,
+    SAMPLES_PER_PARAMETER,
     SWEEP_TOL,
+    _choose_nk,
     _job_cost,
     choose_nk,
+    deepest_delay,
     stabilisation_diagram,
     sweep_fit,
 )
@@ -188,15 +191,20 @@ def test_a_fit_stopped_by_its_cap_continues_exactly(ride, na, cap, stop, where):
 
 def test_a_late_input_past_the_search_range_is_found_by_the_extension(ride):
     """Outputs 8 samples ahead of the input: the best delay lies beyond the searched 0..-6,
-    so the search looks further, once. An absolute acceleration has no direct feed-through
+    so the search looks further. An absolute acceleration has no direct feed-through
     of the base acceleration (the springs and dampers pass it on), so a held input's true
     delay is one sample, and with the input 8 samples late it is -7."""
     late = _late_input(ride[1], 8)
     assert min(NK_SEARCH) > -8
     nk = choose_nk(late, n_jobs=1)
     assert nk == _reference_nk(late, range(min(NK_SEARCH), min(NK_SEARCH) - 4, -1)) == 1 - 8
-    # the extension reaches NK_EXTENSION = 3 beyond the edge: -9
-    assert choose_nk(_late_input(ride[1], 10), n_jobs=1) == min(NK_SEARCH) - 3 == 1 - 10
+    # the extension goes NK_EXTENSION = 3 further while its choice sits at its end: 11 samples late,
+    # twice (to -9, then -12), and holds the lead at -10
+    late = _late_input(ride[1], 11)
+    assert choose_nk(late, n_jobs=1) == 1 - 11
+    # ... down to the most non-causal delay the record supports at the sweep's top order, where it stops
+    assert _choose_nk(late, NK_SEARCH, DELAY_CHOICE_ORDERS, 1, deepest=-9)[0] == -9
+    assert deepest_delay(late, 12) == 37 - late.n_samples // SAMPLES_PER_PARAMETER
     # a narrower search that does not reach the edge is not extended
     assert choose_nk(_late_input(ride[1], 2), nk_values=range(0, -5, -1), n_jobs=1) == 1 - 2
 

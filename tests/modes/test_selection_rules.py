@@ -15,7 +15,7 @@ import pytest
 import armaxmodal as am
 from armaxmodal.exceptions import OrderError
 from armaxmodal.modes.clusters import _supported, cluster_poles, merge_duplicates
-from armaxmodal.modes.diagram import SAMPLES_PER_PARAMETER, _check_top_order, _nk_edge_warning
+from armaxmodal.modes.diagram import SAMPLES_PER_PARAMETER, _check_top_order, _delay_warnings, deepest_delay
 from armaxmodal.modes.intervals import with_intervals
 from armaxmodal.modes.poles import Tolerances, stability_classes
 from armaxmodal.modes.settings import ClusterSettings, CountSettings
@@ -103,11 +103,14 @@ def _recording(n: int) -> am.Recording:
     return am.Recording(60.0, rng.standard_normal(n), rng.standard_normal((n, 1)), ("a",))
 
 
-def test_delay_edge_warning_only_at_the_end_of_the_search():
-    rec = _recording(100)
-    (w,) = _nk_edge_warning(-9, rec)
-    assert w.code == "nk_at_search_edge" and w.value == -9.0 and w.channels == ("base",)
-    assert _nk_edge_warning(-8, rec) == [] and _nk_edge_warning(0, rec) == []
+def test_delay_edge_warning_only_at_the_most_non_causal_delay_the_record_supports():
+    rec = _recording(2000)  # 100 samples a parameter's worth: na = 10 supports nk down to 31 - 100 = -69
+    assert deepest_delay(rec, 10) == -69
+    (w,) = _delay_warnings(-69, rec, 10)
+    assert w.code == "nk_at_search_edge" and w.value == -69.0 and w.channels == ("base",)
+    assert (
+        _delay_warnings(-68, rec, 10) == [] and _delay_warnings(-9, rec, 10) == [] and _delay_warnings(0, rec, 10) == []
+    )
 
 
 @pytest.mark.parametrize("na", [10, 30])
@@ -240,11 +243,11 @@ def test_order_cap_message_names_the_record_the_cause_and_a_supported_range():
         _check_top_order(30, _recording(1040), SimpleNamespace(**{**vars(prep), "band": (0.0, 24.0)}))
 
 
-def test_delay_edge_warning_says_the_range_and_what_to_do():
-    (w,) = _nk_edge_warning(-9, _recording(100))
-    assert "nk = -9 sits at the edge of its search range (-9 to 0)" in w.message
-    tail = "(a late input or a filter delay); look at the sensor_delay check and align the channels."
-    assert w.message.endswith(tail)
+def test_delay_edge_warning_says_the_bound_and_what_to_do():
+    (w,) = _delay_warnings(-9, _recording(100), 2)
+    assert "nk = -9 (9 samples, 150 ms) sits at the most non-causal delay this record supports" in w.message
+    assert "for orders up to na = 2 (20 samples a parameter)" in w.message
+    assert w.message.endswith("look at the sensor_delay check and align the channels, or sweep lower orders.")
 
 
 def test_finite_or_none_keeps_numbers_and_drops_nan_and_inf():
