@@ -18,6 +18,33 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 # (file, original text, mutated text, what it models)
 MUTANTS = [
+    # session 31's delay search; run with --match "(delay search)" --tests tests/estimate/test_sweep_in_process.py
+    # tests/modes/test_selection_rules.py
+    (
+        "armaxmodal/modes/diagram.py",
+        "    beyond = range(nk - 1, max(nk - NK_EXTENSION, deepest) - 1, -1)",
+        "    beyond = range(nk - 1, nk - NK_EXTENSION - 1, -1)",
+        "the widening ignores the record's bound (delay search)",
+    ),
+    (
+        "armaxmodal/modes/diagram.py",
+        "            return _choose_nk(recording, further, na_values, n_jobs, tol, deepest, bar=more)",
+        "            return choose_delay(recording, further, na_values, max_iter=DELAY_CHOICE_ITERATIONS, tol=tol)[0], "
+        "{}",
+        "the search widens once, as before (delay search)",
+    ),
+    (
+        "armaxmodal/modes/diagram.py",
+        "    if nk > deepest_delay(recording, top_na):",
+        "    if nk >= deepest_delay(recording, top_na):",
+        "the edge warning misses the bound itself (delay search)",
+    ),
+    (
+        "armaxmodal/modes/diagram.py",
+        "    return 3 * top_na + 1 - recording.n_samples // SAMPLES_PER_PARAMETER",
+        "    return 3 * top_na - recording.n_samples // SAMPLES_PER_PARAMETER",
+        "the bound forgets the direct term's parameter (delay search)",
+    ),
     # session 30's merges; run with --match "(merged)" --tests tests/modes/test_borderline.py
     # tests/modes/test_mode_count.py tests/modes/test_pipeline.py tests/modes/test_agreement.py
     (
