@@ -183,6 +183,17 @@ CODES: tuple[WarningCode, ...] = (
         "it is a disturbance.",
     ),
     WarningCode(
+        "undriven_resonance",
+        "selection",
+        "a column of the diagram's poles with negative damping at 3 orders or more, beside a clear, coherent H1 peak "
+        "(within 5 %) that no reported mode is near (Painter Street 2021-12-20: 4.34 Hz at 10 orders, the H1 at "
+        "4.25 Hz)",
+        '`"quality": "uncertain"` at best: the frequency is named, no mode is reported (its damping has no estimate)',
+        "Record the motion of the structure's other supports (a bridge's abutments) and give it as the input, or "
+        "take this mode's frequency from the H1; check the input's timing if the outputs may lead it.",
+        uncertain=True,
+    ),
+    WarningCode(
         "damping_unresolved",
         "selection",
         "a mode whose damping interval (taken on log ξ, it never reaches zero) spans a factor e² or more, where the "

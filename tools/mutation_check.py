@@ -18,6 +18,31 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 # (file, original text, mutated text, what it models)
 MUTANTS = [
+    # session 31's undriven resonances; run with --match "(undriven)" --tests tests/modes/test_undriven.py
+    (
+        "armaxmodal/modes/frf.py",
+        "cluster_poles(growing, nas, cluster.freq, None) if len(c) >= cluster.min_orders]",
+        "cluster_poles(growing, nas, cluster.freq, None) if len(c) >= 2]",
+        "two orders make a column (undriven)",
+    ),
+    (
+        "armaxmodal/modes/frf.py",
+        "/ c.freq_hz.median())) <= cluster.freq)",
+        "/ c.freq_hz.median())) <= 0.0)",
+        "a reported mode near the column is ignored (undriven)",
+    ),
+    (
+        "armaxmodal/modes/frf.py",
+        "        near = [p for p in peaks if abs(np.log(p[0] / f)) <= cluster.freq]",
+        "        near = [p for p in peaks if abs(np.log(p[0] / f)) <= 0.5]",
+        "any peak of the band stands for the column's (undriven)",
+    ),
+    (
+        "armaxmodal/modes/frf.py",
+        "    growing = candidate_poles(diagram.poles, band, rejected=(NEGATIVE_DAMPING,))",
+        '    growing = candidate_poles(diagram.poles, band, rejected=(NEGATIVE_DAMPING, ""))',
+        "kept poles taken for growing ones (undriven)",
+    ),
     # session 31's delay search; run with --match "(delay search)" --tests tests/estimate/test_sweep_in_process.py
     # tests/modes/test_selection_rules.py
     (

@@ -1,7 +1,8 @@
 """What the measured FRF says of the selection (thesis Section 3.3.3's check, made quantitative):
 its clear, coherent peaks no selected mode explains (``unexplained_peaks``, at ``PEAK_RESOLUTION``);
 the diagram's clusters at those peaks, which it proposes to the count
-(``modes_at_unexplained_peaks``); and the candidates the modal-model check
+(``modes_at_unexplained_peaks``); the resonances the input does not drive (``undriven_resonances``);
+and the candidates the modal-model check
 (:mod:`armaxmodal.modes.modal_check`, at ``CHECK_RESOLUTION``) does not need, which leave the
 count's start and are offered to it as additions (``modes_the_record_needs``). The count decides.
 
@@ -18,7 +19,8 @@ import pandas as pd
 
 from armaxmodal.modes.clusters import candidate_poles, cluster_poles
 from armaxmodal.modes.modal_check import ModalCheck, check_modes, poles_of, rss_at
-from armaxmodal.modes.notes import not_needed_note
+from armaxmodal.modes.notes import not_needed_note, undriven_resonance_note
+from armaxmodal.modes.poles import NEGATIVE_DAMPING
 from armaxmodal.modes.settings import DEFAULTS, PEAK_RESOLUTION, ClusterSettings, FrfSettings, SelectionSettings
 from armaxmodal.modes.state import SelectionState
 from armaxmodal.quality_warnings import QualityWarning
@@ -178,6 +180,38 @@ def modes_at_unexplained_peaks(
             found.append(near.loc[max(clusters, key=len)])
     found.sort(key=len, reverse=True)
     return [(float(sub.freq_hz.median()), float(sub.damping.median())) for sub in found]
+
+
+def undriven_resonances(
+    diagram, freq_hz, band, nas, cluster: ClusterSettings = DEFAULTS.cluster
+) -> list[QualityWarning]:
+    """An ``undriven_resonance`` note for each column of the diagram's shared poles of negative
+    damping beyond their intervals (``poles.rejection_reasons``; poles of at least
+    ``cluster.min_orders`` orders within the clustering's reach) at a clear, coherent H1 peak
+    (``PEAK_RESOLUTION``), where no reported mode (``freq_hz``) lies within that reach.
+    The record resonates there, but the input does not drive the resonance as it drives a mode of a
+    structure on one moving base: every order fits it with poles that grow. Of the measured records
+    only Painter Street's 2021 and 2023 events hold such a column (4.34 Hz at 10 orders, 4.15 Hz at
+    14), each beside the H1's coherent peak (4.25 and 4.21 Hz) that no mode of theirs is near: a
+    bridge moved at its abutments as well as at the bent its input measures."""
+    growing = candidate_poles(diagram.poles, band, rejected=(NEGATIVE_DAMPING,))
+    columns = [growing.loc[c] for c in cluster_poles(growing, nas, cluster.freq, None) if len(c) >= cluster.min_orders]
+    columns = [
+        c for c in columns if not np.any(np.abs(np.log(np.asarray(freq_hz) / c.freq_hz.median())) <= cluster.freq)
+    ]
+    if not columns:
+        return []
+    res, rec = PEAK_RESOLUTION, diagram.recording
+    centres = [(c.freq_hz.median(), -c.damping.median()) for c in columns]
+    n = resolving_nperseg(rec, *zip(*centres, strict=True), res.lines_per_bandwidth, res.min_segments)
+    peaks = coherent_peaks(rec, n, res.lines_per_bandwidth, band)
+    found = []
+    for column in columns:
+        f = float(column.freq_hz.median())
+        near = [p for p in peaks if abs(np.log(p[0] / f)) <= cluster.freq]
+        if near:
+            found.append(undriven_resonance_note(f, column.na.nunique(), column.damping.to_numpy(), near))
+    return found
 
 
 def unexplained_peaks(recording: Recording, freq_hz, damping, band=None) -> list[QualityWarning]:

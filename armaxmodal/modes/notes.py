@@ -505,6 +505,26 @@ def dropped_where_peaks_remain(count: ModeCount | None, peaks, same_row_freq: fl
     return notes
 
 
+def undriven_resonance_note(f: float, n_orders: int, dampings: np.ndarray, peaks) -> QualityWarning:
+    """The ``undriven_resonance`` note of :func:`~armaxmodal.modes.frf.undriven_resonances`: a column at
+    ``f`` Hz of ``n_orders`` orders whose poles' damping ratios are ``dampings`` (all negative), beside
+    the coherent H1 peaks ``peaks`` (``(Hz, sensor, |H1|)``)."""
+    peak = max(peaks, key=lambda p: p[2])
+    sensors = tuple(sorted({p[1] for p in peaks}))
+    return QualityWarning(
+        "undriven_resonance",
+        sensors,
+        f"the measured FRF peaks at {peak[0]:.2f} Hz ({', '.join(sensors)}) where the diagram holds a column at "
+        f"{f:.2f} Hz of poles with negative damping ({dampings.min():.3f} to {dampings.max():.3f}) at {n_orders} "
+        "orders, and no mode is reported there: the structure resonates at that frequency, but the measured input "
+        "does not drive the resonance as it drives a mode of a structure on one moving base (other supports move "
+        f"it too, or the outputs lead the input). {f:.2f} Hz is the record's estimate of that mode's frequency; its "
+        "damping cannot be estimated from this input",
+        f,
+        (f,),
+    )
+
+
 def not_needed_note(
     f: float, x: float, neighbour_hz: float | None, level: float, alpha: float, rise: float, p: float
 ) -> QualityWarning:

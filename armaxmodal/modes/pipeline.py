@@ -223,7 +223,7 @@ def spread(state: SelectionState, ctx: SelectionContext) -> SelectionState:
 
 def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     """The intervals' parts combined, once; the per-sensor tables; the notes read off the final modes."""
-    from armaxmodal.modes.frf import unexplained_peaks
+    from armaxmodal.modes.frf import undriven_resonances, unexplained_peaks
 
     diagram, notes = ctx.diagram, ctx.settings.notes
     scale, widened = filled_samples_scale(diagram.recording, diagram.preparation)
@@ -239,6 +239,7 @@ def finish(state: SelectionState, ctx: SelectionContext) -> SelectionState:
     peaks = unexplained_peaks(diagram.recording, *explaining, ctx.band)
     state = state.warned(
         *peaks,
+        *undriven_resonances(diagram, explaining[0], ctx.band, ctx.nas, ctx.settings.cluster),
         *dropped_where_peaks_remain(state.count, peaks, ctx.settings.cluster.same_row_freq),
         *oversampling_note(freq, diagram.recording.fs, notes.oversampled_fraction, notes.suggested_band_factor),
         *unresolved_damping_notes(modes, len(ctx.nas)),

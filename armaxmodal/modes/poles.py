@@ -53,6 +53,8 @@ CLASSES = ("new", "f", "f+d", "f+d+v")
 #: reaches above zero: a lightly damped mode the record cannot resolve in damping. Such poles
 #: count towards a mode's support, never as its estimate (see :func:`select_modes`).
 UNRESOLVED_DAMPING = "damping not resolved"
+#: ... and negative beyond its interval: a pole that grows (``frf.undriven_resonances`` reads their columns)
+NEGATIVE_DAMPING = "negative damping"
 
 
 @dataclass(frozen=True)
@@ -176,7 +178,7 @@ def rejection_reasons(
     for row, e_max in zip(poles.itertuples(index=False), top, strict=True):
         if row.damping <= 0:
             sd = getattr(row, "damping_sd", 0.0)
-            reasons.append(UNRESOLVED_DAMPING if row.damping + Z95 * sd > 0 else "negative damping")
+            reasons.append(UNRESOLVED_DAMPING if row.damping + Z95 * sd > 0 else NEGATIVE_DAMPING)
         elif row.damping > max_damping:
             reasons.append("over-damped")
         elif row.freq_hz < f_min:
