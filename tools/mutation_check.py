@@ -335,8 +335,8 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/frf.py",
-        "if len(c) >= cluster.min_orders",
-        "if len(c) >= 99",
+        "cluster_poles(near, nas, cluster.freq, None) if len(c) >= cluster.min_orders",
+        "cluster_poles(near, nas, cluster.freq, None) if len(c) >= 99",
         "no cluster at an unexplained peak proposed (check)",
     ),
     (

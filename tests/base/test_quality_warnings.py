@@ -30,7 +30,7 @@ def test_each_definition_is_complete_and_the_codes_are_unique():
         assert c.stage and len(c.measured) > 20 and c.done and c.advice.endswith("."), c.code
     assert set(UNCERTAIN_CODES) == {"count_undecided", "modes_not_separated", "pick_not_supported", "drift",
                                     "periodic_disturbance", "stuck_samples", "held_samples",
-                                    "dropped_packet"}  # fmt: skip
+                                    "dropped_packet", "undriven_resonance"}  # fmt: skip
 
 
 def test_an_unknown_code_is_refused():
