@@ -53,7 +53,7 @@ MUTANTS = [
     ),
     (
         "armaxmodal/modes/diagram.py",
-        "            return _choose_nk(recording, further, na_values, n_jobs, tol, deepest, bar=more)",
+        "            return _choose_nk(recording, further, na_values, n_jobs, tol, deepest=deepest, bar=more)",
         "            return choose_delay(recording, further, na_values, max_iter=DELAY_CHOICE_ITERATIONS, tol=tol)[0], "
         "{}",
         "the search widens once, as before (delay search)",

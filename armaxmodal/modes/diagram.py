@@ -200,22 +200,19 @@ def choose_nk(recording: Recording, nk_values=NK_SEARCH, na_values=DELAY_CHOICE_
     >>> choose_nk(ride)
     0
     """
-    return _choose_nk(recording, nk_values, na_values, n_jobs)[0]
+    return _choose_nk(recording, nk_values, na_values, n_jobs, deepest=deepest_delay(recording, max(na_values)))[0]
 
 
-def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, deepest=None, bar=None):
+def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, *, deepest: int, bar=None):
     """``(nk, {(SHARED, orders): checkpoint})``: the delay :func:`~armaxmodal.estimate.orders.choose_delay`
     chooses and where its fits stopped, which the sweep continues instead of fitting those orders
     again. A delay at the most non-causal end of the delays searched is a finding acted on: the search
     goes ``NK_EXTENSION`` further, again while the choice stays at its end, down to ``deepest`` (the
-    most non-causal delay at which the record supports the sweep's top order; default: the delay
-    choice's). ``bar`` (tqdm) counts the fits; each extension counts its own on a bar of its own, so that
-    no total grows. 8 iterations settle the choice where delays differ by tens of BIC units or more
-    (checked on every fixture, a lightly damped structure and the real recordings against 20 and 50);
-    where BIC is flatter the cap decides between delays the record does not tell apart
-    (docs/performance.md)."""
-    if deepest is None:
-        deepest = deepest_delay(recording, max(na_values))
+    most non-causal delay at which the record supports the sweep's top order). ``bar`` (tqdm) counts
+    the fits; each extension counts its own on a bar of its own, so that no total grows. 8 iterations
+    settle the choice where delays differ by tens of BIC units or more (checked on every fixture, a
+    lightly damped structure and the real recordings against 20 and 50); where BIC is flatter the cap
+    decides between delays the record does not tell apart (docs/performance.md)."""
     nk, known = choose_delay(
         recording, nk_values, na_values, max_iter=DELAY_CHOICE_ITERATIONS, tol=tol, n_jobs=n_jobs, bar=bar
     )
@@ -230,7 +227,7 @@ def _choose_nk(recording, nk_values, na_values, n_jobs, tol=SWEEP_TOL, deepest=N
             unit="fit",
             disable=bar is None or bar.disable,
         ) as more:
-            return _choose_nk(recording, further, na_values, n_jobs, tol, deepest, bar=more)
+            return _choose_nk(recording, further, na_values, n_jobs, tol, deepest=deepest, bar=more)
     return nk, {(SHARED, orders): checkpoint for orders, checkpoint in known.items()}
 
 
@@ -330,7 +327,7 @@ def stabilisation_diagram(
             first = len(NK_SEARCH) * len(DELAY_CHOICE_ORDERS)
             with tqdm(total=first, desc="input delay choice", unit="fit", disable=not progress) as bar:
                 deepest = deepest_delay(recording, max(orders))
-                nk, known = _choose_nk(recording, NK_SEARCH, DELAY_CHOICE_ORDERS, n_jobs, tol, deepest, bar=bar)
+                nk, known = _choose_nk(recording, NK_SEARCH, DELAY_CHOICE_ORDERS, n_jobs, tol, deepest=deepest, bar=bar)
         sources = [SHARED] + (list(recording.sensors) if per_sensor else [])
         order_list = [Orders(na, default_nb(na, nk), default_nc(na), nk) for na in orders]
         # single sensors cannot support high orders (their bounds are wide): stop them earlier

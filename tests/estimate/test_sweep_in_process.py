@@ -143,7 +143,7 @@ def test_the_sweep_continues_the_delay_choice_fits_exactly(ride):
 
     rec = ride[1]
     with one_blas_thread():
-        nk, checkpoints = _choose_nk(rec, NK_SEARCH, (4, 6), 1)
+        nk, checkpoints = _choose_nk(rec, NK_SEARCH, (4, 6), 1, deepest=deepest_delay(rec, 6))
         assert nk == 0
         assert sorted(checkpoints) == [(SHARED, (na, default_nb(na, nk), default_nc(na), nk)) for na in (4, 6)]
         for job, checkpoint in checkpoints.items():

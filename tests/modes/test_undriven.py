@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 import pytest
@@ -74,3 +75,8 @@ def test_painter_street_2021_names_the_fundamental_the_h1_shows(realdata_dir, ev
     (note,) = [w for w in selection.warnings if w.code == "undriven_resonance"]
     assert abs(note.value / h1_peak_hz - 1) <= 0.03
     assert not np.any(np.abs(selection.modes.freq_hz / h1_peak_hz - 1) <= 0.03) and selection.quality == "poor"
+    # the diagram draws it where it is named, once in the legend
+    ax, _ = selection.diagram.plot(selection)
+    drawn = [line for line in ax.lines if line.get_label() == "resonance the input does not drive"]
+    assert len(drawn) == 1 and drawn[0].get_xdata()[0] == pytest.approx(note.value)
+    plt.close(ax.figure)

@@ -21,6 +21,7 @@ _STYLE = {
 }
 _LOW_COHERENCE = "#fff3b0"  # shading of the bands where some sensor's coherence is low
 _PICKED = "tab:purple"  # the line of a mode picked by hand (an automatic mode's is black, dotted)
+_UNDRIVEN = "tab:brown"  # a resonance named, not reported: the input does not drive it (``undriven_resonance``)
 _MISFIT = "#e53935"  # shading of the bands the modal model does not explain
 
 
@@ -88,6 +89,10 @@ def plot_stabilisation(diagram, selection=None, ax=None):
             ax.axvline(m.freq_hz, **style, label="mode picked by hand" if by_hand and not labelled else None)
             ax_d.axvline(m.freq_hz, **style)
             labelled |= by_hand
+        undriven = [w.value for w in selection.warnings if w.code == "undriven_resonance"]
+        for k, f_hz in enumerate(undriven):  # named where no mode is: its column's poles grow (rejected, faint)
+            label = "resonance the input does not drive" if k == 0 else None
+            ax.axvline(f_hz, color=_UNDRIVEN, lw=1.2, ls="-.", label=label)
         ax.set_ylim(0, top * 1.05)
     lo, hi = _frequency_span(diagram)
     ax.set_xlim(lo, hi)
