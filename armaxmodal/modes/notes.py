@@ -517,9 +517,10 @@ def undriven_resonance_note(f: float, n_orders: int, dampings: np.ndarray, peaks
         f"the measured FRF peaks at {peak[0]:.2f} Hz ({', '.join(sensors)}) where the diagram holds a column at "
         f"{f:.2f} Hz of poles with negative damping ({dampings.min():.3f} to {dampings.max():.3f}) at {n_orders} "
         "orders, and no mode is reported there: the structure resonates at that frequency, but the measured input "
-        "does not drive the resonance as it drives a mode of a structure on one moving base (other supports move "
-        f"it too, or the outputs lead the input). {f:.2f} Hz is the record's estimate of that mode's frequency; its "
-        "damping cannot be estimated from this input",
+        "does not drive the resonance as it drives a mode of a structure on one moving base (as where other "
+        "supports move it through other paths, or the outputs lead the input). "
+        f"{f:.2f} Hz is the record's estimate of that mode's frequency; its damping cannot be estimated from this "
+        "input",
         f,
         (f,),
     )
