@@ -151,7 +151,9 @@ def _saved_track(bridge: str):
 
     folder = RESULTS / bridge
     table = pd.read_csv(folder / "track.csv", parse_dates=["date"])
-    events = pd.read_csv(folder / "events.csv", parse_dates=["date"])
+    events = pd.read_csv(folder / "events.csv", parse_dates=["date"], dtype={"undriven_hz": str}).fillna(
+        {"undriven_hz": ""}
+    )
     trends = pd.read_csv(folder / "trends.csv")
     return Track(table, trends, events, TrackSettings(input_scale=1 / G, input_unit="g"), study=None)
 

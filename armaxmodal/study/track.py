@@ -413,6 +413,11 @@ def follow(study, track: TrackSettings) -> Track:
         f"{row.file}: quality poor (its modes do not explain its FRF), so not matched nor in any trend"
         for row in events[events.quality == "poor"].itertuples()
     ]
+    notes += [
+        f"{row.file}: a resonance its input does not drive named at {row.undriven_hz} Hz (undriven_resonance): "
+        "no mode is reported there, so it is in no track; the figure marks it"
+        for row in events[events.undriven_hz != ""].itertuples()
+    ]
     records = {r["file"]: r for r in study.recordings}
     modes = [_modes(records[name], study.sensors) for name in usable.file]
     labels = match_tracks([[(m["freq_hz"], m["shape"]) for m in ms] for ms in modes], track)
@@ -460,10 +465,17 @@ def _events(study, track: TrackSettings) -> pd.DataFrame:
             "peak_input": r["peak_input"] * track.input_scale,
             "quality": r["quality"],
             "modes_found": len(r["modes"]),
+            "undriven_hz": " ".join(f"{hz:.3f}" for hz in undriven_hz(r)),
         }
         for r in study.recordings
     ]
-    return pd.DataFrame(rows, columns=[*_EVENT_COLUMNS, "modes_found"])
+    return pd.DataFrame(rows, columns=[*_EVENT_COLUMNS, "modes_found", "undriven_hz"])
+
+
+def undriven_hz(record: dict) -> list[float]:
+    """The frequencies (Hz) an event's ``undriven_resonance`` notes name: a resonance the record shows
+    but whose input does not drive it as a mode (no mode is reported there, so it is in no track)."""
+    return [w["value"] for w in record.get("warnings", ()) if w["code"] == "undriven_resonance"]
 
 
 def _event_row(event) -> dict:

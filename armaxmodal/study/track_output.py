@@ -55,7 +55,7 @@ def plot_track(track: Track):
 
     rows = track.table
     dated = rows.date.notna().any()
-    fig, axes = plt.subplots(2, 2 if dated else 1, figsize=(11 if dated else 6.5, 7), squeeze=False)
+    fig, axes = plt.subplots(2, 2 if dated else 1, figsize=(11 if dated else 6.5, 7), squeeze=False, sharex="col")
     unit = track.settings.input_unit
     for (mode, group), colour in zip(rows.groupby("mode"), plt.cm.tab10.colors * 10, strict=False):
         label = f"mode {mode} ({group.freq_hz.median():.2f} Hz, {len(group)} event{'s' * (len(group) > 1)})"
@@ -87,7 +87,8 @@ def plot_track(track: Track):
         if dated:
             axes[1, 1].set_xlabel("date of the event")
             axes[r, 1].tick_params(axis="x", labelrotation=30)
-    if rows.empty:  # every event poor or without a mode: say so where the modes would be
+    _draw_undriven(axes[0, : 1 + dated], track.events)
+    if rows.empty and not (track.events.undriven_hz != "").any():  # nothing to draw: say so where the modes would be
         axes[0, 0].text(
             0.5, 0.5, "no event's modes to follow (see the notes)", ha="center", transform=axes[0, 0].transAxes
         )
@@ -96,6 +97,17 @@ def plot_track(track: Track):
     fig.suptitle("modes across events (red rings: beyond the other events' trend)", fontsize=10)
     fig.tight_layout()
     return fig
+
+
+def _draw_undriven(axes, events: pd.DataFrame) -> None:
+    """Each event's named undriven resonances (no mode, no interval): hollow diamonds on the
+    frequency panels, against the peak input and the date."""
+    named = [(e.peak_input, e.date, float(hz)) for e in events.itertuples() for hz in e.undriven_hz.split()]
+    for ax, at in zip(axes, (0, 1), strict=False):
+        x = [item[at] for item in named if pd.notna(item[at])]
+        y = [item[2] for item in named if pd.notna(item[at])]
+        label = "resonance the input does not drive (no mode)" if x else None
+        ax.scatter(x, y, marker="D", s=30, facecolors="none", edgecolors="k", label=label)
 
 
 def _draw_trend(ax, track: Track, mode: int, group: pd.DataFrame, colour) -> None:

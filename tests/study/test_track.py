@@ -212,3 +212,28 @@ def test_a_structure_whose_every_event_is_poor_writes_its_files_and_says_why(tmp
     assert followed.table.empty and len(followed.events) == 2
     assert [note.split(":")[0] for note in followed.notes] == ["e0.csv", "e1.csv"]
     assert {p.name for p in write_track(followed, tmp_path)} >= {"track.csv", "track.png", "track.html"}
+
+
+def test_a_resonance_the_input_does_not_drive_is_said_and_drawn_not_tracked():
+    """Painter Street's two weakest events as the study leaves them: poor, with an
+    ``undriven_resonance`` note each (4.34 and 4.15 Hz): each is in the events table and the notes,
+    and drawn as a hollow diamond at its peak input, though no mode of it is tracked."""
+    from types import SimpleNamespace
+
+    from armaxmodal.study import plot_track
+    from armaxmodal.study.track import follow, undriven_hz
+
+    def event(name, date, peak, hz):
+        notes = [{"code": "undriven_resonance", "value": hz}, {"code": "resampled", "value": 2.0}]
+        return {"file": name, "labels": {"date": date}, "peak_input": peak, "quality": "poor", "modes": [],
+                "warnings": notes}  # fmt: skip
+
+    recordings = [event("a.csv", "2021-12-20", 0.0085, 4.34), event("b.csv", "2023-08-17", 0.015, 4.15)]
+    assert undriven_hz(recordings[0]) == [4.34]
+    study = SimpleNamespace(recordings=recordings, sensors=("deck",), notes=[], tables=SimpleNamespace(notes=[]))
+    track = follow(study, TrackSettings())
+    assert list(track.events.undriven_hz) == ["4.340", "4.150"] and track.table.empty
+    assert sum("named at 4.340 Hz (undriven_resonance)" in note for note in track.notes) == 1
+    fig = plot_track(track)
+    (diamonds,) = [c for c in fig.axes[0].collections if c.get_label().startswith("resonance the input")]
+    assert np.allclose(diamonds.get_offsets(), [[0.0085, 4.34], [0.015, 4.15]])
