@@ -21,6 +21,7 @@ from scipy import signal
 
 from armaxmodal.io.read import read_recording
 from armaxmodal.study import TrackSettings, track_modes
+from armaxmodal.study.track import undriven_hz
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "results" / "track"
@@ -80,8 +81,7 @@ def checked(track, real: Path, events: list[tuple[str, str]]) -> pd.DataFrame:
         event = track.events.set_index("file").loc[file]
         done = track.study.recordings[[r["file"] for r in track.study.recordings].index(file)]
         freqs = np.array([m["freq_hz"] for m in done["modes"]])
-        # a resonance named in an ``undriven_resonance`` note: the frequency said, no mode reported
-        named = np.array([w["value"] for w in done["warnings"] if w["code"] == "undriven_resonance"])
+        named = np.array(undriven_hz(done))  # named in a note: the frequency said, no mode reported
         for channel, peak, coherence in h1_peaks(real / name):
             nearest = float(freqs[np.argmin(np.abs(np.log(freqs / peak)))]) if freqs.size else np.nan
             rows.append(

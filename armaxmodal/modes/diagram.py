@@ -391,9 +391,10 @@ def _default_orders(recording: Recording, preparation: Preparation | None) -> tu
 
 def _check_top_order(na: int, recording: Recording, preparation: Preparation | None) -> None:
     """Refuse, before any fit, a sweep whose highest order the record cannot support."""
-    per_sensor = 3 * na + 1 - (min(NK_SEARCH) - NK_EXTENSION)
-    if per_sensor * SAMPLES_PER_PARAMETER <= recording.n_samples:
+    # the first extension of the delay search must fit: the parameters at its most non-causal delay
+    if deepest_delay(recording, na) <= min(NK_SEARCH) - NK_EXTENSION:
         return
+    per_sensor = 3 * na + 1 - (min(NK_SEARCH) - NK_EXTENSION)
     top = max(_supported_top_order(recording), 2)
     narrow = [w for w in (preparation.warnings if preparation else ()) if w.code == "narrowband_input"]
     resampled = preparation is not None and preparation.analysis_fs != preparation.original_fs
